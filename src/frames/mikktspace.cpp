@@ -35,6 +35,23 @@ constexpr std::uint8_t kOrientPreserving = 8;  // positive UV area
 // Parallel loops over this many items or fewer run inline; chunks are at least this big.
 constexpr std::size_t kGrain = 2048;
 
+// Stable sort for the short runs this algorithm sorts (edges at a vertex, triangles of a group);
+// falls back to std::stable_sort for long ones.
+template <class It, class Less>
+void insertionSortStable(It begin, It end, Less less) {
+  constexpr std::ptrdiff_t kShortRun = 32;
+  if (end - begin > kShortRun) {
+    std::stable_sort(begin, end, less);
+    return;
+  }
+  for (It i = begin + (begin != end); i < end; ++i) {
+    auto value = *i;
+    It j = i;
+    for (; j != begin && less(value, *(j - 1)); --j) *j = *(j - 1);
+    *j = value;
+  }
+}
+
 template <class F>
 void parallelFor(std::size_t n, F&& body) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain),
@@ -56,55 +73,72 @@ std::uint64_t mix(std::uint64_t h, std::uint32_t w) {
   return h ^ (h >> 29);
 }
 
-std::uint64_t slotHash(const Input& in, std::size_t s) {
+// What welding compares: position, normal and UV, with -0 folded onto +0.
+struct WeldKey {
+  std::array<std::uint32_t, 8> bits;
+  friend bool operator==(const WeldKey&, const WeldKey&) = default;
+};
+
+WeldKey weldKey(const Input& in, std::size_t s) {
   const Vec3f p = in.position[s], n = in.normal[s];
   const Vec2f t = in.uv[s];
-  std::uint64_t h = 0x9e3779b97f4a7c15ull;
-  for (float x : {p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y}) h = mix(h, canonicalBits(x));
-  return h ^ (h >> 32);
+  WeldKey key;
+  std::size_t i = 0;
+  for (float x : {p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y}) key.bits[i++] = canonicalBits(x);
+  return key;
 }
 
-bool sameVertex(const Input& in, std::size_t a, std::size_t b) {
-  return in.position[a] == in.position[b] && in.normal[a] == in.normal[b] && in.uv[a] == in.uv[b];
+std::uint64_t hashKey(const WeldKey& key) {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (std::uint32_t w : key.bits) h = mix(h, w);
+  return h ^ (h >> 32);
 }
 
 std::vector<std::uint32_t> weld(const Input& in) {
   const std::size_t n = in.position.size();
   std::vector<std::uint64_t> hash(n);
-  parallelFor(n, [&](std::size_t s) { hash[s] = slotHash(in, s); });
+  parallelFor(n, [&](std::size_t s) { hash[s] = hashKey(weldKey(in, s)); });
 
   // Partition slots by the top bits of their hash (a stable counting sort, so each bucket lists
-  // its slots in ascending order), then weld each bucket with its own small hash table.
+  // its slots in ascending order), then weld each bucket with its own small hash table over a
+  // copy of its keys, so that a bucket touches only its own memory.
   constexpr int kBucketBits = 8;
   constexpr std::size_t kBuckets = std::size_t{1} << kBucketBits;
+  auto bucketOf = [&](std::size_t s) { return hash[s] >> (64 - kBucketBits); };
   std::vector<std::uint32_t> bucketStart(kBuckets + 1, 0);
-  for (std::size_t s = 0; s < n; ++s) ++bucketStart[(hash[s] >> (64 - kBucketBits)) + 1];
+  for (std::size_t s = 0; s < n; ++s) ++bucketStart[bucketOf(s) + 1];
   for (std::size_t b = 0; b < kBuckets; ++b) bucketStart[b + 1] += bucketStart[b];
   std::vector<std::uint32_t> order(n);
   {
     std::vector<std::uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
-    for (std::size_t s = 0; s < n; ++s)
-      order[fill[hash[s] >> (64 - kBucketBits)]++] = static_cast<std::uint32_t>(s);
+    for (std::size_t s = 0; s < n; ++s) order[fill[bucketOf(s)]++] = static_cast<std::uint32_t>(s);
   }
 
   std::vector<std::uint32_t> rep(n);
   tbb::parallel_for(std::size_t{0}, kBuckets, [&](std::size_t b) {
-    const std::uint32_t begin = bucketStart[b], end = bucketStart[b + 1];
-    if (begin == end) return;
-    const std::size_t capacity = std::bit_ceil(std::size_t{2} * (end - begin));
+    const std::uint32_t begin = bucketStart[b], size = bucketStart[b + 1] - begin;
+    if (size == 0) return;
+    std::vector<WeldKey> keys(size);
+    for (std::uint32_t k = 0; k < size; ++k) keys[k] = weldKey(in, order[begin + k]);
+    const std::size_t capacity = std::bit_ceil(std::size_t{2} * size);
     const std::size_t mask = capacity - 1;
-    std::vector<std::uint32_t> table(capacity, kNone);  // first slot of each distinct vertex
-    for (std::uint32_t k = begin; k < end; ++k) {
-      const std::uint32_t s = order[k];
-      for (std::size_t pos = hash[s] & mask;; pos = (pos + 1) & mask) {
-        const std::uint32_t head = table[pos];
-        if (head == kNone) {
-          table[pos] = s;
+    struct Entry {
+      std::uint64_t hash;
+      std::uint32_t first = kNone;  // bucket-local index of the first slot of a distinct vertex
+    };
+    std::vector<Entry> table(capacity);
+    for (std::uint32_t k = 0; k < size; ++k) {
+      const std::uint32_t s = order[begin + k];
+      const std::uint64_t h = hash[s];
+      for (std::size_t pos = h & mask;; pos = (pos + 1) & mask) {
+        Entry& entry = table[pos];
+        if (entry.first == kNone) {
+          entry = {h, k};
           rep[s] = s;
           break;
         }
-        if (hash[head] == hash[s] && sameVertex(in, head, s)) {
-          rep[s] = head;  // slots arrive in ascending order: the head is the smallest
+        if (entry.hash == h && keys[entry.first] == keys[k]) {
+          rep[s] = order[begin + entry.first];  // ascending order: the first is the smallest
           break;
         }
       }
@@ -118,33 +152,28 @@ std::vector<std::uint32_t> weld(const Input& in) {
 
 struct Tri {
   Vec3f os{}, ot{};          // unit dP/ds, dP/dt (sign-corrected), or zero
-  float magS = 0, magT = 0;  // |dP/ds|, |dP/dt|
   std::int32_t face = 0;     // input face
   std::array<std::int32_t, 3> neighbor{kNoTri, kNoTri, kNoTri};  // across edge (i, i+1)
   std::array<std::int32_t, 3> group{-1, -1, -1};                 // group of corner i
+  std::array<float, 3> angle{};   // interior angle at corner i, in the plane of its normal
   std::array<std::uint8_t, 3> corner{};                         // corner i = face corner
   std::uint8_t flags = 0;
 };
 
-// A tangent frame at one slot, as the algorithm accumulates it.
-struct TSpace {
-  Vec3f os{1, 0, 0};
-  float magS = 1;
-  Vec3f ot{0, 1, 0};
-  float magT = 1;
-  int counter = 0;  // how many triangle corners wrote this slot (quad diagonals: 2)
-  bool orient = false;
-};
+// The frame the algorithm keeps per vertex also carries dP/dt and the derivatives' magnitudes.
+// sgbake outputs the tangent and its sign only, so it keeps the tangent alone: the one place the
+// rest would matter is averaging the two frames of a quad-diagonal corner, where frames with
+// equal tangents but different magnitudes average to the same tangent up to the last bit.
+Vec3f average(Vec3f a, Vec3f b) { return a == b ? a : normalizeIfNotZero(a + b); }
 
-TSpace average(const TSpace& a, const TSpace& b) {
-  if (a.magS == b.magS && a.magT == b.magT && a.os == b.os && a.ot == b.ot) return a;
-  TSpace r;
-  r.magS = 0.5f * (a.magS + b.magS);
-  r.magT = 0.5f * (a.magT + b.magT);
-  r.os = normalizeIfNotZero(a.os + b.os);
-  r.ot = normalizeIfNotZero(a.ot + b.ot);
-  return r;
-}
+// What sub-grouping and averaging read of a triangle of a group, at the group's vertex.
+struct Member {
+  Vec3f os, ot;          // dP/ds, dP/dt projected into the vertex's tangent plane, unit or zero
+  float angle;           // interior angle at the vertex
+  std::int32_t face;     // input face
+  bool any;              // "group with any"
+  std::uint8_t corner;   // which corner of the triangle the vertex is
+};
 
 Vec3f projectNormalized(Vec3f v, Vec3f n) { return normalizeIfNotZero(v - dot(n, v) * n); }
 
@@ -162,59 +191,84 @@ class Engine {
   void run() {
     rep_ = weld(in_);
     splitFaces();
-    orderTriangles();
     initTriangles();
     unifyQuadOrientation();
     findNeighbors();
     buildGroups();
     evaluateGroups();
-    resolveDegenerates();
-    writeOutput();
+    resolve();
   }
 
  private:
-  // Step 3/4: split faces into triangles in input order and mark degenerate ones.
+  // Steps 3 and 4: split faces into triangles, written straight into work order (good triangles
+  // in input order, then degenerate ones in input order).
   void splitFaces() {
     const std::size_t nf = in_.faceStart.size() - 1;
-    std::vector<std::uint32_t> triStart(nf + 1, 0);
-    for (std::size_t f = 0; f < nf; ++f) {
-      const std::uint32_t n = in_.faceStart[f + 1] - in_.faceStart[f];
-      triStart[f + 1] = triStart[f] + (n == 4 ? 2 : (n == 3 ? 1 : 0));
-    }
-    const std::size_t nt = triStart.back();
-    inputTris_.resize(nt);
-    inputSlots_.resize(3 * nt);
+    // Per face: bit 0 = quad split on 0-2, bits 1/2 = first/second triangle degenerate,
+    // bits 3/4 = first/second triangle exists.
+    std::vector<std::uint8_t> shape(nf);
     parallelFor(nf, [&](std::size_t f) {
-      const std::uint32_t s0 = in_.faceStart[f];
-      const std::uint32_t n = in_.faceStart[f + 1] - s0;
+      const std::uint32_t s0 = in_.faceStart[f], n = in_.faceStart[f + 1] - s0;
       if (n != 3 && n != 4) return;
-      const std::uint32_t t = triStart[f];
-      auto emit = [&](std::uint32_t tri, std::array<std::uint8_t, 3> corners) {
-        Tri& info = inputTris_[tri];
-        info.face = static_cast<std::int32_t>(f);
-        info.corner = corners;
-        for (int i = 0; i < 3; ++i) inputSlots_[3 * tri + i] = s0 + corners[i];
-        const Vec3f p0 = in_.position[s0 + corners[0]], p1 = in_.position[s0 + corners[1]],
-                    p2 = in_.position[s0 + corners[2]];
-        if (p0 == p1 || p0 == p2 || p1 == p2) info.flags |= kDegenerate;
-      };
-      if (n == 3) {
-        emit(t, {0, 1, 2});
-        return;
+      const bool on02 = n == 3 || quadSplitsOn02(s0);
+      const auto corners = triangleCorners(n, on02);
+      std::uint8_t code = on02 ? 1 : 0;
+      for (std::uint32_t k = 0; k < (n == 4 ? 2u : 1u); ++k) {
+        code |= static_cast<std::uint8_t>(8u << k);
+        if (isDegenerate(s0, corners[k])) code |= static_cast<std::uint8_t>(2u << k);
       }
-      if (quadSplitsOn02(s0)) {
-        emit(t, {0, 1, 2});
-        emit(t + 1, {0, 2, 3});
-      } else {
-        emit(t, {0, 1, 3});
-        emit(t + 1, {1, 2, 3});
+      shape[f] = code;
+    });
+    // Exclusive prefix counts of good and degenerate triangles per face.
+    goodStart_.resize(nf + 1);
+    std::vector<std::uint32_t> degenerateStart(nf + 1);
+    goodStart_[0] = degenerateStart[0] = 0;
+    for (std::size_t f = 0; f < nf; ++f) {
+      std::uint32_t good = 0, bad = 0;
+      for (unsigned k = 0; k < 2; ++k) {
+        if (!(shape[f] & (8u << k))) continue;
+        (shape[f] & (2u << k)) ? ++bad : ++good;
       }
-      const bool deg0 = inputTris_[t].flags & kDegenerate, deg1 = inputTris_[t + 1].flags & kDegenerate;
-      if (deg0 != deg1) {
-        inputTris_[t].flags |= kQuadOneDegenerate;
-        inputTris_[t + 1].flags |= kQuadOneDegenerate;
+      goodStart_[f + 1] = goodStart_[f] + good;
+      degenerateStart[f + 1] = degenerateStart[f] + bad;
+    }
+    numGood_ = goodStart_[nf];
+    const std::size_t nt = numGood_ + degenerateStart[nf];
+    tris_.resize(nt);
+    slot_.resize(3 * nt);
+    vert_.resize(3 * nt);
+    parallelFor(nf, [&](std::size_t f) {
+      const std::uint32_t s0 = in_.faceStart[f], n = in_.faceStart[f + 1] - s0;
+      if (n != 3 && n != 4) return;
+      const auto corners = triangleCorners(n, shape[f] & 1);
+      const bool oneHalfDegenerate = n == 4 && ((shape[f] >> 1) & 1) != ((shape[f] >> 2) & 1);
+      std::uint32_t good = goodStart_[f], bad = static_cast<std::uint32_t>(numGood_) + degenerateStart[f];
+      for (unsigned k = 0; k < (n == 4 ? 2u : 1u); ++k) {
+        const bool degenerate = shape[f] & (2u << k);
+        const std::uint32_t t = degenerate ? bad++ : good++;
+        Tri& tri = tris_[t];
+        tri.face = static_cast<std::int32_t>(f);
+        tri.corner = corners[k];
+        tri.flags = static_cast<std::uint8_t>((degenerate ? kDegenerate : 0) |
+                                              (oneHalfDegenerate ? kQuadOneDegenerate : 0));
+        for (int i = 0; i < 3; ++i) {
+          slot_[3 * t + i] = s0 + corners[k][i];
+          vert_[3 * t + i] = rep_[s0 + corners[k][i]];
+        }
       }
     });
+  }
+
+  // The corners of the triangles of a face of @p n corners (a quad split on 0-2 or on 1-3).
+  static std::array<std::array<std::uint8_t, 3>, 2> triangleCorners(std::uint32_t n, bool on02) {
+    if (n == 3) return {{{0, 1, 2}, {0, 1, 2}}};
+    if (on02) return {{{0, 1, 2}, {0, 2, 3}}};
+    return {{{0, 1, 3}, {1, 2, 3}}};
+  }
+
+  bool isDegenerate(std::uint32_t s0, const std::array<std::uint8_t, 3>& c) const {
+    const Vec3f p0 = in_.position[s0 + c[0]], p1 = in_.position[s0 + c[1]], p2 = in_.position[s0 + c[2]];
+    return p0 == p1 || p0 == p2 || p1 == p2;
   }
 
   // The shorter UV diagonal; on a tie the shorter position diagonal; on a tie 0-2.
@@ -228,31 +282,6 @@ class Engine {
     return !(p13 < p02);
   }
 
-  // Good triangles first (input order), degenerate ones after.
-  void orderTriangles() {
-    const std::size_t nt = inputTris_.size();
-    std::vector<std::uint32_t> order;
-    order.reserve(nt);
-    for (std::size_t t = 0; t < nt; ++t)
-      if (!(inputTris_[t].flags & kDegenerate)) order.push_back(static_cast<std::uint32_t>(t));
-    numGood_ = order.size();
-    for (std::size_t t = 0; t < nt; ++t)
-      if (inputTris_[t].flags & kDegenerate) order.push_back(static_cast<std::uint32_t>(t));
-    tris_.resize(nt);
-    slot_.resize(3 * nt);
-    vert_.resize(3 * nt);
-    parallelFor(nt, [&](std::size_t t) {
-      const std::uint32_t src = order[t];
-      tris_[t] = inputTris_[src];
-      for (int i = 0; i < 3; ++i) {
-        slot_[3 * t + i] = inputSlots_[3 * src + i];
-        vert_[3 * t + i] = rep_[slot_[3 * t + i]];
-      }
-    });
-    inputTris_ = {};
-    inputSlots_ = {};
-  }
-
   // Step 5: UV derivatives of each good triangle.
   void initTriangles() {
     parallelFor(numGood_, [&](std::size_t t) {
@@ -264,6 +293,7 @@ class Engine {
       const float t21x = t2.x - t1.x, t21y = t2.y - t1.y;
       const float t31x = t3.x - t1.x, t31y = t3.y - t1.y;
       const Vec3f d1 = v2 - v1, d2 = v3 - v1;
+      for (int i = 0; i < 3; ++i) tri.angle[i] = cornerAngle(t, i);
       const float area2 = t21x * t31y - t21y * t31x;
       const Vec3f os = t31y * d1 - t21y * d2;
       const Vec3f ot = -t31x * d1 + t21x * d2;
@@ -274,10 +304,20 @@ class Engine {
       const float sign = (tri.flags & kOrientPreserving) ? 1.0f : -1.0f;
       if (notZero(lenOs)) tri.os = (sign / lenOs) * os;
       if (notZero(lenOt)) tri.ot = (sign / lenOt) * ot;
-      tri.magS = lenOs / absArea;
-      tri.magT = lenOt / absArea;
-      if (notZero(tri.magS) && notZero(tri.magT)) tri.flags &= static_cast<std::uint8_t>(~kGroupWithAny);
+      if (notZero(lenOs / absArea) && notZero(lenOt / absArea))
+        tri.flags &= static_cast<std::uint8_t>(~kGroupWithAny);
     });
+  }
+
+  // The interior angle of triangle @p t at corner @p i, measured in the plane orthogonal to the
+  // corner's normal.
+  float cornerAngle(std::size_t t, int i) const {
+    const Vec3f n = in_.normal[vert_[3 * t + i]];
+    const Vec3f p0 = in_.position[vert_[3 * t + (i > 0 ? i - 1 : 2)]];
+    const Vec3f p1 = in_.position[vert_[3 * t + i]];
+    const Vec3f p2 = in_.position[vert_[3 * t + (i < 2 ? i + 1 : 0)]];
+    const Vec3f e1 = projectNormalized(p0 - p1, n), e2 = projectNormalized(p2 - p1, n);
+    return safeAcos(dot(e1, e2));
   }
 
   // Both halves of a healthy quad take the orientation of the half with the larger UV area
@@ -307,26 +347,33 @@ class Engine {
     const std::size_t ne = 3 * numGood_;
     const std::size_t nv = in_.position.size();
     auto edgeFrom = [&](std::size_t e) { return vert_[e]; };
-    auto edgeTo = [&](std::size_t e) { return vert_[e - e % 3 + (e % 3 + 1) % 3]; };
+    auto edgeTo = [&](std::size_t e) { return vert_[e % 3 == 2 ? e - 2 : e + 1]; };
+    // Per edge: its smaller vertex, and (larger vertex, edge) packed so that sorting the packed
+    // values orders a bucket by larger vertex, then triangle.
+    std::vector<std::uint32_t> smaller(ne);
+    std::vector<std::uint64_t> packed(ne);
+    parallelFor(ne, [&](std::size_t e) {
+      const std::uint32_t a = edgeFrom(e), b = edgeTo(e);
+      smaller[e] = std::min(a, b);
+      packed[e] = (std::uint64_t{std::max(a, b)} << 32) | e;
+    });
     std::vector<std::uint32_t> start(nv + 1, 0);
-    for (std::size_t e = 0; e < ne; ++e) ++start[std::min(edgeFrom(e), edgeTo(e)) + 1];
+    for (std::size_t e = 0; e < ne; ++e) ++start[smaller[e] + 1];
     for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-    std::vector<std::uint32_t> edges(ne);
+    std::vector<std::uint64_t> edges(ne);
     {
       std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-      for (std::size_t e = 0; e < ne; ++e)
-        edges[fill[std::min(edgeFrom(e), edgeTo(e))]++] = static_cast<std::uint32_t>(e);
+      for (std::size_t e = 0; e < ne; ++e) edges[fill[smaller[e]]++] = packed[e];
     }
     parallelFor(nv, [&](std::size_t v) {
       const auto begin = edges.begin() + start[v], end = edges.begin() + start[v + 1];
       if (end - begin < 2) return;
-      auto larger = [&](std::uint32_t e) { return std::max(edgeFrom(e), edgeTo(e)); };
-      std::stable_sort(begin, end, [&](std::uint32_t x, std::uint32_t y) { return larger(x) < larger(y); });
+      insertionSortStable(begin, end, std::less<>{});
       for (auto a = begin; a != end; ++a) {
-        const std::uint32_t ea = *a;
+        const auto ea = static_cast<std::uint32_t>(*a);
         if (tris_[ea / 3].neighbor[ea % 3] != kNoTri) continue;
-        for (auto b = a + 1; b != end && larger(*b) == larger(ea); ++b) {
-          const std::uint32_t eb = *b;
+        for (auto b = a + 1; b != end && (*b >> 32) == (*a >> 32); ++b) {
+          const auto eb = static_cast<std::uint32_t>(*b);
           if (edgeFrom(eb) == edgeTo(ea) && edgeTo(eb) == edgeFrom(ea) &&
               tris_[eb / 3].neighbor[eb % 3] == kNoTri) {
             tris_[ea / 3].neighbor[ea % 3] = static_cast<std::int32_t>(eb / 3);
@@ -394,126 +441,146 @@ class Engine {
     if (left >= 0) stack.push_back(left);
   }
 
+  // Per-thread buffers of evaluateGroup, indexed by a triangle's rank in its group's sorted list.
+  // They only grow, so that evaluating a group allocates nothing.
+  struct Scratch {
+    std::vector<std::uint32_t> faces;  // the group's triangles, ascending
+    std::vector<Member> members;       // what the sub-group test and the average read of each
+    std::vector<std::uint64_t> masks;  // per triangle: the bitset of triangles in its sub-group
+    std::vector<std::uint32_t> uniqueOwner;  // per distinct sub-group: a triangle that has it
+    std::vector<Vec3f> uniqueSpace;          // per distinct sub-group: its tangent
+  };
+
   // Step 7: a frame per (group, triangle corner).
   void evaluateGroups() {
-    cornerSpace_.assign(3 * numGood_, TSpace{});
+    cornerSpace_.resize(3 * numGood_);
     const std::size_t ng = groupVertex_.size();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ng, 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-                        std::vector<std::uint32_t> members;
-                        std::vector<std::vector<std::uint32_t>> subgroups;
-                        std::vector<TSpace> subgroupSpaces;
-                        for (std::size_t g = r.begin(); g != r.end(); ++g)
-                          evaluateGroup(g, members, subgroups, subgroupSpaces);
+                        Scratch scratch;
+                        for (std::size_t g = r.begin(); g != r.end(); ++g) evaluateGroup(g, scratch);
                       });
   }
 
-  void evaluateGroup(std::size_t g, std::vector<std::uint32_t>& members,
-                     std::vector<std::vector<std::uint32_t>>& subgroups,
-                     std::vector<TSpace>& subgroupSpaces) {
-    // Sub-groups split triangles whose projected derivatives point in opposite directions: the
-    // default angular threshold of 180 degrees, cos = -1.
+  // Each triangle of the group gathers a sub-group: the triangles whose projected derivatives do
+  // not point exactly opposite to its own (the algorithm's default angular threshold of 180
+  // degrees), plus those of its own face and any "group with any" triangle. Each distinct
+  // sub-group gets the angle-weighted average of its members' tangents, summed in ascending
+  // triangle order. The test is symmetric, so each pair is tested once.
+  void evaluateGroup(std::size_t g, Scratch& sc) {
     constexpr float kThresholdCos = -1.0f;
     const std::uint32_t vertex = groupVertex_[g];
     const Vec3f n = in_.normal[vertex];
-    const auto faces = std::span(groupFaces_).subspan(groupStart_[g], groupStart_[g + 1] - groupStart_[g]);
-    std::size_t numSubgroups = 0;
-    for (const std::uint32_t f : faces) {
-      const Tri& tri = tris_[f];
-      const int index = tri.group[0] == static_cast<std::int32_t>(g)   ? 0
-                        : tri.group[1] == static_cast<std::int32_t>(g) ? 1
-                                                                        : 2;
-      const Vec3f os = projectNormalized(tri.os, n), ot = projectNormalized(tri.ot, n);
-      members.clear();
-      for (const std::uint32_t t : faces) {
-        const Tri& other = tris_[t];
-        const bool any = (tri.flags | other.flags) & kGroupWithAny;
-        const bool sameFace = tri.face == other.face;
-        if (any || sameFace ||
-            (dot(os, projectNormalized(other.os, n)) > kThresholdCos &&
-             dot(ot, projectNormalized(other.ot, n)) > kThresholdCos))
-          members.push_back(t);
-      }
-      std::sort(members.begin(), members.end());
-      std::size_t l = 0;
-      while (l < numSubgroups && subgroups[l] != members) ++l;
-      if (l == numSubgroups) {
-        if (subgroups.size() <= l) {
-          subgroups.emplace_back();
-          subgroupSpaces.emplace_back();
+    const std::uint32_t begin = groupStart_[g], k = groupStart_[g + 1] - begin;
+    if (sc.faces.size() < k) {
+      sc.faces.resize(k);
+      sc.members.resize(k);
+    }
+    std::copy_n(groupFaces_.begin() + begin, k, sc.faces.begin());
+    insertionSortStable(sc.faces.begin(), sc.faces.begin() + k, std::less<>{});
+    Member* m = sc.members.data();
+    for (std::uint32_t j = 0; j < k; ++j) {
+      const Tri& tri = tris_[sc.faces[j]];
+      const int corner = groupCorner(sc.faces[j], g);
+      m[j].os = projectNormalized(tri.os, n);
+      m[j].angle = tri.angle[corner];
+      m[j].face = tri.face;
+      m[j].any = (tri.flags & kGroupWithAny) != 0;
+      m[j].corner = static_cast<std::uint8_t>(corner);
+    }
+    auto output = [&](std::uint32_t j, Vec3f tangent) { cornerSpace_[3 * sc.faces[j] + m[j].corner] = tangent; };
+    if (k == 1) {  // a corner welded to no other: its own triangle's frame
+      output(0, subgroupTangent(m, k, [](std::uint32_t) { return true; }));
+      return;
+    }
+    for (std::uint32_t j = 0; j < k; ++j) m[j].ot = projectNormalized(tris_[sc.faces[j]].ot, n);
+
+    const std::uint32_t words = (k + 63) / 64;
+    if (sc.masks.size() < std::size_t{k} * words) sc.masks.resize(std::size_t{k} * words);
+    std::uint64_t* masks = sc.masks.data();
+    std::fill_n(masks, std::size_t{k} * words, 0);
+    auto set = [&](std::uint32_t row, std::uint32_t col) { masks[row * words + col / 64] |= std::uint64_t{1} << (col % 64); };
+    for (std::uint32_t j = 0; j < k; ++j) {
+      set(j, j);
+      for (std::uint32_t l = j + 1; l < k; ++l) {
+        if (m[j].any || m[l].any || m[j].face == m[l].face ||
+            (dot(m[j].os, m[l].os) > kThresholdCos && dot(m[j].ot, m[l].ot) > kThresholdCos)) {
+          set(j, l);
+          set(l, j);
         }
-        subgroups[l] = members;
-        subgroupSpaces[l] = evalSpace(members, vertex);
-        ++numSubgroups;
       }
-      TSpace ts = subgroupSpaces[l];
-      ts.orient = groupOrient_[g];
-      cornerSpace_[3 * f + index] = ts;
+    }
+    sc.uniqueOwner.clear();
+    sc.uniqueSpace.clear();
+    for (std::uint32_t j = 0; j < k; ++j) {
+      const std::uint64_t* mask = masks + j * words;
+      std::size_t u = 0;
+      while (u < sc.uniqueOwner.size() && !std::equal(mask, mask + words, masks + sc.uniqueOwner[u] * words)) ++u;
+      if (u == sc.uniqueOwner.size()) {
+        sc.uniqueOwner.push_back(j);
+        sc.uniqueSpace.push_back(subgroupTangent(m, k, [&](std::uint32_t l) { return (mask[l / 64] >> (l % 64)) & 1; }));
+      }
+      output(j, sc.uniqueSpace[u]);
     }
   }
 
-  // The angle-weighted average of the members' derivatives at @p vertex.
-  TSpace evalSpace(const std::vector<std::uint32_t>& members, std::uint32_t vertex) const {
-    TSpace r;
-    r.os = r.ot = Vec3f{0, 0, 0};
-    r.magS = r.magT = 0;
-    float angleSum = 0;
-    for (const std::uint32_t f : members) {
-      const Tri& tri = tris_[f];
-      if (tri.flags & kGroupWithAny) continue;
-      const int i = cornerOf(f, vertex);
-      assert(i >= 0);
-      const Vec3f n = in_.normal[vert_[3 * f + i]];
-      const Vec3f os = projectNormalized(tri.os, n), ot = projectNormalized(tri.ot, n);
-      const Vec3f p0 = in_.position[vert_[3 * f + (i > 0 ? i - 1 : 2)]];
-      const Vec3f p1 = in_.position[vert_[3 * f + i]];
-      const Vec3f p2 = in_.position[vert_[3 * f + (i < 2 ? i + 1 : 0)]];
-      const Vec3f e1 = projectNormalized(p0 - p1, n), e2 = projectNormalized(p2 - p1, n);
-      const float angle = safeAcos(dot(e1, e2));
-      r.os += angle * os;
-      r.ot += angle * ot;
-      r.magS += angle * tri.magS;
-      r.magT += angle * tri.magT;
-      angleSum += angle;
-    }
-    r.os = normalizeIfNotZero(r.os);
-    r.ot = normalizeIfNotZero(r.ot);
-    if (angleSum > 0) {
-      r.magS /= angleSum;
-      r.magT /= angleSum;
-    }
-    return r;
+  // The angle-weighted average of the tangents of the members @p in the sub-group.
+  template <class InSubgroup>
+  static Vec3f subgroupTangent(const Member* m, std::uint32_t k, InSubgroup in) {
+    Vec3f os{0, 0, 0};
+    for (std::uint32_t j = 0; j < k; ++j)
+      if (!m[j].any && in(j)) os += m[j].angle * m[j].os;
+    return normalizeIfNotZero(os);
   }
 
-  // Step 8 and the degenerate epilogue: slot frames from triangle-corner frames.
-  void resolveDegenerates() {
-    slotSpace_.assign(in_.position.size(), TSpace{});
-    for (std::size_t t = 0; t < numGood_; ++t) {
-      for (int i = 0; i < 3; ++i) {
-        if (tris_[t].group[i] < 0) continue;
-        TSpace& out = slotSpace_[slot_[3 * t + i]];
-        const TSpace& ts = cornerSpace_[3 * t + i];
-        const bool orient = ts.orient;
-        if (out.counter == 1) {
-          out = average(out, ts);
-          out.counter = 2;
-        } else {
-          out = ts;
-          out.counter = 1;
-        }
-        out.orient = orient;
+  // Which corner of triangle @p f belongs to group @p g.
+  int groupCorner(std::uint32_t f, std::size_t g) const {
+    const auto& group = tris_[f].group;
+    return group[0] == static_cast<std::int32_t>(g) ? 0 : (group[1] == static_cast<std::int32_t>(g) ? 1 : 2);
+  }
+
+
+  // Step 8 and the degenerate epilogue: slot frames from triangle-corner frames, written
+  // straight to the output.
+  void resolve() {
+    const std::size_t nslots = in_.position.size();
+    std::vector<Vec3f>& tangent = out_.tangent;
+    std::vector<std::uint8_t>& orient = out_.orientationPreserving;
+    tangent.resize(nslots);
+    orient.resize(nslots);
+    // A slot belongs to one face, so faces can be resolved in parallel. Slots no group reached
+    // keep the algorithm's default frame: tangent +x, orientation reversed.
+    parallelFor(goodStart_.size() - 1, [&](std::size_t face) {
+      const std::uint32_t s0 = in_.faceStart[face], n = in_.faceStart[face + 1] - s0;
+      std::array<std::uint8_t, 4> writes{};
+      for (std::uint32_t i = 0; i < n; ++i) {
+        tangent[s0 + i] = Vec3f{1, 0, 0};
+        orient[s0 + i] = 0;
       }
-    }
+      for (std::size_t t = goodStart_[face]; t < goodStart_[face + 1]; ++t) {
+        for (int i = 0; i < 3; ++i) {
+          const std::int32_t g = tris_[t].group[i];
+          if (g < 0) continue;
+          const std::uint32_t c = tris_[t].corner[i];
+          const Vec3f ts = cornerSpace_[3 * t + i];
+          tangent[s0 + c] = writes[c]++ == 1 ? average(tangent[s0 + c], ts) : ts;
+          orient[s0 + c] = groupOrient_[static_cast<std::size_t>(g)];
+        }
+      }
+    });
+    if (numGood_ == tris_.size()) return;  // no degenerate triangles
 
     // Degenerate triangles copy the frame of the first good triangle corner with the same
     // welded vertex; halves of quads whose other half is good are handled below.
-    std::vector<std::uint32_t> firstUse(in_.position.size(), kNone);
+    std::vector<std::uint32_t> firstUse(nslots, kNone);
     for (std::size_t j = 3 * numGood_; j-- > 0;) firstUse[vert_[j]] = static_cast<std::uint32_t>(j);
     for (std::size_t t = numGood_; t < tris_.size(); ++t) {
       if (tris_[t].flags & kQuadOneDegenerate) continue;
       for (int i = 0; i < 3; ++i) {
         const std::uint32_t j = firstUse[vert_[3 * t + i]];
-        if (j != kNone) slotSpace_[slot_[3 * t + i]] = slotSpace_[slot_[j]];
+        if (j == kNone) continue;
+        tangent[slot_[3 * t + i]] = tangent[slot_[j]];
+        orient[slot_[3 * t + i]] = orient[slot_[j]];
       }
     }
     // The corner a good half of a quad does not use takes the frame of the corner at the same
@@ -529,41 +596,30 @@ class Engine {
       const Vec3f target = in_.position[s0 + missing];
       for (int i = 0; i < 3; ++i) {
         if (in_.position[s0 + tri.corner[i]] == target) {
-          slotSpace_[s0 + missing] = slotSpace_[s0 + tri.corner[i]];
+          tangent[s0 + missing] = tangent[s0 + tri.corner[i]];
+          orient[s0 + missing] = orient[s0 + tri.corner[i]];
           break;
         }
       }
     }
   }
 
-  void writeOutput() {
-    const std::size_t n = slotSpace_.size();
-    out_.tangent.resize(n);
-    out_.orientationPreserving.resize(n);
-    parallelFor(n, [&](std::size_t s) {
-      out_.tangent[s] = slotSpace_[s].os;
-      out_.orientationPreserving[s] = slotSpace_[s].orient ? 1 : 0;
-    });
-  }
-
   const Input& in_;
   Output& out_;
   std::vector<std::uint32_t> rep_;  // welded vertex (smallest equal slot) of each slot
 
-  std::vector<Tri> inputTris_;            // input order (temporary)
-  std::vector<std::uint32_t> inputSlots_;  // input order (temporary)
+  std::vector<std::uint32_t> goodStart_;  // #faces+1: face f's good triangles in work order
   std::vector<Tri> tris_;                 // work order
   std::vector<std::uint32_t> slot_;       // 3 per triangle: the slot of each corner
   std::vector<std::uint32_t> vert_;       // 3 per triangle: the welded vertex of each corner
   std::size_t numGood_ = 0;
 
   std::vector<std::uint32_t> groupVertex_;
-  std::vector<bool> groupOrient_;
+  std::vector<std::uint8_t> groupOrient_;
   std::vector<std::uint32_t> groupStart_;
   std::vector<std::uint32_t> groupFaces_;
 
-  std::vector<TSpace> cornerSpace_;  // 3 per good triangle
-  std::vector<TSpace> slotSpace_;
+  std::vector<Vec3f> cornerSpace_;  // 3 per good triangle: the tangent of its group at each corner
 };
 
 }  // namespace

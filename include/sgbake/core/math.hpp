@@ -68,7 +68,8 @@ Vec3T<T> normalizeOr(Vec3T<T> a, Vec3T<T> fallback) {
 /// @brief MikkTSpace's normalize-if-nonzero: a zero vector stays zero.
 template <class T>
 Vec3T<T> normalizeIfNotZero(Vec3T<T> a) {
-  return notZero(a) ? normalizeOr(a, a) : a;
+  if (!notZero(a)) return a;
+  return (T(1) / length(a)) * a;
 }
 
 /// @brief Angle in radians between two vectors, robust for nearly parallel inputs
