@@ -1,1 +1,171 @@
-// placeholder
+/// @file normals.cpp
+/// @brief Face and smooth vertex normals as Blender computes them, and the Mesh invariant check.
+///
+/// Precision: positions are float; every normal is computed and accumulated in double and
+/// rounded to float once at the end. Degenerate policy (as Blender):
+/// - a face whose normal direction is exactly zero (collinear or coincident points; computed in
+///   double from float positions, where the differences and products are exact, so "exactly
+///   zero" means "degenerate in the file's own numbers") gets (0, 0, 1) and still takes part in
+///   vertex normals with that direction, like Blender's Newell fallback;
+/// - a corner with a zero-length edge has weight π/2: Blender normalizes the edge vectors, its
+///   normalize() leaves a zero vector as is, and acos(-dot(0, e)) = π/2;
+/// - a vertex whose weighted sum is zero gets its normalized position, (0, 0, 1) at the origin.
+#include "sgbake/mesh/normals.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "mesh/validate.hpp"
+#include "sgbake/core/math.hpp"
+
+namespace sgbake {
+namespace {
+
+/// Blender's normal for a face of zero area.
+constexpr Vec3d kZeroAreaNormal{0, 0, 1};
+/// Normal of a vertex at the origin whose incident face normals cancel (Blender would leave a
+/// zero vector; sgbake keeps normals unit).
+constexpr Vec3d kOriginVertexNormal{0, 0, 1};
+/// Blender's angle weight of a corner with a zero-length edge (see the file comment).
+constexpr double kZeroEdgeCornerAngle = kPi / 2;
+
+Vec3d cornerPosition(const MeshView& mesh, std::uint32_t corner) {
+  return cast<double>(mesh.positions[mesh.cornerVertex[corner]]);
+}
+
+/// Face @p f's normal direction, not normalized: triangles (p0-p1)×(p1-p2), quads the cross
+/// product of the diagonals (p0-p2)×(p1-p3), larger faces Newell's sum (twice the vector area,
+/// well defined for non-planar faces). All three point the same way for a planar face with
+/// counter-clockwise corners seen from the front.
+Vec3d faceNormalDirection(const MeshView& mesh, std::size_t f) {
+  const std::uint32_t b = mesh.faceStart[f];
+  const std::uint32_t n = mesh.faceSize(f);
+  if (n == 3) {
+    const Vec3d p0 = cornerPosition(mesh, b), p1 = cornerPosition(mesh, b + 1),
+                p2 = cornerPosition(mesh, b + 2);
+    return cross(p0 - p1, p1 - p2);
+  }
+  if (n == 4) {
+    const Vec3d p0 = cornerPosition(mesh, b), p1 = cornerPosition(mesh, b + 1),
+                p2 = cornerPosition(mesh, b + 2), p3 = cornerPosition(mesh, b + 3);
+    return cross(p0 - p2, p1 - p3);
+  }
+  // Newell: for each edge prev → curr, the projected areas under the edge on the three axis
+  // planes.
+  Vec3d sum{};
+  Vec3d prev = cornerPosition(mesh, b + n - 1);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec3d curr = cornerPosition(mesh, b + i);
+    sum.x += (prev.y - curr.y) * (prev.z + curr.z);
+    sum.y += (prev.z - curr.z) * (prev.x + curr.x);
+    sum.z += (prev.x - curr.x) * (prev.y + curr.y);
+    prev = curr;
+  }
+  return sum;
+}
+
+/// Interior angle between the edges from a corner to its previous and next corners, from their
+/// normalized directions: atan2(|a×b|, a·b), accurate also for nearly straight corners.
+double cornerAngle(Vec3d toPrev, Vec3d toNext) {
+  const Vec3d a = normalizeOr(toPrev, Vec3d{});
+  const Vec3d b = normalizeOr(toNext, Vec3d{});
+  if (lengthSquared(a) == 0 || lengthSquared(b) == 0) return kZeroEdgeCornerAngle;
+  return angleBetween(a, b);
+}
+
+}  // namespace
+
+std::vector<Vec3f> computeFaceNormals(const MeshView& mesh) {
+  std::vector<Vec3f> normals(mesh.numFaces());
+  for (std::size_t f = 0; f < normals.size(); ++f) {
+    normals[f] = cast<float>(normalizeOr(faceNormalDirection(mesh, f), kZeroAreaNormal));
+  }
+  return normals;
+}
+
+void computeSmoothNormals(Mesh& mesh) {
+  const MeshView view = mesh.view();
+  std::vector<Vec3d> sum(mesh.numVertices());
+  for (std::size_t f = 0; f < view.numFaces(); ++f) {
+    const Vec3d normal = normalizeOr(faceNormalDirection(view, f), kZeroAreaNormal);
+    const std::uint32_t b = view.faceStart[f];
+    const std::uint32_t n = view.faceSize(f);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const Vec3d prev = cornerPosition(view, b + (i + n - 1) % n);
+      const Vec3d curr = cornerPosition(view, b + i);
+      const Vec3d next = cornerPosition(view, b + (i + 1) % n);
+      sum[view.cornerVertex[b + i]] += cornerAngle(prev - curr, next - curr) * normal;
+    }
+  }
+  std::vector<Vec3f> vertexNormals(sum.size());
+  for (std::size_t v = 0; v < sum.size(); ++v) {
+    const Vec3d fallback = normalizeOr(cast<double>(mesh.positions[v]), kOriginVertexNormal);
+    vertexNormals[v] = cast<float>(normalizeOr(sum[v], fallback));
+  }
+  mesh.cornerNormals.resize(mesh.numCorners());
+  for (std::size_t c = 0; c < mesh.numCorners(); ++c) {
+    mesh.cornerNormals[c] = vertexNormals[mesh.cornerVertex[c]];
+  }
+  mesh.normalSource = NormalSource::kComputed;
+}
+
+Status validate(const Mesh& mesh) {
+  const std::string name = mesh.source.empty() ? "mesh" : detail::displayName(mesh.source);
+  auto fail = [&](const std::string& what) -> Status { return detail::errorIn(name, what); };
+  const std::size_t numCorners = mesh.numCorners();
+  const std::size_t numVertices = mesh.numVertices();
+
+  if (mesh.faceStart.empty() || mesh.faceStart[0] != 0)
+    return fail("faceStart does not start at 0");
+  for (std::size_t f = 0; f + 1 < mesh.faceStart.size(); ++f) {
+    const std::uint64_t begin = mesh.faceStart[f], end = mesh.faceStart[f + 1];
+    if (end < begin + 3) {
+      return fail("face " + std::to_string(f) + " has " +
+                  (end < begin ? "a negative number of" : std::to_string(end - begin)) +
+                  " corners (at least 3 are needed)");
+    }
+  }
+  if (mesh.faceStart.back() != numCorners) {
+    return fail("faceStart ends at " + std::to_string(mesh.faceStart.back()) + " but there are " +
+                std::to_string(numCorners) + " corners");
+  }
+  for (std::size_t c = 0; c < numCorners; ++c) {
+    if (mesh.cornerVertex[c] >= numVertices) {
+      return fail("corner " + std::to_string(c) + " refers to vertex " +
+                  std::to_string(mesh.cornerVertex[c]) + " but there are " +
+                  std::to_string(numVertices) + " vertices");
+    }
+  }
+  for (std::size_t v = 0; v < numVertices; ++v) {
+    if (!isFinite(mesh.positions[v])) {
+      return fail("position of vertex " + std::to_string(v) + " is not finite");
+    }
+  }
+  if (mesh.cornerNormals.size() != numCorners) {
+    return fail("there are " + std::to_string(mesh.cornerNormals.size()) + " corner normals for " +
+                std::to_string(numCorners) + " corners");
+  }
+  for (std::size_t c = 0; c < numCorners; ++c) {
+    const Vec3f n = mesh.cornerNormals[c];
+    const double len = length(cast<double>(n));
+    if (!isFinite(n) || !(std::abs(len - 1.0) <= detail::kUnitLengthTolerance)) {
+      return fail("normal of corner " + std::to_string(c) + " is not a unit vector (length " +
+                  std::to_string(len) + ")");
+    }
+  }
+  for (const UvSet& set : mesh.uvSets) {
+    if (set.uvs.size() != numCorners) {
+      return fail("UV set " + detail::quoted(set.name) + " has " + std::to_string(set.uvs.size()) +
+                  " entries for " + std::to_string(numCorners) + " corners");
+    }
+    for (std::size_t c = 0; c < numCorners; ++c) {
+      if (!isFinite(set.uvs[c])) {
+        return fail("UV set " + detail::quoted(set.name) + " has a non-finite UV at corner " +
+                    std::to_string(c));
+      }
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace sgbake

@@ -10,17 +10,27 @@
 namespace sgbake {
 
 /// @brief Unit face normals, #F. Triangles: normalize((p0-p1)×(p1-p2)); quads: normalize of the
-/// cross product of the diagonals (p0-p2)×(p1-p3); n-gons: Newell's method. A face of zero area
-/// gets (0, 0, 1), Blender's fallback.
+/// cross product of the diagonals (p0-p2)×(p1-p3); n-gons: Newell's method. All point to the side
+/// from which the corners are counter-clockwise. A face of zero area (its cross product, computed
+/// in double from the float positions, is exactly zero) gets (0, 0, 1), Blender's fallback.
 std::vector<Vec3f> computeFaceNormals(const MeshView& mesh);
 
 /// @brief Smooth shading, as Blender's vertex normals: each vertex normal is the normalized sum of
 /// the normals of the faces around it (by vertex index), each weighted by the face's interior
-/// angle at that vertex. A vertex whose sum vanishes gets its normalized position (Blender's
-/// fallback), or (0, 0, 1) at the origin. Writes every corner of @p mesh and sets normalSource.
+/// angle at that vertex (so splitting a face into several does not change the result). Computed
+/// and accumulated in double, stored as float. Degenerate cases follow Blender: a zero-area face
+/// contributes (0, 0, 1); a corner with a zero-length edge has weight π/2 (Blender's acos of the
+/// dot product with a zero vector). A vertex whose sum vanishes gets its normalized position
+/// (Blender's fallback), or (0, 0, 1) at the origin. Writes every corner of @p mesh and sets
+/// normalSource to kComputed.
+/// @note Precondition: @p mesh satisfies the index invariants of Mesh (positions may be anything
+/// finite; normals are not read).
 void computeSmoothNormals(Mesh& mesh);
 
 /// @brief Checks the Mesh invariants (see Mesh); names @p mesh.source in the message.
+///
+/// Unit length means within eight float ulps of 1 (about 9.5e-7). Returns ErrorCode::kBadInput
+/// with a one-line message `<source>: <what is wrong>` for the first violation found.
 Status validate(const Mesh& mesh);
 
 }  // namespace sgbake
