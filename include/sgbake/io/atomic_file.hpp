@@ -1,0 +1,84 @@
+/// @file atomic_file.hpp
+/// @brief Output files written all-or-nothing: a reader sees either the old file or the whole new
+/// one, never a partial file, whatever happens to the writer.
+///
+/// The data goes to a temporary file in the target's directory (same filesystem, so the final
+/// rename(2) is atomic) and is renamed over the target only when the writer commits. A writer that
+/// is destroyed, fails or is discarded before committing removes its temporary file and leaves an
+/// existing target byte-identical.
+#pragma once
+
+#include <filesystem>
+#include <string_view>
+
+#include "sgbake/core/result.hpp"
+
+namespace sgbake {
+
+/// @brief Options for AtomicFile.
+struct AtomicFileOptions {
+  /// fsync(2) the data before the rename and the directory after it, so that the new content
+  /// also survives a power loss. Off by default: it can cost more than producing the data, and
+  /// the all-or-nothing guarantee towards other processes holds without it.
+  bool durable = false;
+};
+
+/// @brief A file being written under a temporary name, renamed over its target by commit().
+///
+/// The temporary is `<target>.tmp-<pid>-<random hex>` in the target's directory, created
+/// exclusively (O_EXCL) with mode 0666 minus the umask like any new file, or with the permission
+/// bits of the file it will replace. A symbolic link at the target is replaced, not followed.
+/// Code that must write a path itself (an image library, say) can write to tempPath() and then
+/// call commit().
+///
+/// Errors: a target that cannot be created (missing directory, no permission, a directory in its
+/// place) is ErrorCode::kBadInput; a failing write, sync or rename (disk full, I/O error) is
+/// ErrorCode::kInternal. Messages name the target path.
+///
+/// @note Not thread-safe: one writer per thread. Move-only.
+class AtomicFile {
+ public:
+  /// @brief Creates the temporary file next to @p target.
+  static Result<AtomicFile> create(const std::filesystem::path& target,
+                                   const AtomicFileOptions& options = {});
+
+  AtomicFile(AtomicFile&& other) noexcept;
+  AtomicFile& operator=(AtomicFile&& other) noexcept;
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  /// @brief Removes the temporary file unless commit() succeeded.
+  ~AtomicFile();
+
+  /// @brief Appends @p bytes to the temporary file (retrying short and interrupted writes).
+  /// @note After a failed write the writer is discarded; later calls fail too.
+  Status write(std::string_view bytes);
+
+  /// @brief Closes the temporary file and renames it over the target. After a failure the
+  /// temporary file is removed and the target is untouched.
+  Status commit();
+
+  /// @brief Abandons the file: closes and removes the temporary. Idempotent.
+  void discard() noexcept;
+
+  /// @brief True until commit() or discard() (or a failure) ends the writer.
+  bool isOpen() const { return fd_ >= 0; }
+
+  const std::filesystem::path& target() const { return target_; }
+  const std::filesystem::path& tempPath() const { return temp_; }
+
+ private:
+  AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd, bool durable)
+      : target_(std::move(target)), temp_(std::move(temp)), fd_(fd), durable_(durable) {}
+
+  std::filesystem::path target_;
+  std::filesystem::path temp_;
+  int fd_ = -1;  ///< open descriptor of temp_, or -1 once committed or discarded
+  bool durable_ = false;
+};
+
+/// @brief Writes @p bytes to @p target all-or-nothing (AtomicFile::create, write, commit).
+Status writeFileAtomically(const std::filesystem::path& target, std::string_view bytes,
+                           const AtomicFileOptions& options = {});
+
+}  // namespace sgbake

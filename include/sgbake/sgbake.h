@@ -1,0 +1,93 @@
+/// @file sgbake.h
+/// @brief sgbake's C ABI: flat arrays in, flat arrays out, status codes, no exceptions.
+///
+/// Meant for callers that cannot use C++ — above all the Blender add-on, through Python's ctypes.
+/// Every function validates its arguments completely before computing, never throws, never
+/// prints and never exits; failures are a status code plus a one-line message written into a
+/// caller-provided buffer.
+///
+/// Conventions shared by every array below (the same as the C++ `sgbake::MeshView`):
+/// - `#V` vertices, `#F` faces, `#C` face corners (Blender's "loops"). Corners are stored face
+///   after face, each face's corners in winding order.
+/// - Arrays are dense, row-major, C order: "#C × 3" means `3 * #C` values, corner `c` occupying
+///   elements `[3c, 3c+3)` (a contiguous numpy array of shape (#C, 3)).
+/// - Positions, normals and tangents are in object space, right-handed, unitless (whatever unit
+///   the positions use). UVs have their origin at the bottom left, u to the right, v up (Blender).
+/// - The library copies what it needs: no pointer is kept after a call returns.
+/// - Functions are thread-safe: concurrent calls on different output arrays are fine.
+#ifndef SGBAKE_SGBAKE_H
+#define SGBAKE_SGBAKE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#define SGBAKE_C_API
+#else
+/// Exported even if the library is ever built with hidden visibility: ctypes looks these up.
+#define SGBAKE_C_API __attribute__((visibility("default")))
+#endif
+
+/// The version of this header, as "MAJOR.MINOR.PATCH"; sgbake_version() reports the library's.
+#define SGBAKE_VERSION_STRING "0.1.0"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// @brief Status codes returned by every sgbake_* function (the same as the CLI's exit codes).
+enum sgbake_status {
+  SGBAKE_OK = 0,             ///< success; every output array has been written
+  SGBAKE_ERROR_INTERNAL = 1, ///< a bug or a resource failure (e.g. out of memory) in sgbake
+  SGBAKE_ERROR_BAD_INPUT = 2 ///< the arguments are inconsistent or the data is invalid
+};
+
+/// @brief The library's version, "MAJOR.MINOR.PATCH" (a static string; never NULL).
+SGBAKE_C_API const char* sgbake_version(void);
+
+/// @brief MikkTSpace tangent frames per face corner, identical to Blender's (see the C++
+/// `sgbake::computeTangents` for the algorithm: triangles and quads as they are, n-gons by ear
+/// clipping, corners welded only where position, normal and UV are exactly equal).
+///
+/// @param[in]  positions       #V × 3 floats: vertex positions (x, y, z), object space.
+/// @param[in]  num_vertices    #V.
+/// @param[in]  face_start      #F + 1 offsets into the corner arrays: face f owns corners
+///                             [face_start[f], face_start[f+1]). face_start[0] must be 0,
+///                             face_start[#F] must be #C, and every face needs at least 3 corners.
+///                             (Blender: `polygons.loop_start` with #C appended.)
+/// @param[in]  num_faces       #F.
+/// @param[in]  corner_vertex   #C vertex indices, each < #V (Blender: `loops.vertex_index`).
+/// @param[in]  corner_normals  #C × 3 floats: unit normal of each corner, object space (the split
+///                             or custom normal; the face normal on flat faces).
+/// @param[in]  corner_uvs      #C × 2 floats: texture coordinates (u, v) of each corner.
+/// @param[in]  num_corners     #C (must fit in 32 bits).
+/// @param[in]  threads         maximum number of threads; 0 = all cores. The result is
+///                             bit-identical for every value.
+/// @param[out] out_tangents    #C × 3 floats: unit tangent of each corner, object space.
+/// @param[out] out_signs       #C floats, each +1 or -1: the bitangent is
+///                             `sign * cross(normal, tangent)`.
+/// @param[out] error_buf       receives a NUL-terminated one-line message when the call fails
+///                             (truncated to fit); may be NULL. Untouched on success.
+/// @param[in]  error_buf_size  size of error_buf in bytes, terminating NUL included; may be 0.
+///
+/// @return SGBAKE_OK, SGBAKE_ERROR_BAD_INPUT or SGBAKE_ERROR_INTERNAL. On failure the output
+///         arrays may have been partly written and must not be used.
+///
+/// @note Validated before anything is computed (failures are SGBAKE_ERROR_BAD_INPUT): pointers
+///       are non-NULL wherever their array is non-empty; face_start is as described above;
+///       every corner_vertex is < #V; every position, normal and UV is finite; every normal has
+///       unit length to within 1e-3; threads >= 0. A mesh with no faces and no corners succeeds
+///       and writes nothing (face_start may then be NULL).
+SGBAKE_C_API int sgbake_compute_tangents(const float* positions, size_t num_vertices,
+                                         const uint32_t* face_start, size_t num_faces,
+                                         const uint32_t* corner_vertex,
+                                         const float* corner_normals, const float* corner_uvs,
+                                         size_t num_corners, int threads, float* out_tangents,
+                                         float* out_signs, char* error_buf,
+                                         size_t error_buf_size);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* SGBAKE_SGBAKE_H */

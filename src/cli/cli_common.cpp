@@ -1,0 +1,188 @@
+/// @file cli_common.cpp
+/// @brief The helpers every subcommand shares (see cli.hpp).
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include <tbb/info.h>
+
+#include "cli.hpp"
+
+namespace sgbake::cli {
+
+const char* const kExitCodeHelp =
+    "Exit codes:\n"
+    "  0  success\n"
+    "  1  internal error (a bug in sgbake, out of memory, disk full)\n"
+    "  2  bad usage or bad input (unknown option, unreadable or invalid file)\n";
+
+const CLI::Validator kNonNegativeInteger(
+    [](std::string& value) -> std::string {
+      std::size_t used = 0;
+      try {
+        if (!value.empty() && value[0] != '-' && std::stoll(value, &used) >= 0 &&
+            used == value.size()) {
+          return {};
+        }
+      } catch (const std::exception&) {
+        // Not a number or out of range: reported below.
+      }
+      return "'" + value + "' is not an integer >= 0";
+    },
+    /*validator_desc=*/"");
+
+ExitCode exitCodeFor(ErrorCode code) {
+  return code == ErrorCode::kBadInput ? kExitBadInput : kExitInternal;
+}
+
+void printError(std::string_view message) {
+  std::string line = "sgbake: error: ";
+  line.append(message);
+  std::replace_if(line.begin(), line.end(), [](char ch) { return ch == '\n' || ch == '\r'; },
+                  ' ');
+  line += '\n';
+  std::fputs(line.c_str(), stderr);
+  std::fflush(stderr);
+}
+
+// ---- Thread cap -------------------------------------------------------------------------------
+
+ThreadLimit::ThreadLimit(int threads) {
+  if (threads > 0) {
+    control_.emplace(tbb::global_control::max_allowed_parallelism,
+                     static_cast<std::size_t>(threads));
+  }
+}
+
+int ThreadLimit::effectiveThreads() const {
+  const auto cap =
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  return static_cast<int>(std::min<std::size_t>(
+      cap, static_cast<std::size_t>(std::max(1, tbb::info::default_concurrency()))));
+}
+
+// ---- Removing temporary files when a signal ends the process ---------------------------------
+//
+// A fixed table of paths that a signal handler may read: registering copies the path and then
+// publishes the slot; the handler only calls unlink(2), which is async-signal-safe.
+
+namespace {
+
+constexpr std::size_t kMaxPendingFiles = 8;
+constexpr std::size_t kMaxPathBytes = 4096;
+
+struct PendingFile {
+  volatile std::sig_atomic_t used = 0;
+  char path[kMaxPathBytes] = {};
+};
+
+PendingFile g_pendingFiles[kMaxPendingFiles];
+
+extern "C" void removePendingFilesAndDie(int signal) {
+  for (PendingFile& file : g_pendingFiles) {
+    if (file.used) ::unlink(file.path);
+  }
+  // The handler was installed with SA_RESETHAND: re-raising runs the default action (the
+  // process dies of this signal, as the parent expects) once the handler returns.
+  ::raise(signal);
+}
+
+/// Registers @p path for removal on a fatal signal; returns its slot, or -1 when the table is
+/// full or the path too long (then the file is merely not cleaned up after a signal).
+int registerPendingFile(const std::filesystem::path& path) {
+  const std::string& text = path.native();
+  if (text.size() >= kMaxPathBytes) return -1;
+  for (std::size_t i = 0; i < kMaxPendingFiles; ++i) {
+    PendingFile& file = g_pendingFiles[i];
+    if (file.used) continue;
+    std::memcpy(file.path, text.c_str(), text.size() + 1);
+    std::atomic_signal_fence(std::memory_order_seq_cst);  // the path is complete before use
+    file.used = 1;
+    return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void unregisterPendingFile(int slot) {
+  if (slot >= 0) g_pendingFiles[slot].used = 0;
+}
+
+/// Slot of each open Output's temporary file; Outputs are few and short-lived, so a linear
+/// lookup by path keeps Output itself free of signal bookkeeping.
+int findPendingFile(const std::filesystem::path& path) {
+  for (std::size_t i = 0; i < kMaxPendingFiles; ++i) {
+    if (g_pendingFiles[i].used && path.native() == g_pendingFiles[i].path) {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+}  // namespace
+
+void installSignalCleanup() {
+  struct sigaction action {};
+  action.sa_handler = removePendingFilesAndDie;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+    ::sigaction(signal, &action, nullptr);
+  }
+}
+
+// ---- Output -----------------------------------------------------------------------------------
+
+Output::Output(std::optional<AtomicFile> file) : file_(std::move(file)) {
+  if (file_) registerPendingFile(file_->tempPath());
+}
+
+Output::Output(Output&& other) noexcept : file_(std::exchange(other.file_, std::nullopt)) {}
+
+Output::~Output() {
+  if (file_) {
+    unregisterPendingFile(findPendingFile(file_->tempPath()));
+    file_->discard();
+  }
+}
+
+Result<Output> Output::open(const std::string& path) {
+  if (path == "-") return Output(std::nullopt);
+  Result<AtomicFile> file = AtomicFile::create(path);
+  if (!file) return file.error();
+  return Output(std::move(file.value()));
+}
+
+std::string Output::name() const { return file_ ? file_->target().string() : "-"; }
+
+Status Output::write(std::string_view bytes) {
+  if (file_) return file_->write(bytes);
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(STDOUT_FILENO, bytes.data(), bytes.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return Error::internal("cannot write to standard output: " +
+                             std::generic_category().message(errno));
+    }
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return Ok{};
+}
+
+Status Output::finish() {
+  if (!file_) return Ok{};
+  const int slot = findPendingFile(file_->tempPath());
+  Status committed = file_->commit();
+  unregisterPendingFile(slot);
+  return committed;
+}
+
+}  // namespace sgbake::cli

@@ -1,0 +1,173 @@
+/// @file atomic_file.cpp
+/// @brief AtomicFile on POSIX: open(O_EXCL) a sibling temporary, write(2), rename(2).
+#include "sgbake/io/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <system_error>
+#include <utility>
+
+namespace sgbake {
+namespace {
+
+/// How many random temporary names to try before giving up (each collision is ~2^-64 likely,
+/// so more than one attempt only matters when something else is creating files with our names).
+constexpr int kMaxNameAttempts = 16;
+
+std::string describeErrno(int err) { return std::generic_category().message(err); }
+
+/// `<target>: <what>: <strerror>` — the one-line message format of every failure here.
+Error ioError(ErrorCode code, const std::filesystem::path& target, std::string_view what,
+              int err) {
+  return {code, target.string() + ": " + std::string(what) + ": " + describeErrno(err)};
+}
+
+/// `<filename>.tmp-<pid>-<16 hex digits>` next to @p target.
+std::filesystem::path makeTempName(const std::filesystem::path& target, std::mt19937_64& rng) {
+  char suffix[64];
+  std::snprintf(suffix, sizeof suffix, ".tmp-%ld-%016llx", static_cast<long>(::getpid()),
+                static_cast<unsigned long long>(rng()));
+  std::filesystem::path temp = target;
+  temp += suffix;
+  return temp;
+}
+
+/// The directory that holds @p target ("." for a bare file name).
+std::filesystem::path parentDirectory(const std::filesystem::path& target) {
+  std::filesystem::path dir = target.parent_path();
+  return dir.empty() ? std::filesystem::path(".") : dir;
+}
+
+/// A file that replaces @p target keeps its permission bits (best effort: the new file simply
+/// keeps the umask's mode when that fails).
+void keepPermissionsOf(const std::filesystem::path& target, int fd) {
+  struct stat existing {};
+  if (::stat(target.c_str(), &existing) == 0 && S_ISREG(existing.st_mode)) {
+    ::fchmod(fd, existing.st_mode & 07777);
+  }
+}
+
+/// fsync(2) of a directory, so that a rename inside it is durable.
+int syncDirectory(const std::filesystem::path& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  const int err = ::fsync(fd) == 0 ? 0 : errno;
+  ::close(fd);
+  return err;
+}
+
+}  // namespace
+
+Result<AtomicFile> AtomicFile::create(const std::filesystem::path& target,
+                                      const AtomicFileOptions& options) {
+  if (target.empty() || !target.has_filename()) {
+    // (Built with append: `"'" + std::string` trips GCC 12's false -Wrestrict, bug 105651.)
+    std::string message = "'";
+    message.append(target.string()).append("': not a file name");
+    return Error::badInput(std::move(message));
+  }
+  std::error_code ec;
+  if (std::filesystem::is_directory(target, ec)) {
+    return Error::badInput(target.string() + ": is a directory");
+  }
+
+  // Seeded per call from the OS: two processes (or two writers in one) never share a sequence.
+  std::random_device entropy;
+  std::mt19937_64 rng((static_cast<std::uint64_t>(entropy()) << 32) ^ entropy());
+  for (int attempt = 0; attempt < kMaxNameAttempts; ++attempt) {
+    std::filesystem::path temp = makeTempName(target, rng);
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      keepPermissionsOf(target, fd);
+      return AtomicFile(target, std::move(temp), fd, options.durable);
+    }
+    if (errno != EEXIST) return ioError(ErrorCode::kBadInput, target, "cannot create file", errno);
+  }
+  return ioError(ErrorCode::kInternal, target, "cannot create a unique temporary file", EEXIST);
+}
+
+AtomicFile::AtomicFile(AtomicFile&& other) noexcept
+    : target_(std::move(other.target_)),
+      temp_(std::move(other.temp_)),
+      fd_(std::exchange(other.fd_, -1)),
+      durable_(other.durable_) {}
+
+AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
+  if (this != &other) {
+    discard();
+    target_ = std::move(other.target_);
+    temp_ = std::move(other.temp_);
+    fd_ = std::exchange(other.fd_, -1);
+    durable_ = other.durable_;
+  }
+  return *this;
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+
+void AtomicFile::discard() noexcept {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  fd_ = -1;
+  ::unlink(temp_.c_str());
+}
+
+Status AtomicFile::write(std::string_view bytes) {
+  if (fd_ < 0) return Error::internal(target_.string() + ": write after the file was closed");
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd_, bytes.data(), bytes.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      discard();
+      return ioError(ErrorCode::kInternal, target_, "cannot write", err);
+    }
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return Ok{};
+}
+
+Status AtomicFile::commit() {
+  if (fd_ < 0) return Error::internal(target_.string() + ": commit after the file was closed");
+  if (durable_ && ::fsync(fd_) != 0) {
+    const int err = errno;
+    discard();
+    return ioError(ErrorCode::kInternal, target_, "cannot sync", err);
+  }
+  // close() can report a deferred write error (NFS, quotas): the data is not safe to publish.
+  const int closeResult = ::close(std::exchange(fd_, -1));
+  if (closeResult != 0 && errno != EINTR) {
+    const int err = errno;
+    ::unlink(temp_.c_str());
+    return ioError(ErrorCode::kInternal, target_, "cannot write", err);
+  }
+  if (::rename(temp_.c_str(), target_.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(temp_.c_str());
+    return ioError(ErrorCode::kInternal, target_, "cannot replace file", err);
+  }
+  if (durable_) {
+    if (const int err = syncDirectory(parentDirectory(target_)); err != 0) {
+      return ioError(ErrorCode::kInternal, target_, "cannot sync directory", err);
+    }
+  }
+  return Ok{};
+}
+
+Status writeFileAtomically(const std::filesystem::path& target, std::string_view bytes,
+                           const AtomicFileOptions& options) {
+  Result<AtomicFile> file = AtomicFile::create(target, options);
+  if (!file) return file.error();
+  if (Status s = file->write(bytes); !s) return s;
+  return file->commit();
+}
+
+}  // namespace sgbake

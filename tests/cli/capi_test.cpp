@@ -1,0 +1,239 @@
+/// @file capi_test.cpp
+/// @brief The C ABI (sgbake.h): same frames as the C++ API, and every inconsistent argument is a
+/// status code with a message rather than a crash.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/mesh/mesh.hpp"
+#include "sgbake/sgbake.h"
+
+namespace sgbake {
+namespace {
+
+/// Two quads side by side (the right one bent up along the shared edge) and a triangle on top,
+/// as flat C arrays; normals are the unit face normals, so faces are flat-shaded.
+struct FlatMesh {
+  std::vector<float> positions = {0, 0, 0,  1, 0, 0,  1, 1, 0,  0, 1, 0,
+                                  2, 0, 1,  2, 1, 1,  0.5f, 2, 0};
+  std::vector<std::uint32_t> faceStart = {0, 4, 8, 11};
+  std::vector<std::uint32_t> cornerVertex = {0, 1, 2, 3,  1, 4, 5, 2,  3, 2, 6};
+  std::vector<float> cornerNormals;
+  std::vector<float> cornerUvs = {0, 0,  0.5f, 0,  0.5f, 0.5f,  0, 0.5f,
+                                  0.5f, 0,  1, 0,  1, 0.5f,  0.5f, 0.5f,
+                                  0, 0.5f,  0.5f, 0.5f,  0.25f, 1};
+
+  FlatMesh() {
+    const float s = 1.0f / std::sqrt(2.0f);
+    const float faceNormals[3][3] = {{0, 0, 1}, {-s, 0, s}, {0, 0, 1}};
+    for (std::size_t f = 0; f + 1 < faceStart.size(); ++f) {
+      for (std::uint32_t c = faceStart[f]; c < faceStart[f + 1]; ++c) {
+        cornerNormals.insert(cornerNormals.end(), faceNormals[f], faceNormals[f] + 3);
+      }
+    }
+  }
+  std::size_t numVertices() const { return positions.size() / 3; }
+  std::size_t numFaces() const { return faceStart.size() - 1; }
+  std::size_t numCorners() const { return cornerVertex.size(); }
+};
+
+/// The outputs and status of one sgbake_compute_tangents call.
+struct CallResult {
+  int status = -1;
+  std::vector<float> tangents;
+  std::vector<float> signs;
+  std::string message;
+};
+
+CallResult callC(const FlatMesh& m, int threads = 0) {
+  CallResult r;
+  r.tangents.assign(3 * m.numCorners(), -7.0f);
+  r.signs.assign(m.numCorners(), -7.0f);
+  char error[256] = "untouched";
+  r.status = sgbake_compute_tangents(m.positions.data(), m.numVertices(), m.faceStart.data(),
+                                     m.numFaces(), m.cornerVertex.data(), m.cornerNormals.data(),
+                                     m.cornerUvs.data(), m.numCorners(), threads,
+                                     r.tangents.data(), r.signs.data(), error, sizeof error);
+  r.message = error;
+  return r;
+}
+
+TEST(CApi, VersionIsTheHeaderVersion) {
+  ASSERT_NE(sgbake_version(), nullptr);
+  EXPECT_STREQ(sgbake_version(), SGBAKE_VERSION_STRING);
+}
+
+TEST(CApi, GivesTheSameFramesAsTheCppApi) {
+  const FlatMesh m;
+  const CallResult c = callC(m);
+  ASSERT_EQ(c.status, SGBAKE_OK) << c.message;
+  EXPECT_EQ(c.message, "untouched");  // the error buffer is left alone on success
+
+  std::vector<Vec3f> positions, normals;
+  std::vector<Vec2f> uvs;
+  for (std::size_t v = 0; v < m.numVertices(); ++v) {
+    positions.push_back({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]});
+  }
+  for (std::size_t i = 0; i < m.numCorners(); ++i) {
+    normals.push_back(
+        {m.cornerNormals[3 * i], m.cornerNormals[3 * i + 1], m.cornerNormals[3 * i + 2]});
+    uvs.push_back({m.cornerUvs[2 * i], m.cornerUvs[2 * i + 1]});
+  }
+  const MeshView view{positions, m.faceStart, m.cornerVertex, normals, uvs};
+  const Result<CornerTangents> cpp = computeTangents(view);
+  ASSERT_TRUE(cpp.ok()) << cpp.error().message;
+
+  for (std::size_t i = 0; i < m.numCorners(); ++i) {
+    // Bit-identical: the C ABI copies the arrays and calls the same kernel.
+    EXPECT_EQ(c.tangents[3 * i], cpp->tangent[i].x) << "corner " << i;
+    EXPECT_EQ(c.tangents[3 * i + 1], cpp->tangent[i].y) << "corner " << i;
+    EXPECT_EQ(c.tangents[3 * i + 2], cpp->tangent[i].z) << "corner " << i;
+    EXPECT_EQ(c.signs[i], cpp->sign[i]) << "corner " << i;
+    EXPECT_TRUE(c.signs[i] == 1.0f || c.signs[i] == -1.0f);
+  }
+  // A sanity anchor independent of the C++ API: u runs along +x on the flat bottom-left quad.
+  EXPECT_NEAR(c.tangents[0], 1.0f, 1e-6f);
+  EXPECT_NEAR(c.tangents[1], 0.0f, 1e-6f);
+  EXPECT_EQ(c.signs[0], 1.0f);
+}
+
+TEST(CApi, ThreadCountDoesNotChangeTheResult) {
+  const FlatMesh m;
+  const CallResult one = callC(m, 1);
+  const CallResult all = callC(m, 0);
+  ASSERT_EQ(one.status, SGBAKE_OK) << one.message;
+  ASSERT_EQ(all.status, SGBAKE_OK) << all.message;
+  EXPECT_EQ(one.tangents, all.tangents);
+  EXPECT_EQ(one.signs, all.signs);
+}
+
+TEST(CApi, EmptyMeshSucceeds) {
+  char error[64] = "";
+  EXPECT_EQ(sgbake_compute_tangents(nullptr, 0, nullptr, 0, nullptr, nullptr, nullptr, 0, 0,
+                                    nullptr, nullptr, error, sizeof error),
+            SGBAKE_OK)
+      << error;
+}
+
+/// A bad argument is SGBAKE_ERROR_BAD_INPUT and a message that mentions @p mention.
+void expectBadInput(const FlatMesh& m, const std::string& mention, int threads = 0) {
+  const CallResult r = callC(m, threads);
+  EXPECT_EQ(r.status, SGBAKE_ERROR_BAD_INPUT) << r.message;
+  EXPECT_NE(r.message.find(mention), std::string::npos) << r.message;
+  EXPECT_EQ(r.message.find('\n'), std::string::npos) << r.message;
+}
+
+TEST(CApi, RejectsCornerVertexOutOfRange) {
+  FlatMesh m;
+  m.cornerVertex[5] = 7;
+  expectBadInput(m, "corner_vertex[5] = 7");
+}
+
+TEST(CApi, RejectsNonFiniteData) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  {
+    FlatMesh m;
+    m.positions[4] = nan;
+    expectBadInput(m, "positions[1]");
+  }
+  {
+    FlatMesh m;
+    m.cornerNormals[9] = inf;
+    expectBadInput(m, "corner_normals[3]");
+  }
+  {
+    FlatMesh m;
+    m.cornerUvs[21] = nan;
+    expectBadInput(m, "corner_uvs[10]");
+  }
+}
+
+TEST(CApi, RejectsInconsistentFaceStart) {
+  {
+    FlatMesh m;
+    m.faceStart = {0, 8, 4, 11};  // not monotone
+    expectBadInput(m, "face_start");
+  }
+  {
+    FlatMesh m;
+    m.faceStart = {0, 4, 6, 11};  // a two-corner face
+    expectBadInput(m, "face 1 has 2 corners");
+  }
+  {
+    FlatMesh m;
+    m.faceStart = {1, 4, 8, 11};
+    expectBadInput(m, "face_start[0]");
+  }
+  {
+    FlatMesh m;
+    m.faceStart = {0, 4, 7, 10};  // does not end at num_corners
+    expectBadInput(m, "num_corners");
+  }
+  {
+    FlatMesh m;
+    m.faceStart = {0, 4, 8, 11, 14, 17, 20};  // more faces than 11 corners can hold
+    expectBadInput(m, "num_faces");
+  }
+}
+
+TEST(CApi, RejectsNonUnitNormalsAndNegativeThreads) {
+  {
+    FlatMesh m;
+    m.cornerNormals[0] = 2.0f;
+    expectBadInput(m, "unit length");
+  }
+  expectBadInput(FlatMesh{}, "threads", -1);
+}
+
+TEST(CApi, RejectsNullArrays) {
+  const FlatMesh m;
+  std::vector<float> tangents(3 * m.numCorners()), signs(m.numCorners());
+  char error[256] = "";
+  EXPECT_EQ(sgbake_compute_tangents(m.positions.data(), m.numVertices(), m.faceStart.data(),
+                                    m.numFaces(), m.cornerVertex.data(), m.cornerNormals.data(),
+                                    nullptr, m.numCorners(), 0, tangents.data(), signs.data(),
+                                    error, sizeof error),
+            SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_NE(std::string(error).find("corner_uvs is NULL"), std::string::npos) << error;
+  EXPECT_EQ(sgbake_compute_tangents(m.positions.data(), m.numVertices(), m.faceStart.data(),
+                                    m.numFaces(), m.cornerVertex.data(), m.cornerNormals.data(),
+                                    m.cornerUvs.data(), m.numCorners(), 0, nullptr, signs.data(),
+                                    error, sizeof error),
+            SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_NE(std::string(error).find("out_tangents is NULL"), std::string::npos) << error;
+}
+
+TEST(CApi, TruncatesTheMessageToATooSmallErrorBuffer) {
+  FlatMesh m;
+  m.cornerVertex[0] = 99;
+  std::vector<float> tangents(3 * m.numCorners()), signs(m.numCorners());
+  const auto call = [&](char* buffer, std::size_t size) {
+    return sgbake_compute_tangents(m.positions.data(), m.numVertices(), m.faceStart.data(),
+                                   m.numFaces(), m.cornerVertex.data(), m.cornerNormals.data(),
+                                   m.cornerUvs.data(), m.numCorners(), 0, tangents.data(),
+                                   signs.data(), buffer, size);
+  };
+
+  char buffer[16];
+  std::memset(buffer, '#', sizeof buffer);
+  EXPECT_EQ(call(buffer, 8), SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_EQ(std::strlen(buffer), 7u);  // 7 characters and the terminating NUL
+  EXPECT_EQ(std::string(buffer), "sgbake_");
+  for (std::size_t i = 8; i < sizeof buffer; ++i) EXPECT_EQ(buffer[i], '#') << "overrun at " << i;
+
+  char one = '#';
+  EXPECT_EQ(call(&one, 1), SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_EQ(one, '\0');
+  EXPECT_EQ(call(nullptr, 0), SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_EQ(call(nullptr, 100), SGBAKE_ERROR_BAD_INPUT);
+}
+
+}  // namespace
+}  // namespace sgbake
