@@ -1,0 +1,161 @@
+/// @file projection.hpp
+/// @brief Planar (seed 001 eq. 39-44) and triplanar (eq. 45-50, seed 003) projections of height
+/// maps, tangent-space normal maps and object-space normal maps, as surface gradients.
+///
+/// **Orientation conventions.** Each axis plane is textured at a cyclic pair of object
+/// coordinates, so that (s axis) × (t axis) = the plane's axis (right-handed, seen from the
+/// positive side of the axis the image is not mirrored):
+///
+///   | plane | (s, t) before tiling | s axis | t axis | normal axis |
+///   |-------|----------------------|--------|--------|-------------|
+///   | X     | (y, z)               | +Y     | +Z     | +X          |
+///   | Y     | (z, x)               | +Z     | +X     | +Y          |
+///   | Z     | (x, y)               | +X     | +Y     | +Z          |
+///
+/// and the texture is looked up at (s, t) = tiling ∘ (plane coordinates) + offset. "Triplanar's
+/// Z plane is textured at (x, y) · tiling."
+///
+/// **Volume-gradient formulation.** A planar height map is a height volume constant along the
+/// plane's axis (eq. 8); its volume gradient is
+/// ∇h = scale · (tiling.x·∂h/∂s · e_s + tiling.y·∂h/∂t · e_t), and Γ is its projection onto the
+/// tangent plane, ∇h − ⟨∇h, N⟩N (eq. 30, 50; equal to eq. 44). A tangent-space normal map on a
+/// plane is read as the slopes of such a height (eq. 14, in the plane's frame
+/// I = e_s, J = e_t, K = e_n). Triplanar blends the three volume gradients with weights frozen
+/// at the point (eq. 46-49, the weights' own derivatives are neglected as in eq. 48) and
+/// projects once. There are no per-side sign flips: the height always displaces along the
+/// surface normal, so faces looking down −axis see the image mirrored, with bumps still outward.
+/// Object-space normal maps are blended as surface gradients (eq. 45).
+#pragma once
+
+#include <array>
+
+#include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/surface_gradient.hpp"
+#include "sgbake/gradient/surface_point.hpp"
+#include "sgbake/gradient/texture.hpp"
+
+namespace sgbake {
+
+/// @brief The object axis a plane is perpendicular to (also the index into weight arrays).
+enum class ProjectionAxis : int { kX = 0, kY = 1, kZ = 2 };
+
+/// @brief A projection plane's unit axes in object space: texture s, texture t, and normal
+/// (s × t = n), see the table in the file comment.
+struct PlaneAxes {
+  Vec3d s, t, n;
+};
+
+/// @brief The axes of the plane perpendicular to @p axis.
+PlaneAxes planeAxes(ProjectionAxis axis);
+
+/// @brief Plane coordinates of an object-space point, before tiling: (x, y) for Z, (y, z) for X,
+/// (z, x) for Y.
+Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis);
+
+/// @brief How a plane is textured: (s, t) = tiling ∘ planeCoordinates(P) + offset.
+struct PlanarMapping {
+  ProjectionAxis axis = ProjectionAxis::kZ;
+  Vec2d tiling{1, 1};  ///< repeats per object unit along s and t
+  Vec2d offset{0, 0};  ///< texture units
+};
+
+/// @brief Texture coordinates of @p position under @p mapping.
+Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping);
+
+/// @brief Volume gradient of `scale · h(tiling ∘ planeCoordinates(P) + offset)`:
+/// scale · (tiling.x · dhdst.x · e_s + tiling.y · dhdst.y · e_t), object units per object unit.
+///
+/// @param[in] dhdst (∂h/∂s, ∂h/∂t) at the point, per texture unit
+Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale);
+
+/// @brief Options shared by planar and triplanar normal-map lookups.
+struct ProjectedNormalOptions {
+  NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< tangent-space maps only
+  double minNormalZ = kMinTangentNormalZ;     ///< tangent-space guard (slopesFromTangentNormal)
+  double minCosine = kMinObjectNormalCosine;  ///< object-space guard (gradientFromObjectNormal)
+};
+
+/// @brief Γ of a height map projected on one axis plane (eq. 39-44, 50).
+/// @param[in] scale object units of height per texture unit of value
+/// @note Samples @p texture once.
+Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& mapping, double scale,
+                           const SurfacePoint& point);
+
+/// @brief Γ of a tangent-space normal map projected on one axis plane (eq. 42-44): the decoded
+/// normal, read in the plane's frame (x along e_s, y along e_t, z along e_n), gives the slopes of
+/// a planar height (with the n_z guard of slopesFromTangentNormal); Γ is that height's projected
+/// volume gradient, times @p strength.
+/// @note Samples @p texture once.
+Vec3d planarTangentNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
+                                  double strength, const SurfacePoint& point,
+                                  const ProjectedNormalOptions& options = {});
+
+/// @brief Γ of an object-space normal map looked up through a planar projection (eq. 38): the
+/// decoded normal is an object-space normal whatever the projection, so tiling moves the lookup
+/// but does not scale Γ; @p strength does. Negative/grazing normals as gradientFromObjectNormal.
+/// @note Samples @p texture once.
+Vec3d planarObjectNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
+                                 double strength, const SurfacePoint& point,
+                                 const ProjectedNormalOptions& options = {});
+
+// ---------------------------------------------------------------------------------------------
+// Triplanar
+// ---------------------------------------------------------------------------------------------
+
+/// Default exponent of the triplanar blend weights.
+inline constexpr double kDefaultTriplanarSharpness = 4;
+/// Default threshold below which a plane's blend weight counts as zero and it is not sampled.
+inline constexpr double kDefaultMinTriplanarWeight = 1e-3;
+
+/// @brief Blend weights of the three planes at one normal, indexed by ProjectionAxis.
+struct TriplanarWeights {
+  std::array<double, 3> w{};  ///< sum to 1 over the active planes; 0 for skipped planes
+  int active = 0;             ///< number of planes with w > 0 (0 only for a zero/NaN normal)
+};
+
+/// @brief Triplanar blend weights from the shading normal N:
+/// w_i = |n_i|^sharpness / Σ_j |n_j|^sharpness, then planes with w_i < minWeight are dropped
+/// (not sampled) and the remaining weights are renormalized to sum to 1.
+///
+/// Renormalizing keeps the bump strength independent of the threshold and makes a point whose
+/// normal is within the threshold of an axis exactly the planar projection on that axis (eq. 50).
+/// Weights are computed as (|n_i| / max_j |n_j|)^sharpness, so no exponent under- or overflows
+/// all three (the dominant plane always gets ratio 1). sharpness is clamped to ≥ 0; 0 gives 1/3
+/// to every plane (0^0 = 1), larger values give narrower transitions (4 by default; 1 is the
+/// plain |n_i| / Σ|n_j|). minWeight is clamped to [0, 1/3] so the
+/// dominant plane (weight ≥ 1/3) always survives. A zero or non-finite N gives no active plane.
+TriplanarWeights triplanarWeights(Vec3d normal, double sharpness = kDefaultTriplanarSharpness,
+                                  double minWeight = kDefaultMinTriplanarWeight);
+
+/// @brief Options of a triplanar lookup (the same mapping on all three planes).
+struct TriplanarOptions {
+  Vec2d tiling{1, 1};  ///< repeats per object unit, on every plane
+  Vec2d offset{0, 0};  ///< texture units, on every plane
+  /// Multiplies Γ: the height scale (object units per unit of value) for height maps, the
+  /// strength for normal maps.
+  double scale = 1;
+  double sharpness = kDefaultTriplanarSharpness;  ///< see triplanarWeights
+  double minWeight = kDefaultMinTriplanarWeight;  ///< see triplanarWeights
+  ProjectedNormalOptions normal{};                ///< decoding of normal maps
+};
+
+/// @brief Γ of a height map by triplanar projection (seed 003; eq. 46-49 then eq. 30):
+/// ∇h = Σ_i w_i · planeVolumeGradient_i, Γ = ∇h − ⟨∇h, N⟩N.
+/// @note Samples @p texture once per active plane (planes below minWeight are not sampled).
+Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptions& options,
+                              const SurfacePoint& point);
+
+/// @brief Γ of a tangent-space normal map by triplanar projection: each active plane's texel,
+/// read in that plane's frame, gives slopes (eq. 14), blended into one volume gradient like
+/// triplanarHeightGradient (Mikkelsen's volume-gradient triplanar, seed 003).
+/// @note Samples @p texture once per active plane.
+Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
+                                     const SurfacePoint& point);
+
+/// @brief Γ of an object-space normal map by triplanar projection (eq. 45):
+/// Γ = scale · Σ_i w_i · gradientFromObjectNormal(N_i, N).
+/// @note Samples @p texture once per active plane.
+Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
+                                    const SurfacePoint& point);
+
+}  // namespace sgbake

@@ -1,0 +1,42 @@
+/// @file surface_point.hpp
+/// @brief Where bump sources are evaluated: a surface point with its geometric context.
+///
+/// The same SurfacePoint describes a mesh corner, a texel's point on a triangle, or a point of a
+/// limit surface, so every source kernel serves the per-corner table, the baker and the add-on.
+#pragma once
+
+#include <array>
+
+#include "sgbake/core/vec.hpp"
+
+namespace sgbake {
+
+/// Maximum number of UV sets a SurfacePoint carries.
+inline constexpr int kMaxUvSets = 4;
+
+/// @brief One UV set at a surface point: the coordinates and the surface's derivatives w.r.t.
+/// them (T = ∂P/∂u and B = ∂P/∂v of seed 001 eq. 3; not normalized, not orthogonal).
+///
+/// On a mesh these are the triangle's constant derivatives; on a limit surface the exact ones.
+/// When the UV triangle is degenerate both are zero (kernels then return Γ = 0, see
+/// gradientFromUvDerivatives).
+struct UvFrame {
+  Vec2d uv{};    ///< (u, v); u right, v up (Blender), no tiling applied
+  Vec3d dPdu{};  ///< object-space ∂P/∂u
+  Vec3d dPdv{};  ///< object-space ∂P/∂v
+};
+
+/// @brief A point on the surface, in object space.
+struct SurfacePoint {
+  Vec3d position{};  ///< P
+  Vec3d normal{0, 0, 1};  ///< N, the unit shading normal (interpolated and renormalized)
+  std::array<UvFrame, kMaxUvSets> uv{};  ///< UV sets 0 .. numUvSets-1
+  int numUvSets = 0;
+  /// MikkTSpace frame of UV set 0, interpolated as the consumer of a tangent-space normal map
+  /// does (unit tangent per corner, interpolated; see docs): tangent and bitangent sign.
+  Vec3d tangent{1, 0, 0};
+  double bitangentSign = 1;
+  bool hasTangentFrame = false;
+};
+
+}  // namespace sgbake

@@ -1,0 +1,168 @@
+// Float images and loading them through OpenImageIO (see image.hpp for the conventions).
+
+#include "sgbake/gradient/image.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+namespace sgbake {
+
+Image::Image(int width, int height, int channels)
+    : width_(width), height_(height), channels_(channels) {
+  assert(width >= 1 && height >= 1 && channels >= 1);
+  data_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
+                   static_cast<std::size_t>(channels),
+               0.0f);
+}
+
+namespace {
+
+// Rec. 709 luma weights (Blender's default OCIO config, `rgb_to_y` in Cycles).
+constexpr double kLumaR = 0.2126;
+constexpr double kLumaG = 0.7152;
+constexpr double kLumaB = 0.0722;
+
+// Text made safe for a one-line message: control characters become '?'.
+std::string oneLine(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
+// An OIIO error (possibly several lines) as one line: lines joined with "; ".
+std::string oiioReason(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+  std::string joined;
+  for (char c : text) {
+    if (c == '\n') {
+      joined += "; ";
+    } else {
+      joined += c;
+    }
+  }
+  if (joined.empty()) joined = "unknown error";
+  return oneLine(joined);
+}
+
+std::string channelsText(int n) { return std::to_string(n) + (n == 1 ? " channel" : " channels"); }
+
+Error fileError(const std::filesystem::path& path, std::string_view what) {
+  return Error::badInput(oneLine(path.string()) + ": " + std::string(what));
+}
+
+// How many leading file channels to read for a selection, or -1 when the file has too few.
+int channelsToRead(ImageChannels selection, int fileChannels) {
+  switch (selection) {
+    case ImageChannels::kAll:
+      return fileChannels;
+    case ImageChannels::kFirst:
+      return 1;
+    case ImageChannels::kLuminance:
+      return fileChannels >= 3 ? 3 : 1;
+    case ImageChannels::kRgb:
+      return fileChannels >= 3 ? 3 : -1;
+  }
+  return -1;
+}
+
+}  // namespace
+
+Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOptions& options) {
+  // Existence and kind first: OIIO's messages for these are vague.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) {
+    return fileError(path, "cannot open file (no such file)");
+  }
+  if (std::filesystem::is_directory(status)) {
+    return fileError(path, "cannot read file (it is a directory)");
+  }
+  if (std::filesystem::is_regular_file(status)) {
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (!ec && size == 0) return fileError(path, "file is empty");
+  }
+
+  // Keep unassociated alpha as stored: by default OIIO premultiplies colour by alpha on read,
+  // which would change the heights/normals of any texel with alpha < 1.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string(), &config);
+  if (!in) {
+    return fileError(path, "cannot read image (" + oiioReason(OIIO::geterror()) + ")");
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+    return fileError(path, "image has zero size (" + std::to_string(spec.width) + "x" +
+                               std::to_string(spec.height) + ", " + channelsText(spec.nchannels) +
+                               ")");
+  }
+  if (spec.depth > 1) return fileError(path, "volume images are not supported");
+  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide) {
+    return fileError(path, "image is too large (" + std::to_string(spec.width) + "x" +
+                               std::to_string(spec.height) + "; at most " +
+                               std::to_string(kMaxImageSide) + " per side)");
+  }
+  const int readChannels = channelsToRead(options.channels, spec.nchannels);
+  if (readChannels < 0) {
+    return fileError(path, "image has " + channelsText(spec.nchannels) + " but 3 are needed (RGB)");
+  }
+
+  const int width = spec.width;
+  const int height = spec.height;
+  Image read;
+  try {
+    read = Image(width, height, readChannels);
+  } catch (const std::bad_alloc&) {
+    return fileError(path, "image is too large to fit in memory (" + std::to_string(width) + "x" +
+                               std::to_string(height) + ")");
+  }
+
+  // Read straight into bottom-up order: start at the last stored row (the file's top row) and
+  // step backwards one row per scanline.
+  const auto pixelBytes = static_cast<OIIO::stride_t>(sizeof(float)) * readChannels;
+  const OIIO::stride_t rowBytes = pixelBytes * width;
+  float* topRow = &read.at(0, height - 1, 0);
+  if (!in->read_image(0, 0, 0, readChannels, OIIO::TypeDesc::FLOAT, topRow, pixelBytes,
+                      -rowBytes)) {
+    return fileError(path, "cannot read image (" + oiioReason(in->geterror()) + ")");
+  }
+  in->close();
+
+  // Non-finite values (possible in float formats) would poison every filtered sample.
+  const std::span<const float> values = read.pixels();
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      const std::size_t texel = i / static_cast<std::size_t>(readChannels);
+      const auto x = static_cast<int>(texel % static_cast<std::size_t>(width));
+      const auto y = static_cast<int>(texel / static_cast<std::size_t>(width));
+      return fileError(path, "pixel at column " + std::to_string(x) + ", row " +
+                                 std::to_string(read.yFromFileRow(y)) +
+                                 " (from the top), channel " +
+                                 std::to_string(i % static_cast<std::size_t>(readChannels)) +
+                                 " is not a finite number");
+    }
+  }
+
+  if (options.channels != ImageChannels::kLuminance || readChannels == 1) return read;
+
+  Image luminance(width, height, 1);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const double luma =
+          kLumaR * read.at(x, y, 0) + kLumaG * read.at(x, y, 1) + kLumaB * read.at(x, y, 2);
+      luminance.at(x, y) = static_cast<float>(luma);
+    }
+  }
+  return luminance;
+}
+
+}  // namespace sgbake

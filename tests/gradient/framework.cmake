@@ -1,0 +1,8 @@
+# framework tests: the surface-gradient core (eq. 31, 33, 38, normal-map decoding), planar and
+# triplanar projections, layer compositing and the per-corner driver, against analytic
+# references (linear and sine height fields with exact derivatives) and invariants.
+sgbake_add_gtest(gradient_framework_tests
+  surface_gradient_test.cpp
+  projection_test.cpp
+  layers_test.cpp
+  corners_test.cpp)

@@ -1,0 +1,274 @@
+// loadImage: bit depths and formats (written here with OpenImageIO, then read back), the
+// bottom-up texel orientation, channel selection, and one-line kBadInput errors for bad files.
+
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/image.hpp"
+
+namespace sgbake {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh directory for this test's files.
+fs::path testDir() {
+  const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path dir =
+      fs::path(testing::TempDir()) /
+      (std::string("sgbake_image_") + info->test_suite_name() + "_" + info->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Writes W×H×C pixels given in file order (top row first) with OpenImageIO.
+template <class T>
+void writeImage(const fs::path& path, int width, int height, int channels, OIIO::TypeDesc type,
+                const std::vector<T>& pixels, bool unassociatedAlpha = false, int tile = 0) {
+  ASSERT_EQ(pixels.size(), static_cast<std::size_t>(width * height * channels));
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path.string());
+  ASSERT_TRUE(out) << OIIO::geterror();
+  OIIO::ImageSpec spec(width, height, channels, type);
+  if (unassociatedAlpha) spec.attribute("oiio:UnassociatedAlpha", 1);
+  if (tile > 0) spec.tile_width = spec.tile_height = tile;  // tiled file (EXR, TIFF)
+  ASSERT_TRUE(out->open(path.string(), spec)) << out->geterror();
+  ASSERT_TRUE(out->write_image(type, pixels.data())) << out->geterror();
+  ASSERT_TRUE(out->close());
+}
+
+void writeBytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream file(path, std::ios::binary);
+  file << bytes;
+}
+
+// Checks an error: kBadInput, one line, starting with "<path>: <start>".
+void expectFileError(const Result<Image>& image, const fs::path& path, const std::string& start) {
+  ASSERT_FALSE(image.ok()) << path;
+  EXPECT_EQ(image.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(image.error().message.find('\n'), std::string::npos) << image.error().message;
+  EXPECT_EQ(image.error().message.rfind(path.string() + ": " + start, 0), 0u)
+      << image.error().message;
+}
+
+// Pixel value pattern of texel column x, file row r, channel c (distinct everywhere).
+int pattern(int x, int r, int c) { return 7 * x + 31 * r + 101 * c; }
+
+TEST(LoadImage, EightBitPngBecomesUnitFloats) {
+  const fs::path path = testDir() / "rgb8.png";
+  const int w = 5, h = 3, c = 3;
+  std::vector<std::uint8_t> pixels;
+  for (int r = 0; r < h; ++r) {
+    for (int x = 0; x < w; ++x) {
+      for (int k = 0; k < c; ++k) pixels.push_back(static_cast<std::uint8_t>(pattern(x, r, k)));
+    }
+  }
+  pixels[0] = 255;  // full scale
+  pixels[1] = 0;
+  writeImage(path, w, h, c, OIIO::TypeDesc::UINT8, pixels);
+
+  const Result<Image> image = loadImage(path);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  ASSERT_EQ(image->width(), w);
+  ASSERT_EQ(image->height(), h);
+  ASSERT_EQ(image->channels(), c);
+  for (int r = 0; r < h; ++r) {
+    for (int x = 0; x < w; ++x) {
+      for (int k = 0; k < c; ++k) {
+        const double expected = pixels[static_cast<std::size_t>((r * w + x) * c + k)] / 255.0;
+        EXPECT_NEAR(image->at(x, image->yFromFileRow(r), k), expected, 1e-7);
+      }
+    }
+  }
+  EXPECT_EQ(image->at(0, h - 1, 0), 1.0f);
+  EXPECT_EQ(image->at(0, h - 1, 1), 0.0f);
+}
+
+TEST(LoadImage, SixteenBitPngAndTiffBecomeUnitFloats) {
+  const fs::path dir = testDir();
+  const int w = 4, h = 3;
+  std::vector<std::uint16_t> pixels;
+  for (int r = 0; r < h; ++r) {
+    for (int x = 0; x < w; ++x) pixels.push_back(static_cast<std::uint16_t>(pattern(x, r, 0) * 97));
+  }
+  pixels[1] = 65535;
+  pixels[2] = 1;  // a value an 8-bit path would lose
+  for (const char* name : {"gray16.png", "gray16.tif"}) {
+    const fs::path path = dir / name;
+    writeImage(path, w, h, 1, OIIO::TypeDesc::UINT16, pixels);
+    const Result<Image> image = loadImage(path);
+    ASSERT_TRUE(image.ok()) << image.error().message;
+    ASSERT_EQ(image->channels(), 1);
+    for (int r = 0; r < h; ++r) {
+      for (int x = 0; x < w; ++x) {
+        const double expected = pixels[static_cast<std::size_t>(r * w + x)] / 65535.0;
+        EXPECT_NEAR(image->at(x, image->yFromFileRow(r)), expected, 1e-7) << name;
+      }
+    }
+    EXPECT_EQ(image->at(1, h - 1), 1.0f) << name;
+    EXPECT_GT(image->at(2, h - 1), 0.0f) << name;
+  }
+}
+
+TEST(LoadImage, FloatExrAndTiffAreRaw) {
+  const fs::path dir = testDir();
+  const int w = 3, h = 2, c = 3;
+  // Raw floats: negative, above 1, tiny, large — no normalization, no colour conversion.
+  const std::vector<float> pixels = {-1.5f, 0.25f, 3.75f, 1e-20f, 123456.0f, 0.1f,
+                                     2.0f,  -0.0f, 0.5f,  0.3f,   0.7f,      -8.0f,
+                                     1.0f,  1.25f, 0.0f,  42.0f,  -42.0f,    0.015625f};
+  for (const char* name : {"rgb.exr", "rgb_float.tif", "rgb_tiled.exr"}) {
+    const fs::path path = dir / name;
+    const bool tiled = std::string(name).find("tiled") != std::string::npos;
+    writeImage(path, w, h, c, OIIO::TypeDesc::FLOAT, pixels, false, tiled ? 16 : 0);
+    const Result<Image> image = loadImage(path);
+    ASSERT_TRUE(image.ok()) << image.error().message;
+    ASSERT_EQ(image->channels(), c);
+    for (int r = 0; r < h; ++r) {
+      for (int x = 0; x < w; ++x) {
+        for (int k = 0; k < c; ++k) {
+          EXPECT_EQ(image->at(x, image->yFromFileRow(r), k),
+                    pixels[static_cast<std::size_t>((r * w + x) * c + k)])
+              << name;
+        }
+      }
+    }
+  }
+}
+
+TEST(LoadImage, TopFileRowIsTheTopOfTextureSpace) {
+  // File row 0 (the top of the picture) is texel row y = H − 1, whose centre is t = 1 − 0.5/H.
+  const fs::path path = testDir() / "rows.png";
+  const int w = 4, h = 8;
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(w * h), 0);
+  for (int x = 0; x < w; ++x) pixels[static_cast<std::size_t>(x)] = 255;  // top file row white
+  writeImage(path, w, h, 1, OIIO::TypeDesc::UINT8, pixels);
+
+  const Result<Image> image = loadImage(path);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(image->at(2, h - 1), 1.0f);
+  EXPECT_EQ(image->at(2, 0), 0.0f);
+  EXPECT_DOUBLE_EQ(image->texelCentre(2, h - 1).y, 1.0 - 0.5 / h);
+
+  // Through a texture: white near t = 1, black near t = 0.
+  const Result<ImageScalarTexture> texture = ImageScalarTexture::create(*image);
+  ASSERT_TRUE(texture.ok());
+  EXPECT_EQ(texture->sample({0.3, 1.0 - 0.5 / h}).value, 1.0);
+  EXPECT_EQ(texture->sample({0.3, 0.5 / h}).value, 0.0);
+  EXPECT_EQ(texture->sample({0.3, 0.5}).value, 0.0);
+  // Between the top texel row and the row below, the height rises with t.
+  EXPECT_GT(texture->sample({0.3, 1.0 - 1.0 / h}).gradient.y, 0.0);
+}
+
+TEST(LoadImage, ChannelSelection) {
+  const fs::path dir = testDir();
+  const int w = 2, h = 2;
+  // RGBA with alpha 0.5 (128): colour must come back unpremultiplied, as stored.
+  const std::vector<std::uint8_t> rgba = {200, 100, 50, 128, 10, 20, 30,  128,
+                                          255, 0,   0,  128, 0,  0,  255, 128};
+  const fs::path rgbaPath = dir / "rgba.png";
+  writeImage(rgbaPath, w, h, 4, OIIO::TypeDesc::UINT8, rgba, /*unassociatedAlpha=*/true);
+
+  const Result<Image> all = loadImage(rgbaPath);
+  ASSERT_TRUE(all.ok()) << all.error().message;
+  ASSERT_EQ(all->channels(), 4);
+  EXPECT_NEAR(all->at(0, h - 1, 0), 200 / 255.0, 1e-7);  // not 200·128/255
+  EXPECT_NEAR(all->at(0, h - 1, 3), 128 / 255.0, 1e-7);
+
+  const Result<Image> first = loadImage(rgbaPath, {ImageChannels::kFirst});
+  ASSERT_TRUE(first.ok());
+  ASSERT_EQ(first->channels(), 1);
+  EXPECT_NEAR(first->at(1, h - 1), 10 / 255.0, 1e-7);
+
+  const Result<Image> luminance = loadImage(rgbaPath, {ImageChannels::kLuminance});
+  ASSERT_TRUE(luminance.ok());
+  ASSERT_EQ(luminance->channels(), 1);
+  EXPECT_NEAR(luminance->at(0, h - 1), (0.2126 * 200 + 0.7152 * 100 + 0.0722 * 50) / 255.0, 1e-6);
+  EXPECT_NEAR(luminance->at(1, 0), 0.0722, 1e-6);  // pure blue, bottom-right
+
+  const Result<Image> rgb = loadImage(rgbaPath, {ImageChannels::kRgb});
+  ASSERT_TRUE(rgb.ok());
+  ASSERT_EQ(rgb->channels(), 3);
+  EXPECT_NEAR(rgb->at(0, 0, 0), 1.0, 1e-7);
+
+  // A grey file: luminance is the grey channel; RGB is an error.
+  const fs::path grayPath = dir / "gray.png";
+  writeImage(grayPath, w, h, 1, OIIO::TypeDesc::UINT8, std::vector<std::uint8_t>{0, 51, 102, 255});
+  const Result<Image> grayLuminance = loadImage(grayPath, {ImageChannels::kLuminance});
+  ASSERT_TRUE(grayLuminance.ok());
+  EXPECT_NEAR(grayLuminance->at(1, h - 1), 0.2, 1e-7);
+  expectFileError(loadImage(grayPath, {ImageChannels::kRgb}), grayPath,
+                  "image has 1 channel but 3 are needed (RGB)");
+}
+
+TEST(LoadImage, BadFilesAreOneLineBadInputErrors) {
+  const fs::path dir = testDir();
+
+  const fs::path missing = dir / "missing.png";
+  expectFileError(loadImage(missing), missing, "cannot open file");
+
+  const fs::path empty = dir / "empty.png";
+  writeBytes(empty, "");
+  expectFileError(loadImage(empty), empty, "file is empty");
+
+  const fs::path garbage = dir / "garbage.png";
+  writeBytes(garbage, std::string("\x89PNG\r\n\x1a\n this is not a PNG\n\x00\x01\x02", 31));
+  expectFileError(loadImage(garbage), garbage, "cannot read image (");
+
+  const fs::path text = dir / "notes.exr";
+  writeBytes(text, "hello\nworld\n");
+  expectFileError(loadImage(text), text, "cannot read image (");
+
+  const fs::path directory = dir / "folder.png";
+  fs::create_directories(directory);
+  expectFileError(loadImage(directory), directory, "cannot read file");
+
+  // A valid PNG cut in the middle of its pixel data.
+  const fs::path full = dir / "full.png";
+  std::vector<std::uint8_t> noise(64 * 64 * 3);
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<std::uint8_t>(i * 7919);
+  writeImage(full, 64, 64, 3, OIIO::TypeDesc::UINT8, noise);
+  std::ifstream in(full, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const fs::path truncated = dir / "truncated.png";
+  writeBytes(truncated, bytes.substr(0, bytes.size() / 2));
+  expectFileError(loadImage(truncated), truncated, "cannot read image (");
+
+  // Headers that claim a zero-size or a too-large image (binary PGM: the pixel data need not
+  // follow, the sizes are checked first).
+  const fs::path zero = dir / "zero.pgm";
+  writeBytes(zero, "P5\n0 4\n255\n");
+  expectFileError(loadImage(zero), zero, "image has zero size (0x4, 1 channel)");
+
+  const fs::path huge = dir / "huge.pgm";
+  writeBytes(huge, "P5\n70000 2\n255\n");
+  expectFileError(loadImage(huge), huge, "image is too large (70000x2; at most 65536 per side)");
+}
+
+TEST(LoadImage, ControlCharactersInTheNameStayOnOneLine) {
+  const fs::path path = testDir() / "evil\nname.png";
+  const Result<Image> image = loadImage(path);
+  ASSERT_FALSE(image.ok());
+  EXPECT_EQ(image.error().message.find('\n'), std::string::npos) << image.error().message;
+}
+
+TEST(Image, StorageIsBottomUpAndInterleaved) {
+  Image image(3, 2, 2);
+  image.at(2, 1, 1) = 5.0f;  // last texel of the top row, second channel
+  EXPECT_EQ(image.pixels().back(), 5.0f);
+  image.at(0, 0, 0) = 7.0f;  // bottom-left texel
+  EXPECT_EQ(image.pixels().front(), 7.0f);
+  EXPECT_EQ(image.yFromFileRow(0), 1);
+  EXPECT_EQ(image.texelCentre(0, 0), (Vec2d{0.5 / 3, 0.25}));
+}
+
+}  // namespace
+}  // namespace sgbake

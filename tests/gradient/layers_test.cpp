@@ -1,0 +1,312 @@
+// Layers and their composite (seed 001 eq. 34-35): Γ = Σ weight · mask · Γ_i, linearity in the
+// heights, masks and weights that skip sampling, invalid layers as values, and every source kind
+// dispatched to its kernel.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "sgbake/core/math.hpp"
+#include "sgbake/gradient/layers.hpp"
+
+namespace sgbake {
+namespace {
+
+double maxAbsDiff(Vec3d a, Vec3d b) {
+  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
+}
+
+/// h(s, t) = a·s + b·t + c·sin(2π s)·cos(2π t): exact derivatives; counts its samples.
+class AnalyticHeight final : public ScalarTexture {
+ public:
+  AnalyticHeight(double a, double b, double c) : a_(a), b_(b), c_(c) {}
+  ScalarSample sample(Vec2d st) const override {
+    ++count;
+    const double w = 2 * kPi;
+    return {a_ * st.x + b_ * st.y + c_ * std::sin(w * st.x) * std::cos(w * st.y),
+            {a_ + c_ * w * std::cos(w * st.x) * std::cos(w * st.y),
+             b_ - c_ * w * std::sin(w * st.x) * std::sin(w * st.y)}};
+  }
+  mutable std::atomic<int> count{0};
+
+ private:
+  double a_, b_, c_;
+};
+
+/// α·h1 + β·h2 as one texture (for the linearity test).
+class SumTexture final : public ScalarTexture {
+ public:
+  SumTexture(double alpha, const ScalarTexture& h1, double beta, const ScalarTexture& h2)
+      : alpha_(alpha), beta_(beta), h1_(h1), h2_(h2) {}
+  ScalarSample sample(Vec2d st) const override {
+    const ScalarSample a = h1_.sample(st), b = h2_.sample(st);
+    return {alpha_ * a.value + beta_ * b.value, alpha_ * a.gradient + beta_ * b.gradient};
+  }
+
+ private:
+  double alpha_, beta_;
+  const ScalarTexture &h1_, &h2_;
+};
+
+class ConstantTexture final : public ScalarTexture {
+ public:
+  explicit ConstantTexture(double v) : v_(v) {}
+  ScalarSample sample(Vec2d) const override { return {v_, {0, 0}}; }
+
+ private:
+  double v_;
+};
+
+/// A tangent-space map whose texel varies with (s, t) and stays above the horizon.
+class WavyNormalTexture final : public VectorTexture {
+ public:
+  Vec3d sample(Vec2d st) const override {
+    ++count;
+    const Vec3d n =
+        normalizeOr(Vec3d{0.4 * std::sin(5 * st.x), 0.3 * std::cos(3 * st.y), 1}, Vec3d{});
+    return 0.5 * n + Vec3d{0.5, 0.5, 0.5};
+  }
+  mutable std::atomic<int> count{0};
+};
+
+/// A point with two UV sets on a sheared, tilted frame and a MikkTSpace frame.
+SurfacePoint samplePoint(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  SurfacePoint p;
+  p.position = {u(rng), u(rng), u(rng)};
+  const Vec3d dPdu{1 + 0.3 * u(rng), 0.2 * u(rng), 0.3 * u(rng)};
+  const Vec3d dPdv{0.2 * u(rng), 1 + 0.3 * u(rng), 0.3 * u(rng)};
+  p.normal = normalizeOr(cross(dPdu, dPdv), Vec3d{0, 0, 1});
+  p.numUvSets = 2;
+  p.uv[0] = {{u(rng), u(rng)}, dPdu, dPdv};
+  p.uv[1] = {{u(rng), u(rng)}, 2.0 * dPdv, -0.5 * dPdu};
+  p.tangent = normalizeOr(dPdu - dot(dPdu, p.normal) * p.normal, Vec3d{1, 0, 0});
+  p.bitangentSign = 1;
+  p.hasTangentFrame = true;
+  return p;
+}
+
+TEST(Composite, IsTheWeightedMaskedSumOfTheSourceGradients) {
+  AnalyticHeight h1(0.5, -0.2, 0.1), h2(0, 0.3, 0.2);
+  WavyNormalTexture ts;
+  ConstantTexture mask(0.25);
+  const UvHeightSource a{&h1, 0, 0.7, {2, 2}, {0.1, 0}};
+  const TangentNormalSource b{&ts, 1, {}};
+  TriplanarSource c;
+  c.height = &h2;
+  c.options.scale = 0.3;
+  const std::vector<Layer> layers{{a, 1.5, {}}, {b, -0.5, {&mask, 1}}, {c, 2.0, {}}};
+  std::mt19937_64 rng(31);
+  for (int i = 0; i < 200; ++i) {
+    const SurfacePoint p = samplePoint(rng);
+    const Vec3d expected =
+        1.5 * layerGradient(a, p) + (-0.5 * 0.25) * layerGradient(b, p) + 2.0 * layerGradient(c, p);
+    EXPECT_LT(maxAbsDiff(compositeGradient(layers, p), expected), 1e-14);
+    EXPECT_LT(maxAbsDiff(perturbedNormal(p, layers), resolveNormal(p.normal, expected)), 1e-14);
+  }
+}
+
+// Eq. 35: Γ(α h1 + β h2) = α Γ(h1) + β Γ(h2), for UV heights, planar and triplanar projections.
+TEST(Composite, IsLinearInTheHeights) {
+  AnalyticHeight h1(0.5, -0.2, 0.1), h2(-0.1, 0.3, 0.25);
+  const double alpha = 0.7, beta = -1.3;
+  SumTexture sum(alpha, h1, beta, h2);
+  std::mt19937_64 rng(32);
+  for (int i = 0; i < 200; ++i) {
+    const SurfacePoint p = samplePoint(rng);
+    const auto check = [&](auto make) {
+      const std::vector<Layer> separate{{make(&h1), alpha, {}}, {make(&h2), beta, {}}};
+      const std::vector<Layer> combined{{make(&sum), 1.0, {}}};
+      EXPECT_LT(maxAbsDiff(compositeGradient(separate, p), compositeGradient(combined, p)), 1e-13);
+    };
+    check([i](const ScalarTexture* t) {
+      return UvHeightSource{t, i % 2, 0.8, {1.5, 0.5}, {0, 0}};
+    });
+    check([](const ScalarTexture* t) {
+      PlanarSource s;
+      s.height = t;
+      s.mapping.axis = ProjectionAxis::kY;
+      return s;
+    });
+    check([](const ScalarTexture* t) {
+      TriplanarSource s;
+      s.height = t;
+      s.options.sharpness = 2;
+      return s;
+    });
+  }
+}
+
+// Eq. 34: the weight is the height scale.
+TEST(Composite, WeightScalesLikeTheHeightScale) {
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  std::mt19937_64 rng(33);
+  const SurfacePoint p = samplePoint(rng);
+  const std::vector<Layer> weighted{{UvHeightSource{&h, 0, 1.0}, 2.5, {}}};
+  const std::vector<Layer> scaled{{UvHeightSource{&h, 0, 2.5}, 1.0, {}}};
+  EXPECT_LT(maxAbsDiff(compositeGradient(weighted, p), compositeGradient(scaled, p)), 1e-15);
+}
+
+TEST(Composite, ZeroWeightsAndZeroMasksDoNotSample) {
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  ConstantTexture zero(0), negative(-3), big(7), half(0.5);
+  std::mt19937_64 rng(34);
+  const SurfacePoint p = samplePoint(rng);
+  const UvHeightSource src{&h, 0, 1.0};
+  EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, 0.0, {}}}, p), Vec3d{});
+  EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, 1.0, {&zero, 0}}}, p), Vec3d{});
+  EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, 1.0, {&negative, 0}}}, p), Vec3d{});  // → 0
+  EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, std::nan(""), {}}}, p), Vec3d{});
+  EXPECT_EQ(h.count, 0);
+  const Vec3d full = layerGradient(src, p);
+  EXPECT_EQ(h.count, 1);
+  EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, 1.0, {&big, 1}}}, p), full);  // clamped to 1
+  EXPECT_LT(
+      maxAbsDiff(compositeGradient(std::vector<Layer>{{src, 1.0, {&half, 0}}}, p), 0.5 * full),
+      1e-16);
+  EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, 1.0, {&half, 3}}}, p), Vec3d{});  // no set 3
+  EXPECT_EQ(compositeGradient({}, p), Vec3d{});
+  EXPECT_LT(maxAbsDiff(perturbedNormal(p, {}), p.normal), 1e-15);
+}
+
+TEST(Layers, InvalidLayersContributeNothingAndAreReported) {
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  WavyNormalTexture ts;
+  std::mt19937_64 rng(35);
+  const SurfacePoint p = samplePoint(rng);
+  EXPECT_EQ(layerGradient(UvHeightSource{}, p), Vec3d{});
+  EXPECT_EQ(layerGradient(UvHeightSource{&h, 2}, p), Vec3d{});  // the point has sets 0 and 1
+  EXPECT_EQ(layerGradient(TangentNormalSource{}, p), Vec3d{});
+  EXPECT_EQ(layerGradient(ObjectNormalSource{}, p), Vec3d{});
+  EXPECT_EQ(layerGradient(VolumeSource{}, p), Vec3d{});
+  TriplanarSource wrongTexture;
+  wrongTexture.kind = ProjectedKind::kTangentNormal;
+  wrongTexture.height = &h;  // a height texture for a normal-map kind
+  EXPECT_EQ(layerGradient(wrongTexture, p), Vec3d{});
+
+  const std::vector<Layer> good{{UvHeightSource{&h, 1}, 1, {}},
+                                {TangentNormalSource{&ts, 0, {}}, 1, {}}};
+  EXPECT_TRUE(validateLayers(good, 2).ok());
+
+  auto message = [](const std::vector<Layer>& layers, int sets) {
+    const Status s = validateLayers(layers, sets);
+    EXPECT_FALSE(s.ok());
+    return s.ok() ? std::string() : s.error().message;
+  };
+  EXPECT_EQ(message({{UvHeightSource{&h, 1}, 1, {}}}, 1),
+            "layer 0 (UV height map): UV set 1 does not exist (the mesh has 1 usable)");
+  EXPECT_EQ(message({good[0], {TangentNormalSource{}, 1, {}}}, 2),
+            "layer 1 (tangent-space normal map): no texture");
+  EXPECT_EQ(message({{wrongTexture, 1, {}}}, 1),
+            "layer 0 (triplanar projection): no normal-map texture");
+  EXPECT_EQ(message({{UvHeightSource{&h, 0}, std::nan(""), {}}}, 1),
+            "layer 0 (UV height map): weight is not finite");
+  EXPECT_EQ(message({{UvHeightSource{&h, 0, 1, {std::nan(""), 1}}, 1, {}}}, 1),
+            "layer 0 (UV height map): tiling is not finite");
+  EXPECT_EQ(message({{VolumeSource{}, 1, {}}}, 0), "layer 0 (height volume): no volume");
+  EXPECT_EQ(message({{UvHeightSource{&h, 0}, 1, {&h, 5}}}, 1),
+            "layer 0 (UV height map): mask: UV set 5 does not exist (the mesh has 1 usable)");
+  EXPECT_EQ(h.count, 0);  // validation never samples
+}
+
+// A tangent-space map on UV set 1 equals the same map on UV set 0 when the two sets are
+// identical and the MikkTSpace frame of set 0 is the UV-derivative frame.
+TEST(Layers, TangentNormalOnASecondIdenticalUvSetEqualsTheFirst) {
+  WavyNormalTexture ts;
+  std::mt19937_64 rng(36);
+  for (int i = 0; i < 200; ++i) {
+    SurfacePoint p = samplePoint(rng);
+    p.uv[1] = p.uv[0];
+    TangentNormalSource first{&ts, 0, {}}, second{&ts, 1, {}};
+    first.options.tiling = second.options.tiling = {3, 2};
+    const Vec3d a = layerGradient(first, p);   // MikkTSpace frame
+    const Vec3d b = layerGradient(second, p);  // UV-derivative frame of set 1
+    EXPECT_LT(maxAbsDiff(a, b), 1e-14);
+    EXPECT_GT(length(a), 0.0);
+  }
+}
+
+TEST(Layers, VolumeSourceProjectsTheVolumeGradient) {
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  std::mt19937_64 rng(37);
+  for (int i = 0; i < 100; ++i) {
+    const SurfacePoint p = samplePoint(rng);
+    const Vec3d g = sine->analyticGradient(p.position);
+    const Vec3d expected = 0.5 * (g - dot(g, p.normal) * p.normal);
+    const Vec3d analytic =
+        layerGradient(VolumeSource{&*sine, GradientScheme::kAnalytic, 0, 0.5}, p);
+    EXPECT_LT(maxAbsDiff(analytic, expected), 1e-15);
+    const Vec3d central =
+        layerGradient(VolumeSource{&*sine, GradientScheme::kCentral, defaultStep(4), 0.5}, p);
+    EXPECT_LT(maxAbsDiff(central, expected), 1e-8);
+  }
+}
+
+TEST(Layers, PlanarAndObjectSpaceSourcesDispatchToTheirKernels) {
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  WavyNormalTexture ts;
+  std::mt19937_64 rng(38);
+  const SurfacePoint p = samplePoint(rng);
+  PlanarSource planar;
+  planar.kind = ProjectedKind::kTangentNormal;
+  planar.normals = &ts;
+  planar.mapping = {ProjectionAxis::kX, {2, 1}, {0, 0.5}};
+  planar.scale = 0.5;
+  EXPECT_EQ(layerGradient(planar, p), planarTangentNormalGradient(ts, planar.mapping, 0.5, p));
+  const ObjectNormalSource os{&ts, 1, {2, 2}, {0, 0}, 0.5};
+  const Vec2d st = textureCoordinates(p.uv[1].uv, {2, 2}, {0, 0});
+  EXPECT_EQ(layerGradient(os, p),
+            0.5 * gradientFromObjectNormal(decodeNormalTexel(ts.sample(st)), p.normal));
+}
+
+// No NaN from any layer kind at random points with extreme parameters (1e±8 scales, tilings and
+// weights, grazing normals, degenerate frames).
+TEST(Layers, NoNanForExtremeParameters) {
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  WavyNormalTexture ts;
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  std::mt19937_64 rng(39);
+  const double scales[] = {1e-8, 1, 1e8};
+  for (const double s : scales) {
+    for (const double t : scales) {
+      for (const ProjectedKind kind :
+           {ProjectedKind::kHeight, ProjectedKind::kTangentNormal, ProjectedKind::kObjectNormal}) {
+        TriplanarSource tri;
+        tri.kind = kind;
+        tri.height = &h;
+        tri.normals = &ts;
+        tri.options.scale = s;
+        tri.options.tiling = {t, t};
+        const std::vector<Layer> layers{
+            {UvHeightSource{&h, 0, s, {t, t}}, s, {}},
+            {TangentNormalSource{
+                 &ts, 1, {NormalMapGreen::kDirectX, TangentFrameChoice::kAuto, s, {t, t}}},
+             1,
+             {}},
+            {ObjectNormalSource{&ts, 0, {t, t}, {0, 0}, s}, 1, {}},
+            {VolumeSource{&*sine, GradientScheme::kTetrahedral, 1e-3 * t, s}, 1, {}},
+            {tri, 1 / s, {}}};
+        for (int i = 0; i < 50; ++i) {
+          SurfacePoint p = samplePoint(rng);
+          if (i % 5 == 0) p.uv[0].dPdv = p.uv[0].dPdu;  // degenerate UV frame
+          if (i % 5 == 1) p.normal = normalizeOr(Vec3d{1, 1e-9, 0}, Vec3d{});  // grazing axes
+          if (i % 5 == 2) p.tangent = {};  // zero MikkTSpace tangent
+          p.position = t * p.position;
+          const Vec3d gamma = compositeGradient(layers, p);
+          ASSERT_TRUE(isFinite(gamma)) << s << " " << t << " " << i;
+          const Vec3d n = perturbedNormal(p, layers, cofactor(Mat3::diagonal({s, 1, 1 / t})));
+          ASSERT_TRUE(isFinite(n));
+          EXPECT_NEAR(length(n), 1.0, 1e-12);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sgbake

@@ -1,0 +1,418 @@
+// Planar (seed 001 eq. 39-44) and triplanar (eq. 45-50, seed 003) projections: orientation
+// conventions, equality with the UV-mapped bake and with planar mapping (eq. 50), the closed-form
+// projected volume gradient, the blend weights and their skip threshold (counted samples), and
+// finiteness at grazing normals and extreme scales.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "sgbake/core/math.hpp"
+#include "sgbake/gradient/projection.hpp"
+
+namespace sgbake {
+namespace {
+
+double maxAbsDiff(Vec3d a, Vec3d b) {
+  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
+}
+
+/// h(s, t) = A sin(2π s + φ) cos(2π t) + c·s, exact derivatives; counts its samples.
+class SineTexture final : public ScalarTexture {
+ public:
+  ScalarSample sample(Vec2d st) const override {
+    ++count;
+    last = st;
+    const double w = 2 * kPi;
+    return {0.3 * std::sin(w * st.x + 0.4) * std::cos(w * st.y) + 0.1 * st.x,
+            {0.3 * w * std::cos(w * st.x + 0.4) * std::cos(w * st.y) + 0.1,
+             -0.3 * w * std::sin(w * st.x + 0.4) * std::sin(w * st.y)}};
+  }
+  mutable std::atomic<int> count{0};
+  mutable Vec2d last{};
+};
+
+/// The tangent-space normal map of a height texture: channels = n/2 + 1/2 with
+/// n = normalize(−∂h/∂s, −∂h/∂t, 1) (green flipped for DirectX). Counts its samples.
+class HeightNormalTexture final : public VectorTexture {
+ public:
+  explicit HeightNormalTexture(const ScalarTexture& height,
+                               NormalMapGreen green = NormalMapGreen::kOpenGL)
+      : height_(height), green_(green) {}
+  Vec3d sample(Vec2d st) const override {
+    ++count;
+    const Vec2d g = height_.sample(st).gradient;
+    Vec3d n = normalizeOr(Vec3d{-g.x, -g.y, 1}, Vec3d{0, 0, 1});
+    if (green_ == NormalMapGreen::kDirectX) n.y = -n.y;
+    return 0.5 * n + Vec3d{0.5, 0.5, 0.5};
+  }
+  mutable std::atomic<int> count{0};
+
+ private:
+  const ScalarTexture& height_;
+  NormalMapGreen green_;
+};
+
+/// An object-space normal map whose normal varies with (s, t); counts its samples.
+class ObjectNormalTexture final : public VectorTexture {
+ public:
+  Vec3d sample(Vec2d st) const override {
+    ++count;
+    const Vec3d n = normalizeOr(
+        Vec3d{std::sin(3 * st.x), std::cos(2 * st.y), 0.5 + 0.3 * std::sin(st.x + st.y)},
+        Vec3d{0, 0, 1});
+    return 0.5 * n + Vec3d{0.5, 0.5, 0.5};
+  }
+  mutable std::atomic<int> count{0};
+};
+
+SurfacePoint pointAt(Vec3d position, Vec3d normal) {
+  SurfacePoint p;
+  p.position = position;
+  p.normal = normalizeOr(normal, Vec3d{0, 0, 1});
+  return p;
+}
+
+constexpr ProjectionAxis kAxes[] = {ProjectionAxis::kX, ProjectionAxis::kY, ProjectionAxis::kZ};
+
+// ---------------------------------------------------------------------------------------------
+// orientation
+
+TEST(Planar, PlanesAreCyclicAndRightHanded) {
+  for (const ProjectionAxis axis : kAxes) {
+    const PlaneAxes a = planeAxes(axis);
+    EXPECT_EQ(cross(a.s, a.t), a.n);
+    const Vec3d p{1, 2, 3};
+    const Vec2d st = planeCoordinates(p, axis);
+    EXPECT_EQ(st.x, dot(p, a.s));
+    EXPECT_EQ(st.y, dot(p, a.t));
+  }
+  EXPECT_EQ(planeCoordinates({1, 2, 3}, ProjectionAxis::kZ), Vec2d(1, 2));  // (x, y)
+  EXPECT_EQ(planeCoordinates({1, 2, 3}, ProjectionAxis::kX), Vec2d(2, 3));  // (y, z)
+  EXPECT_EQ(planeCoordinates({1, 2, 3}, ProjectionAxis::kY), Vec2d(3, 1));  // (z, x)
+}
+
+TEST(Triplanar, ZPlaneIsTexturedAtXYTimesTiling) {
+  SineTexture tex;
+  TriplanarOptions o;
+  o.tiling = {2, 3};
+  o.offset = {0.25, -0.5};
+  triplanarHeightGradient(tex, o, pointAt({0.5, 0.75, 9}, {0, 0, 1}));
+  EXPECT_EQ(tex.count, 1);
+  EXPECT_EQ(tex.last, Vec2d(2 * 0.5 + 0.25, 3 * 0.75 - 0.5));
+  triplanarHeightGradient(tex, o, pointAt({0.5, 0.75, 9}, {-1, 0, 0}));  // X plane: (y, z)
+  EXPECT_EQ(tex.last, Vec2d(2 * 0.75 + 0.25, 3 * 9 - 0.5));
+  triplanarHeightGradient(tex, o, pointAt({0.5, 0.75, 9}, {0, 1, 0}));  // Y plane: (z, x)
+  EXPECT_EQ(tex.last, Vec2d(2 * 9 + 0.25, 3 * 0.5 - 0.5));
+}
+
+// ---------------------------------------------------------------------------------------------
+// planar
+
+// On a tilted plane z = αx + βy parametrized by (u, v) = (x, y), the planar Z projection and the
+// UV-mapped bake (eq. 31 with ∂P/∂u = (1, 0, α), ∂P/∂v = (0, 1, β)) are the same Γ; likewise for
+// the X and Y planes with the coordinates permuted.
+TEST(Planar, HeightEqualsTheUvMappedBakeWhenUvIsThePlaneCoordinates) {
+  SineTexture tex;
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst = 0;
+  for (const ProjectionAxis axis : kAxes) {
+    const PlaneAxes a = planeAxes(axis);
+    for (int i = 0; i < 500; ++i) {
+      const double alpha = u(rng), beta = u(rng);
+      const Vec2d st{u(rng), u(rng)};
+      const Vec3d position = st.x * a.s + st.y * a.t + (alpha * st.x + beta * st.y) * a.n;
+      const Vec3d dPdu = a.s + alpha * a.n, dPdv = a.t + beta * a.n;
+      Vec3d normal = normalizeOr(cross(dPdu, dPdv), Vec3d{});
+      if (i % 2) normal = -normal;  // the back side: same Γ
+      const PlanarMapping mapping{axis, {1.5, -2}, {0.1, 0.3}};
+      const SurfacePoint p = pointAt(position, normal);
+      const Vec3d planar = planarHeightGradient(tex, mapping, 0.7, p);
+      const ScalarSample h = tex.sample(textureCoordinates(st, mapping.tiling, mapping.offset));
+      const Vec3d uvMapped = gradientFromUvDerivatives(
+          {st, dPdu, dPdv}, normal, uvDerivativesFromTexture(h, mapping.tiling, 0.7));
+      worst = std::max(worst, maxAbsDiff(planar, uvMapped));
+    }
+  }
+  EXPECT_LT(worst, 1e-13);
+}
+
+// Eq. 44 written out: Γ = [[1 − n_x², −n_x n_y], [−n_x n_y, 1 − n_y²], [−n_x n_z, −n_y n_z]] γ.
+TEST(Planar, HeightOnTheZPlaneIsEquation44) {
+  SineTexture tex;
+  std::mt19937_64 rng(22);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 500; ++i) {
+    const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+    const PlanarMapping mapping{ProjectionAxis::kZ, {1, 1}, {0, 0}};
+    const Vec2d g = tex.sample(planeCoordinates(p.position, ProjectionAxis::kZ)).gradient;
+    const Vec3d n = p.normal;
+    const Vec3d expected{(1 - n.x * n.x) * g.x - n.x * n.y * g.y,
+                         -n.x * n.y * g.x + (1 - n.y * n.y) * g.y,
+                         -n.x * n.z * g.x - n.y * n.z * g.y};
+    EXPECT_LT(maxAbsDiff(planarHeightGradient(tex, mapping, 1, p), expected), 1e-13);
+  }
+}
+
+// A tangent-space map that is the normal map of a height bakes exactly like the height, in both
+// green conventions, on every plane.
+TEST(Planar, TangentNormalMapOfAHeightEqualsTheHeight) {
+  SineTexture tex;
+  HeightNormalTexture gl(tex), dx(tex, NormalMapGreen::kDirectX);
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst = 0;
+  for (const ProjectionAxis axis : kAxes) {
+    for (int i = 0; i < 300; ++i) {
+      const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+      const PlanarMapping mapping{axis, {0.5, 1.5}, {0.2, 0.1}};
+      const Vec3d height = planarHeightGradient(tex, mapping, 0.8, p);
+      const Vec3d fromGl = planarTangentNormalGradient(gl, mapping, 0.8, p);
+      const Vec3d fromDx =
+          planarTangentNormalGradient(dx, mapping, 0.8, p, {NormalMapGreen::kDirectX});
+      worst = std::max({worst, maxAbsDiff(height, fromGl), maxAbsDiff(height, fromDx)});
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+}
+
+// A sine height on the plane z = 0 by planar projection: the closed-form normal.
+TEST(Planar, SineHeightOnThePlaneGivesTheClosedFormNormal) {
+  SineTexture tex;
+  const PlanarMapping mapping{ProjectionAxis::kZ, {2, 0.5}, {0.1, 0.2}};
+  for (int i = 0; i < 100; ++i) {
+    const Vec3d position{0.037 * i - 1, 0.021 * i, 0};
+    const Vec2d g = tex.sample(planarTextureCoordinates(position, mapping)).gradient;
+    const Vec3d expected = normalizeOr(Vec3d{-0.4 * 2 * g.x, -0.4 * 0.5 * g.y, 1}, Vec3d{});
+    const Vec3d normal = resolveNormal(
+        {0, 0, 1}, planarHeightGradient(tex, mapping, 0.4, pointAt(position, {0, 0, 1})));
+    EXPECT_LT(maxAbsDiff(normal, expected), 1e-12);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// triplanar weights
+
+TEST(TriplanarWeights, AreNormalizedPowersOfTheNormal) {
+  const Vec3d n = normalizeOr(Vec3d{0.3, -0.5, 0.8}, Vec3d{});
+  const TriplanarWeights w = triplanarWeights(n, 2, 0);
+  const double sum = n.x * n.x + n.y * n.y + n.z * n.z;
+  EXPECT_NEAR(w.w[0], n.x * n.x / sum, 1e-15);
+  EXPECT_NEAR(w.w[1], n.y * n.y / sum, 1e-15);
+  EXPECT_NEAR(w.w[2], n.z * n.z / sum, 1e-15);
+  EXPECT_EQ(w.active, 3);
+  const TriplanarWeights equal = triplanarWeights(n, 0, 0);
+  for (double x : equal.w) EXPECT_NEAR(x, 1.0 / 3, 1e-15);
+}
+
+TEST(TriplanarWeights, SkipPlanesBelowTheThresholdAndRenormalize) {
+  // n = (1, 0.1, 0): w_y = 1e-4 / (1 + 1e-4) < 1e-3 with sharpness 4.
+  const TriplanarWeights w = triplanarWeights(normalizeOr(Vec3d{1, 0.1, 0}, Vec3d{}), 4, 1e-3);
+  EXPECT_EQ(w.active, 1);
+  EXPECT_EQ(w.w[0], 1.0);
+  EXPECT_EQ(w.w[1], 0.0);
+  // ... but it is kept with a lower threshold.
+  EXPECT_EQ(triplanarWeights(normalizeOr(Vec3d{1, 0.1, 0}, Vec3d{}), 4, 1e-5).active, 2);
+}
+
+TEST(TriplanarWeights, NeverUnderflowOrDivideByZero) {
+  for (const double sharpness : {0.0, 1.0, 4.0, 1e3, 1e8, 1e300, -5.0, std::nan("")}) {
+    for (const Vec3d n : {Vec3d{0.6, 0.8, 0}, Vec3d{1, 1, 1}, Vec3d{1e-300, 0, 0}, Vec3d{0, 0, -1},
+                          Vec3d{0.5, 0.5, 0.7071}}) {
+      const TriplanarWeights w = triplanarWeights(n, sharpness, 1e-3);
+      ASSERT_GE(w.active, 1);
+      double sum = 0;
+      for (double x : w.w) {
+        ASSERT_TRUE(std::isfinite(x));
+        EXPECT_GE(x, 0);
+        sum += x;
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-15);
+    }
+  }
+  EXPECT_EQ(triplanarWeights({0, 0, 0}).active, 0);
+  EXPECT_EQ(triplanarWeights({std::nan(""), 0, 1}).active, 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// triplanar
+
+// Eq. 50: with N along an axis only that plane contributes and triplanar is planar mapping.
+TEST(Triplanar, NormalAlongAnAxisEqualsPlanarMapping) {
+  SineTexture tex;
+  HeightNormalTexture tsTex(tex);
+  ObjectNormalTexture osTex;
+  TriplanarOptions o;
+  o.tiling = {1.5, 0.5};
+  o.offset = {0.3, 0.1};
+  o.scale = 0.6;
+  std::mt19937_64 rng(24);
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (const ProjectionAxis axis : kAxes) {
+    for (const double side : {1.0, -1.0}) {
+      for (int i = 0; i < 50; ++i) {
+        const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, side * planeAxes(axis).n);
+        const PlanarMapping m{axis, o.tiling, o.offset};
+        EXPECT_EQ(triplanarHeightGradient(tex, o, p), planarHeightGradient(tex, m, o.scale, p));
+        EXPECT_EQ(triplanarTangentNormalGradient(tsTex, o, p),
+                  planarTangentNormalGradient(tsTex, m, o.scale, p));
+        EXPECT_EQ(triplanarObjectNormalGradient(osTex, o, p),
+                  planarObjectNormalGradient(osTex, m, o.scale, p));
+      }
+    }
+  }
+}
+
+// With N along +Z (or −Z) and UV = (x, y), triplanar equals the UV-mapped bake of the same
+// texture, for heights, tangent-space maps (UV-derivative frame) and object-space maps.
+TEST(Triplanar, NormalAlongAnAxisEqualsTheUvMappedBake) {
+  SineTexture tex;
+  HeightNormalTexture tsTex(tex);
+  ObjectNormalTexture osTex;
+  TriplanarOptions o;
+  o.tiling = {2, 3};
+  o.offset = {0.1, 0.2};
+  std::mt19937_64 rng(25);
+  std::uniform_real_distribution<double> u(-2, 2);
+  double worst = 0;
+  for (const double side : {1.0, -1.0}) {
+    for (int i = 0; i < 200; ++i) {
+      SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {0, 0, side});
+      p.numUvSets = 1;
+      p.uv[0] = {{p.position.x, p.position.y}, {1, 0, 0}, {0, 1, 0}};
+      const Vec2d st = textureCoordinates(p.uv[0].uv, o.tiling, o.offset);
+      const Vec3d uvHeight = gradientFromUvDerivatives(
+          p.uv[0], p.normal, uvDerivativesFromTexture(tex.sample(st), o.tiling, o.scale));
+      TangentNormalOptions ts;
+      ts.tiling = o.tiling;
+      ts.frame = TangentFrameChoice::kUvDerivatives;
+      const Vec3d uvTangent =
+          gradientFromTangentNormal(decodeNormalTexel(tsTex.sample(st)), p, 0, ts);
+      const Vec3d uvObject =
+          gradientFromObjectNormal(decodeNormalTexel(osTex.sample(st)), p.normal);
+      worst = std::max({worst, maxAbsDiff(triplanarHeightGradient(tex, o, p), uvHeight),
+                        maxAbsDiff(triplanarTangentNormalGradient(tsTex, o, p), uvTangent),
+                        maxAbsDiff(triplanarObjectNormalGradient(osTex, o, p), uvObject)});
+    }
+  }
+  EXPECT_LT(worst, 1e-13);
+}
+
+// The volume-gradient formulation: Γ is the tangential part of the gradient of the blended
+// volume H(P) = Σ w_i · scale · h(tiling ∘ plane_i(P) + offset) with the weights frozen (eq. 48),
+// checked against central differences of H.
+TEST(Triplanar, HeightIsTheProjectedGradientOfTheBlendedVolume) {
+  SineTexture tex;
+  TriplanarOptions o;
+  o.tiling = {1.3, 0.7};
+  o.offset = {0.2, -0.1};
+  o.scale = 0.5;
+  o.sharpness = 2;
+  std::mt19937_64 rng(26);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 200; ++i) {
+    const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+    const TriplanarWeights w = triplanarWeights(p.normal, o.sharpness, o.minWeight);
+    auto volume = [&](Vec3d q) {
+      double h = 0;
+      for (const ProjectionAxis axis : kAxes) {
+        const PlanarMapping m{axis, o.tiling, o.offset};
+        h += w.w[static_cast<std::size_t>(axis)] * o.scale *
+             tex.sample(planarTextureCoordinates(q, m)).value;
+      }
+      return h;
+    };
+    const double e = 1e-6;
+    Vec3d grad{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      Vec3d d{};
+      d[k] = e;
+      grad[k] = (volume(p.position + d) - volume(p.position - d)) / (2 * e);
+    }
+    const Vec3d expected = grad - dot(grad, p.normal) * p.normal;
+    EXPECT_LT(maxAbsDiff(triplanarHeightGradient(tex, o, p), expected), 1e-8);
+  }
+}
+
+// Eq. 45: object-space triplanar is the weighted blend of the per-plane eq. 38 gradients.
+TEST(Triplanar, ObjectNormalsBlendPerPlaneGradients) {
+  ObjectNormalTexture tex;
+  TriplanarOptions o;
+  o.sharpness = 1;
+  const SurfacePoint p = pointAt({0.3, -0.2, 0.5}, {0.4, 0.5, 0.6});
+  const TriplanarWeights w = triplanarWeights(p.normal, o.sharpness, o.minWeight);
+  Vec3d expected{};
+  for (const ProjectionAxis axis : kAxes) {
+    const PlanarMapping m{axis, o.tiling, o.offset};
+    expected += w.w[static_cast<std::size_t>(axis)] * planarObjectNormalGradient(tex, m, 1, p);
+  }
+  EXPECT_LT(maxAbsDiff(triplanarObjectNormalGradient(tex, o, p), expected), 1e-15);
+}
+
+// Planes below the weight threshold are not sampled: 1, 2 or 3 samples per point.
+TEST(Triplanar, PlanesBelowTheThresholdAreNotSampled) {
+  struct Case {
+    Vec3d normal;
+    int samples;
+  };
+  const Case cases[] = {{{1, 0, 0}, 1}, {{0, -1, 0}, 1},
+                        {{0, 0, 1}, 1}, {{1, 0.1, 0}, 1},  // w_y ≈ 1e-4 < 1e-3
+                        {{1, 1, 0}, 2}, {{0, 0.6, -0.8}, 2},
+                        {{1, 1, 1}, 3}, {{1, 0.3, 0.3}, 3}};  // w = 0.0081/1.0162 ≈ 8e-3 ≥ 1e-3
+  for (const Case& c : cases) {
+    SineTexture height;
+    HeightNormalTexture ts(height);
+    ObjectNormalTexture os;
+    const SurfacePoint p = pointAt({0.1, 0.2, 0.3}, c.normal);
+    const TriplanarOptions o;
+    triplanarHeightGradient(height, o, p);
+    EXPECT_EQ(height.count, c.samples) << c.normal.x << " " << c.normal.y << " " << c.normal.z;
+    triplanarTangentNormalGradient(ts, o, p);
+    EXPECT_EQ(ts.count, c.samples);
+    triplanarObjectNormalGradient(os, o, p);
+    EXPECT_EQ(os.count, c.samples);
+  }
+}
+
+// Grazing and diagonal normals, extreme tiling and scale: finite, and the resolved normal unit.
+TEST(Triplanar, GrazingNormalsAndExtremeScalesAreFinite) {
+  SineTexture tex;
+  HeightNormalTexture ts(tex);
+  ObjectNormalTexture os;
+  std::mt19937_64 rng(27);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double scales[] = {1e-8, 1e-3, 1, 1e3, 1e8};
+  int n = 0;
+  for (const double tiling : scales) {
+    for (const double scale : scales) {
+      for (int i = 0; i < 40; ++i) {
+        Vec3d normal{u(rng), u(rng), u(rng)};
+        if (i % 4 == 0) normal = {1, 1, 1};
+        if (i % 4 == 1) normal = {1, 1e-9, 0};
+        if (i % 4 == 2) normal = {0.70710678, 0.70710678, 1e-12};
+        const SurfacePoint p = pointAt({u(rng) * scale, u(rng), u(rng) / scale}, normal);
+        TriplanarOptions o;
+        o.tiling = {tiling, 1 / tiling};
+        o.scale = scale;
+        o.sharpness = i % 3 == 0 ? 1e6 : 4;
+        for (const Vec3d gamma :
+             {triplanarHeightGradient(tex, o, p), triplanarTangentNormalGradient(ts, o, p),
+              triplanarObjectNormalGradient(os, o, p)}) {
+          ASSERT_TRUE(isFinite(gamma));
+          const Vec3d resolved = resolveNormal(p.normal, gamma);
+          ASSERT_TRUE(isFinite(resolved));
+          EXPECT_NEAR(length(resolved), 1.0, 1e-12);
+          ++n;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(n, 5 * 5 * 40 * 3);
+}
+
+}  // namespace
+}  // namespace sgbake
