@@ -13,6 +13,9 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <new>
+#include <type_traits>
 #include <span>
 
 #include <tbb/blocked_range.h>
@@ -60,6 +63,37 @@ void parallelFor(std::size_t n, F&& body) {
                     });
 }
 
+// A fixed-size array whose elements are constructed by all threads at once: the first touch of
+// freshly allocated memory (page faults and zeroing) is a large part of this algorithm's cost,
+// and std::vector would pay it on one thread.
+template <class T>
+class ParallelArray {
+  static_assert(std::is_trivially_destructible_v<T>);
+
+ public:
+  ParallelArray() = default;
+  explicit ParallelArray(std::size_t n) { resize(n); }
+  void resize(std::size_t n) {
+    data_.reset(static_cast<T*>(::operator new(n * sizeof(T))));
+    size_ = n;
+    parallelFor(n, [&](std::size_t i) { ::new (static_cast<void*>(data_.get() + i)) T(); });
+  }
+  std::size_t size() const { return size_; }
+  T& operator[](std::size_t i) { return data_[i]; }
+  const T& operator[](std::size_t i) const { return data_[i]; }
+  T* begin() { return data_.get(); }
+  T* end() { return data_.get() + size_; }
+  const T* begin() const { return data_.get(); }
+  const T* end() const { return data_.get() + size_; }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { ::operator delete(static_cast<void*>(p)); }
+  };
+  std::unique_ptr<T[], Free> data_;
+  std::size_t size_ = 0;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Welding: rep[s] = the smallest slot whose position, normal and UV equal slot s's exactly.
 
@@ -94,9 +128,9 @@ std::uint64_t hashKey(const WeldKey& key) {
   return h ^ (h >> 32);
 }
 
-std::vector<std::uint32_t> weld(const Input& in) {
+ParallelArray<std::uint32_t> weld(const Input& in) {
   const std::size_t n = in.position.size();
-  std::vector<std::uint64_t> hash(n);
+  ParallelArray<std::uint64_t> hash(n);
   parallelFor(n, [&](std::size_t s) { hash[s] = hashKey(weldKey(in, s)); });
 
   // Partition slots by the top bits of their hash (a stable counting sort, so each bucket lists
@@ -108,13 +142,13 @@ std::vector<std::uint32_t> weld(const Input& in) {
   std::vector<std::uint32_t> bucketStart(kBuckets + 1, 0);
   for (std::size_t s = 0; s < n; ++s) ++bucketStart[bucketOf(s) + 1];
   for (std::size_t b = 0; b < kBuckets; ++b) bucketStart[b + 1] += bucketStart[b];
-  std::vector<std::uint32_t> order(n);
+  ParallelArray<std::uint32_t> order(n);
   {
     std::vector<std::uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
     for (std::size_t s = 0; s < n; ++s) order[fill[bucketOf(s)]++] = static_cast<std::uint32_t>(s);
   }
 
-  std::vector<std::uint32_t> rep(n);
+  ParallelArray<std::uint32_t> rep(n);
   tbb::parallel_for(std::size_t{0}, kBuckets, [&](std::size_t b) {
     const std::uint32_t begin = bucketStart[b], size = bucketStart[b + 1] - begin;
     if (size == 0) return;
@@ -350,8 +384,8 @@ class Engine {
     auto edgeTo = [&](std::size_t e) { return vert_[e % 3 == 2 ? e - 2 : e + 1]; };
     // Per edge: its smaller vertex, and (larger vertex, edge) packed so that sorting the packed
     // values orders a bucket by larger vertex, then triangle.
-    std::vector<std::uint32_t> smaller(ne);
-    std::vector<std::uint64_t> packed(ne);
+    ParallelArray<std::uint32_t> smaller(ne);
+    ParallelArray<std::uint64_t> packed(ne);
     parallelFor(ne, [&](std::size_t e) {
       const std::uint32_t a = edgeFrom(e), b = edgeTo(e);
       smaller[e] = std::min(a, b);
@@ -360,7 +394,7 @@ class Engine {
     std::vector<std::uint32_t> start(nv + 1, 0);
     for (std::size_t e = 0; e < ne; ++e) ++start[smaller[e] + 1];
     for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-    std::vector<std::uint64_t> edges(ne);
+    ParallelArray<std::uint64_t> edges(ne);
     {
       std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
       for (std::size_t e = 0; e < ne; ++e) edges[fill[smaller[e]]++] = packed[e];
@@ -606,12 +640,12 @@ class Engine {
 
   const Input& in_;
   Output& out_;
-  std::vector<std::uint32_t> rep_;  // welded vertex (smallest equal slot) of each slot
+  ParallelArray<std::uint32_t> rep_;  // welded vertex (smallest equal slot) of each slot
 
   std::vector<std::uint32_t> goodStart_;  // #faces+1: face f's good triangles in work order
-  std::vector<Tri> tris_;                 // work order
-  std::vector<std::uint32_t> slot_;       // 3 per triangle: the slot of each corner
-  std::vector<std::uint32_t> vert_;       // 3 per triangle: the welded vertex of each corner
+  ParallelArray<Tri> tris_;               // work order
+  ParallelArray<std::uint32_t> slot_;     // 3 per triangle: the slot of each corner
+  ParallelArray<std::uint32_t> vert_;     // 3 per triangle: the welded vertex of each corner
   std::size_t numGood_ = 0;
 
   std::vector<std::uint32_t> groupVertex_;
@@ -619,7 +653,7 @@ class Engine {
   std::vector<std::uint32_t> groupStart_;
   std::vector<std::uint32_t> groupFaces_;
 
-  std::vector<Vec3f> cornerSpace_;  // 3 per good triangle: the tangent of its group at each corner
+  ParallelArray<Vec3f> cornerSpace_;  // 3 per good triangle: the tangent of its group at each corner
 };
 
 }  // namespace
