@@ -12,13 +12,12 @@
 
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/projection.hpp"
+#include "support/analytic_textures.hpp"
 
 namespace sgbake {
 namespace {
 
-double maxAbsDiff(Vec3d a, Vec3d b) {
-  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
-}
+using test::maxAbsDiff;
 
 /// h(s, t) = A sin(2π s + φ) cos(2π t) + c·s, exact derivatives; counts its samples.
 class SineTexture final : public ScalarTexture {

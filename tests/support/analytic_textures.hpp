@@ -1,0 +1,36 @@
+// Textures with closed-form values and exact derivatives, for tests whose reference is analytic.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "sgbake/core/math.hpp"
+#include "sgbake/gradient/texture.hpp"
+
+namespace sgbake::test {
+
+/// Largest componentwise difference of two vectors.
+inline double maxAbsDiff(Vec3d a, Vec3d b) {
+  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
+}
+
+/// h(s, t) = a·s + b·t + c·sin(2π s)·cos(2π t), exact derivatives; counts its samples
+/// (thread-safe), so tests can check what was (not) evaluated.
+class AnalyticHeight final : public ScalarTexture {
+ public:
+  AnalyticHeight(double a, double b, double c) : a_(a), b_(b), c_(c) {}
+  ScalarSample sample(Vec2d st) const override {
+    ++count;
+    const double w = 2 * kPi;
+    return {a_ * st.x + b_ * st.y + c_ * std::sin(w * st.x) * std::cos(w * st.y),
+            {a_ + c_ * w * std::cos(w * st.x) * std::cos(w * st.y),
+             b_ - c_ * w * std::sin(w * st.x) * std::sin(w * st.y)}};
+  }
+  mutable std::atomic<int> count{0};
+
+ private:
+  double a_, b_, c_;
+};
+
+}  // namespace sgbake::test
