@@ -1,0 +1,142 @@
+// Timings of the baker: a 4096² map of meshes/suzanne.obj (7872 quads) with one UV height layer,
+// for 1 and 2 threads, plus the raster alone (mask) and the padding passes.
+//
+//   ninja -C build sgbake_bench_bake && build/bench/sgbake_bench_bake
+//   SGBAKE_BENCH_MESH=other.obj build/bench/sgbake_bench_bake    # another mesh (needs UVs)
+//
+// Benchmarks (wall time, milliseconds; the argument is the thread count):
+//   - BM_TangentNormal/threads:N — bakeMap(kTangentNormal, 4096², 1 sample) with a bilinear
+//     2048² height map: the speed target (Blender's Cycles bake takes 25–35 s);
+//   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
+//   - BM_Mask/threads:N — the raster and coverage alone (no shading);
+//   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map.
+// Setup (loading the mesh, MikkTSpace, building the texture) is not timed; writing files is not
+// part of this library.
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/core/math.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/image.hpp"
+#include "sgbake/mesh/io.hpp"
+
+namespace {
+
+using namespace sgbake;
+
+constexpr int kBakeSize = 4096;
+constexpr int kHeightMapSize = 2048;
+
+struct Scene {
+  Mesh mesh;
+  CornerTangents tangents;
+  std::optional<ImageScalarTexture> height;
+  std::vector<Layer> layers;
+};
+
+/// Loaded once: the mesh, its tangents and a 2048² height map of a few summed sines.
+const Scene& scene() {
+  static const std::unique_ptr<Scene> s = [] {
+    auto out = std::make_unique<Scene>();
+    const char* env = std::getenv("SGBAKE_BENCH_MESH");
+    // meshes/ next to bench/ (CMake passes this file's absolute path).
+    const std::filesystem::path path =
+        env ? std::filesystem::path(env)
+            : std::filesystem::path(__FILE__).parent_path().parent_path() / "meshes" / "suzanne.obj";
+    Result<Mesh> mesh = loadMesh(path, {.requireUvs = true});
+    if (!mesh) {
+      std::fprintf(stderr, "%s\n", mesh.error().message.c_str());
+      std::exit(1);
+    }
+    out->mesh = std::move(*mesh);
+    Result<CornerTangents> tangents = computeTangents(out->mesh.view(0));
+    if (!tangents) std::exit(1);
+    out->tangents = std::move(*tangents);
+    Image image(kHeightMapSize, kHeightMapSize, 1);
+    for (int y = 0; y < kHeightMapSize; ++y)
+      for (int x = 0; x < kHeightMapSize; ++x) {
+        const double a = 2 * kPi * x / kHeightMapSize, b = 2 * kPi * y / kHeightMapSize;
+        image.at(x, y) = static_cast<float>(0.5 + 0.25 * std::sin(17 * a) * std::cos(23 * b) +
+                                            0.1 * std::sin(101 * a + 37 * b));
+      }
+    Result<ImageScalarTexture> texture = ImageScalarTexture::create(image);
+    if (!texture) std::exit(1);
+    out->height.emplace(std::move(*texture));
+    out->layers.push_back(Layer{UvHeightSource{&*out->height, 0, 0.02}, 1.0, {}});
+    return out;
+  }();
+  return *s;
+}
+
+void bake(benchmark::State& state, MapKind kind, bool withLayers) {
+  const Scene& s = scene();
+  BakeSettings settings;
+  settings.map = kind;
+  settings.width = settings.height = kBakeSize;
+  settings.threads = static_cast<int>(state.range(0));
+  const BakeInput input{&s.mesh, &s.tangents, withLayers ? std::span<const Layer>(s.layers) : std::span<const Layer>()};
+  for (auto _ : state) {
+    Result<FloatImage> image = bakeMap(input, settings);
+    if (!image) state.SkipWithError(image.error().message.c_str());
+    benchmark::DoNotOptimize(image);
+  }
+  state.counters["texels"] = double(kBakeSize) * kBakeSize;
+}
+
+void BM_TangentNormal(benchmark::State& state) { bake(state, MapKind::kTangentNormal, true); }
+void BM_TangentNormalNoLayers(benchmark::State& state) { bake(state, MapKind::kTangentNormal, false); }
+void BM_Mask(benchmark::State& state) { bake(state, MapKind::kMask, false); }
+
+const FloatImage& tangentMap() {
+  static const FloatImage map = [] {
+    const Scene& s = scene();
+    BakeSettings settings;
+    settings.width = settings.height = kBakeSize;
+    return std::move(*bakeMap({&s.mesh, &s.tangents, s.layers}, settings));
+  }();
+  return map;
+}
+
+void BM_ExtendMargin16(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    FloatImage image = tangentMap();
+    state.ResumeTiming();
+    extendMargin(image, 16, static_cast<int>(state.range(0)));
+    benchmark::DoNotOptimize(image);
+  }
+}
+
+void BM_PushPull(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    FloatImage image = tangentMap();
+    state.ResumeTiming();
+    pushPullFill(image, static_cast<int>(state.range(0)));
+    benchmark::DoNotOptimize(image);
+  }
+}
+
+void threadArgs(benchmark::internal::Benchmark* b) {
+  b->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+}
+
+}  // namespace
+
+BENCHMARK(BM_TangentNormal)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalNoLayers)->Apply(threadArgs);
+BENCHMARK(BM_Mask)->Apply(threadArgs);
+BENCHMARK(BM_ExtendMargin16)->Apply(threadArgs);
+BENCHMARK(BM_PushPull)->Apply(threadArgs);
+
+BENCHMARK_MAIN();

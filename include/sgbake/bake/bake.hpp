@@ -1,0 +1,174 @@
+/// @file bake.hpp
+/// @brief Baking maps in UV space: the texel raster, per-texel frames as Blender's baker builds
+/// them, the map kinds, and edge padding. Pure in-memory; writing files is in bake/image_output.hpp.
+///
+/// ## Triangles (Blender's "looptris")
+/// Faces are rasterized as the triangles Blender 3.4 tessellates them into (loopTriangles()):
+///  - a triangle as it is;
+///  - a quad (c0, c1, c2, c3) as (c0, c1, c2), (c0, c2, c3), **unless** c1 and c3 lie on the same
+///    side of the diagonal c0–c2, i.e. `⟨(P1−P0)×(P2−P0), (P3−P0)×(P2−P0)⟩ > 0` in float (a quad
+///    reflex at c1 or c3, or a bow-tie), where it is (c0, c1, c3), (c1, c2, c3). Ties (c1 or c3 on
+///    the diagonal, degenerate quads) keep the c0–c2 split. Verified with Blender 3.4.1 headless
+///    (`Mesh.calc_loop_triangles()` on convex, reflex-at-0/1/2/3, collinear, twisted and bow-tie
+///    quads): identical triangles and corner order in every case.
+///  - an n-gon by triangulatePolygon (ear clipping in the plane of its Newell normal). Blender
+///    uses its own polyfill, which may choose other diagonals (a regular pentagon: Blender
+///    (4,0,1), (1,2,3), (1,3,4); ours (4,0,1), (4,1,2), (2,3,4)); the covered texels are the same
+///    for planar, convex-in-UV n-gons, but the interpolated frames of non-planar or non-affine
+///    n-gons differ between the two triangulations.
+///
+/// ## Texels and coverage
+/// Texel (x, y) of a W×H bake of UDIM tile t, y counted **up** from the bottom, has its centre at
+/// `u = u0 + (x + 0.5)/W`, `v = v0 + (y + 0.5)/H` with `(u0, v0) = ((t−1001) % 10, (t−1001) / 10)`;
+/// it is stored in row `H − 1 − y` of FloatImage (rows top first, as files store them). With
+/// N×N supersampling its samples are at `u0 + (x + (i+0.5)/N)/W`, `v0 + (y + (j+0.5)/N)/H`,
+/// i, j = 0 … N−1 (N = 1: the texel centre). A sample belongs to the triangle containing it.
+///
+/// **Edge rule.** A sample exactly on an edge or vertex is treated as displaced by an
+/// infinitesimal ε·(1, 2) + ε²·(1, 0) texels: the direction in which Blender nudges every sample
+/// (it moves UVs by −(0.001, 0.002) texels so that texel centres on pixel-aligned edges pick one
+/// triangle), taken to the limit so that it decides exact ties only. Edge functions are evaluated
+/// with the two endpoints in a canonical order, so the two triangles sharing an edge compute the
+/// same value with opposite signs: every sample of a watertight UV region is claimed by exactly
+/// one triangle (no double counting, no gaps), whatever the rounding. Triangles with zero UV area
+/// cover nothing. Triangles reaching outside the tile are clipped to it.
+///
+/// **Supersampling.** A texel's value is the plain average (box filter) of the values of its
+/// covered samples, as stored: for normal maps the average of the *encoded* colours, i.e.
+/// encode(mean of the unit normals), not renormalized. Its coverage is the fraction of its N²
+/// samples that are covered. Texels no sample covers get the map's background and coverage 0.
+///
+/// ## Per-texel frame (CONVENTIONS.md, "Per-texel frame in Blender's baker")
+/// At a sample with barycentrics (b0, b1, b2) in triangle (c0, c1, c2):
+/// `T = Σ bi·Ti` (unit MikkTSpace corner tangents, not renormalized), `N = Σ bi·Ni` (corner
+/// normals; flat faces carry their face normal at every corner), `sign = Σ bi·si < 0 ? −1 : +1`,
+/// `B = sign·N×T`, `P = Σ bi·Pi`, UVs interpolated, and ∂P/∂u, ∂P/∂v the triangle's constant
+/// derivatives. The gradient engine sees a SurfacePoint with normal = normalize(N) and tangent
+/// frame (T, Σ bi·si). Tangent-space output is `normalize(inverse([T B N]) · N')`.
+///
+/// ## Threads
+/// The image is cut into blocks of rows processed in parallel (TBB); each texel is written by one
+/// task and its samples are summed in a fixed order, so 1 and N threads give identical bits.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "sgbake/core/result.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/surface_gradient.hpp"
+#include "sgbake/mesh/mesh.hpp"
+
+namespace sgbake {
+
+/// @brief The maps sgbake bakes (CLI names in parentheses).
+enum class MapKind {
+  kTangentNormal,    ///< ("tangent-normal") RGB = n_ts/2 + 0.5, Blender's per-texel frame
+  kObjectNormal,     ///< ("object-normal") RGB = n_obj/2 + 0.5
+  kHeight,           ///< ("height") R = Σ weight·mask·scale·h of the height layers (UV, volume, planar, triplanar)
+  kDerivative,       ///< ("derivative") RG = (∂h/∂u, ∂h/∂v) = (⟨Γ,∂P/∂u⟩, ⟨Γ,∂P/∂v⟩) of the bake's UV set (seed 001 eq. 32)
+  kSurfaceGradient,  ///< ("surface-gradient") RGB = object-space Γ, raw (not encoded)
+  kTangent,          ///< ("tangent") RGB = normalize(T)/2 + 0.5 (T interpolated, unnormalized)
+  kBitangent,        ///< ("bitangent") RGB = normalize(sign·N×T)/2 + 0.5
+  kMask,             ///< ("mask") R = coverage in [0, 1] (fraction of samples inside a triangle)
+};
+
+/// @brief Parses a CLI/scene map name ("tangent-normal", ...); kBadInput names the unknown map.
+Result<MapKind> parseMapKind(std::string_view name);
+/// @brief The CLI/scene name of @p kind.
+std::string_view mapKindName(MapKind kind);
+/// @brief Channels the map stores (1, 2 or 3).
+int mapChannels(MapKind kind);
+/// @brief Whether the map needs MikkTSpace tangent frames (besides what its layers need):
+/// kTangentNormal, kTangent, kBitangent.
+bool mapNeedsTangents(MapKind kind);
+
+/// @brief A float image in memory, rows top first (as files store them), channels interleaved.
+///
+/// Row r holds the texels with y = H − 1 − r (y counted up from the bottom, v up).
+struct FloatImage {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;    ///< width·height·channels
+  std::vector<float> coverage;  ///< width·height, fraction of the texel's samples inside the mesh
+  float& at(int x, int row, int c) { return pixels[(static_cast<std::size_t>(row) * width + x) * channels + c]; }
+  float at(int x, int row, int c) const { return pixels[(static_cast<std::size_t>(row) * width + x) * channels + c]; }
+};
+
+/// First UDIM tile number: the tile [0,1)².
+inline constexpr int kFirstUdimTile = 1001;
+/// Last UDIM tile number Blender accepts (u tile 9, v tile 99).
+inline constexpr int kLastUdimTile = 2000;
+/// Largest N of N×N supersampling.
+inline constexpr int kMaxBakeSamples = 16;
+/// Largest width or height of a bake, texels.
+inline constexpr int kMaxBakeSide = 65536;
+
+/// @brief What to bake.
+struct BakeSettings {
+  MapKind map = MapKind::kTangentNormal;
+  int width = 1024, height = 1024;  ///< texels, 1 … kMaxBakeSide
+  int samples = 1;        ///< N: N×N samples per texel (supersampling), averaged; 1 … kMaxBakeSamples
+  int uvSet = 0;          ///< UV set that places the mesh in the image
+  int udimTile = 1001;    ///< which UDIM tile (1001 = [0,1)²), kFirstUdimTile … kLastUdimTile
+  NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< kDirectX flips G of kTangentNormal
+  int threads = 0;        ///< 0 = all cores; the result does not depend on it
+};
+
+/// @brief Everything a bake reads: the mesh, its tangent frames (may be null when no map or
+/// layer needs them), and the layers.
+struct BakeInput {
+  const Mesh* mesh = nullptr;
+  /// MikkTSpace frames per corner of **UV set 0** (computeTangents(mesh.view(0))), or nullptr.
+  /// They define the tangent space of kTangentNormal/kTangent/kBitangent whatever uvSet places
+  /// the texels (Blender: the tangents of the active UV map), and are the SurfacePoint's tangent
+  /// frame for tangent-space layers.
+  const CornerTangents* tangents = nullptr;
+  std::span<const Layer> layers;  ///< composited in order; textures must outlive the bake
+};
+
+/// @brief Bakes one map. Texels no triangle covers get the map's background (tangent-space
+/// normal (0.5, 0.5, 1), zero elsewhere) and coverage 0.
+///
+/// @return width × height × mapChannels(map) image with coverage; kBadInput when the mesh is
+///         null or has no UV set @p settings.uvSet, a setting is out of range, the map needs
+///         tangents and none (or a wrong number) are given, or validateLayers rejects a layer;
+///         kInternal when memory runs out.
+Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings);
+
+/// @brief The triangles the baker rasterizes, as global corner indices, face after face (see
+/// "Triangles" in the file comment): #F triangles for a triangle mesh, 2 per quad, k−2 per k-gon.
+std::vector<std::array<std::uint32_t, 3>> loopTriangles(const Mesh& mesh);
+
+/// @brief UDIM tiles (1001, 1002, ...) that UV set @p uvSet touches, ascending.
+///
+/// A tile is touched when a triangle with nonzero UV area overlaps the tile's open square
+/// (touching its border only does not count). Parts of the UV layout outside tiles
+/// 1001 … 2000 (negative u or v, u ≥ 10, v ≥ 100) are ignored. Empty when the set does not exist.
+std::vector<int> udimTiles(const Mesh& mesh, int uvSet);
+
+/// @brief Edge padding as Blender's "Extend" margin (IMB_filter_extend, what Blender 3.4 runs for
+/// margin type Extend): @p margin passes, each filling every not-yet-filled texel that has a
+/// filled **4-neighbour** with the weighted average of its filled 8-neighbours (weight 2 for the
+/// 4 edge neighbours, 1 for the 4 diagonal ones), all reading the state before the pass.
+///
+/// Texels with coverage > 0 are the initial filled set. The filled region therefore grows one
+/// ring per pass in the **L1 (Manhattan) metric**: after the call, exactly the texels within
+/// L1 distance ≤ margin of a covered texel have been written. Coverage is left unchanged (it
+/// stays the geometric coverage, e.g. for an alpha channel). Parallel, deterministic.
+/// @param[in] threads 0 = all cores; the result does not depend on it
+void extendMargin(FloatImage& image, int margin, int threads = 0);
+
+/// @brief Fills every uncovered texel (coverage 0) by push-pull (Gortler et al. 1996): a
+/// pyramid of 2×2 weighted averages of the covered texels (weights clamped to 1), then, from
+/// the coarsest level down, each texel with weight w < 1 becomes w·own + (1−w)·(bilinear
+/// interpolation of the coarser level). Covered texels (coverage > 0) keep their values bit for
+/// bit; an image without covered texels is left unchanged. Coverage is left unchanged, so
+/// texels written by extendMargin count as holes here. Parallel, deterministic.
+/// @param[in] threads 0 = all cores; the result does not depend on it
+void pushPullFill(FloatImage& image, int threads = 0);
+
+}  // namespace sgbake

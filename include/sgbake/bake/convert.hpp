@@ -1,0 +1,62 @@
+/// @file convert.hpp
+/// @brief Re-expressing a baked normal map between object space and tangent space with Blender's
+/// per-texel frame (bake.hpp, "Per-texel frame"), texel by texel.
+#pragma once
+
+#include <string_view>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/core/result.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/surface_gradient.hpp"
+#include "sgbake/mesh/mesh.hpp"
+
+namespace sgbake {
+
+/// @brief The space a normal map's colours are expressed in.
+enum class NormalSpace {
+  kObject,   ///< ("object") the object's local frame
+  kTangent,  ///< ("tangent") MikkTSpace per texel: R = +T, G = +B (OpenGL) or −B (DirectX), B = +N
+};
+
+/// @brief Parses "object" or "tangent"; kBadInput names the unknown space.
+Result<NormalSpace> parseNormalSpace(std::string_view name);
+/// @brief "object" or "tangent".
+std::string_view normalSpaceName(NormalSpace space);
+
+/// @brief How convertNormalMap places the mesh in the image.
+struct ConvertSettings {
+  int uvSet = 0;        ///< UV set that places the mesh in the image
+  int udimTile = 1001;  ///< which UDIM tile the image is
+  /// Green convention of the tangent-space side (the input when converting from tangent space,
+  /// the output when converting to it).
+  NormalMapGreen green = NormalMapGreen::kOpenGL;
+  int samples = 1;  ///< N×N frames per texel, results averaged (encoded), as bakeMap
+  int threads = 0;  ///< 0 = all cores; the result does not depend on it
+};
+
+/// @brief Converts the normal map @p input from space @p from to space @p to.
+///
+/// For every texel a triangle covers (bakeMap's raster and edge rule), the texel's colour c is
+/// decoded as n = 2c − 1 (G negated for DirectX on the tangent side) and, at each covered
+/// sample, re-expressed in the per-texel frame (T, B = sign·N×T, N interpolated as Blender's
+/// baker does):
+///  - object → tangent: normalize(inverse([T B N]) · n) (the inverse, not the transpose), the
+///    flat (0, 0, 1) where the frame is degenerate;
+///  - tangent → object: normalize(x·T + y·B + z·N);
+///  - same space: normalize(n) (a renormalization pass);
+/// then encoded n/2 + 0.5 and averaged over the texel's covered samples. A zero input normal
+/// converts to the flat normal of the target space. Texels no triangle covers keep the input's
+/// values; channels after the first three are copied unchanged. The output's coverage is the
+/// raster's (the input's coverage is not read).
+///
+/// @param[in] tangents MikkTSpace frames per corner of UV set 0 (see BakeInput::tangents)
+/// @param[in] input    W×H image with ≥ 3 channels, rows top first; it defines the output size
+/// @return W×H image with input.channels channels; kBadInput when the input is empty or has fewer
+///         than 3 channels, pixel storage does not match its size, the mesh has no UV set
+///         settings.uvSet, the tangents do not match the mesh, or a setting is out of range.
+Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tangents,
+                                    const FloatImage& input, NormalSpace from, NormalSpace to,
+                                    const ConvertSettings& settings = {});
+
+}  // namespace sgbake

@@ -1,0 +1,377 @@
+// bakeMap: the map kinds as shaders over the texel raster (raster.hpp), with Blender's per-texel
+// frame (texel_frame.hpp) and the gradient engine's layers.
+#include "sgbake/bake/bake.hpp"
+
+#include <array>
+#include <cmath>
+#include <new>
+#include <string>
+
+#include "bake/height.hpp"
+#include "bake/raster.hpp"
+#include "bake/texel_frame.hpp"
+#include "sgbake/core/math.hpp"
+#include "sgbake/gradient/projection.hpp"
+
+namespace sgbake {
+
+// ---------------------------------------------------------------------------------------------
+// Map kinds
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+struct MapInfo {
+  MapKind kind;
+  std::string_view name;
+  int channels;
+  bool needsTangents;
+};
+
+constexpr std::array<MapInfo, 8> kMaps{{
+    {MapKind::kTangentNormal, "tangent-normal", 3, true},
+    {MapKind::kObjectNormal, "object-normal", 3, false},
+    {MapKind::kHeight, "height", 1, false},
+    {MapKind::kDerivative, "derivative", 2, false},
+    {MapKind::kSurfaceGradient, "surface-gradient", 3, false},
+    {MapKind::kTangent, "tangent", 3, true},
+    {MapKind::kBitangent, "bitangent", 3, true},
+    {MapKind::kMask, "mask", 1, false},
+}};
+
+const MapInfo& info(MapKind kind) {
+  for (const MapInfo& m : kMaps)
+    if (m.kind == kind) return m;
+  return kMaps[0];  // unreachable for valid enumerators
+}
+
+}  // namespace
+
+Result<MapKind> parseMapKind(std::string_view name) {
+  std::string known;
+  for (const MapInfo& m : kMaps) {
+    if (m.name == name) return m.kind;
+    known += known.empty() ? "" : ", ";
+    known += m.name;
+  }
+  return Error::badInput("unknown map '" + std::string(name) + "' (expected one of: " + known + ")");
+}
+
+std::string_view mapKindName(MapKind kind) { return info(kind).name; }
+int mapChannels(MapKind kind) { return info(kind).channels; }
+bool mapNeedsTangents(MapKind kind) { return info(kind).needsTangents; }
+
+// ---------------------------------------------------------------------------------------------
+// Per-triangle data and heights
+// ---------------------------------------------------------------------------------------------
+
+namespace bake_detail {
+
+void triangleDerivatives(const std::array<Vec3d, 3>& p, const std::array<Vec2d, 3>& uv,
+                         Vec3d& dPdu, Vec3d& dPdv) {
+  const Vec3d e1 = p[1] - p[0], e2 = p[2] - p[0];
+  const Vec2d d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+  const double det = d1.x * d2.y - d2.x * d1.y;
+  const double scale = std::sqrt(lengthSquared(d1) * lengthSquared(d2));
+  if (!(std::abs(det) > kMinUvTriangleSine * scale) || !std::isfinite(det)) {
+    dPdu = {};
+    dPdv = {};
+    return;
+  }
+  // [e1 e2] = [∂P/∂u ∂P/∂v] · [[d1.x d2.x] [d1.y d2.y]], solved by Cramer's rule.
+  const double inv = 1 / det;
+  dPdu = inv * (d2.y * e1 - d1.y * e2);
+  dPdv = inv * (d1.x * e2 - d2.x * e1);
+}
+
+void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
+                         const std::array<std::uint32_t, 3>& corners, int bakeUvSet,
+                         ShadingTriangle& tri) {
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::uint32_t c = corners[i];
+    tri.position[i] = cast<double>(mesh.positions[mesh.cornerVertex[c]]);
+    tri.normal[i] = cast<double>(mesh.cornerNormals[c]);
+    if (tangents != nullptr) {
+      tri.tangent[i] = cast<double>(tangents->tangent[c]);
+      tri.sign[i] = tangents->sign[c];
+    }
+  }
+  tri.hasTangents = tangents != nullptr;
+  tri.faceNormal = normalizeOr(cross(tri.position[1] - tri.position[0], tri.position[2] - tri.position[0]),
+                               Vec3d{0, 0, 1});
+  tri.numUvSets = static_cast<int>(std::min<std::size_t>(mesh.uvSets.size(), kMaxUvSets));
+  for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s) {
+    for (std::size_t i = 0; i < 3; ++i) tri.uv[s][i] = cast<double>(mesh.uvSets[s].uvs[corners[i]]);
+    triangleDerivatives(tri.position, tri.uv[s], tri.dPdu[s], tri.dPdv[s]);
+  }
+  const std::size_t b = static_cast<std::size_t>(bakeUvSet);
+  if (bakeUvSet < tri.numUvSets) {
+    tri.bakeDPdu = tri.dPdu[b];
+    tri.bakeDPdv = tri.dPdv[b];
+  } else {
+    const std::vector<Vec2f>& uvs = mesh.uvSets[b].uvs;
+    triangleDerivatives(tri.position,
+                        {cast<double>(uvs[corners[0]]), cast<double>(uvs[corners[1]]),
+                         cast<double>(uvs[corners[2]])},
+                        tri.bakeDPdu, tri.bakeDPdv);
+  }
+}
+
+namespace {
+
+bool hasUvSet(const SurfacePoint& point, int uvSet) {
+  return uvSet >= 0 && uvSet < point.numUvSets && uvSet < kMaxUvSets;
+}
+
+double heightOf(const UvHeightSource& s, const SurfacePoint& p) {
+  if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return 0;
+  const Vec2d st = textureCoordinates(p.uv[static_cast<std::size_t>(s.uvSet)].uv, s.tiling, s.offset);
+  return s.scale * s.texture->sample(st).value;
+}
+double heightOf(const VolumeSource& s, const SurfacePoint& p) {
+  return s.volume == nullptr ? 0 : s.scale * s.volume->value(p.position);
+}
+double heightOf(const PlanarSource& s, const SurfacePoint& p) {
+  if (s.kind != ProjectedKind::kHeight || s.height == nullptr) return 0;
+  return s.scale * s.height->sample(planarTextureCoordinates(p.position, s.mapping)).value;
+}
+double heightOf(const TriplanarSource& s, const SurfacePoint& p) {
+  if (s.kind != ProjectedKind::kHeight || s.height == nullptr) return 0;
+  const TriplanarWeights w = triplanarWeights(p.normal, s.options.sharpness, s.options.minWeight);
+  double h = 0;
+  for (const ProjectionAxis axis : {ProjectionAxis::kX, ProjectionAxis::kY, ProjectionAxis::kZ}) {
+    const double weight = w.w[static_cast<std::size_t>(axis)];
+    if (weight == 0) continue;  // below the threshold: not sampled (as the gradient)
+    const PlanarMapping mapping{axis, s.options.tiling, s.options.offset};
+    h += weight * s.options.scale * s.height->sample(planarTextureCoordinates(p.position, mapping)).value;
+  }
+  return h;
+}
+double heightOf(const TangentNormalSource&, const SurfacePoint&) { return 0; }
+double heightOf(const ObjectNormalSource&, const SurfacePoint&) { return 0; }
+
+}  // namespace
+
+double layerHeight(const LayerSource& source, const SurfacePoint& point) {
+  const double h = std::visit([&](const auto& s) { return heightOf(s, point); }, source);
+  return std::isfinite(h) ? h : 0.0;
+}
+
+double compositeHeight(std::span<const Layer> layers, const SurfacePoint& point) {
+  double h = 0;
+  for (const Layer& layer : layers) {
+    if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+    const double factor = layer.weight * layerMask(layer.mask, point);
+    if (factor == 0) continue;
+    h += factor * layerHeight(layer.source, point);
+  }
+  return std::isfinite(h) ? h : 0.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shaders (see raster.hpp for the interface)
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+/// State every bake shader shares: the mesh, tangents, layers, and the current triangle.
+struct BakeShaderBase {
+  const Mesh* mesh = nullptr;
+  const CornerTangents* tangents = nullptr;
+  std::span<const Layer> layers;
+  int uvSet = 0;
+  NormalMapGreen green = NormalMapGreen::kOpenGL;
+  ShadingTriangle tri;
+  SurfacePoint point;  ///< constant fields set per triangle, the rest per sample
+
+  void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
+    loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+    beginSurfacePoint(tri, point);
+  }
+  const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
+    return surfacePointAt(tri, b, f, point);
+  }
+  /// perturbedNormal(point, layers) in object space: N' = normalize(N − Γ) (eq. 33 with the
+  /// identity cofactor). Equal to resolveNormal(N, Γ) up to the sign of zero components, without
+  /// its identity matrix products and its fallback normalization (computed for every texel).
+  Vec3d perturbed(const Vec3d& b, const TexelFrame& f) {
+    const SurfacePoint& p = pointAt(b, f);
+    return normalizeOr(p.normal - compositeGradient(layers, p), p.normal);
+  }
+  static void put(const Vec3d& v, double* out) {
+    out[0] = v.x;
+    out[1] = v.y;
+    out[2] = v.z;
+  }
+};
+
+struct TangentNormalShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    const Vec3d normal = layers.empty() ? unitNormal(tri, f) : perturbed(b, f);
+    Vec3d n = objectToTangent(f, normal);
+    if (green == NormalMapGreen::kDirectX) n.y = -n.y;
+    put(encodeNormal(n), out);
+  }
+};
+
+struct ObjectNormalShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    put(encodeNormal(layers.empty() ? unitNormal(tri, f) : perturbed(b, f)), out);
+  }
+};
+
+struct HeightShader : BakeShaderBase {
+  static constexpr int kChannels = 1;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    out[0] = compositeHeight(layers, pointAt(b, f));
+  }
+};
+
+struct DerivativeShader : BakeShaderBase {
+  static constexpr int kChannels = 2;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    const Vec3d gamma = compositeGradient(layers, pointAt(b, f));
+    out[0] = dot(gamma, tri.bakeDPdu);
+    out[1] = dot(gamma, tri.bakeDPdv);
+  }
+};
+
+struct SurfaceGradientShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    put(compositeGradient(layers, pointAt(b, f)), out);
+  }
+};
+
+struct TangentShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    put(encodeNormal(normalizeOr(texelFrame(tri, b).tangent, Vec3d{})), out);
+  }
+};
+
+struct BitangentShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    put(encodeNormal(normalizeOr(texelFrame(tri, b).bitangent, Vec3d{})), out);
+  }
+};
+
+struct MaskShader {
+  static constexpr int kChannels = 1;
+  void beginTriangle(const std::array<std::uint32_t, 3>&) {}
+  void shade(const Vec3d&, int, int, double* out) const { out[0] = 1; }
+};
+
+}  // namespace
+}  // namespace bake_detail
+
+// ---------------------------------------------------------------------------------------------
+// bakeMap
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+Status validateSettings(const BakeInput& input, const BakeSettings& s) {
+  if (input.mesh == nullptr) return Error::badInput("bake: no mesh");
+  const Mesh& mesh = *input.mesh;
+  const std::string where = mesh.source.empty() ? std::string("bake") : mesh.source;
+  if (s.width < 1 || s.height < 1 || s.width > kMaxBakeSide || s.height > kMaxBakeSide) {
+    return Error::badInput(where + ": bake size " + std::to_string(s.width) + "x" +
+                           std::to_string(s.height) + " is out of range (1 to " +
+                           std::to_string(kMaxBakeSide) + " per side)");
+  }
+  if (s.samples < 1 || s.samples > kMaxBakeSamples) {
+    return Error::badInput(where + ": samples " + std::to_string(s.samples) +
+                           " is out of range (1 to " + std::to_string(kMaxBakeSamples) + ")");
+  }
+  if (s.uvSet < 0 || !mesh.hasUvSet(static_cast<std::size_t>(s.uvSet))) {
+    return Error::badInput(where + ": the mesh has no UV set " + std::to_string(s.uvSet) + " (it has " +
+                           std::to_string(mesh.uvSets.size()) + ")");
+  }
+  if (s.udimTile < kFirstUdimTile || s.udimTile > kLastUdimTile) {
+    return Error::badInput(where + ": UDIM tile " + std::to_string(s.udimTile) +
+                           " is out of range (1001 to 2000)");
+  }
+  if (s.threads < 0) return Error::badInput(where + ": threads must be 0 (all cores) or more");
+  if (input.tangents != nullptr && (input.tangents->tangent.size() != mesh.numCorners() ||
+                                    input.tangents->sign.size() != mesh.numCorners())) {
+    return Error::badInput(where + ": tangent frames do not match the mesh (" +
+                           std::to_string(input.tangents->tangent.size()) + " for " +
+                           std::to_string(mesh.numCorners()) + " corners)");
+  }
+  if (mapNeedsTangents(s.map) && input.tangents == nullptr) {
+    return Error::badInput(where + ": the " + std::string(mapKindName(s.map)) +
+                           " map needs tangent frames (none given)");
+  }
+  return validateLayers(input.layers, static_cast<int>(mesh.uvSets.size()));
+}
+
+template <class Shader>
+void runBake(const bake_detail::RasterJob& job, const Shader& shader,
+             const bake_detail::RasterOutput& output, FloatImage& image) {
+  bake_detail::rasterize(job, shader, output, image);
+}
+
+}  // namespace
+
+Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings) {
+  if (Status s = validateSettings(input, settings); !s) return s.error();
+  const Mesh& mesh = *input.mesh;
+  try {
+    const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+    FloatImage image;
+    bake_detail::allocateImage(image, settings.width, settings.height, mapChannels(settings.map),
+                               settings.threads);
+
+    bake_detail::RasterJob job;
+    job.triangles = triangles;
+    job.uvs = mesh.uvSets[static_cast<std::size_t>(settings.uvSet)].uvs;
+    job.width = settings.width;
+    job.height = settings.height;
+    job.samples = settings.samples;
+    job.udimTile = settings.udimTile;
+    job.threads = settings.threads;
+
+    bake_detail::BakeShaderBase base;
+    base.mesh = &mesh;
+    base.tangents = input.tangents;
+    base.layers = input.layers;
+    base.uvSet = settings.uvSet;
+    base.green = settings.green;
+
+    static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
+    static constexpr float kZero[3] = {0, 0, 0};
+    bake_detail::RasterOutput output{kZero, false};
+    using namespace bake_detail;
+    switch (settings.map) {
+      case MapKind::kTangentNormal:
+        output.background = kFlat;
+        runBake(job, TangentNormalShader{base}, output, image);
+        break;
+      case MapKind::kObjectNormal: runBake(job, ObjectNormalShader{base}, output, image); break;
+      case MapKind::kHeight: runBake(job, HeightShader{base}, output, image); break;
+      case MapKind::kDerivative: runBake(job, DerivativeShader{base}, output, image); break;
+      case MapKind::kSurfaceGradient: runBake(job, SurfaceGradientShader{base}, output, image); break;
+      case MapKind::kTangent: runBake(job, TangentShader{base}, output, image); break;
+      case MapKind::kBitangent: runBake(job, BitangentShader{base}, output, image); break;
+      case MapKind::kMask:
+        output.valueIsCoverage = true;
+        runBake(job, MaskShader{}, output, image);
+        break;
+    }
+    return image;
+  } catch (const std::bad_alloc&) {
+    return Error::internal("bake: out of memory for a " + std::to_string(settings.width) + "x" +
+                           std::to_string(settings.height) + " map");
+  }
+}
+
+}  // namespace sgbake

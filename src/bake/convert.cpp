@@ -1,0 +1,143 @@
+// convertNormalMap: object ↔ tangent space per texel, with the same raster and per-texel frame
+// as bakeMap (raster.hpp, texel_frame.hpp).
+#include "sgbake/bake/convert.hpp"
+
+#include <new>
+#include <string>
+
+#include "bake/raster.hpp"
+#include "bake/texel_frame.hpp"
+
+namespace sgbake {
+
+Result<NormalSpace> parseNormalSpace(std::string_view name) {
+  if (name == "object") return NormalSpace::kObject;
+  if (name == "tangent") return NormalSpace::kTangent;
+  return Error::badInput("unknown normal space '" + std::string(name) +
+                         "' (expected object or tangent)");
+}
+
+std::string_view normalSpaceName(NormalSpace space) {
+  return space == NormalSpace::kObject ? "object" : "tangent";
+}
+
+namespace bake_detail {
+namespace {
+
+/// Converts the input texel under each covered sample (see convertNormalMap).
+struct ConvertShader {
+  static constexpr int kChannels = 3;
+  const Mesh* mesh = nullptr;
+  const CornerTangents* tangents = nullptr;
+  const FloatImage* input = nullptr;
+  NormalSpace from = NormalSpace::kObject, to = NormalSpace::kTangent;
+  NormalMapGreen green = NormalMapGreen::kOpenGL;
+  int uvSet = 0;
+  ShadingTriangle tri;
+
+  void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
+    loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+  }
+
+  void shade(const Vec3d& b, int x, int y, double* out) const {
+    const int row = input->height - 1 - y;
+    const Vec3d c{input->at(x, row, 0), input->at(x, row, 1), input->at(x, row, 2)};
+    const Vec3d n = decodeNormalTexel(
+        c, from == NormalSpace::kTangent ? green : NormalMapGreen::kOpenGL);
+    const TexelFrame f = texelFrame(tri, b);
+    Vec3d result;
+    if (from == to) {
+      result = normalizeOr(n, to == NormalSpace::kTangent ? Vec3d{0, 0, 1} : unitNormal(tri, f));
+    } else if (to == NormalSpace::kTangent) {
+      result = objectToTangent(f, n);
+    } else {
+      result = tangentToObject(tri, f, n);
+    }
+    if (to == NormalSpace::kTangent && green == NormalMapGreen::kDirectX) result.y = -result.y;
+    const Vec3d e = encodeNormal(result);
+    out[0] = e.x;
+    out[1] = e.y;
+    out[2] = e.z;
+  }
+};
+
+}  // namespace
+}  // namespace bake_detail
+
+Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tangents,
+                                    const FloatImage& input, NormalSpace from, NormalSpace to,
+                                    const ConvertSettings& settings) {
+  const std::string where = mesh.source.empty() ? std::string("convert") : mesh.source;
+  if (input.width < 1 || input.height < 1 || input.width > kMaxBakeSide ||
+      input.height > kMaxBakeSide) {
+    return Error::badInput(where + ": the normal map is empty or too large (" +
+                           std::to_string(input.width) + "x" + std::to_string(input.height) + ")");
+  }
+  if (input.channels < 3) {
+    return Error::badInput(where + ": the normal map has " + std::to_string(input.channels) +
+                           " channels but 3 are needed (RGB)");
+  }
+  const std::size_t texels = static_cast<std::size_t>(input.width) * input.height;
+  if (input.pixels.size() != texels * static_cast<std::size_t>(input.channels)) {
+    return Error::badInput(where + ": the normal map's pixels do not match its size");
+  }
+  if (settings.uvSet < 0 || !mesh.hasUvSet(static_cast<std::size_t>(settings.uvSet))) {
+    return Error::badInput(where + ": the mesh has no UV set " + std::to_string(settings.uvSet) +
+                           " (it has " + std::to_string(mesh.uvSets.size()) + ")");
+  }
+  if (tangents.tangent.size() != mesh.numCorners() || tangents.sign.size() != mesh.numCorners()) {
+    return Error::badInput(where + ": tangent frames do not match the mesh (" +
+                           std::to_string(tangents.tangent.size()) + " for " +
+                           std::to_string(mesh.numCorners()) + " corners)");
+  }
+  if (settings.udimTile < kFirstUdimTile || settings.udimTile > kLastUdimTile) {
+    return Error::badInput(where + ": UDIM tile " + std::to_string(settings.udimTile) +
+                           " is out of range (1001 to 2000)");
+  }
+  if (settings.samples < 1 || settings.samples > kMaxBakeSamples) {
+    return Error::badInput(where + ": samples " + std::to_string(settings.samples) +
+                           " is out of range (1 to " + std::to_string(kMaxBakeSamples) + ")");
+  }
+  if (settings.threads < 0) return Error::badInput(where + ": threads must be 0 (all cores) or more");
+
+  try {
+    const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+    FloatImage output;
+    output.width = input.width;
+    output.height = input.height;
+    output.channels = input.channels;
+    bake_detail::runWithThreads(settings.threads, [&] {
+      tbb::parallel_invoke(
+          [&] { output.pixels = input.pixels; },  // uncovered texels and extra channels keep the input
+          [&] { output.coverage.resize(texels); });
+    });
+
+    bake_detail::RasterJob job;
+    job.triangles = triangles;
+    job.uvs = mesh.uvSets[static_cast<std::size_t>(settings.uvSet)].uvs;
+    job.width = input.width;
+    job.height = input.height;
+    job.samples = settings.samples;
+    job.udimTile = settings.udimTile;
+    job.threads = settings.threads;
+
+    bake_detail::ConvertShader shader;
+    shader.mesh = &mesh;
+    shader.tangents = &tangents;
+    shader.input = &input;
+    shader.from = from;
+    shader.to = to;
+    shader.green = settings.green;
+    shader.uvSet = settings.uvSet;
+
+    bake_detail::RasterOutput rasterOutput;
+    rasterOutput.keepUncovered = true;
+    bake_detail::rasterize(job, shader, rasterOutput, output);
+    return output;
+  } catch (const std::bad_alloc&) {
+    return Error::internal(where + ": out of memory converting a " + std::to_string(input.width) +
+                           "x" + std::to_string(input.height) + " normal map");
+  }
+}
+
+}  // namespace sgbake

@@ -1,0 +1,260 @@
+/// @file raster.hpp
+/// @brief Private: the texel raster shared by bakeMap and convertNormalMap (see bake.hpp, "Texels
+/// and coverage", for the conventions it implements).
+///
+/// rasterize() walks the texels of one UDIM tile, finds the triangle that claims each sample and
+/// hands (triangle, barycentrics) to a Shader, a small class with a compile-time channel count:
+///
+///     struct Shader {
+///       static constexpr int kChannels = 3;
+///       // Called once per (row block, triangle) before its samples; `corners` are global corner
+///       // indices of the triangle.
+///       void beginTriangle(const std::array<std::uint32_t, 3>& corners);
+///       // One covered sample; writes kChannels values to out. x, y: texel, y up.
+///       void shade(const Vec3d& bary, int x, int y, double* out);
+///     };
+///
+/// Each row block gets its own copy of the shader (so shaders may keep per-triangle state), and
+/// no shader call is virtual: the per-sample path is inlined into the raster loop.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/core/vec.hpp"
+
+namespace sgbake::bake_detail {
+
+/// Rows of texels per parallel work item. Fixed (not derived from the thread count), so the
+/// partition of the work, and therefore every result bit, is the same for any number of threads.
+inline constexpr int kRowsPerBlock = 8;
+
+/// @brief One edge of a triangle as an affine function of the texel-space point p:
+/// E(p) = a·p.x + b·p.y + c, positive inside the triangle, zero on the edge.
+struct EdgeFunction {
+  double a = 0, b = 0, c = 0;
+  /// Whether samples exactly on the edge (E == 0) belong to this triangle (the nudge rule).
+  bool claimsTies = false;
+
+  double operator()(double x, double y) const { return a * x + b * y + c; }
+  bool inside(double e) const { return e > 0 || (e == 0 && claimsTies); }
+};
+
+/// @brief A triangle set up for rasterization in texel space (x right, y up, units of texels,
+/// origin at the tile's lower-left corner).
+struct RasterTriangle {
+  std::array<EdgeFunction, 3> edge;  ///< edge[i] is opposite corner i: E_i ∝ barycentric b_i
+  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  ///< inclusive texel bounding box, clipped to the tile
+};
+
+/// @brief Sets up @p triangle from its corners' texel-space positions.
+///
+/// Edge functions are computed with the edge's endpoints in lexicographic (x, then y) order and
+/// negated as needed, so a neighbour sharing the edge gets bitwise the opposite function; ties go
+/// to the triangle into which the nudge direction ε·(1, 2) + ε²·(1, 0) points.
+/// @return false when the triangle has zero area (it covers nothing) or is outside the tile
+bool setupRasterTriangle(const std::array<Vec2d, 3>& texel, int width, int height,
+                         RasterTriangle& triangle);
+
+/// @brief Texel-space position of UV @p uv in a width × height bake of tile @p udimTile.
+inline Vec2d uvToTexel(Vec2f uv, int udimTile, int width, int height) {
+  const int index = udimTile - kFirstUdimTile;
+  return {(static_cast<double>(uv.x) - static_cast<double>(index % 10)) * width,
+          (static_cast<double>(uv.y) - static_cast<double>(index / 10)) * height};
+}
+
+/// @brief What to rasterize: the triangles, where their corners sit in the image, and how.
+struct RasterJob {
+  std::span<const std::array<std::uint32_t, 3>> triangles;  ///< global corner indices
+  std::span<const Vec2f> uvs;  ///< #C corner UVs of the UV set that places the texels
+  int width = 0, height = 0, samples = 1, udimTile = kFirstUdimTile, threads = 0;
+};
+
+/// @brief Triangles overlapping each block of kRowsPerBlock rows, in ascending triangle order
+/// (compressed rows: the triangles of block k are index[start[k] .. start[k+1])).
+struct TriangleBins {
+  std::vector<std::uint32_t> start;
+  std::vector<std::uint32_t> index;
+};
+
+/// @brief Bins the job's triangles by row block (serial; a few ns per triangle).
+TriangleBins binTriangles(const RasterJob& job);
+
+/// @brief Runs @p work() in a task arena of at most @p threads threads (0: the caller's arena,
+/// i.e. all cores by default).
+template <class Work>
+void runWithThreads(int threads, const Work& work) {
+  if (threads > 0) {
+    tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
+    arena.execute(work);
+  } else {
+    work();
+  }
+}
+
+/// @brief Sizes @p image (width × height × channels, coverage width × height), allocating the
+/// two buffers concurrently: first-touching hundreds of MB is a serial cost that limits scaling.
+/// Their contents are left to rasterize().
+inline void allocateImage(FloatImage& image, int width, int height, int channels, int threads) {
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  const std::size_t texels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  runWithThreads(threads, [&] {
+    tbb::parallel_invoke([&] { image.pixels.resize(texels * static_cast<std::size_t>(channels)); },
+                         [&] { image.coverage.resize(texels); });
+  });
+}
+
+/// @brief How rasterize() finishes a texel.
+struct RasterOutput {
+  std::span<const float> background;  ///< kChannels values of texels no sample covers
+  bool valueIsCoverage = false;       ///< kMask: the value is the coverage fraction itself
+  /// Leave the pixels of uncovered texels as they are (convertNormalMap) instead of writing the
+  /// background (their coverage is still set to 0).
+  bool keepUncovered = false;
+};
+
+/// @brief Rasterizes @p job into @p image (already sized width × height × image.channels with
+/// image.channels ≥ Shader::kChannels, coverage width × height) with @p prototype copied once per
+/// row block. Only channels 0 … kChannels−1 are written.
+///
+/// Texels with covered samples get the mean of the shader's values over those samples and
+/// coverage = covered / N²; others get @p output.background and coverage 0.
+template <class Shader>
+void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput& output,
+               FloatImage& image) {
+  constexpr int kC = Shader::kChannels;
+  const int W = job.width, H = job.height, N = job.samples;
+  const std::size_t stride = static_cast<std::size_t>(image.channels);
+  const TriangleBins bins = binTriangles(job);
+  const int numBlocks = (H + kRowsPerBlock - 1) / kRowsPerBlock;
+
+  std::vector<double> offsets(static_cast<std::size_t>(N));
+  for (int i = 0; i < N; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / N;
+
+  // Per-thread scratch for N > 1: per-texel sums (double) and sample counts of one block.
+  tbb::enumerable_thread_specific<std::vector<double>> sumsTls;
+  tbb::enumerable_thread_specific<std::vector<int>> countsTls;
+
+  auto processBlock = [&](int block) {
+    const int yBegin = block * kRowsPerBlock;
+    const int yEnd = std::min(H, yBegin + kRowsPerBlock);
+    const std::size_t blockTexels = static_cast<std::size_t>(yEnd - yBegin) * W;
+    auto pixelAt = [&](int x, int y) {
+      return image.pixels.data() + (static_cast<std::size_t>(H - 1 - y) * W + x) * stride;
+    };
+    auto coverageAt = [&](int x, int y) -> float& {
+      return image.coverage[static_cast<std::size_t>(H - 1 - y) * W + x];
+    };
+
+    // Start from "nothing covered": background (unless kept) and coverage 0.
+    for (int y = yBegin; y < yEnd; ++y) {
+      for (int x = 0; x < W; ++x) {
+        coverageAt(x, y) = 0;
+        if (!output.keepUncovered) {
+          float* pixel = pixelAt(x, y);
+          for (int c = 0; c < kC; ++c) pixel[c] = output.background[static_cast<std::size_t>(c)];
+        }
+      }
+    }
+    std::vector<double>* sums = nullptr;
+    std::vector<int>* counts = nullptr;
+    if (N > 1) {
+      sums = &sumsTls.local();
+      counts = &countsTls.local();
+      sums->assign(blockTexels * kC, 0.0);
+      counts->assign(blockTexels, 0);
+    }
+
+    Shader shader = prototype;
+    double value[kC];
+    for (std::uint32_t k = bins.start[block]; k < bins.start[block + 1]; ++k) {
+      const std::array<std::uint32_t, 3>& corners = job.triangles[bins.index[k]];
+      RasterTriangle tri;
+      const std::array<Vec2d, 3> texel{uvToTexel(job.uvs[corners[0]], job.udimTile, W, H),
+                                       uvToTexel(job.uvs[corners[1]], job.udimTile, W, H),
+                                       uvToTexel(job.uvs[corners[2]], job.udimTile, W, H)};
+      if (!setupRasterTriangle(texel, W, H, tri)) continue;
+      const int ya = std::max(tri.y0, yBegin), yb = std::min(tri.y1, yEnd - 1);
+      if (ya > yb) continue;
+      bool begun = false;  // load the shading data only if a sample is inside
+      for (int y = ya; y <= yb; ++y) {
+        for (int x = tri.x0; x <= tri.x1; ++x) {
+          for (int j = 0; j < N; ++j) {
+            const double py = y + offsets[static_cast<std::size_t>(j)];
+            for (int i = 0; i < N; ++i) {
+              const double px = x + offsets[static_cast<std::size_t>(i)];
+              const double e0 = tri.edge[0](px, py);
+              if (!tri.edge[0].inside(e0)) continue;
+              const double e1 = tri.edge[1](px, py);
+              if (!tri.edge[1].inside(e1)) continue;
+              const double e2 = tri.edge[2](px, py);
+              if (!tri.edge[2].inside(e2)) continue;
+              if (!begun) {
+                shader.beginTriangle(corners);
+                begun = true;
+              }
+              // Barycentrics from the edge functions; all three are ≥ 0 here.
+              const double sum = e0 + e1 + e2;
+              const double inv = sum > 0 ? 1 / sum : 0;
+              const Vec3d bary = sum > 0 ? Vec3d{e0 * inv, e1 * inv, e2 * inv}
+                                         : Vec3d{1.0 / 3, 1.0 / 3, 1.0 / 3};
+              shader.shade(bary, x, y, value);
+              if (N == 1) {  // each texel has one sample, claimed once: store it
+                float* pixel = pixelAt(x, y);
+                for (int c = 0; c < kC; ++c) pixel[c] = static_cast<float>(value[c]);
+                coverageAt(x, y) = 1;
+              } else {
+                const std::size_t local = static_cast<std::size_t>(y - yBegin) * W + x;
+                for (int c = 0; c < kC; ++c) (*sums)[local * kC + c] += value[c];
+                ++(*counts)[local];
+              }
+            }
+          }
+        }
+      }
+    }
+
+    if (N > 1) {  // mean of the covered samples, coverage = covered / N²
+      for (int y = yBegin; y < yEnd; ++y) {
+        for (int x = 0; x < W; ++x) {
+          const std::size_t local = static_cast<std::size_t>(y - yBegin) * W + x;
+          const int count = (*counts)[local];
+          if (count == 0) continue;
+          float* pixel = pixelAt(x, y);
+          const double* sum = sums->data() + local * kC;
+          for (int c = 0; c < kC; ++c) pixel[c] = static_cast<float>(sum[c] / count);
+          coverageAt(x, y) = static_cast<float>(count) / static_cast<float>(N * N);
+        }
+      }
+    }
+    if (output.valueIsCoverage) {
+      for (int y = yBegin; y < yEnd; ++y)
+        for (int x = 0; x < W; ++x)
+          if (coverageAt(x, y) > 0)
+            for (int c = 0; c < kC; ++c) pixelAt(x, y)[c] = coverageAt(x, y);
+    }
+  };
+
+  runWithThreads(job.threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, numBlocks, 1),
+                      [&](const tbb::blocked_range<int>& r) {
+                        for (int b = r.begin(); b != r.end(); ++b) processBlock(b);
+                      });
+  });
+}
+
+}  // namespace sgbake::bake_detail

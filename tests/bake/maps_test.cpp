@@ -1,0 +1,373 @@
+// The map kinds against closed forms: a flat plane, a linear height field (constant exact
+// answer), and Blender's per-texel frame (T, N, sign interpolated; inverse, not transpose) on a
+// hand-built triangle with hand-made tangents.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bake_test_util.hpp"
+#include "support/parametric_mesh.hpp"
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/volume.hpp"
+
+namespace sgbake {
+namespace {
+
+constexpr double kFloatTol = 2e-6;  // values are stored as float
+
+Vec3d encode(Vec3d n) { return {0.5 * n.x + 0.5, 0.5 * n.y + 0.5, 0.5 * n.z + 0.5}; }
+
+void expectNear(Vec3d a, Vec3d b, double tol, const std::string& what) {
+  EXPECT_NEAR(a.x, b.x, tol) << what;
+  EXPECT_NEAR(a.y, b.y, tol) << what;
+  EXPECT_NEAR(a.z, b.z, tol) << what;
+}
+
+/// A plane P = (Lx·u, Ly·v, 0) over UV [0.1, 0.9]², as a grid of quads (UV = grid parameter).
+Mesh scaledPlane(double lx, double ly) {
+  return test::gridMesh(
+      [&](double s, double t) {
+        const double u = 0.1 + 0.8 * s, v = 0.1 + 0.8 * t;
+        return test::SurfacePoint{{lx * u, ly * v, 0}, {0, 0, 1}, {lx, 0, 0}, {0, ly, 0}};
+      },
+      4, 3, [](double s, double t) { return Vec2d{0.1 + 0.8 * s, 0.1 + 0.8 * t}; });
+}
+
+Result<FloatImage> bake(const Mesh& mesh, const CornerTangents* tangents, std::span<const Layer> layers,
+                        MapKind kind, int size = 32, int samples = 1) {
+  BakeSettings s;
+  s.map = kind;
+  s.width = size;
+  s.height = size;
+  s.samples = samples;
+  return bakeMap({&mesh, tangents, layers}, s);
+}
+
+TEST(Maps, NamesChannelsAndTangentNeeds) {
+  for (const MapKind k : {MapKind::kTangentNormal, MapKind::kObjectNormal, MapKind::kHeight, MapKind::kDerivative,
+                          MapKind::kSurfaceGradient, MapKind::kTangent, MapKind::kBitangent, MapKind::kMask}) {
+    const Result<MapKind> parsed = parseMapKind(mapKindName(k));
+    ASSERT_TRUE(parsed.ok());
+    EXPECT_EQ(*parsed, k);
+  }
+  EXPECT_EQ(mapChannels(MapKind::kDerivative), 2);
+  EXPECT_EQ(mapChannels(MapKind::kHeight), 1);
+  EXPECT_EQ(mapChannels(MapKind::kObjectNormal), 3);
+  EXPECT_TRUE(mapNeedsTangents(MapKind::kTangentNormal));
+  EXPECT_FALSE(mapNeedsTangents(MapKind::kObjectNormal));
+  const Result<MapKind> bad = parseMapKind("normal");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("'normal'"), std::string::npos);
+  EXPECT_NE(bad.error().message.find("tangent-normal"), std::string::npos);
+}
+
+TEST(Maps, FlatPlaneWithoutLayersBakesTheFlatNormal) {
+  const Mesh mesh = scaledPlane(2, 3);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  for (const MapKind kind : {MapKind::kTangentNormal, MapKind::kObjectNormal}) {
+    const Result<FloatImage> image = bake(mesh, &*tangents, {}, kind);
+    ASSERT_TRUE(image.ok()) << image.error().message;
+    int covered = 0;
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 32; ++x) {
+        const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+        const bool inside = u > 0.1 && u < 0.9 && v > 0.1 && v < 0.9;
+        ASSERT_EQ(test::coverageUp(*image, x, y), inside ? 1.0f : 0.0f);
+        const Vec3d c = test::pixelUp(*image, x, y);
+        if (inside) {
+          ++covered;
+          EXPECT_EQ(c.x, 0.5) << mapKindName(kind) << " " << x << "," << y;
+          EXPECT_EQ(c.y, 0.5) << mapKindName(kind) << " " << x << "," << y;
+          EXPECT_EQ(c.z, 1.0) << mapKindName(kind) << " " << x << "," << y;
+        } else {
+          const Vec3d background = kind == MapKind::kTangentNormal ? Vec3d{0.5, 0.5, 1.0} : Vec3d{0, 0, 0};
+          EXPECT_EQ(c, background);
+        }
+      }
+    }
+    EXPECT_EQ(covered, 26 * 26);
+  }
+}
+
+TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
+  // h = scale·(a·u + b·v) on P = (Lx u, Ly v, 0): Γ = scale·(a/Lx, b/Ly, 0), N' = normalize(−Γ + ẑ),
+  // MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself.
+  const double lx = 2, ly = 0.5, a = 0.3, b = -0.2, scale = 0.7;
+  const Mesh mesh = scaledPlane(lx, ly);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::LinearHeight height(a, b);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, scale}, 1.0, {}}};
+  const Vec3d gamma{scale * a / lx, scale * b / ly, 0};
+  const Vec3d perturbed = normalizeOr(Vec3d{-gamma.x, -gamma.y, 1}, Vec3d{});
+
+  for (const int samples : {1, 3}) {
+    const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal, 32, samples);
+    const auto on = bake(mesh, &*tangents, layers, MapKind::kObjectNormal, 32, samples);
+    const auto sg = bake(mesh, &*tangents, layers, MapKind::kSurfaceGradient, 32, samples);
+    const auto dv = bake(mesh, &*tangents, layers, MapKind::kDerivative, 32, samples);
+    const auto ht = bake(mesh, &*tangents, layers, MapKind::kHeight, 32, samples);
+    ASSERT_TRUE(tn.ok() && on.ok() && sg.ok() && dv.ok() && ht.ok());
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 32; ++x) {
+        if (test::coverageUp(*tn, x, y) != 1.0f) continue;
+        const std::string at = std::to_string(x) + "," + std::to_string(y);
+        expectNear(test::pixelUp(*tn, x, y), encode(perturbed), kFloatTol, "tangent-normal " + at);
+        expectNear(test::pixelUp(*on, x, y), encode(perturbed), kFloatTol, "object-normal " + at);
+        expectNear(test::pixelUp(*sg, x, y), gamma, 1e-6, "surface gradient " + at);
+        const int row = 31 - y;
+        EXPECT_NEAR(dv->at(x, row, 0), scale * a, 1e-6) << at;
+        EXPECT_NEAR(dv->at(x, row, 1), scale * b, 1e-6) << at;
+        if (samples == 1) {  // the mean of a linear function over the samples is its centre value
+          const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+          EXPECT_NEAR(ht->at(x, row, 0), scale * (a * u + b * v), 1e-6) << at;
+        }
+      }
+    }
+  }
+}
+
+TEST(Maps, HeightSumsWeightedMaskedHeightLayers) {
+  // On the plane P = (2u, 0.5v, 0): a volume sine along x, a planar (Z) linear height map and a
+  // triplanar one (only the Z plane is active for N = ẑ), weighted, one of them masked by 0.5;
+  // a tangent-space normal-map layer adds no height.
+  const Mesh mesh = scaledPlane(2, 0.5);
+  const Result<DirectionalSine> sine = DirectionalSine::create({0.1, 0.75, {1, 0, 0}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  const test::LinearHeight planar(0.4, -0.3);
+  const test::ConstantColour tilted(Vec3d{0.7, 0.5, 0.9});
+  PlanarSource planarSource;
+  planarSource.height = &planar;
+  planarSource.mapping.tiling = {2, 3};
+  planarSource.scale = 0.2;
+  TriplanarSource triplanar;
+  triplanar.height = &planar;
+  triplanar.options.scale = 0.05;
+  TangentNormalSource normalMap;
+  normalMap.texture = &tilted;
+  class HalfMask final : public ScalarTexture {
+   public:
+    ScalarSample sample(Vec2d) const override { return {0.5, {0, 0}}; }
+  } mask;
+  const std::vector<Layer> layers{
+      Layer{VolumeSource{&*sine, GradientScheme::kAnalytic, 0, 2.0}, 1.5, {}},
+      Layer{planarSource, -1.0, LayerMask{&mask, 0}},
+      Layer{triplanar, 1.0, {}},
+      Layer{normalMap, 1.0, {}},
+  };
+  const auto ht = bake(mesh, nullptr, layers, MapKind::kHeight, 32);
+  ASSERT_TRUE(ht.ok()) << ht.error().message;
+  int checked = 0;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      if (test::coverageUp(*ht, x, y) != 1.0f) continue;
+      const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+      const Vec3d p{2 * u, 0.5 * v, 0};
+      const double volume = 2.0 * 0.1 * std::sin(2 * kPi * 0.75 * p.x + 0.3);
+      const double planarH = 0.2 * (0.4 * 2 * p.x - 0.3 * 3 * p.y);
+      const double triplanarH = 0.05 * (0.4 * p.x - 0.3 * p.y);
+      EXPECT_NEAR(ht->at(x, 31 - y, 0), 1.5 * volume - 0.5 * planarH + triplanarH, 1e-6) << x << "," << y;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 26 * 26);
+}
+
+TEST(Maps, DirectXGreenFlipsG) {
+  const Mesh mesh = scaledPlane(1, 1);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::LinearHeight height(0.2, 0.4);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, 1.0}, 1.0, {}}};
+  BakeSettings s;
+  s.width = s.height = 16;
+  const Result<FloatImage> gl = bakeMap({&mesh, &*tangents, layers}, s);
+  s.green = NormalMapGreen::kDirectX;
+  const Result<FloatImage> dx = bakeMap({&mesh, &*tangents, layers}, s);
+  ASSERT_TRUE(gl.ok() && dx.ok());
+  for (std::size_t i = 0; i < gl->coverage.size(); ++i) {
+    EXPECT_EQ(dx->pixels[3 * i], gl->pixels[3 * i]);
+    EXPECT_FLOAT_EQ(dx->pixels[3 * i + 1], 1.0f - gl->pixels[3 * i + 1]);
+    EXPECT_EQ(dx->pixels[3 * i + 2], gl->pixels[3 * i + 2]);
+  }
+}
+
+// --- Blender's per-texel frame on a hand-built triangle --------------------------------------
+
+struct HandTriangle {
+  Mesh mesh;
+  CornerTangents tangents;
+  std::array<Vec2d, 3> uv;
+  std::array<Vec3d, 3> normal, tangent;
+  std::array<double, 3> sign;
+};
+
+HandTriangle handTriangle() {
+  HandTriangle h;
+  h.uv = {Vec2d{0.05, 0.05}, Vec2d{0.95, 0.1}, Vec2d{0.2, 0.9}};
+  h.normal = {normalizeOr(Vec3d{0, 0, 1}, Vec3d{}), normalizeOr(Vec3d{0.3, 0, 1}, Vec3d{}),
+              normalizeOr(Vec3d{0, -0.4, 1}, Vec3d{})};
+  // Unit tangents, deliberately not orthogonal to the normals, and a sign change inside.
+  h.tangent = {normalizeOr(Vec3d{1, 0, 0.2}, Vec3d{}), normalizeOr(Vec3d{1, 0.2, 0.1}, Vec3d{}),
+               normalizeOr(Vec3d{0.8, -0.3, 0.3}, Vec3d{})};
+  h.sign = {1, 1, -1};
+  std::vector<Vec3f> normals;
+  for (int i = 0; i < 3; ++i) {
+    normals.push_back(cast<float>(h.normal[i]));
+    h.normal[i] = cast<double>(normals.back());  // what the baker reads
+    h.tangents.tangent.push_back(cast<float>(h.tangent[i]));
+    h.tangent[i] = cast<double>(h.tangents.tangent.back());
+    h.tangents.sign.push_back(static_cast<float>(h.sign[i]));
+  }
+  h.mesh = test::polygonMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0.2f}}, {{0, 1, 2}},
+                             {cast<float>(h.uv[0]), cast<float>(h.uv[1]), cast<float>(h.uv[2])},
+                             {0, 0, 1}, normals);
+  for (int i = 0; i < 3; ++i) h.uv[i] = cast<double>(h.mesh.uvSets[0].uvs[i]);
+  return h;
+}
+
+/// Barycentrics of (u, v) in the UV triangle, by Cramer's rule.
+Vec3d barycentrics(const std::array<Vec2d, 3>& t, double u, double v) {
+  const double d = (t[1].x - t[0].x) * (t[2].y - t[0].y) - (t[2].x - t[0].x) * (t[1].y - t[0].y);
+  const double b1 = ((u - t[0].x) * (t[2].y - t[0].y) - (t[2].x - t[0].x) * (v - t[0].y)) / d;
+  const double b2 = ((t[1].x - t[0].x) * (v - t[0].y) - (u - t[0].x) * (t[1].y - t[0].y)) / d;
+  return {1 - b1 - b2, b1, b2};
+}
+
+/// x with M x = n for M = [T B N], by Gaussian elimination with partial pivoting (independent of
+/// the baker's adjugate formula).
+Vec3d solve(Vec3d T, Vec3d B, Vec3d N, Vec3d n) {
+  double m[3][4] = {{T.x, B.x, N.x, n.x}, {T.y, B.y, N.y, n.y}, {T.z, B.z, N.z, n.z}};
+  for (int c = 0; c < 3; ++c) {
+    int p = c;
+    for (int r = c + 1; r < 3; ++r)
+      if (std::abs(m[r][c]) > std::abs(m[p][c])) p = r;
+    for (int k = 0; k < 4; ++k) std::swap(m[c][k], m[p][k]);
+    for (int r = 0; r < 3; ++r) {
+      if (r == c) continue;
+      const double f = m[r][c] / m[c][c];
+      for (int k = 0; k < 4; ++k) m[r][k] -= f * m[c][k];
+    }
+  }
+  return {m[0][3] / m[0][0], m[1][3] / m[1][1], m[2][3] / m[2][2]};
+}
+
+TEST(Maps, PerTexelFrameMatchesTheClosedForm) {
+  const HandTriangle h = handTriangle();
+  // A constant object-space normal map: the perturbed normal is exactly its (unit) value.
+  const Vec3d objectNormal = normalizeOr(Vec3d{0.25, -0.15, 1}, Vec3d{});
+  const test::ConstantColour map(encode(objectNormal));
+  const std::vector<Layer> layers{Layer{ObjectNormalSource{&map, 0}, 1.0, {}}};
+
+  const int size = 48;
+  const auto tangentMap = bake(h.mesh, &h.tangents, {}, MapKind::kTangent, size);
+  const auto bitangentMap = bake(h.mesh, &h.tangents, {}, MapKind::kBitangent, size);
+  const auto normalMap = bake(h.mesh, &h.tangents, {}, MapKind::kObjectNormal, size);
+  const auto tsMap = bake(h.mesh, &h.tangents, layers, MapKind::kTangentNormal, size);
+  ASSERT_TRUE(tangentMap.ok() && bitangentMap.ok() && normalMap.ok() && tsMap.ok());
+
+  int covered = 0, negative = 0;
+  double transposeError = 0;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const Vec3d b = barycentrics(h.uv, (x + 0.5) / size, (y + 0.5) / size);
+      const bool inside = b.x > 1e-9 && b.y > 1e-9 && b.z > 1e-9;
+      const bool outside = b.x < -1e-9 || b.y < -1e-9 || b.z < -1e-9;
+      if (!inside && !outside) continue;  // on an edge: either is right
+      ASSERT_EQ(test::coverageUp(*tangentMap, x, y), inside ? 1.0f : 0.0f) << x << "," << y;
+      if (!inside) continue;
+      ++covered;
+      const Vec3d T = b.x * h.tangent[0] + b.y * h.tangent[1] + b.z * h.tangent[2];
+      const Vec3d N = b.x * h.normal[0] + b.y * h.normal[1] + b.z * h.normal[2];
+      const double s = b.x * h.sign[0] + b.y * h.sign[1] + b.z * h.sign[2];
+      negative += s < 0;
+      const Vec3d B = (s < 0 ? -1.0 : 1.0) * cross(N, T);
+      const std::string at = std::to_string(x) + "," + std::to_string(y);
+      expectNear(test::pixelUp(*tangentMap, x, y), encode(normalizeOr(T, Vec3d{})), kFloatTol, "T " + at);
+      expectNear(test::pixelUp(*bitangentMap, x, y), encode(normalizeOr(B, Vec3d{})), kFloatTol, "B " + at);
+      expectNear(test::pixelUp(*normalMap, x, y), encode(normalizeOr(N, Vec3d{})), kFloatTol, "N " + at);
+      const Vec3d ts = normalizeOr(solve(T, B, N, objectNormal), Vec3d{});
+      expectNear(test::pixelUp(*tsMap, x, y), encode(ts), kFloatTol, "tangent-space " + at);
+      // The transpose would be wrong here (T is not orthogonal to N): make sure the test can tell.
+      const Vec3d transposed = normalizeOr(Vec3d{dot(T, objectNormal), dot(B, objectNormal), dot(N, objectNormal)}, Vec3d{});
+      transposeError = std::max(transposeError, length(transposed - ts));
+    }
+  }
+  EXPECT_GT(covered, 500);
+  EXPECT_GT(negative, 20);  // the interpolated sign flips inside the triangle
+  EXPECT_GT(transposeError, 1e-2);
+}
+
+TEST(Maps, SupersampledNormalsAreTheMeanOfEncodedSamples) {
+  // With 2×2 samples the tangent map of the hand triangle is the mean of the four encoded
+  // sample values (box filter, not renormalized), where all four samples are inside.
+  const HandTriangle h = handTriangle();
+  const int size = 24;
+  const auto map = bake(h.mesh, &h.tangents, {}, MapKind::kTangent, size, 2);
+  ASSERT_TRUE(map.ok());
+  int checked = 0;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      Vec3d sum{};
+      bool all = true;
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+          const Vec3d b = barycentrics(h.uv, (x + (i + 0.5) / 2) / size, (y + (j + 0.5) / 2) / size);
+          all = all && b.x > 1e-9 && b.y > 1e-9 && b.z > 1e-9;
+          sum += encode(normalizeOr(b.x * h.tangent[0] + b.y * h.tangent[1] + b.z * h.tangent[2], Vec3d{}));
+        }
+      if (!all) continue;
+      ++checked;
+      ASSERT_EQ(test::coverageUp(*map, x, y), 1.0f);
+      expectNear(test::pixelUp(*map, x, y), 0.25 * sum, kFloatTol, std::to_string(x) + "," + std::to_string(y));
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(Maps, BadInputIsAnErrorValue) {
+  const Mesh mesh = scaledPlane(1, 1);
+  BakeSettings s;
+  s.width = s.height = 8;
+  EXPECT_FALSE(bakeMap({nullptr, nullptr, {}}, s).ok());
+  const Result<FloatImage> noTangents = bakeMap({&mesh, nullptr, {}}, s);
+  ASSERT_FALSE(noTangents.ok());
+  EXPECT_EQ(noTangents.error().code, ErrorCode::kBadInput);
+  EXPECT_NE(noTangents.error().message.find("tangent"), std::string::npos);
+  s.map = MapKind::kObjectNormal;
+  EXPECT_TRUE(bakeMap({&mesh, nullptr, {}}, s).ok());
+  auto expectBad = [&](BakeSettings bad) {
+    const Result<FloatImage> r = bakeMap({&mesh, nullptr, {}}, bad);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::kBadInput) << r.error().message;
+  };
+  BakeSettings t = s;
+  t.uvSet = 1;
+  expectBad(t);
+  t = s;
+  t.samples = 0;
+  expectBad(t);
+  t = s;
+  t.samples = kMaxBakeSamples + 1;
+  expectBad(t);
+  t = s;
+  t.udimTile = 1000;
+  expectBad(t);
+  t = s;
+  t.width = 0;
+  expectBad(t);
+  t = s;
+  t.threads = -1;
+  expectBad(t);
+  CornerTangents wrong;
+  wrong.tangent.resize(3);
+  wrong.sign.resize(3);
+  EXPECT_FALSE(bakeMap({&mesh, &wrong, {}}, s).ok());
+  const std::vector<Layer> badLayer{Layer{UvHeightSource{nullptr, 0, 1.0}, 1.0, {}}};
+  EXPECT_FALSE(bakeMap({&mesh, nullptr, badLayer}, s).ok());
+}
+
+}  // namespace
+}  // namespace sgbake

@@ -1,0 +1,160 @@
+// Edge padding: Blender's Extend margin grows ring by ring in the L1 metric with IMB_filter_extend's
+// 2/1 weights; push-pull fills every hole and keeps covered texels.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <random>
+
+#include "sgbake/bake/bake.hpp"
+
+namespace sgbake {
+namespace {
+
+constexpr float kHole = std::numeric_limits<float>::quiet_NaN();
+
+/// W×H×C image of holes (NaN, coverage 0).
+FloatImage holes(int w, int h, int c) {
+  FloatImage image;
+  image.width = w;
+  image.height = h;
+  image.channels = c;
+  image.pixels.assign(static_cast<std::size_t>(w) * h * c, kHole);
+  image.coverage.assign(static_cast<std::size_t>(w) * h, 0.0f);
+  return image;
+}
+
+void cover(FloatImage& image, int x, int row, std::initializer_list<float> value, float coverage = 1) {
+  int c = 0;
+  for (const float v : value) image.at(x, row, c++) = v;
+  image.coverage[static_cast<std::size_t>(row) * image.width + x] = coverage;
+}
+
+bool isHole(const FloatImage& image, int x, int row) { return std::isnan(image.at(x, row, 0)); }
+
+TEST(ExtendMargin, GrowsOneL1RingPerPass) {
+  // A 3×2 island; after margin k exactly the texels within L1 distance k of it are written.
+  for (int margin = 0; margin <= 5; ++margin) {
+    FloatImage image = holes(20, 17, 2);
+    for (int row = 7; row < 9; ++row)
+      for (int x = 8; x < 11; ++x) cover(image, x, row, {0.25f, -3.0f});
+    const std::vector<float> coverage = image.coverage;
+    extendMargin(image, margin);
+    EXPECT_EQ(image.coverage, coverage);  // coverage stays geometric
+    for (int row = 0; row < 17; ++row) {
+      for (int x = 0; x < 20; ++x) {
+        const int dx = x < 8 ? 8 - x : (x > 10 ? x - 10 : 0);
+        const int dr = row < 7 ? 7 - row : (row > 8 ? row - 8 : 0);
+        const bool within = dx + dr <= margin;
+        ASSERT_EQ(!isHole(image, x, row), within) << "margin " << margin << " at " << x << "," << row;
+        if (within) {  // averages of equal values
+          EXPECT_EQ(image.at(x, row, 0), 0.25f);
+          EXPECT_EQ(image.at(x, row, 1), -3.0f);
+        }
+      }
+    }
+  }
+}
+
+TEST(ExtendMargin, WeightsEdgeNeighboursTwiceAsMuchAsDiagonalOnes) {
+  // a = 3 at (1, 1), b = 9 at (3, 0) (x, row). One pass:
+  FloatImage image = holes(5, 3, 1);
+  cover(image, 1, 1, {3.0f});
+  cover(image, 3, 0, {9.0f});
+  extendMargin(image, 1);
+  EXPECT_FLOAT_EQ(image.at(2, 1, 0), (2 * 3.0f + 9.0f) / 3);  // a beside (2), b diagonal (1)
+  EXPECT_FLOAT_EQ(image.at(2, 0, 0), (2 * 9.0f + 3.0f) / 3);  // b beside (2), a diagonal (1)
+  EXPECT_FLOAT_EQ(image.at(0, 1, 0), 3.0f);
+  EXPECT_FLOAT_EQ(image.at(1, 0, 0), 3.0f);
+  EXPECT_FLOAT_EQ(image.at(1, 2, 0), 3.0f);
+  EXPECT_FLOAT_EQ(image.at(4, 0, 0), 9.0f);
+  EXPECT_FLOAT_EQ(image.at(3, 1, 0), 9.0f);
+  // A diagonal neighbour alone does not fill a texel (Blender requires an edge neighbour).
+  EXPECT_TRUE(isHole(image, 0, 0));
+  EXPECT_TRUE(isHole(image, 0, 2));
+  EXPECT_TRUE(isHole(image, 2, 2));
+  // The second pass reads the first ring: (0, 0) now has edge neighbours (1, 0) and (0, 1).
+  extendMargin(image, 1);  // covered set is still {a, b}: the same first ring again
+  EXPECT_TRUE(isHole(image, 0, 0));
+  FloatImage twice = holes(5, 3, 1);
+  cover(twice, 1, 1, {3.0f});
+  cover(twice, 3, 0, {9.0f});
+  extendMargin(twice, 2);
+  EXPECT_FLOAT_EQ(twice.at(0, 0, 0), 3.0f);  // (1,0) and (0,1) both 3, (1,1) diagonal 3
+  EXPECT_FLOAT_EQ(twice.at(2, 2, 0), (2 * 3.0f + 2 * 5.0f + 3.0f + 9.0f) / 6);
+}
+
+TEST(ExtendMargin, ThreadsGiveIdenticalBits) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> value(0, 1);
+  FloatImage image = holes(300, 211, 3);
+  for (int k = 0; k < 400; ++k)
+    cover(image, static_cast<int>(rng() % 300), static_cast<int>(rng() % 211), {value(rng), value(rng), value(rng)});
+  FloatImage a = image, b = image;
+  extendMargin(a, 7, 1);
+  extendMargin(b, 7, 2);
+  EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)), 0);
+}
+
+TEST(PushPullFill, FillsEveryHoleAndKeepsCoveredTexels) {
+  for (const auto& [w, h] : std::vector<std::array<int, 2>>{{64, 64}, {37, 19}, {1, 9}, {129, 3}}) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> value(-1, 2);
+    FloatImage image = holes(w, h, 3);
+    for (int k = 0; k < std::max(1, w * h / 50); ++k)
+      cover(image, static_cast<int>(rng() % w), static_cast<int>(rng() % h), {value(rng), value(rng), value(rng)},
+            k % 3 == 0 ? 0.5f : 1.0f);
+    const FloatImage before = image;
+    float lo = INFINITY, hi = -INFINITY;
+    for (std::size_t i = 0; i < before.coverage.size(); ++i)
+      if (before.coverage[i] > 0)
+        for (int c = 0; c < 3; ++c) {
+          lo = std::min(lo, before.pixels[3 * i + c]);
+          hi = std::max(hi, before.pixels[3 * i + c]);
+        }
+    pushPullFill(image, 2);
+    FloatImage serial = before;
+    pushPullFill(serial, 1);
+    EXPECT_EQ(std::memcmp(image.pixels.data(), serial.pixels.data(), image.pixels.size() * sizeof(float)), 0);
+    EXPECT_EQ(image.coverage, before.coverage);
+    for (std::size_t i = 0; i < image.coverage.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const float v = image.pixels[3 * i + c];
+        ASSERT_FALSE(std::isnan(v)) << w << "x" << h << " texel " << i;
+        if (before.coverage[i] > 0) {
+          ASSERT_EQ(std::memcmp(&v, &before.pixels[3 * i + c], sizeof(float)), 0);
+        } else {  // a convex combination of the sources
+          EXPECT_GE(v, lo - 1e-6f);
+          EXPECT_LE(v, hi + 1e-6f);
+        }
+      }
+    }
+  }
+}
+
+TEST(PushPullFill, ConstantSourcesGiveAConstantFillAndNoSourcesChangeNothing) {
+  FloatImage image = holes(50, 30, 1);
+  cover(image, 3, 4, {0.75f});
+  cover(image, 40, 20, {0.75f});
+  pushPullFill(image);
+  for (const float v : image.pixels) EXPECT_FLOAT_EQ(v, 0.75f);
+  FloatImage empty = holes(8, 8, 2);
+  pushPullFill(empty);
+  for (const float v : empty.pixels) EXPECT_TRUE(std::isnan(v));
+}
+
+TEST(Padding, InvalidImagesAreIgnored) {
+  FloatImage bad;
+  bad.width = 4;
+  bad.height = 4;
+  bad.channels = 3;
+  bad.pixels.assign(5, 0.0f);  // wrong size: nothing happens, nothing crashes
+  extendMargin(bad, 3);
+  pushPullFill(bad);
+  EXPECT_EQ(bad.pixels.size(), 5u);
+}
+
+}  // namespace
+}  // namespace sgbake

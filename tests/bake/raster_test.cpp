@@ -1,0 +1,271 @@
+// The texel raster: Blender's looptris, texel centres and row order, the edge rule (every sample
+// of a watertight UV region claimed exactly once), supersampled coverage, UDIM tiles, threads.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+#include "bake_test_util.hpp"
+#include "support/parametric_mesh.hpp"
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/frames/tangents.hpp"
+
+namespace sgbake {
+namespace {
+
+using Tri = std::array<std::uint32_t, 3>;
+
+Mesh quadMesh(std::vector<Vec3f> p) {
+  return test::polygonMesh(p, {{0, 1, 2, 3}}, {{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+}
+
+Result<FloatImage> bakeMask(const Mesh& mesh, int w, int h, int samples = 1, int tile = 1001) {
+  BakeSettings s;
+  s.map = MapKind::kMask;
+  s.width = w;
+  s.height = h;
+  s.samples = samples;
+  s.udimTile = tile;
+  return bakeMap({&mesh, nullptr, {}}, s);
+}
+
+// --- looptris (verified against Blender 3.4.1's Mesh.calc_loop_triangles) -------------------
+
+TEST(LoopTriangles, ConvexQuadSplitsOnDiagonal02) {
+  const auto t = loopTriangles(quadMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}));
+  EXPECT_EQ(t, (std::vector<Tri>{{0, 1, 2}, {0, 2, 3}}));
+}
+
+TEST(LoopTriangles, QuadReflexAtCorner1Or3FlipsToDiagonal13) {
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {0.3f, 0.6f, 0}, {1, 1, 0}, {0, 1, 0}})),
+            (std::vector<Tri>{{0, 1, 3}, {1, 2, 3}}));
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0.6f, 0.3f, 0}})),
+            (std::vector<Tri>{{0, 1, 3}, {1, 2, 3}}));
+  // Bow-tie and a twisted non-planar quad, as Blender.
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0}})),
+            (std::vector<Tri>{{0, 1, 3}, {1, 2, 3}}));
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {1, 0, 1.5f}, {1, 1, 0}, {0, 1, 1.5f}})),
+            (std::vector<Tri>{{0, 1, 3}, {1, 2, 3}}));
+}
+
+TEST(LoopTriangles, ReflexAt0Or2AndTiesKeepDiagonal02) {
+  const std::vector<Tri> keep{{0, 1, 2}, {0, 2, 3}};
+  EXPECT_EQ(loopTriangles(quadMesh({{0.7f, 0.7f, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}})), keep);
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {1, 0, 0}, {0.4f, 0.4f, 0}, {0, 1, 0}})), keep);
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {0.5f, 0.5f, 0}, {1, 1, 0}, {0, 1, 0}})), keep);
+  EXPECT_EQ(loopTriangles(quadMesh({{0, 0, 0}, {1, 0, 0}, {0, 0, 0}, {0, 1, 0}})), keep);
+}
+
+TEST(LoopTriangles, TrianglesAndNgons) {
+  const Mesh mesh = test::polygonMesh(
+      {{0, 0, 0}, {1, 0, 0}, {2, 1, 0}, {1, 2, 0}, {0, 1, 0}, {3, 3, 0}},
+      {{0, 1, 2, 3, 4}, {1, 5, 2}}, std::vector<Vec2f>(8, Vec2f{0, 0}));
+  const auto t = loopTriangles(mesh);
+  ASSERT_EQ(t.size(), 4u);
+  EXPECT_EQ(t[3], (Tri{5, 6, 7}));
+  for (int i = 0; i < 3; ++i)
+    for (const std::uint32_t c : t[static_cast<std::size_t>(i)]) EXPECT_LT(c, 5u);
+}
+
+// --- coverage and the edge rule --------------------------------------------------------------
+
+TEST(Raster, SquareSplitInTwoCoversEveryTexelExactlyOnce) {
+  // The diagonal passes exactly through texel centres when W == H: the tie rule must give each
+  // to exactly one triangle (coverage 2 would mean a double count, 0 a gap).
+  const Mesh mesh = test::uvPlaneMesh({{{0, 0}, {1, 0}, {1, 1}, {0, 1}}});
+  for (const auto& [w, h, n] : std::vector<std::array<int, 3>>{{64, 64, 1}, {37, 23, 1}, {16, 16, 3}, {9, 9, 4}}) {
+    const Result<FloatImage> mask = bakeMask(mesh, w, h, n);
+    ASSERT_TRUE(mask.ok()) << mask.error().message;
+    for (std::size_t i = 0; i < mask->coverage.size(); ++i) {
+      ASSERT_EQ(mask->coverage[i], 1.0f) << w << "x" << h << " N=" << n << " texel " << i;
+      ASSERT_EQ(mask->pixels[i], 1.0f);
+    }
+  }
+}
+
+TEST(Raster, FansAndJitteredGridsCoverExactlyOnce) {
+  // A square as a fan of 4 triangles around its centre (a vertex on a texel centre), and a grid of
+  // quads with jittered interior UVs: samples on shared edges and vertices are claimed once.
+  const Mesh fan = test::uvPlaneMesh({{{0, 0}, {1, 0}, {0.5f, 0.5f}},
+                                      {{1, 0}, {1, 1}, {0.5f, 0.5f}},
+                                      {{1, 1}, {0, 1}, {0.5f, 0.5f}},
+                                      {{0, 1}, {0, 0}, {0.5f, 0.5f}}});
+  for (const int w : {8, 9, 32}) {
+    const Result<FloatImage> mask = bakeMask(fan, w, w, w == 8 ? 2 : 1);
+    ASSERT_TRUE(mask.ok());
+    for (const float c : mask->coverage) ASSERT_EQ(c, 1.0f) << w;
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> jitter(-0.3f, 0.3f);
+  const int n = 6;
+  std::vector<std::vector<Vec2f>> grid(n + 1, std::vector<Vec2f>(n + 1));
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const bool border = i == 0 || j == 0 || i == n || j == n;
+      grid[j][i] = {(float(i) + (border ? 0.0f : jitter(rng))) / float(n),
+                    (float(j) + (border ? 0.0f : jitter(rng))) / float(n)};
+    }
+  // Pixel-aligned interior vertices too: every other one snapped to a texel centre of a 48² bake.
+  for (int j = 1; j < n; j += 2)
+    for (int i = 1; i < n; i += 2) grid[j][i] = {(8.0f * float(i) + 0.5f) / 48, (8.0f * float(j) + 0.5f) / 48};
+  std::vector<std::vector<Vec2f>> faces;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) faces.push_back({grid[j][i], grid[j][i + 1], grid[j + 1][i + 1], grid[j + 1][i]});
+  const Mesh jittered = test::uvPlaneMesh(faces);
+  for (const int samples : {1, 3}) {
+    const Result<FloatImage> mask = bakeMask(jittered, 48, 48, samples);
+    ASSERT_TRUE(mask.ok());
+    for (const float c : mask->coverage) ASSERT_EQ(c, 1.0f) << "samples " << samples;
+  }
+}
+
+TEST(Raster, TexelCentresAndRowOrder) {
+  // A quad covering exactly u < 1/2: columns x < W/2 (centres (x + 0.5)/W < 1/2), every row.
+  for (const int w : {8, 7, 33}) {
+    const Mesh left = test::uvPlaneMesh({{{0, 0}, {0.5f, 0}, {0.5f, 1}, {0, 1}}});
+    const Result<FloatImage> mask = bakeMask(left, w, 5);
+    ASSERT_TRUE(mask.ok());
+    for (int row = 0; row < 5; ++row)
+      for (int x = 0; x < w; ++x)
+        EXPECT_EQ(mask->coverage[static_cast<std::size_t>(row) * w + x], (x + 0.5) / w < 0.5 ? 1.0f : 0.0f)
+            << "W=" << w << " x=" << x;
+  }
+  // A quad covering v < 1/2 covers the bottom rows, i.e. the *last* rows of the image.
+  const Mesh bottom = test::uvPlaneMesh({{{0, 0}, {1, 0}, {1, 0.5f}, {0, 0.5f}}});
+  const Result<FloatImage> mask = bakeMask(bottom, 4, 6);
+  ASSERT_TRUE(mask.ok());
+  for (int row = 0; row < 6; ++row)
+    for (int x = 0; x < 4; ++x)
+      EXPECT_EQ(mask->coverage[static_cast<std::size_t>(row) * 4 + x], row >= 3 ? 1.0f : 0.0f) << row;
+}
+
+TEST(Raster, EdgeThroughTexelCentresGoesToTheNudgedSide) {
+  // Two quads meeting at u = 4.5/8, the centre of column 4. Blender nudges samples by
+  // +(0.001, 0.002) texels, so column 4 belongs to the right quad; together they cover it once.
+  const float m = 4.5f / 8;
+  const Mesh left = test::uvPlaneMesh({{{0, 0}, {m, 0}, {m, 1}, {0, 1}}});
+  const Mesh right = test::uvPlaneMesh({{{m, 0}, {1, 0}, {1, 1}, {m, 1}}});
+  const Result<FloatImage> a = bakeMask(left, 8, 3), b = bakeMask(right, 8, 3);
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (int x = 0; x < 8; ++x) {
+    EXPECT_EQ(a->coverage[static_cast<std::size_t>(x)], x < 4 ? 1.0f : 0.0f) << x;
+    EXPECT_EQ(b->coverage[static_cast<std::size_t>(x)], x >= 4 ? 1.0f : 0.0f) << x;
+  }
+  // Horizontal edge through row centres: the upper quad (nudge +y) takes the row.
+  const float mv = 2.5f / 6;
+  const Mesh low = test::uvPlaneMesh({{{0, 0}, {1, 0}, {1, mv}, {0, mv}}});
+  const Result<FloatImage> c = bakeMask(low, 2, 6);
+  ASSERT_TRUE(c.ok());
+  for (int y = 0; y < 6; ++y) EXPECT_EQ(test::coverageUp(*c, 0, y), y < 2 ? 1.0f : 0.0f) << y;
+}
+
+TEST(Raster, MirroredAndDegenerateUvTriangles) {
+  // Clockwise UVs (a mirrored island) cover like counter-clockwise ones; zero-area UV triangles
+  // cover nothing.
+  const Mesh cw = test::uvPlaneMesh({{{0, 0}, {0, 1}, {1, 1}, {1, 0}}});
+  const Result<FloatImage> mask = bakeMask(cw, 16, 16);
+  ASSERT_TRUE(mask.ok());
+  for (const float c : mask->coverage) ASSERT_EQ(c, 1.0f);
+  // A triangle far larger than the tile covers all of it.
+  const Mesh huge = test::uvPlaneMesh({{{-1000, -1000}, {3000, -1000}, {-1000, 3000}}});
+  const Result<FloatImage> all = bakeMask(huge, 16, 16, 2);
+  ASSERT_TRUE(all.ok());
+  for (const float c : all->coverage) ASSERT_EQ(c, 1.0f);
+  const Mesh flat = test::uvPlaneMesh({{{0, 0}, {1, 1}, {0.5f, 0.5f}}});
+  const Result<FloatImage> none = bakeMask(flat, 16, 16);
+  ASSERT_TRUE(none.ok());
+  for (const float c : none->coverage) ASSERT_EQ(c, 0.0f);
+}
+
+TEST(Raster, SupersampledCoverageIsTheFractionOfSamples) {
+  // Edge at u = 1.5/4: in column 1 the samples at x + 1/8 and x + 3/8 are inside, x + 5/8, 7/8
+  // outside: coverage 8/16 with 4×4 samples; the mask equals the coverage.
+  const float m = 1.5f / 4;
+  const Mesh left = test::uvPlaneMesh({{{0, 0}, {m, 0}, {m, 1}, {0, 1}}});
+  const Result<FloatImage> mask = bakeMask(left, 4, 2, 4);
+  ASSERT_TRUE(mask.ok());
+  for (int row = 0; row < 2; ++row) {
+    const float* c = mask->coverage.data() + row * 4;
+    EXPECT_EQ(c[0], 1.0f);
+    EXPECT_EQ(c[1], 0.5f);
+    EXPECT_EQ(c[2], 0.0f);
+    EXPECT_EQ(c[3], 0.0f);
+    EXPECT_EQ(mask->pixels[static_cast<std::size_t>(row) * 4 + 1], 0.5f);
+  }
+}
+
+// --- UDIM ------------------------------------------------------------------------------------
+
+TEST(Udim, TilesAreReportedAndEachBakeSeesOnlyItsTile) {
+  const Mesh mesh = test::uvPlaneMesh({{{0.25f, 0.25f}, {0.75f, 0.25f}, {0.75f, 0.75f}, {0.25f, 0.75f}},
+                                       {{1.25f, 0.25f}, {1.75f, 0.25f}, {1.75f, 0.5f}, {1.25f, 0.5f}}});
+  EXPECT_EQ(udimTiles(mesh, 0), (std::vector<int>{1001, 1002}));
+  EXPECT_TRUE(udimTiles(mesh, 1).empty());
+
+  const Result<FloatImage> t1 = bakeMask(mesh, 8, 8, 1, 1001);
+  const Result<FloatImage> t2 = bakeMask(mesh, 8, 8, 1, 1002);
+  const Result<FloatImage> t3 = bakeMask(mesh, 8, 8, 1, 1003);
+  ASSERT_TRUE(t1.ok() && t2.ok() && t3.ok());
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      const bool inX = x >= 2 && x < 6;
+      EXPECT_EQ(test::coverageUp(*t1, x, y), inX && y >= 2 && y < 6 ? 1.0f : 0.0f);
+      EXPECT_EQ(test::coverageUp(*t2, x, y), inX && y >= 2 && y < 4 ? 1.0f : 0.0f);
+      EXPECT_EQ(test::coverageUp(*t3, x, y), 0.0f);
+    }
+  }
+}
+
+TEST(Udim, RowsOfTilesBordersAndOutOfRange) {
+  // A quad in tile 1011 (v ∈ [1, 2)), a triangle that only touches tile 1003's border, and
+  // geometry at negative u (no tile).
+  const Mesh mesh = test::uvPlaneMesh({{{0.1f, 1.1f}, {0.9f, 1.1f}, {0.9f, 1.9f}, {0.1f, 1.9f}},
+                                       {{2.2f, 0.2f}, {3.0f, 0.5f}, {2.2f, 0.8f}},
+                                       {{-0.5f, 0.2f}, {-0.1f, 0.2f}, {-0.1f, 0.6f}}});
+  EXPECT_EQ(udimTiles(mesh, 0), (std::vector<int>{1003, 1011}));
+  const Result<FloatImage> t = bakeMask(mesh, 10, 10, 1, 1011);
+  ASSERT_TRUE(t.ok());
+  EXPECT_EQ(test::coverageUp(*t, 5, 5), 1.0f);
+  EXPECT_EQ(test::coverageUp(*t, 0, 0), 0.0f);
+  // A triangle spanning two tiles is baked, clipped, into both.
+  const Mesh spanning = test::uvPlaneMesh({{{0.5f, 0.1f}, {1.5f, 0.1f}, {1.0f, 0.9f}}});
+  EXPECT_EQ(udimTiles(spanning, 0), (std::vector<int>{1001, 1002}));
+  const Result<FloatImage> a = bakeMask(spanning, 16, 16, 1, 1001), b = bakeMask(spanning, 16, 16, 1, 1002);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(test::coverageUp(*a, 15, 4), 1.0f);
+  EXPECT_EQ(test::coverageUp(*b, 0, 4), 1.0f);
+}
+
+// --- threads ---------------------------------------------------------------------------------
+
+TEST(Raster, OneAndManyThreadsGiveIdenticalBits) {
+  const Mesh mesh = test::gridMesh(test::torus, 24, 12);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::SineHeight height(0.01, 3);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, 1.0}, 1.0, {}}};
+  for (const MapKind kind : {MapKind::kTangentNormal, MapKind::kHeight, MapKind::kDerivative}) {
+    BakeSettings s;
+    s.map = kind;
+    s.width = 203;
+    s.height = 97;
+    s.samples = 2;
+    FloatImage reference;
+    for (const int threads : {1, 2, 3, 0}) {
+      s.threads = threads;
+      Result<FloatImage> image = bakeMap({&mesh, &*tangents, layers}, s);
+      ASSERT_TRUE(image.ok()) << image.error().message;
+      if (threads == 1) {
+        reference = std::move(*image);
+        continue;
+      }
+      ASSERT_EQ(image->pixels.size(), reference.pixels.size());
+      EXPECT_EQ(std::memcmp(image->pixels.data(), reference.pixels.data(), reference.pixels.size() * sizeof(float)), 0)
+          << mapKindName(kind) << " threads " << threads;
+      EXPECT_EQ(image->coverage, reference.coverage);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sgbake
