@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job: install what is needed, build sgbake, and run it on the bundled default scene.
-# Outputs go to out/ (override with SGBAKE_OUT).
+# The main job: install what is needed, build sgbake, and bake the bundled default scene
+# (meshes/default_scene.json: Suzanne with a height map and a triplanar layer) into out/
+# (override with SGBAKE_OUT), plus the mesh's MikkTSpace tangent frames as CSV.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
@@ -9,5 +10,6 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSGBAKE_BUILD_TESTS=OFF
 cmake --build build
 out="${SGBAKE_OUT:-out}"
 mkdir -p "$out"
-./build/src/sgbake tangents meshes/suzanne.obj -o "$out/suzanne_tangents.csv" --stats
+./build/src/sgbake bake meshes/default_scene.json --out-dir "$out" --stats
+./build/src/sgbake tangents meshes/suzanne.obj -o "$out/suzanne_tangents.csv"
 echo "wrote $out/suzanne_tangents.csv ($(($(wc -l < "$out/suzanne_tangents.csv") - 1)) corners)"

@@ -15,6 +15,13 @@
 #include "sgbake/sgbake.h"
 
 namespace sgbake::cli {
+
+// (These two belong in cli.hpp next to defineTangentsCommand.)
+/// `sgbake bake`: bake the maps of a scene, or one map (bake_command.cpp).
+CommandAction defineBakeCommand(CLI::App& app);
+/// `sgbake convert`: a normal map between object and tangent space (convert_command.cpp).
+CommandAction defineConvertCommand(CLI::App& app);
+
 namespace {
 
 /// Every subcommand, in the order `sgbake --help` lists them. A new subcommand (`bake`,
@@ -22,6 +29,10 @@ namespace {
 constexpr CommandSpec kCommands[] = {
     {"tangents", "Compute MikkTSpace tangent frames per face corner and write them as CSV",
      defineTangentsCommand},
+    {"bake", "Bake normal, height, mask and other maps of a scene (or one map) to images",
+     defineBakeCommand},
+    {"convert", "Convert a normal map between object space and tangent space",
+     defineConvertCommand},
 };
 
 constexpr const char* kDescription =
@@ -33,6 +44,8 @@ constexpr const char* kFooter =
     "Examples:\n"
     "  sgbake tangents mesh.obj -o tangents.csv\n"
     "  sgbake tangents mesh.obj --uv 1 --threads 4 --stats > tangents.csv\n"
+    "  sgbake bake meshes/default_scene.json --out-dir out\n"
+    "  sgbake convert --mesh mesh.obj --from object --to tangent n_os.exr -o n_ts.exr\n"
     "\n";
 
 /// The names of all subcommands, for messages: "tangents, bake".

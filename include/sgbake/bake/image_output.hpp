@@ -1,0 +1,88 @@
+/// @file image_output.hpp
+/// @brief Writing baked maps to image files (EXR, PNG, TIFF through OpenImageIO), all or nothing,
+/// and the `<UDIM>` token of output file names.
+///
+/// Every file is written to a temporary file in the target's directory and renamed over the
+/// target only once it is complete (sgbake/io/atomic_file.hpp): a failed or interrupted write
+/// never leaves a partial image and never touches an existing file at the target.
+///
+/// Orientation: FloatImage rows are top first, like every image file, so row r of the image is
+/// row r of the file (CONVENTIONS.md, "Texture space"). Values are written as they are (data,
+/// no colour transform); integer formats clamp to [0, 1] and round to the nearest code.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/core/result.hpp"
+
+namespace sgbake {
+
+/// @brief Image file formats writeImage can produce.
+enum class ImageFormat {
+  kAuto,  ///< from the file name's extension (.exr, .png, .tif/.tiff; case-insensitive)
+  kExr,   ///< OpenEXR, zip-compressed; half (16) or float (32) channels
+  kPng,   ///< PNG, 8- or 16-bit unsigned integers
+  kTiff,  ///< TIFF, zip-compressed; 8- or 16-bit unsigned integers or 32-bit float
+};
+
+/// @brief Parses a format name: "exr", "png", "tif"/"tiff" (case-insensitive).
+/// @return kBadInput naming the format and listing the known ones.
+Result<ImageFormat> parseImageFormat(std::string_view name);
+
+/// @brief The lower-case name of @p format ("exr", "png", "tiff"; "auto" for kAuto).
+std::string_view imageFormatName(ImageFormat format);
+
+/// @brief The format writeImage picks for @p path with ImageFormat::kAuto.
+/// @return kBadInput naming the file when the extension is missing or unknown.
+Result<ImageFormat> imageFormatFromPath(const std::filesystem::path& path);
+
+/// @brief The bit depth used when ImageWriteOptions::bitDepth is 0: 16 (EXR half, 16-bit PNG and
+/// TIFF) for every map but the mask, which gets 8 bits in PNG and TIFF (its values are coverage
+/// fractions; 8 bits resolve 1/255, finer than any supersampling grid up to 15×15).
+int defaultBitDepth(ImageFormat format, MapKind map);
+
+/// @brief Whether @p format can store @p bitDepth-bit channels (EXR 16/32, PNG 8/16, TIFF 8/16/32).
+bool formatSupportsBitDepth(ImageFormat format, int bitDepth);
+
+/// @brief Options of writeImage.
+struct ImageWriteOptions {
+  ImageFormat format = ImageFormat::kAuto;  ///< kAuto: from the file name's extension
+  /// Bits per channel: 8, 16 or 32; 0 = 16. EXR: 16 = half, 32 = float; PNG: 8 or 16-bit
+  /// integers; TIFF: 8/16-bit integers or 32-bit float.
+  int bitDepth = 0;
+  /// Append FloatImage::coverage as an alpha channel (unassociated: colour is not divided or
+  /// multiplied by it; PNG gets `oiio:UnassociatedAlpha = 1`).
+  bool alpha = false;
+};
+
+/// @brief Writes @p image to @p path, all or nothing.
+///
+/// Channels: 1 → grey ("Y"), 2 → R, G (plus a zero B channel in PNG and TIFF, which have no
+/// two-channel colour layout: two channels would be read as grey + alpha), 3 → R, G, B; plus A
+/// when options.alpha. Integer formats: each value is clamped to [0, 1] and rounded to the
+/// nearest of 2^bits − 1 codes; NaN is written as 0. EXR keeps values as they are (half rounds
+/// to nearest even; values beyond ±65504 become ±infinity in half).
+///
+/// Errors name the file, in one line: an extension writeImage does not know
+/// (`out/n.jpg: unknown image format '.jpg' (use .exr, .png, .tif or .tiff)`), a bit depth the
+/// format cannot store (`out/n.png: PNG cannot store 32-bit channels (use 8 or 16)`), an empty or
+/// inconsistent image, and a missing or unwritable directory (`out/n.png: cannot create file: No
+/// such file or directory`) are kBadInput; a failure while writing (disk full) is kInternal.
+/// On any failure the target is left as it was and no temporary file remains.
+Status writeImage(const FloatImage& image, const std::filesystem::path& path,
+                  const ImageWriteOptions& options = {});
+
+/// The token an output file name carries to be baked once per UDIM tile.
+inline constexpr std::string_view kUdimToken = "<UDIM>";
+
+/// @brief Whether @p path contains kUdimToken.
+bool hasUdimToken(std::string_view path);
+
+/// @brief @p path with every kUdimToken replaced by the tile number ("n.<UDIM>.png", 1002 →
+/// "n.1002.png"). Paths without the token are returned unchanged.
+std::string expandUdimToken(std::string_view path, int tile);
+
+}  // namespace sgbake

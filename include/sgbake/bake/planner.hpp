@@ -1,0 +1,187 @@
+/// @file planner.hpp
+/// @brief From a Scene to files on disk: a Plan of exactly the work the outputs need, its
+/// explanation (`sgbake bake --explain`), the manifest that makes re-runs incremental, and the
+/// execution.
+///
+/// ## What the planner leaves out
+/// - Tangent frames, unless an output map is expressed in them (tangent-normal, tangent,
+///   bitangent) or a layer an output reads is a tangent-space normal map on UV set 0 (decoded in
+///   the MikkTSpace frame). The corner table computes its own.
+/// - Layers no output reads: weight 0; every layer for tangent, bitangent and mask maps (they
+///   read none); layers without a height (normal maps) for height maps; everything read only by
+///   outputs that are up to date.
+/// - Images only those layers use. An image file read by several layers is loaded once per
+///   channel selection (heights and masks: luminance; normal maps: RGB), and one texture is made
+///   per (image, filter, wrap), whatever the number of layers using it.
+/// - Outputs that are up to date (see the manifest), unless PlanOptions::force.
+/// The kernels skip more on their own: texels outside the UV islands (background, then margin)
+/// and triplanar planes whose blend weight is below the layer's min_weight. explainPlan lists
+/// all of it under "skipped:".
+///
+/// ## The manifest
+/// `.sgbake-manifest.json` in the directory of each output, one entry per output file name:
+/// ```json
+/// { "sgbake_manifest": 1,
+///   "outputs": {
+///     "n.png": { "parameters": { ...canonical parameters... },
+///                "inputs": { "/abs/path/m.obj": "fnv1a64:89abcdef01234567", ... },
+///                "files": { "n.png": "fnv1a64:0123456789abcdef" } } } }
+/// ```
+/// - "parameters": everything that determines the output besides file contents — the map and
+///   its settings, the mesh's canonical path, the UV set, every layer it reads (with canonical
+///   image paths), the subdivision block and the sgbake version — as JSON with sorted keys.
+/// - "inputs": canonical path → 64-bit FNV-1a hash of the file's bytes, for the mesh and every
+///   image the output reads.
+/// - "files": the file name of each written file (one per UDIM tile for `<UDIM>` names) → hash
+///   of its bytes as written.
+/// An output is up to date when its entry exists, the parameters are equal, every input hash
+/// matches the file now, and every written file still exists with the recorded hash. Entries of
+/// other outputs in the same directory are kept. A manifest that cannot be read is ignored
+/// (everything in that directory is re-baked) and rewritten.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sgbake/bake/scene.hpp"
+#include "sgbake/core/result.hpp"
+#include "sgbake/gradient/image.hpp"
+
+namespace sgbake {
+
+/// File name of the manifest, written in each output directory.
+inline constexpr const char* kManifestName = ".sgbake-manifest.json";
+
+/// @brief 64-bit FNV-1a of @p bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
+std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash = 0xcbf29ce484222325ULL);
+
+/// @brief "fnv1a64:" and the 16 lower-case hex digits of the FNV-1a hash of the file at @p path.
+/// @return kBadInput naming the file when it cannot be read.
+Result<std::string> hashFile(const std::filesystem::path& path);
+
+/// @brief An image file to read, once.
+struct PlannedImage {
+  std::filesystem::path path;       ///< as the scene resolved it (for messages)
+  std::filesystem::path canonical;  ///< weakly_canonical(path): with channels, the dedupe key
+  ImageChannels channels = ImageChannels::kLuminance;  ///< kLuminance or kRgb (normal maps)
+  std::vector<std::string> users;                      ///< "layers[0]", "layers[2].mask", ...
+};
+
+/// @brief A texture made from a loaded image, shared by every layer with the same settings.
+struct PlannedTexture {
+  std::size_t image = 0;  ///< index into Plan::images
+  bool vector = false;    ///< ImageVectorTexture (normal maps) or ImageScalarTexture
+  Filter filter = Filter::kBilinear;
+  Wrap wrap = Wrap::kRepeat;
+};
+
+/// @brief A scene layer some output to bake reads.
+struct PlannedLayer {
+  std::size_t sceneLayer = 0;          ///< index into Scene::layers
+  std::optional<std::size_t> texture;  ///< index into Plan::textures (image layers)
+  std::optional<std::size_t> mask;     ///< index into Plan::textures (masked layers)
+};
+
+/// @brief One scene output.
+struct PlannedOutput {
+  std::size_t sceneOutput = 0;      ///< index into Scene::outputs
+  bool upToDate = false;            ///< the manifest says nothing changed: not baked
+  std::vector<std::size_t> layers;  ///< indices into Plan::layers it reads, in scene order
+  std::string parameters;           ///< canonical JSON of its parameters (manifest)
+  /// The files it depends on (canonical path → hash): the mesh and its layers' images. Empty
+  /// when the manifest is off.
+  std::vector<std::pair<std::string, std::string>> inputHashes;
+};
+
+/// @brief One line of the plan: what is done and why.
+struct PlanStep {
+  std::string what;
+  std::string why;
+};
+
+/// @brief Options of makePlan.
+struct PlanOptions {
+  bool force = false;       ///< bake every output, up to date or not
+  bool useManifest = true;  ///< read and write the manifest (false: always bake, write none)
+};
+
+/// @brief The work a scene needs, decided before any of it is done.
+struct Plan {
+  Scene scene;
+  PlanOptions options;
+  bool loadMesh = false;         ///< false when every output is up to date
+  bool computeTangents = false;  ///< MikkTSpace frames of UV set 0 for the baker
+  std::vector<PlannedImage> images;
+  std::vector<PlannedTexture> textures;
+  std::vector<PlannedLayer> layers;
+  std::vector<PlannedOutput> outputs;  ///< one per scene output, in scene order
+  std::vector<PlanStep> steps;         ///< in execution order
+  std::vector<PlanStep> skipped;       ///< work left out, and why
+  double planSeconds = 0;              ///< time makePlan took (mostly hashing files)
+
+  /// @brief Number of outputs that will be baked.
+  std::size_t outputsToBake() const;
+};
+
+/// @brief Plans @p scene: checks that the files it reads exist, decides what each output reads,
+/// and (with the manifest) which outputs are up to date.
+/// @return kBadInput for a scene asking for subdivision ("subdivision is not supported yet"),
+/// a missing mesh or image (naming the file and the layer), or a scene validateScene rejects.
+Result<Plan> makePlan(Scene scene, const PlanOptions& options = {});
+
+/// @brief The plan as text: a header, one numbered line per step (what: why), and a "skipped:"
+/// list with reasons. Every line ends with '\n'.
+std::string explainPlan(const Plan& plan);
+
+/// @brief Progress of executePlan: @p done of @p total units of work are finished, and the
+/// one that starts now is @p what.
+struct BakeProgress {
+  std::size_t done = 0;
+  std::size_t total = 0;
+  std::string_view what;
+};
+
+/// @brief Options of executePlan.
+struct ExecuteOptions {
+  int threads = 0;  ///< maximum threads of every kernel; 0 = all cores
+  /// Called before each unit of work (loading, tangents, each output tile) and once at the end
+  /// with done == total; may be empty.
+  std::function<void(const BakeProgress&)> progress;
+};
+
+/// @brief What happened to one output.
+struct OutputReport {
+  std::filesystem::path file;                ///< the scene's file name (may contain `<UDIM>`)
+  bool baked = false;                        ///< false: up to date, not touched
+  std::vector<std::filesystem::path> files;  ///< files written (one per UDIM tile)
+};
+
+/// @brief Timings (seconds) and counts of an execution.
+struct ExecuteReport {
+  std::vector<OutputReport> outputs;  ///< one per scene output, in scene order
+  std::size_t imagesLoaded = 0;
+  std::size_t texturesCreated = 0;
+  bool tangentsComputed = false;
+  std::size_t tilesBaked = 0;
+  double loadSeconds = 0;      ///< mesh, images, textures, volumes
+  double tangentsSeconds = 0;  ///< MikkTSpace frames
+  double bakeSeconds = 0;      ///< bakeMap and the corner table
+  double padSeconds = 0;       ///< margins
+  double writeSeconds = 0;     ///< image and CSV files, output hashes, manifests
+};
+
+/// @brief Runs @p plan: loads the mesh (it must have UVs) and images, computes tangents if
+/// needed, bakes each output that is not up to date (every UDIM tile of a `<UDIM>` file name,
+/// else its tile), pads it, writes it all or nothing, and records it in the manifest.
+///
+/// Everything is loaded and checked before the first file is written, so bad input (an
+/// unreadable image, a mesh without UVs or without a UV set an output or layer names) leaves
+/// every output untouched. Output directories are created when missing.
+Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& options = {});
+
+}  // namespace sgbake

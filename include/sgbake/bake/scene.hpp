@@ -1,0 +1,257 @@
+/// @file scene.hpp
+/// @brief Bake scenes: which mesh, which bump layers, which maps to write — parsed strictly from
+/// the scene JSON that `sgbake bake SCENE.json` reads.
+///
+/// ## The scene file
+/// ```json
+/// { "mesh": "m.obj", "uv": 0,
+///   "subdivision": {"level": "limit" | 2, "uv_smooth": "keep-boundaries", "boundary": "all"},
+///   "layers": [
+///     {"type": "height", "image": "h.exr", "scale": 0.1, "filter": "bicubic", "uv": 0},
+///     {"type": "normal", "image": "n.png", "space": "tangent", "green": "opengl"},
+///     {"type": "volume", "function": "sine", "amplitude": 1, "frequency": 1,
+///      "direction": [1,0,0], "phase": 0, "gradient": "analytic", "step": 0.001},
+///     {"type": "triplanar", "image": "t.png", "kind": "height", "scale": 0.1, "tiling": 1,
+///      "sharpness": 4} ],
+///   "outputs": [ {"map": "tangent-normal", "file": "out/n.png", "size": 2048, "margin": 16,
+///                 "samples": 1, "green": "opengl"} ] }
+/// ```
+/// `sgbake bake --help` lists every key. The rules:
+/// - Relative paths (mesh, images, masks, output files) are relative to the scene file's
+///   directory (output files: to SceneParseOptions::outputDir when given).
+/// - Strict: an unknown key is an error naming it, its place and the closest known key
+///   (`outputs[0]: unknown key 'sise' (did you mean 'size'?)`); so are wrong types, values out of
+///   range and unknown names. Keys starting with `_` are comments and are ignored.
+/// - Defaults: top-level "uv" (default 0) is the UV set of every layer and output that does not
+///   give its own; size 1024, margin 16, padding "extend", samples 1, green "opengl", weight 1,
+///   filter "bilinear", tiling 1, offset 0, scale/strength 1, triplanar sharpness 4.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/bake/convert.hpp"
+#include "sgbake/bake/image_output.hpp"
+#include "sgbake/core/result.hpp"
+#include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/projection.hpp"
+#include "sgbake/gradient/volume.hpp"
+
+namespace sgbake {
+
+/// Default output size (Blender's default bake image) and margin (Blender's default), texels.
+/// Sizes and margins go up to kMaxBakeSide, samples to kMaxBakeSamples, tiles from
+/// kFirstUdimTile to kLastUdimTile (bake.hpp).
+inline constexpr int kDefaultOutputSize = 1024;
+inline constexpr int kDefaultMargin = 16;
+
+/// @brief The "type" of a scene layer.
+enum class SceneLayerType {
+  kHeight,     ///< "height": a height image on a UV set (UvHeightSource)
+  kNormal,     ///< "normal": a tangent- or object-space normal map on a UV set
+  kVolume,     ///< "volume": a procedural height volume (VolumeSource)
+  kPlanar,     ///< "planar": an image projected along one axis (PlanarSource)
+  kTriplanar,  ///< "triplanar": an image projected on the three axis planes (TriplanarSource)
+};
+
+/// @brief The scene name of @p type ("height", ...).
+std::string_view sceneLayerTypeName(SceneLayerType type);
+
+/// @brief "function" of a volume layer.
+enum class VolumeFunction {
+  kSine,   ///< DirectionalSine
+  kNoise,  ///< GradientNoise
+};
+
+/// @brief How an output fills the texels outside the UV islands ("padding").
+enum class PaddingMode {
+  kExtend,    ///< "extend": extendMargin by the output's margin (Blender's "Extend")
+  kPushPull,  ///< "push-pull": pushPullFill, every uncovered texel (the margin is ignored)
+};
+
+/// @brief Subdivision "uv_smooth" (Blender's UV Smooth of the Subdivision Surface modifier).
+enum class SubdivisionUvSmooth {
+  kNone,                         ///< "none"
+  kKeepCorners,                  ///< "keep-corners"
+  kKeepCornersJunctions,         ///< "keep-corners-junctions"
+  kKeepCornersJunctionsConcave,  ///< "keep-corners-junctions-concave"
+  kKeepBoundaries,               ///< "keep-boundaries" (Blender's default)
+  kAll,                          ///< "all"
+};
+
+/// @brief Subdivision "boundary" (Blender's Boundary Smooth).
+enum class SubdivisionBoundary {
+  kAll,          ///< "all" (Blender's default)
+  kKeepCorners,  ///< "keep-corners"
+};
+
+/// @brief The scene's "subdivision" block. Parsed and validated; not implemented yet (the
+/// planner reports a scene that asks for it as unsupported).
+struct SceneSubdivision {
+  bool present = false;  ///< the scene has a "subdivision" block
+  bool limit = false;    ///< "level": "limit" — the limit surface
+  int level = 0;         ///< "level": N — N uniform levels (0 = none)
+  SubdivisionUvSmooth uvSmooth = SubdivisionUvSmooth::kKeepBoundaries;
+  SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
+  /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
+  bool requested() const { return present && (limit || level > 0); }
+};
+
+/// @brief A layer's optional "mask": a scalar image on a UV set that scales its Γ (LayerMask).
+/// Written either as a file name or as {"image", "uv", "tiling", "offset", "filter"}.
+struct SceneMask {
+  std::filesystem::path image;  ///< resolved against the scene's directory
+  int uvSet = 0;  ///< "uv"; default: the layer's UV set (the scene's for volumes, projections)
+  Vec2d tiling{1, 1};
+  Vec2d offset{0, 0};
+  Filter filter = Filter::kBilinear;
+};
+
+/// @brief One entry of "layers". Only the members of its type are meaningful.
+struct SceneLayer {
+  SceneLayerType type = SceneLayerType::kHeight;
+  std::string name;   ///< optional "name", for messages and --explain
+  double weight = 1;  ///< "weight": any finite value; 0 disables the layer
+  std::optional<SceneMask> mask;
+
+  // Image layers (height, normal, planar, triplanar).
+  std::filesystem::path image;        ///< "image", resolved against the scene's directory
+  Filter filter = Filter::kBilinear;  ///< "filter": bilinear | bicubic | hermite (heights only)
+  Wrap wrap = Wrap::kRepeat;          ///< "wrap": repeat | clamp
+  int uvSet = 0;                      ///< "uv" (height, normal)
+  Vec2d tiling{1, 1};                 ///< "tiling": a number or [s, t]
+  Vec2d offset{0, 0};                 ///< "offset": [s, t]
+  /// "scale" (height, planar, triplanar: object units per unit of value; strength for projected
+  /// normal maps) or "strength" (normal).
+  double scale = 1;
+  NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
+  NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps, all projections)
+  ProjectedKind kind = ProjectedKind::kHeight;     ///< "kind" (planar, triplanar)
+  ProjectionAxis axis = ProjectionAxis::kZ;        ///< "axis" (planar)
+  double sharpness = kDefaultTriplanarSharpness;   ///< "sharpness" (triplanar)
+  double minWeight = kDefaultMinTriplanarWeight;   ///< "min_weight" (triplanar)
+
+  // Volume layers.
+  VolumeFunction function = VolumeFunction::kSine;      ///< "function"
+  double amplitude = 1;                                 ///< "amplitude"
+  double frequency = 1;                                 ///< "frequency"
+  Vec3d direction{1, 0, 0};                             ///< "direction" (sine)
+  double phase = 0;                                     ///< "phase" (sine), radians
+  std::uint64_t seed = 0;                               ///< "seed" (noise)
+  int octaves = 1;                                      ///< "octaves" (noise)
+  GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
+  std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
+
+  /// @brief Whether the layer reads an image ("image" key): every type but volume.
+  bool hasImage() const { return type != SceneLayerType::kVolume; }
+  /// @brief Whether its image is a normal map (three channels) rather than heights.
+  bool readsNormals() const;
+  /// @brief Whether the layer has a height (a height map can bake it): height, volume, and
+  /// planar/triplanar of kind height. Normal maps have slopes only.
+  bool hasHeight() const;
+};
+
+/// @brief What an output writes.
+enum class OutputKind {
+  kMap,      ///< a baked map (MapKind), written as an image
+  kCorners,  ///< "map": "corners": the per-corner table (corners.hpp) as CSV
+};
+
+/// @brief One entry of "outputs".
+struct SceneOutput {
+  OutputKind kind = OutputKind::kMap;
+  MapKind map = MapKind::kTangentNormal;  ///< for kMap
+  /// "file", resolved against the output directory; may contain `<UDIM>` (one file per tile
+  /// the UV set touches).
+  std::filesystem::path file;
+  int width = kDefaultOutputSize;                  ///< "size" or "width"
+  int height = kDefaultOutputSize;                 ///< "size" or "height"
+  int margin = kDefaultMargin;                     ///< "margin", texels
+  PaddingMode padding = PaddingMode::kExtend;      ///< "padding"
+  int samples = 1;                                 ///< "samples": N×N per texel
+  int uvSet = 0;                                   ///< "uv"
+  NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps)
+  int tile = kFirstUdimTile;  ///< "tile": the UDIM tile when the file has no `<UDIM>` token
+  ImageFormat format = ImageFormat::kAuto;  ///< "format": exr | png | tiff (default: extension)
+  int bitDepth = 0;                         ///< "bit_depth": 8, 16 or 32; 0 = defaultBitDepth
+  bool alpha = false;                       ///< "alpha": write the coverage as alpha
+
+  /// @brief The image format the file is written in (format, else from the extension).
+  ImageFormat resolvedFormat() const;
+  /// @brief The bit depth written (bitDepth, else defaultBitDepth).
+  int resolvedBitDepth() const;
+};
+
+/// @brief A parsed scene: every path resolved, every value validated.
+struct Scene {
+  std::filesystem::path source;  ///< the scene file ("" for scenes built in code)
+  std::filesystem::path mesh;    ///< resolved
+  int uvSet = 0;                 ///< top-level "uv": default UV set of layers and outputs
+  SceneSubdivision subdivision;
+  std::vector<SceneLayer> layers;
+  std::vector<SceneOutput> outputs;
+};
+
+/// @brief Where parseScene resolves relative paths and how it names the scene in messages.
+struct SceneParseOptions {
+  std::filesystem::path baseDir;    ///< relative mesh/image paths start here ("" = cwd)
+  std::filesystem::path outputDir;  ///< relative output files start here ("" = baseDir)
+  std::string name = "scene";       ///< prefix of every message ("scene.json: ...")
+};
+
+/// @brief Parses and validates a scene from JSON text.
+///
+/// Checks syntax, every key and type, and every value's range; resolves paths. Does not touch
+/// the files it names (the planner checks them).
+/// @return kBadInput with one line `<name>: <where>: <what>`, e.g.
+///   `scene.json: outputs[0]: unknown key 'sise' (did you mean 'size'?)`,
+///   `scene.json: outputs[0]: size 100000 is out of range 1..65536`,
+///   `scene.json: outputs[1]: unknown map 'tangent-normals' (did you mean 'tangent-normal'?)`.
+Result<Scene> parseScene(std::string_view json, const SceneParseOptions& options);
+
+/// @brief Reads @p path and parses it, relative paths against its directory.
+/// @param[in] outputDir relative output files start here ("" = the scene's directory)
+Result<Scene> loadScene(const std::filesystem::path& path,
+                        const std::filesystem::path& outputDir = {});
+
+/// @brief Checks a scene built in code with the same rules parseScene applies to values
+/// (ranges, finite numbers, formats and bit depths, duplicate output files, at least one output).
+/// @return kBadInput naming the layer or output (`outputs[0]: size 0 is out of range 1..65536`).
+Status validateScene(const Scene& scene);
+
+/// @brief The scene name of @p filter ("bilinear", "bicubic", "hermite").
+std::string_view filterName(Filter filter);
+
+/// @brief A short description of @p layer for messages and --explain, e.g.
+/// `height image meshes/h.png`, `tangent-space normal map n.png`, `volume noise`,
+/// `triplanar height t.png`; prefixed with the layer's "name" when it has one.
+std::string describeLayer(const SceneLayer& layer);
+
+/// @brief The parameters of @p layer as canonical JSON text: sorted keys, every default filled
+/// in, image paths made canonical (absolute, symbolic links resolved) — equal text means an
+/// equal layer. For the manifest.
+std::string layerParametersJson(const SceneLayer& layer);
+
+/// @brief The parameters of @p output as canonical JSON text (like layerParametersJson; the
+/// file itself is not included, the resolved format and bit depth are).
+std::string outputParametersJson(const SceneOutput& output);
+
+/// @brief The subdivision block as canonical JSON text ("null" when the scene has none).
+std::string subdivisionParametersJson(const SceneSubdivision& subdivision);
+
+/// @brief @p path made absolute and canonical as far as it exists (weakly_canonical); the
+/// lexically normal absolute path when that fails.
+std::filesystem::path canonicalPath(const std::filesystem::path& path);
+
+/// @brief The closest of @p candidates to @p word (edit distance at most 2 and less than half
+/// its length), or "" — for "did you mean" suggestions.
+std::string closestMatch(std::string_view word, const std::vector<std::string>& candidates);
+
+}  // namespace sgbake

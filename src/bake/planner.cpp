@@ -1,0 +1,1010 @@
+/// @file planner.cpp
+/// @brief Planning a scene, explaining the plan, the manifest, and running the plan (see
+/// planner.hpp).
+#include "sgbake/bake/planner.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <memory>
+#include <new>
+#include <set>
+#include <system_error>
+#include <tuple>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/bake/image_output.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/corners.hpp"
+#include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/volume.hpp"
+#include "sgbake/io/atomic_file.hpp"
+#include "sgbake/mesh/io.hpp"
+#include "sgbake/sgbake.h"
+
+namespace sgbake {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+/// Version of the manifest's layout ("sgbake_manifest": 1).
+constexpr int kManifestVersion = 1;
+
+/// Seconds since @p start.
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// "scene.json: " for scenes read from a file, "" for scenes built in code.
+std::string scenePrefix(const Scene& scene) {
+  return scene.source.empty() ? std::string() : scene.source.string() + ": ";
+}
+
+std::string layerLabel(std::size_t i) { return "layers[" + std::to_string(i) + "]"; }
+std::string outputLabel(std::size_t i) { return "outputs[" + std::to_string(i) + "]"; }
+
+/// The directory that holds @p file ("." for a bare name).
+fs::path directoryOf(const fs::path& file) {
+  const fs::path dir = file.parent_path();
+  return dir.empty() ? fs::path(".") : dir;
+}
+
+/// Why @p output does not read @p layer, or "" when it does.
+std::string whyNotRead(const SceneOutput& output, const SceneLayer& layer) {
+  if (layer.weight == 0) return "weight 0";
+  if (output.kind == OutputKind::kCorners) return {};
+  switch (output.map) {
+    case MapKind::kTangent:
+    case MapKind::kBitangent:
+    case MapKind::kMask:
+      return std::string(mapKindName(output.map)) + " maps read no layers";
+    case MapKind::kHeight:
+      if (!layer.hasHeight())
+        return "height maps read only layers with a height (normal maps have none)";
+      break;
+    default:
+      break;
+  }
+  return {};
+}
+
+/// Whether a layer read by a baked map needs MikkTSpace frames: a tangent-space normal map on
+/// UV set 0 is decoded in them (TangentFrameChoice::kAuto).
+bool layerNeedsTangents(const SceneLayer& layer) {
+  return layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent &&
+         layer.uvSet == 0;
+}
+
+std::string describeOutput(const SceneOutput& output) {
+  if (output.kind == OutputKind::kCorners) return "the corner table " + output.file.string();
+  return "the " + std::string(mapKindName(output.map)) + " map " + output.file.string();
+}
+
+// ---- Manifest ----------------------------------------------------------------------------------
+
+/// The manifests of the output directories, read once per plan.
+class ManifestCache {
+ public:
+  /// The entry of @p file in its directory's manifest, or null.
+  const json* entry(const fs::path& file) {
+    const json& manifest = load(directoryOf(file));
+    const auto outputs = manifest.find("outputs");
+    if (outputs == manifest.end() || !outputs->is_object()) return nullptr;
+    const auto found = outputs->find(file.filename().string());
+    return found == outputs->end() ? nullptr : &*found;
+  }
+
+ private:
+  const json& load(const fs::path& dir) {
+    const std::string key = dir.string();
+    if (const auto it = manifests_.find(key); it != manifests_.end()) return it->second;
+    json manifest = json::object();
+    std::ifstream in(dir / kManifestName, std::ios::binary);
+    if (in) {
+      // A manifest that is not ours or not valid JSON counts as empty: everything re-bakes.
+      json parsed = json::parse(in, nullptr, /*allow_exceptions=*/false);
+      if (parsed.is_object() && parsed.value("sgbake_manifest", 0) == kManifestVersion) {
+        manifest = std::move(parsed);
+      }
+    }
+    return manifests_.emplace(key, std::move(manifest)).first->second;
+  }
+
+  std::map<std::string, json> manifests_;
+};
+
+/// Records @p entry for @p file in its directory's manifest (read, modify, write atomically).
+Status recordInManifest(const fs::path& file, const json& entry) {
+  const fs::path path = directoryOf(file) / kManifestName;
+  json manifest = json::object();
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (in) {
+      json parsed = json::parse(in, nullptr, /*allow_exceptions=*/false);
+      if (parsed.is_object() && parsed.value("sgbake_manifest", 0) == kManifestVersion) {
+        manifest = std::move(parsed);
+      }
+    }
+  }
+  manifest["sgbake_manifest"] = kManifestVersion;
+  if (!manifest.contains("outputs") || !manifest["outputs"].is_object()) {
+    manifest["outputs"] = json::object();
+  }
+  manifest["outputs"][file.filename().string()] = entry;
+  const std::string text = manifest.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+  return writeFileAtomically(path, text);
+}
+
+/// Whether the manifest entry says @p planned needs no baking.
+bool isUpToDate(const json* entry, const PlannedOutput& planned, const fs::path& file) {
+  if (entry == nullptr || !entry->is_object()) return false;
+  const auto parameters = entry->find("parameters");
+  if (parameters == entry->end() || parameters->dump() != planned.parameters) return false;
+  const auto inputs = entry->find("inputs");
+  if (inputs == entry->end() || !inputs->is_object() ||
+      inputs->size() != planned.inputHashes.size()) {
+    return false;
+  }
+  for (const auto& [path, hash] : planned.inputHashes) {
+    const auto recorded = inputs->find(path);
+    if (recorded == inputs->end() || *recorded != hash) return false;
+  }
+  const auto files = entry->find("files");
+  if (files == entry->end() || !files->is_object() || files->empty()) return false;
+  for (const auto& [name, hash] : files->items()) {
+    Result<std::string> now = hashFile(directoryOf(file) / name);
+    if (!now || !hash.is_string() || *now != hash.get<std::string>()) return false;
+  }
+  return true;
+}
+
+// ---- Planning ----------------------------------------------------------------------------------
+
+/// Checks that an input file exists and is a regular file.
+Status checkInputFile(const Scene& scene, const std::string& user, std::string_view what,
+                      const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) {
+    return Error::badInput(scenePrefix(scene) + user + ": " + std::string(what) + " " +
+                           path.string() + " does not exist");
+  }
+  if (!fs::is_regular_file(status)) {
+    return Error::badInput(scenePrefix(scene) + user + ": " + std::string(what) + " " +
+                           path.string() + " is not a file");
+  }
+  return Ok{};
+}
+
+/// Builds the plan's image, texture and layer lists for the layers in @p used.
+void planLayers(Plan& plan, const std::set<std::size_t>& used) {
+  std::map<std::pair<std::string, int>, std::size_t> imageIndex;
+  std::map<std::tuple<std::size_t, bool, int, int>, std::size_t> textureIndex;
+  const auto addTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
+                              const std::string& user) {
+    const ImageChannels channels = vector ? ImageChannels::kRgb : ImageChannels::kLuminance;
+    const fs::path canonical = canonicalPath(path);
+    const auto imageKey = std::make_pair(canonical.string(), static_cast<int>(channels));
+    auto [image, newImage] = imageIndex.emplace(imageKey, plan.images.size());
+    if (newImage) plan.images.push_back({path, canonical, channels, {}});
+    plan.images[image->second].users.push_back(user);
+    const auto textureKey =
+        std::make_tuple(image->second, vector, static_cast<int>(filter), static_cast<int>(wrap));
+    auto [texture, newTexture] = textureIndex.emplace(textureKey, plan.textures.size());
+    if (newTexture) plan.textures.push_back({image->second, vector, filter, wrap});
+    return texture->second;
+  };
+  for (const std::size_t i : used) {
+    const SceneLayer& layer = plan.scene.layers[i];
+    PlannedLayer planned;
+    planned.sceneLayer = i;
+    if (layer.hasImage()) {
+      planned.texture =
+          addTexture(layer.image, layer.readsNormals(), layer.filter, layer.wrap, layerLabel(i));
+    }
+    if (layer.mask) {
+      planned.mask = addTexture(layer.mask->image, false, layer.mask->filter, Wrap::kRepeat,
+                                layerLabel(i) + ".mask");
+    }
+    plan.layers.push_back(planned);
+  }
+}
+
+std::string joinLabels(const std::vector<std::string>& labels) {
+  std::string text;
+  for (const std::string& label : labels) {
+    if (!text.empty()) text += ", ";
+    text += label;
+  }
+  return text;
+}
+
+/// A number in its shortest "%g" form (0.001, not 0.001000).
+std::string formatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+std::string channelsName(ImageChannels channels) {
+  return channels == ImageChannels::kRgb ? "RGB" : "luminance";
+}
+
+/// The plan's steps and skipped list, for explainPlan.
+void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
+  const Scene& scene = plan.scene;
+  std::vector<std::string> toBake;
+  for (const PlannedOutput& output : plan.outputs) {
+    if (!output.upToDate) toBake.push_back(scene.outputs[output.sceneOutput].file.string());
+  }
+
+  // Steps, in execution order.
+  if (plan.loadMesh) {
+    plan.steps.push_back({"load mesh " + scene.mesh.string() + ", UVs required",
+                          "read by every output to bake: " + joinLabels(toBake)});
+  }
+  for (const PlannedImage& image : plan.images) {
+    plan.steps.push_back(
+        {"load image " + image.path.string() + " as " + channelsName(image.channels),
+         "read by " + joinLabels(image.users)});
+  }
+  for (std::size_t t = 0; t < plan.textures.size(); ++t) {
+    const PlannedTexture& texture = plan.textures[t];
+    std::vector<std::string> users;
+    for (const PlannedLayer& layer : plan.layers) {
+      if (layer.texture == t) users.push_back(layerLabel(layer.sceneLayer));
+      if (layer.mask == t) users.push_back(layerLabel(layer.sceneLayer) + ".mask");
+    }
+    plan.steps.push_back({"make " + std::string(texture.vector ? "vector" : "scalar") +
+                              " texture " + plan.images[texture.image].path.string() + ", " +
+                              std::string(filterName(texture.filter)) + ", " +
+                              (texture.wrap == Wrap::kRepeat ? "repeat" : "clamp"),
+                          "sampled by " + joinLabels(users)});
+  }
+  for (const PlannedLayer& layer : plan.layers) {
+    if (scene.layers[layer.sceneLayer].type == SceneLayerType::kVolume) {
+      const SceneLayer& volume = scene.layers[layer.sceneLayer];
+      plan.steps.push_back(
+          {"make " + describeLayer(volume) + " for " + layerLabel(layer.sceneLayer),
+           volume.step ? "gradient step " + formatNumber(*volume.step)
+                       : "gradient step: 2^-20 of the mesh's bounding-box diagonal"});
+    }
+  }
+  if (plan.computeTangents) {
+    plan.steps.push_back(
+        {"compute MikkTSpace tangent frames of UV set 0", joinLabels(tangentReasons)});
+  }
+  for (const PlannedOutput& planned : plan.outputs) {
+    if (planned.upToDate) continue;
+    const SceneOutput& output = scene.outputs[planned.sceneOutput];
+    std::vector<std::string> read;
+    for (const std::size_t l : planned.layers)
+      read.push_back(layerLabel(plan.layers[l].sceneLayer));
+    const std::string reads = read.empty() ? "reads no layers" : "reads " + joinLabels(read);
+    if (output.kind == OutputKind::kCorners) {
+      plan.steps.push_back({"evaluate the corner table " + output.file.string(),
+                            reads + "; MikkTSpace frames of UV set 0 computed with it"});
+      plan.steps.push_back({"write " + output.file.string() + " as CSV", "all or nothing"});
+      continue;
+    }
+    const bool udim = hasUdimToken(output.file.string());
+    plan.steps.push_back(
+        {"bake " + output.file.string() + ": " + std::string(mapKindName(output.map)) + " " +
+             std::to_string(output.width) + "x" + std::to_string(output.height) + ", " +
+             std::to_string(output.samples) + "x" + std::to_string(output.samples) +
+             " samples per texel, UV set " + std::to_string(output.uvSet) + ", " +
+             (udim ? "every UDIM tile the UV set touches"
+                   : "UDIM tile " + std::to_string(output.tile)),
+         reads});
+    if (output.map == MapKind::kMask) {
+      // Padding would overwrite the coverage the mask is made of.
+    } else if (output.padding == PaddingMode::kPushPull) {
+      plan.steps.push_back({"pad " + output.file.string() + " by push-pull",
+                            "fills every texel outside the UV islands"});
+    } else if (output.margin > 0) {
+      plan.steps.push_back(
+          {"pad " + output.file.string() + ": extend " + std::to_string(output.margin) + " texels",
+           "margin against bleeding at UV seams under filtering and mipmaps"});
+    }
+    const ImageFormat format = output.resolvedFormat();
+    std::string formatText(imageFormatName(format));
+    for (char& c : formatText) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    const int depth = output.resolvedBitDepth();
+    const std::string depthText = format == ImageFormat::kExr ? (depth == 32 ? "float" : "half")
+                                  : depth == 32               ? "32-bit float"
+                                                              : std::to_string(depth) + "-bit";
+    plan.steps.push_back({"write " + output.file.string() + " as " + depthText + " " + formatText +
+                              (output.alpha ? " with alpha = coverage" : ""),
+                          "all or nothing: temporary file, then rename"});
+  }
+  if (plan.options.useManifest && !toBake.empty()) {
+    plan.steps.push_back({"record the outputs in " + std::string(kManifestName),
+                          "the next run re-bakes only what changed"});
+  }
+
+  // Skipped work.
+  for (const PlannedOutput& planned : plan.outputs) {
+    if (planned.upToDate) {
+      const SceneOutput& output = scene.outputs[planned.sceneOutput];
+      plan.skipped.push_back(
+          {output.file.string(), "up to date (inputs, parameters and file match " +
+                                     (directoryOf(output.file) / kManifestName).string() +
+                                     "; --force re-bakes)"});
+    }
+  }
+  if (!plan.loadMesh) {
+    plan.skipped.push_back({"load mesh " + scene.mesh.string(), "every output is up to date"});
+  }
+  std::set<std::size_t> planned;
+  for (const PlannedLayer& layer : plan.layers) planned.insert(layer.sceneLayer);
+  for (std::size_t i = 0; i < scene.layers.size(); ++i) {
+    const SceneLayer& layer = scene.layers[i];
+    const std::string what = layerLabel(i) + " (" + describeLayer(layer) + ")";
+    if (planned.count(i) == 0) {
+      std::set<std::string> reasons;
+      for (const PlannedOutput& output : plan.outputs) {
+        const std::string why = whyNotRead(scene.outputs[output.sceneOutput], layer);
+        if (!why.empty()) {
+          reasons.insert(why);
+        } else if (output.upToDate) {
+          reasons.insert("the outputs that read it are up to date");
+        }
+      }
+      std::vector<std::string> list(reasons.begin(), reasons.end());
+      plan.skipped.push_back({what + (layer.hasImage() ? " and its image" : ""),
+                              "no output to bake reads it: " + joinLabels(list)});
+      continue;
+    }
+    for (const PlannedOutput& output : plan.outputs) {
+      if (output.upToDate) continue;
+      const std::string why = whyNotRead(scene.outputs[output.sceneOutput], layer);
+      if (!why.empty()) {
+        plan.skipped.push_back(
+            {what + " for " + scene.outputs[output.sceneOutput].file.string(), why});
+      }
+    }
+  }
+  if (!plan.computeTangents && plan.loadMesh) {
+    plan.skipped.push_back({"tangent frames (MikkTSpace)",
+                            "no map to bake is tangent-normal, tangent or bitangent, and no layer "
+                            "it reads is a tangent-space normal map on UV set 0"});
+  }
+  bool images = false;
+  for (const PlannedOutput& output : plan.outputs) {
+    if (!output.upToDate && scene.outputs[output.sceneOutput].kind == OutputKind::kMap)
+      images = true;
+  }
+  if (images) {
+    plan.skipped.push_back({"texels outside the UV islands",
+                            "not shaded by the baker (background value, then margin or padding)"});
+  }
+  for (const PlannedLayer& layer : plan.layers) {
+    const SceneLayer& source = scene.layers[layer.sceneLayer];
+    if (source.type == SceneLayerType::kTriplanar) {
+      plan.skipped.push_back({"triplanar planes of " + layerLabel(layer.sceneLayer) +
+                                  " with blend weight below " + formatNumber(source.minWeight),
+                              "not sampled by the kernel (the other planes are renormalized)"});
+    }
+    if (source.mask) {
+      plan.skipped.push_back(
+          {layerLabel(layer.sceneLayer) + " where its mask is 0", "not sampled by the kernel"});
+    }
+  }
+}
+
+}  // namespace
+
+// ---- Hashing -----------------------------------------------------------------------------------
+
+std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash) {
+  constexpr std::uint64_t kPrime = 0x100000001b3ULL;
+  for (const char c : bytes) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= kPrime;
+  }
+  return hash;
+}
+
+Result<std::string> hashFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error::badInput(path.string() + ": cannot read file");
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  std::vector<char> buffer(1 << 16);
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto n = static_cast<std::size_t>(in.gcount());
+    hash = fnv1a64(std::string_view(buffer.data(), n), hash);
+  }
+  if (in.bad()) return Error::badInput(path.string() + ": cannot read file");
+  char text[32];
+  std::snprintf(text, sizeof text, "fnv1a64:%016" PRIx64, hash);
+  return std::string(text);
+}
+
+// ---- makePlan ----------------------------------------------------------------------------------
+
+std::size_t Plan::outputsToBake() const {
+  return static_cast<std::size_t>(std::count_if(
+      outputs.begin(), outputs.end(), [](const PlannedOutput& o) { return !o.upToDate; }));
+}
+
+Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string prefix = scenePrefix(scene);
+  if (Status valid = validateScene(scene); !valid) {
+    return Error::badInput(prefix + valid.error().message);
+  }
+  if (scene.subdivision.requested()) {
+    return Error::badInput(prefix +
+                           "subdivision: subdivision is not supported yet (remove the "
+                           "'subdivision' block or set \"level\": 0)");
+  }
+  if (Status ok = checkInputFile(scene, "mesh", "file", scene.mesh); !ok) return ok.error();
+
+  Plan plan;
+  plan.options = options;
+  plan.scene = std::move(scene);
+  const Scene& s = plan.scene;
+
+  // Which layers each output reads; the files each output depends on.
+  std::map<std::string, std::string> hashes;  // canonical path → hash
+  const auto hashOf = [&](const fs::path& path, const std::string& user,
+                          std::string_view what) -> Result<std::string> {
+    const std::string canonical = canonicalPath(path).string();
+    if (const auto it = hashes.find(canonical); it != hashes.end()) return it->second;
+    if (Status ok = checkInputFile(s, user, what, path); !ok) return ok.error();
+    Result<std::string> hash = hashFile(path);
+    if (!hash) return Error::badInput(prefix + user + ": " + hash.error().message);
+    hashes.emplace(canonical, *hash);
+    return hash;
+  };
+
+  ManifestCache manifests;
+  const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
+                             "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
+                             ",\"mesh\":" + json(canonicalPath(s.mesh).string()).dump();
+  for (std::size_t o = 0; o < s.outputs.size(); ++o) {
+    const SceneOutput& output = s.outputs[o];
+    PlannedOutput planned;
+    planned.sceneOutput = o;
+    std::string layersJson;
+    std::vector<fs::path> inputs{s.mesh};
+    std::vector<std::string> users{"mesh"};
+    for (std::size_t l = 0; l < s.layers.size(); ++l) {
+      const SceneLayer& layer = s.layers[l];
+      if (!whyNotRead(output, layer).empty()) continue;
+      planned.layers.push_back(l);  // scene index for now; remapped below
+      layersJson += (layersJson.empty() ? "" : ",") + layerParametersJson(layer);
+      if (layer.hasImage()) {
+        inputs.push_back(layer.image);
+        users.push_back(layerLabel(l));
+      }
+      if (layer.mask) {
+        inputs.push_back(layer.mask->image);
+        users.push_back(layerLabel(l) + ".mask");
+      }
+    }
+    planned.parameters = common + ",\"output\":" + outputParametersJson(output) + ",\"layers\":[" +
+                         layersJson + "]}";
+    planned.parameters = json::parse(planned.parameters).dump();  // canonical key order
+    if (options.useManifest) {
+      for (std::size_t i = 0; i < inputs.size(); ++i) {
+        Result<std::string> hash =
+            hashOf(inputs[i], users[i],
+                   i == 0 ? "file" : (users[i].ends_with(".mask") ? "mask image" : "image"));
+        if (!hash) return hash.error();
+        planned.inputHashes.emplace_back(canonicalPath(inputs[i]).string(), *hash);
+      }
+      std::sort(planned.inputHashes.begin(), planned.inputHashes.end());
+      planned.inputHashes.erase(std::unique(planned.inputHashes.begin(), planned.inputHashes.end()),
+                                planned.inputHashes.end());
+      if (!options.force) {
+        planned.upToDate = isUpToDate(manifests.entry(output.file), planned, output.file);
+      }
+    }
+    plan.outputs.push_back(std::move(planned));
+  }
+
+  // The layers, images and textures of the outputs to bake.
+  std::set<std::size_t> used;
+  std::vector<std::string> tangentReasons;
+  for (const PlannedOutput& output : plan.outputs) {
+    if (output.upToDate) continue;
+    const SceneOutput& out = s.outputs[output.sceneOutput];
+    plan.loadMesh = true;
+    if (out.kind == OutputKind::kMap && mapNeedsTangents(out.map)) {
+      tangentReasons.push_back(describeOutput(out) + " is expressed in them");
+    }
+    for (const std::size_t l : output.layers) {
+      used.insert(l);
+      if (out.kind == OutputKind::kMap && layerNeedsTangents(s.layers[l])) {
+        tangentReasons.push_back(layerLabel(l) +
+                                 ", a tangent-space normal map on UV set 0, is "
+                                 "decoded in them for " +
+                                 out.file.string());
+      }
+    }
+  }
+  plan.computeTangents = !tangentReasons.empty();
+  planLayers(plan, used);
+  // Output layer lists: scene indices → indices into plan.layers (up-to-date outputs: none).
+  for (PlannedOutput& output : plan.outputs) {
+    std::vector<std::size_t> mapped;
+    if (!output.upToDate) {
+      for (const std::size_t l : output.layers) {
+        for (std::size_t p = 0; p < plan.layers.size(); ++p) {
+          if (plan.layers[p].sceneLayer == l) mapped.push_back(p);
+        }
+      }
+    }
+    output.layers = std::move(mapped);
+  }
+  // Every image to load must exist (checked here so no output is touched on bad input).
+  for (const PlannedImage& image : plan.images) {
+    if (Status ok = checkInputFile(s, image.users.front(), "image", image.path); !ok) {
+      return ok.error();
+    }
+  }
+  describePlan(plan, tangentReasons);
+  plan.planSeconds = secondsSince(start);
+  return plan;
+}
+
+// ---- explainPlan -------------------------------------------------------------------------------
+
+std::string explainPlan(const Plan& plan) {
+  const Scene& scene = plan.scene;
+  std::string text =
+      "plan for " +
+      (scene.source.empty() ? std::string("the command line") : scene.source.string()) + ": " +
+      std::to_string(plan.outputsToBake()) + " of " + std::to_string(scene.outputs.size()) +
+      " output" + (scene.outputs.size() == 1 ? "" : "s") + " to bake\n";
+  if (plan.steps.empty())
+    text += "steps: none\n";
+  else
+    text += "steps:\n";
+  for (std::size_t i = 0; i < plan.steps.size(); ++i) {
+    text +=
+        "  " + std::to_string(i + 1) + ". " + plan.steps[i].what + " (" + plan.steps[i].why + ")\n";
+  }
+  text += "skipped:";
+  text += plan.skipped.empty() ? " nothing\n" : "\n";
+  for (const PlanStep& skipped : plan.skipped) {
+    text += "  - " + skipped.what + ": " + skipped.why + "\n";
+  }
+  return text;
+}
+
+// ---- executePlan -------------------------------------------------------------------------------
+
+namespace {
+
+/// Everything loaded for a run; layers point into the textures and volumes held here.
+struct Loaded {
+  Mesh mesh;
+  std::vector<std::unique_ptr<ImageScalarTexture>> scalar;  ///< per plan texture (or null)
+  std::vector<std::unique_ptr<ImageVectorTexture>> vector;  ///< per plan texture (or null)
+  std::vector<std::unique_ptr<HeightVolume>> volumes;
+  std::vector<Layer> layers;  ///< per plan layer
+  std::optional<CornerTangents> tangents;
+};
+
+/// Calls the progress callback, if any.
+class ProgressReporter {
+ public:
+  ProgressReporter(const ExecuteOptions& options, std::size_t total)
+      : callback_(options.progress), total_(total) {}
+  void start(std::string_view what) {
+    if (callback_) callback_({done_, total_, what});
+  }
+  void finishOne() { ++done_; }
+  void addWork(std::size_t units) { total_ += units; }
+  void finishAll() {
+    if (callback_) callback_({total_, total_, "done"});
+  }
+
+ private:
+  const std::function<void(const BakeProgress&)>& callback_;
+  std::size_t total_;
+  std::size_t done_ = 0;
+};
+
+/// The length of the mesh's bounding-box diagonal (the scale of volume gradient steps).
+double boundingBoxDiagonal(const Mesh& mesh) {
+  if (mesh.positions.empty()) return 1;
+  Vec3d lo{mesh.positions[0].x, mesh.positions[0].y, mesh.positions[0].z};
+  Vec3d hi = lo;
+  for (const Vec3f& p : mesh.positions) {
+    lo = {std::min<double>(lo.x, p.x), std::min<double>(lo.y, p.y), std::min<double>(lo.z, p.z)};
+    hi = {std::max<double>(hi.x, p.x), std::max<double>(hi.y, p.y), std::max<double>(hi.z, p.z)};
+  }
+  const Vec3d d = hi - lo;
+  return std::sqrt(dot(d, d));
+}
+
+/// The UV set check: every UV set an output bakes on or a layer reads must exist.
+Status checkUvSets(const Plan& plan, const Mesh& mesh) {
+  const Scene& s = plan.scene;
+  const auto missing = [&](const std::string& user, int uvSet) {
+    return Error::badInput(s.mesh.string() + ": has " + std::to_string(mesh.uvSets.size()) +
+                           " UV set(s) but " + user + " uses UV set " + std::to_string(uvSet) +
+                           " (UV sets are numbered from 0)");
+  };
+  for (const PlannedOutput& output : plan.outputs) {
+    const SceneOutput& out = s.outputs[output.sceneOutput];
+    if (!output.upToDate && out.kind == OutputKind::kMap &&
+        !mesh.hasUvSet(static_cast<std::size_t>(out.uvSet))) {
+      return missing(outputLabel(output.sceneOutput), out.uvSet);
+    }
+  }
+  for (const PlannedLayer& planned : plan.layers) {
+    const SceneLayer& layer = s.layers[planned.sceneLayer];
+    const bool uvLayer =
+        layer.type == SceneLayerType::kHeight || layer.type == SceneLayerType::kNormal;
+    if (uvLayer && !mesh.hasUvSet(static_cast<std::size_t>(layer.uvSet))) {
+      return missing(layerLabel(planned.sceneLayer), layer.uvSet);
+    }
+    if (layer.mask && !mesh.hasUvSet(static_cast<std::size_t>(layer.mask->uvSet))) {
+      return missing(layerLabel(planned.sceneLayer) + ".mask", layer.mask->uvSet);
+    }
+  }
+  return Ok{};
+}
+
+/// Loads the images of the plan and makes its textures.
+Status loadTextures(const Plan& plan, Loaded& loaded, ProgressReporter& progress,
+                    ExecuteReport& report) {
+  loaded.scalar.resize(plan.textures.size());
+  loaded.vector.resize(plan.textures.size());
+  for (std::size_t i = 0; i < plan.images.size(); ++i) {
+    const PlannedImage& planned = plan.images[i];
+    progress.start("loading " + planned.path.string());
+    LoadImageOptions imageOptions;
+    imageOptions.channels = planned.channels;
+    Result<Image> image = loadImage(planned.path, imageOptions);
+    if (!image) return image.error();
+    ++report.imagesLoaded;
+    for (std::size_t t = 0; t < plan.textures.size(); ++t) {
+      const PlannedTexture& texture = plan.textures[t];
+      if (texture.image != i) continue;
+      if (texture.vector) {
+        VectorTextureOptions textureOptions;
+        textureOptions.filter = texture.filter;
+        textureOptions.wrap = texture.wrap;
+        Result<ImageVectorTexture> made = ImageVectorTexture::create(*image, textureOptions);
+        if (!made)
+          return Error{made.error().code, planned.path.string() + ": " + made.error().message};
+        loaded.vector[t] = std::make_unique<ImageVectorTexture>(std::move(*made));
+      } else {
+        ScalarTextureOptions textureOptions;
+        textureOptions.filter = texture.filter;
+        textureOptions.wrap = texture.wrap;
+        Result<ImageScalarTexture> made = ImageScalarTexture::create(*image, textureOptions);
+        if (!made)
+          return Error{made.error().code, planned.path.string() + ": " + made.error().message};
+        loaded.scalar[t] = std::make_unique<ImageScalarTexture>(std::move(*made));
+      }
+      ++report.texturesCreated;
+    }
+    progress.finishOne();  // the Image itself is released here: textures keep their own copy
+  }
+  return Ok{};
+}
+
+/// Builds the volume of a volume layer.
+Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
+  if (layer.function == VolumeFunction::kSine) {
+    DirectionalSineParams params;
+    params.amplitude = layer.amplitude;
+    params.frequency = layer.frequency;
+    params.direction = layer.direction;
+    params.phase = layer.phase;
+    Result<DirectionalSine> sine = DirectionalSine::create(params);
+    if (!sine) return sine.error();
+    return std::unique_ptr<HeightVolume>(std::make_unique<DirectionalSine>(std::move(*sine)));
+  }
+  GradientNoiseParams params;
+  params.amplitude = layer.amplitude;
+  params.frequency = layer.frequency;
+  params.seed = layer.seed;
+  params.octaves = layer.octaves;
+  Result<GradientNoise> noise = GradientNoise::create(params);
+  if (!noise) return noise.error();
+  return std::unique_ptr<HeightVolume>(std::make_unique<GradientNoise>(std::move(*noise)));
+}
+
+/// The library Layer of a planned layer (textures and volumes must be loaded).
+Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& loaded,
+                        double objectSize) {
+  const SceneLayer& layer = plan.scene.layers[planned.sceneLayer];
+  const ScalarTexture* scalar = planned.texture ? loaded.scalar[*planned.texture].get() : nullptr;
+  const VectorTexture* vector = planned.texture ? loaded.vector[*planned.texture].get() : nullptr;
+  Layer result;
+  result.weight = layer.weight;
+  if (layer.mask && planned.mask) {
+    result.mask.texture = loaded.scalar[*planned.mask].get();
+    result.mask.uvSet = layer.mask->uvSet;
+    result.mask.tiling = layer.mask->tiling;
+    result.mask.offset = layer.mask->offset;
+  }
+  ProjectedNormalOptions projected;
+  projected.green = layer.green;
+  switch (layer.type) {
+    case SceneLayerType::kHeight: {
+      UvHeightSource source;
+      source.texture = scalar;
+      source.uvSet = layer.uvSet;
+      source.scale = layer.scale;
+      source.tiling = layer.tiling;
+      source.offset = layer.offset;
+      result.source = source;
+      break;
+    }
+    case SceneLayerType::kNormal:
+      if (layer.space == NormalSpace::kTangent) {
+        TangentNormalSource source;
+        source.texture = vector;
+        source.uvSet = layer.uvSet;
+        source.options.green = layer.green;
+        source.options.strength = layer.scale;
+        source.options.tiling = layer.tiling;
+        source.options.offset = layer.offset;
+        result.source = source;
+      } else {
+        ObjectNormalSource source;
+        source.texture = vector;
+        source.uvSet = layer.uvSet;
+        source.tiling = layer.tiling;
+        source.offset = layer.offset;
+        source.strength = layer.scale;
+        result.source = source;
+      }
+      break;
+    case SceneLayerType::kVolume: {
+      Result<std::unique_ptr<HeightVolume>> volume = makeVolume(layer);
+      if (!volume) {
+        return Error::badInput(scenePrefix(plan.scene) + layerLabel(planned.sceneLayer) + ": " +
+                               volume.error().message);
+      }
+      loaded.volumes.push_back(std::move(*volume));
+      VolumeSource source;
+      source.volume = loaded.volumes.back().get();
+      source.scheme = layer.gradient;
+      source.step = layer.step ? *layer.step : defaultStep(objectSize);
+      result.source = source;
+      break;
+    }
+    case SceneLayerType::kPlanar: {
+      PlanarSource source;
+      source.kind = layer.kind;
+      source.height = scalar;
+      source.normals = vector;
+      source.mapping.axis = layer.axis;
+      source.mapping.tiling = layer.tiling;
+      source.mapping.offset = layer.offset;
+      source.scale = layer.scale;
+      source.normal = projected;
+      result.source = source;
+      break;
+    }
+    case SceneLayerType::kTriplanar: {
+      TriplanarSource source;
+      source.kind = layer.kind;
+      source.height = scalar;
+      source.normals = vector;
+      source.options.tiling = layer.tiling;
+      source.options.offset = layer.offset;
+      source.options.scale = layer.scale;
+      source.options.sharpness = layer.sharpness;
+      source.options.minWeight = layer.minWeight;
+      source.options.normal = projected;
+      result.source = source;
+      break;
+    }
+  }
+  return result;
+}
+
+/// Applies the output's padding to a baked tile.
+void pad(const SceneOutput& output, FloatImage& image, int threads) {
+  if (output.map == MapKind::kMask) return;  // padding would overwrite the coverage it shows
+  if (output.padding == PaddingMode::kPushPull) {
+    pushPullFill(image, threads);
+  } else if (output.margin > 0) {
+    extendMargin(image, output.margin, threads);
+  }
+}
+
+/// Creates the directory of @p file when it is missing.
+Status ensureDirectory(const fs::path& file) {
+  const fs::path dir = file.parent_path();
+  if (dir.empty()) return Ok{};
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return Ok{};
+  fs::create_directories(dir, ec);
+  if (ec) {
+    return Error::badInput(file.string() + ": cannot create directory " + dir.string() + ": " +
+                           ec.message());
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& options) {
+  const Scene& s = plan.scene;
+  ExecuteReport report;
+  for (const PlannedOutput& output : plan.outputs) {
+    report.outputs.push_back({s.outputs[output.sceneOutput].file, false, {}});
+  }
+  if (plan.outputsToBake() == 0) return report;
+
+  using Clock = std::chrono::steady_clock;
+  ProgressReporter progress(options, 1 + plan.images.size() + (plan.computeTangents ? 1 : 0));
+  Loaded loaded;
+
+  // 1. Everything is loaded and checked before the first output is written.
+  auto start = Clock::now();
+  progress.start("loading " + s.mesh.string());
+  LoadOptions meshOptions;
+  meshOptions.requireUvs = true;
+  Result<Mesh> mesh = loadMesh(s.mesh, meshOptions);
+  if (!mesh) return mesh.error();
+  loaded.mesh = std::move(*mesh);
+  progress.finishOne();
+  if (Status ok = checkUvSets(plan, loaded.mesh); !ok) return ok.error();
+  if (Status ok = loadTextures(plan, loaded, progress, report); !ok) return ok.error();
+  const double objectSize = boundingBoxDiagonal(loaded.mesh);
+  for (const PlannedLayer& planned : plan.layers) {
+    Result<Layer> layer = makeLayer(plan, planned, loaded, objectSize);
+    if (!layer) return layer.error();
+    loaded.layers.push_back(std::move(*layer));
+  }
+  const int numUvSets =
+      static_cast<int>(std::min<std::size_t>(loaded.mesh.uvSets.size(), kMaxUvSets));
+  if (Status valid = validateLayers(loaded.layers, numUvSets); !valid) {
+    return Error{valid.error().code, scenePrefix(s) + valid.error().message};
+  }
+  report.loadSeconds = secondsSince(start);
+
+  // Every output directory must exist (created here) and be writable before the long work.
+  for (const PlannedOutput& planned : plan.outputs) {
+    if (planned.upToDate) continue;
+    const fs::path file =
+        expandUdimToken(s.outputs[planned.sceneOutput].file.string(), kFirstUdimTile);
+    if (Status ok = ensureDirectory(file); !ok) return ok.error();
+    Result<AtomicFile> probe = AtomicFile::create(file);  // removed again when it goes out of scope
+    if (!probe) return probe.error();
+  }
+
+  if (plan.computeTangents) {
+    start = Clock::now();
+    progress.start("computing tangent frames");
+    TangentOptions tangentOptions;
+    tangentOptions.threads = options.threads;
+    Result<CornerTangents> tangents = computeTangents(loaded.mesh.view(0), tangentOptions);
+    if (!tangents) {
+      return Error{tangents.error().code, s.mesh.string() + ": " + tangents.error().message};
+    }
+    loaded.tangents = std::move(*tangents);
+    report.tangentsComputed = true;
+    progress.finishOne();
+    report.tangentsSeconds = secondsSince(start);
+  }
+
+  // 2. The tiles of every output to bake (known now that the mesh is loaded).
+  std::vector<std::vector<int>> tiles(plan.outputs.size());
+  for (std::size_t o = 0; o < plan.outputs.size(); ++o) {
+    const PlannedOutput& planned = plan.outputs[o];
+    if (planned.upToDate) continue;
+    const SceneOutput& output = s.outputs[planned.sceneOutput];
+    if (output.kind == OutputKind::kCorners) {
+      tiles[o] = {0};
+    } else if (hasUdimToken(output.file.string())) {
+      tiles[o] = udimTiles(loaded.mesh, output.uvSet);
+      if (tiles[o].empty()) tiles[o] = {kFirstUdimTile};
+    } else {
+      tiles[o] = {output.tile};
+    }
+    progress.addWork(tiles[o].size());
+  }
+
+  // 3. Bake, pad and write each output; record it in the manifest.
+  for (std::size_t o = 0; o < plan.outputs.size(); ++o) {
+    const PlannedOutput& planned = plan.outputs[o];
+    if (planned.upToDate) continue;
+    const SceneOutput& output = s.outputs[planned.sceneOutput];
+    std::vector<Layer> layers;
+    for (const std::size_t l : planned.layers) layers.push_back(loaded.layers[l]);
+    OutputReport& outputReport = report.outputs[o];
+    json files = json::object();
+
+    for (const int tile : tiles[o]) {
+      const fs::path file = output.kind == OutputKind::kCorners
+                                ? output.file
+                                : fs::path(expandUdimToken(output.file.string(), tile));
+      progress.start("baking " + file.string());
+      start = Clock::now();
+      if (output.kind == OutputKind::kCorners) {
+        CornerOptions cornerOptions;
+        cornerOptions.threads = options.threads;
+        Result<std::vector<CornerSample>> corners =
+            evaluateCorners(loaded.mesh, layers, cornerOptions);
+        if (!corners) {
+          return Error{corners.error().code, s.mesh.string() + ": " + corners.error().message};
+        }
+        const std::string table = formatCornerTable(*corners);
+        report.bakeSeconds += secondsSince(start);
+        start = Clock::now();
+        if (Status ok = writeFileAtomically(file, table); !ok) return ok.error();
+        report.writeSeconds += secondsSince(start);
+      } else {
+        BakeInput input;
+        input.mesh = &loaded.mesh;
+        input.tangents = loaded.tangents ? &*loaded.tangents : nullptr;
+        input.layers = layers;
+        BakeSettings settings;
+        settings.map = output.map;
+        settings.width = output.width;
+        settings.height = output.height;
+        settings.samples = output.samples;
+        settings.uvSet = output.uvSet;
+        settings.udimTile = tile;
+        settings.green = output.green;
+        settings.threads = options.threads;
+        Result<FloatImage> image = bakeMap(input, settings);
+        if (!image) {
+          return Error{image.error().code, file.string() + ": " + image.error().message};
+        }
+        report.bakeSeconds += secondsSince(start);
+        start = Clock::now();
+        pad(output, *image, options.threads);
+        report.padSeconds += secondsSince(start);
+        start = Clock::now();
+        ImageWriteOptions writeOptions;
+        writeOptions.format = output.resolvedFormat();
+        writeOptions.bitDepth = output.resolvedBitDepth();
+        writeOptions.alpha = output.alpha;
+        if (Status ok = writeImage(*image, file, writeOptions); !ok) return ok.error();
+        report.writeSeconds += secondsSince(start);
+      }
+      outputReport.files.push_back(file);
+      ++report.tilesBaked;
+      start = Clock::now();
+      if (plan.options.useManifest) {
+        Result<std::string> hash = hashFile(file);
+        if (!hash) return Error::internal(hash.error().message);
+        files[file.filename().string()] = *hash;
+      }
+      report.writeSeconds += secondsSince(start);
+      progress.finishOne();
+    }
+    outputReport.baked = true;
+
+    if (plan.options.useManifest) {
+      start = Clock::now();
+      json inputs = json::object();
+      for (const auto& [path, hash] : planned.inputHashes) inputs[path] = hash;
+      const json entry = {{"parameters", json::parse(planned.parameters)},
+                          {"inputs", std::move(inputs)},
+                          {"files", std::move(files)}};
+      if (Status ok = recordInManifest(output.file, entry); !ok) return ok.error();
+      report.writeSeconds += secondsSince(start);
+    }
+  }
+  progress.finishAll();
+  return report;
+}
+
+}  // namespace sgbake

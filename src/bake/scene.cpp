@@ -1,0 +1,1009 @@
+/// @file scene.cpp
+/// @brief The strict scene-JSON parser (see scene.hpp).
+///
+/// Parsing walks the document with an ObjectReader per JSON object: it knows the object's place
+/// ("outputs[0]"), the keys allowed there, and reads typed, range-checked values. A failure is
+/// thrown inside this file as a SceneFailure and becomes one kBadInput line in parseScene; no
+/// exception leaves the library.
+#include "sgbake/bake/scene.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+namespace sgbake {
+namespace {
+
+using nlohmann::json;
+
+/// A parse failure: where (a JSON path such as "outputs[0]", "" for the top level) and what.
+struct SceneFailure {
+  std::string where;
+  std::string what;
+};
+
+[[noreturn]] void fail(std::string where, std::string what) {
+  throw SceneFailure{std::move(where), std::move(what)};
+}
+
+std::string quote(std::string_view text) {
+  // (Built with append: `"'" + std::string` trips GCC 12's false -Wrestrict, bug 105651.)
+  std::string quoted = "'";
+  quoted.append(text).append("'");
+  return quoted;
+}
+
+/// "a, b or c".
+std::string listNames(const std::vector<std::string>& names) {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) text += i + 1 == names.size() ? " or " : ", ";
+    text += names[i];
+  }
+  return text;
+}
+
+/// A JSON value for messages: strings quoted, numbers as written, containers by kind.
+std::string describeValue(const json& value) {
+  if (value.is_string()) return quote(value.get<std::string>());
+  if (value.is_number() || value.is_boolean() || value.is_null()) return value.dump();
+  return std::string("an ") + (value.is_array() ? "array" : "object");
+}
+
+/// "a string", "an array", ...
+std::string describeType(const json& value) {
+  const std::string type = value.type_name();
+  const bool vowel = type[0] == 'a' || type[0] == 'o';
+  return (vowel ? "an " : "a ") + type;
+}
+
+std::string appendPath(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
+/// Message of a range check, shared with validateScene: "size 0 is out of range 1..65536".
+std::string rangeMessage(std::string_view name, long long value, long long min, long long max) {
+  return std::string(name) + " " + std::to_string(value) + " is out of range " +
+         std::to_string(min) + ".." + std::to_string(max);
+}
+
+/// A named value of an enumeration in the scene ("bicubic" → Filter::kBicubic).
+template <class E>
+struct Named {
+  const char* name;
+  E value;
+};
+
+constexpr Named<Filter> kFilters[] = {
+    {"bilinear", Filter::kBilinear}, {"bicubic", Filter::kBicubic}, {"hermite", Filter::kHermite}};
+constexpr Named<Wrap> kWraps[] = {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClamp}};
+constexpr Named<NormalSpace> kSpaces[] = {{"tangent", NormalSpace::kTangent},
+                                          {"object", NormalSpace::kObject}};
+constexpr Named<NormalMapGreen> kGreens[] = {{"opengl", NormalMapGreen::kOpenGL},
+                                             {"directx", NormalMapGreen::kDirectX}};
+constexpr Named<ProjectedKind> kKinds[] = {{"height", ProjectedKind::kHeight},
+                                           {"tangent-normal", ProjectedKind::kTangentNormal},
+                                           {"object-normal", ProjectedKind::kObjectNormal}};
+constexpr Named<ProjectionAxis> kAxes[] = {
+    {"x", ProjectionAxis::kX}, {"y", ProjectionAxis::kY}, {"z", ProjectionAxis::kZ}};
+constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
+                                                {"noise", VolumeFunction::kNoise}};
+constexpr Named<GradientScheme> kSchemes[] = {{"analytic", GradientScheme::kAnalytic},
+                                              {"central", GradientScheme::kCentral},
+                                              {"tetrahedral", GradientScheme::kTetrahedral}};
+constexpr Named<PaddingMode> kPaddings[] = {{"extend", PaddingMode::kExtend},
+                                            {"push-pull", PaddingMode::kPushPull}};
+constexpr Named<SceneLayerType> kLayerTypes[] = {{"height", SceneLayerType::kHeight},
+                                                 {"normal", SceneLayerType::kNormal},
+                                                 {"volume", SceneLayerType::kVolume},
+                                                 {"planar", SceneLayerType::kPlanar},
+                                                 {"triplanar", SceneLayerType::kTriplanar}};
+constexpr Named<SubdivisionUvSmooth> kUvSmooths[] = {
+    {"none", SubdivisionUvSmooth::kNone},
+    {"keep-corners", SubdivisionUvSmooth::kKeepCorners},
+    {"keep-corners-junctions", SubdivisionUvSmooth::kKeepCornersJunctions},
+    {"keep-corners-junctions-concave", SubdivisionUvSmooth::kKeepCornersJunctionsConcave},
+    {"keep-boundaries", SubdivisionUvSmooth::kKeepBoundaries},
+    {"all", SubdivisionUvSmooth::kAll}};
+constexpr Named<SubdivisionBoundary> kBoundaries[] = {
+    {"all", SubdivisionBoundary::kAll}, {"keep-corners", SubdivisionBoundary::kKeepCorners}};
+
+/// The names of an enumeration table, in order.
+template <class E, std::size_t N>
+std::vector<std::string> namesOf(const Named<E> (&table)[N]) {
+  std::vector<std::string> names;
+  for (const Named<E>& entry : table) names.emplace_back(entry.name);
+  return names;
+}
+
+/// The names of every map an output may ask for: the MapKinds and "corners".
+std::vector<std::string> outputMapNames() {
+  std::vector<std::string> names;
+  for (const MapKind kind :
+       {MapKind::kTangentNormal, MapKind::kObjectNormal, MapKind::kHeight, MapKind::kDerivative,
+        MapKind::kSurfaceGradient, MapKind::kTangent, MapKind::kBitangent, MapKind::kMask}) {
+    names.emplace_back(mapKindName(kind));
+  }
+  names.emplace_back("corners");
+  return names;
+}
+
+/// "unknown filter 'bicubc' (did you mean 'bicubic'?)" or "... (expected bilinear, ...)".
+std::string unknownNameMessage(std::string_view what, std::string_view value,
+                               const std::vector<std::string>& names) {
+  const std::string suggestion = closestMatch(value, names);
+  std::string message = "unknown " + std::string(what) + " " + quote(value);
+  if (!suggestion.empty()) return message + " (did you mean " + quote(suggestion) + "?)";
+  return message + " (expected " + listNames(names) + ")";
+}
+
+/// Keys that are comments: anything starting with '_'.
+bool isComment(std::string_view key) { return !key.empty() && key.front() == '_'; }
+
+/// Reads one JSON object of the scene: its allowed keys, typed and range-checked values.
+class ObjectReader {
+ public:
+  /// @param where  the object's JSON path ("outputs[0]"; "" at the top level)
+  /// @param what   what the object is, for messages ("a height layer", "an output")
+  ObjectReader(const json& object, std::string where, std::string what)
+      : object_(object), where_(std::move(where)), what_(std::move(what)) {
+    if (!object_.is_object()) {
+      fail(where_, "expected an object for " + what_ + ", not " + describeType(object_));
+    }
+  }
+
+  const std::string& where() const { return where_; }
+
+  /// @brief Fails on the first key not in @p allowed (comments aside). @p elsewhere maps keys
+  /// that are valid in a sibling context to a hint naming it ("it is for volume layers").
+  void checkKeys(const std::vector<std::string>& allowed,
+                 const std::map<std::string, std::string>& elsewhere = {}) const {
+    for (const auto& item : object_.items()) {
+      const std::string& key = item.key();
+      if (isComment(key) || std::find(allowed.begin(), allowed.end(), key) != allowed.end()) {
+        continue;
+      }
+      if (const auto hint = elsewhere.find(key); hint != elsewhere.end()) {
+        fail(where_,
+             "key " + quote(key) + " does not apply to " + what_ + " (" + hint->second + ")");
+      }
+      const std::string suggestion = closestMatch(key, allowed);
+      if (!suggestion.empty()) {
+        fail(where_, "unknown key " + quote(key) + " (did you mean " + quote(suggestion) + "?)");
+      }
+      fail(where_, "unknown key " + quote(key) + " (expected " + listNames(allowed) + ")");
+    }
+  }
+
+  bool has(std::string_view key) const { return object_.contains(key); }
+
+  const json& at(std::string_view key) const { return object_.at(std::string(key)); }
+
+  void require(std::string_view key) const {
+    if (!has(key)) fail(where_, "missing key " + quote(key) + " in " + what_);
+  }
+
+  std::string string(std::string_view key) const {
+    const json& value = at(key);
+    if (!value.is_string()) typeError(key, "a string", value);
+    return value.get<std::string>();
+  }
+
+  bool boolean(std::string_view key) const {
+    const json& value = at(key);
+    if (!value.is_boolean()) typeError(key, "true or false", value);
+    return value.get<bool>();
+  }
+
+  /// A finite number.
+  double number(std::string_view key) const { return numberValue(key, at(key)); }
+
+  /// A number >= @p min (finite).
+  double numberAtLeast(std::string_view key, double min, bool exclusive) const {
+    const double value = number(key);
+    if (exclusive ? !(value > min) : !(value >= min)) {
+      std::ostringstream bound;
+      bound << min;
+      fail(where_, std::string(key) + " " + at(key).dump() + " must be " +
+                       (exclusive ? "greater than " : "at least ") + bound.str());
+    }
+    return value;
+  }
+
+  /// An integer in [min, max]; integral floats (2048.0) are accepted.
+  long long integer(std::string_view key, long long min, long long max) const {
+    const json& value = at(key);
+    long long result = 0;
+    if (value.is_number_integer()) {
+      if (value.is_number_unsigned() &&
+          value.get<std::uint64_t>() > static_cast<std::uint64_t>(max)) {
+        fail(where_, std::string(key) + " " + value.dump() + " is out of range " +
+                         std::to_string(min) + ".." + std::to_string(max));
+      }
+      result = value.get<long long>();
+    } else if (value.is_number_float()) {
+      const double d = value.get<double>();
+      if (!std::isfinite(d) || d != std::floor(d)) typeError(key, "an integer", value);
+      if (d < static_cast<double>(min) || d > static_cast<double>(max)) {
+        fail(where_, std::string(key) + " " + value.dump() + " is out of range " +
+                         std::to_string(min) + ".." + std::to_string(max));
+      }
+      result = static_cast<long long>(d);
+    } else {
+      typeError(key, "an integer", value);
+    }
+    if (result < min || result > max) fail(where_, rangeMessage(key, result, min, max));
+    return result;
+  }
+
+  int smallInteger(std::string_view key, int min, int max) const {
+    return static_cast<int>(integer(key, min, max));
+  }
+
+  /// A non-negative integer of up to 64 bits (noise seeds).
+  std::uint64_t unsignedInteger(std::string_view key) const {
+    const json& value = at(key);
+    if (value.is_number_unsigned()) return value.get<std::uint64_t>();
+    if (value.is_number_integer()) {
+      fail(where_, std::string(key) + " " + value.dump() + " must be at least 0");
+    }
+    typeError(key, "an integer", value);
+  }
+
+  /// A number (both components equal) or an array of two numbers.
+  Vec2d vec2(std::string_view key) const {
+    const json& value = at(key);
+    if (value.is_number()) {
+      const double d = numberValue(key, value);
+      return {d, d};
+    }
+    if (!value.is_array() || value.size() != 2) {
+      typeError(key, "a number or an array of 2 numbers", value);
+    }
+    return {numberValue(key, value[0]), numberValue(key, value[1])};
+  }
+
+  /// An array of three numbers.
+  Vec3d vec3(std::string_view key) const {
+    const json& value = at(key);
+    if (!value.is_array() || value.size() != 3) typeError(key, "an array of 3 numbers", value);
+    return {numberValue(key, value[0]), numberValue(key, value[1]), numberValue(key, value[2])};
+  }
+
+  /// One of the names in @p table.
+  template <class E, std::size_t N>
+  E name(std::string_view key, const Named<E> (&table)[N]) const {
+    const std::string text = string(key);
+    for (const Named<E>& entry : table) {
+      if (text == entry.name) return entry.value;
+    }
+    fail(where_, unknownNameMessage(key, text, namesOf(table)));
+  }
+
+  /// Reads @p key into @p out when present.
+  template <class E, std::size_t N>
+  void optionalName(std::string_view key, const Named<E> (&table)[N], E& out) const {
+    if (has(key)) out = name(key, table);
+  }
+
+ private:
+  [[noreturn]] void typeError(std::string_view key, std::string_view expected,
+                              const json& value) const {
+    fail(where_, quote(key) + " must be " + std::string(expected) + ", not " +
+                     (value.is_number() ? describeValue(value) : describeType(value)));
+  }
+
+  double numberValue(std::string_view key, const json& value) const {
+    if (!value.is_number()) typeError(key, "a number", value);
+    const double d = value.get<double>();
+    if (!std::isfinite(d)) fail(where_, quote(key) + " must be a finite number");
+    return d;
+  }
+
+  const json& object_;
+  std::string where_;
+  std::string what_;
+};
+
+/// Resolves a scene path: absolute as is, relative against @p base; lexically normalized.
+std::filesystem::path resolvePath(const std::filesystem::path& base, const std::string& text) {
+  const std::filesystem::path path(text);
+  if (path.is_absolute() || base.empty()) return path.lexically_normal();
+  return (base / path).lexically_normal();
+}
+
+/// A path key: a non-empty string, resolved against @p base.
+std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key,
+                                const std::filesystem::path& base) {
+  const std::string text = reader.string(key);
+  if (text.empty()) fail(reader.where(), quote(key) + " is empty");
+  return resolvePath(base, text);
+}
+
+// ---- Keys of each kind of object ---------------------------------------------------------------
+
+const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers", "outputs"};
+const std::vector<std::string> kSubdivisionKeys = {"level", "uv_smooth", "boundary"};
+const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
+const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
+const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
+
+/// The keys of a layer of @p type beyond kLayerCommonKeys.
+std::vector<std::string> layerKeys(SceneLayerType type) {
+  std::vector<std::string> keys = kLayerCommonKeys;
+  const auto add = [&keys](std::initializer_list<const char*> more) {
+    keys.insert(keys.end(), more.begin(), more.end());
+  };
+  if (type != SceneLayerType::kVolume)
+    keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
+  switch (type) {
+    case SceneLayerType::kHeight:
+      add({"uv", "scale"});
+      break;
+    case SceneLayerType::kNormal:
+      add({"uv", "space", "green", "strength"});
+      break;
+    case SceneLayerType::kVolume:
+      add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
+           "gradient", "step"});
+      break;
+    case SceneLayerType::kPlanar:
+      add({"kind", "axis", "scale", "green"});
+      break;
+    case SceneLayerType::kTriplanar:
+      add({"kind", "scale", "sharpness", "min_weight", "green"});
+      break;
+  }
+  return keys;
+}
+
+/// For a layer of @p type: keys that other layer types accept, with a hint naming them.
+std::map<std::string, std::string> layerKeysElsewhere(SceneLayerType type) {
+  const std::vector<std::string> own = layerKeys(type);
+  std::map<std::string, std::vector<std::string>> users;
+  for (const Named<SceneLayerType>& other : kLayerTypes) {
+    if (other.value == type) continue;
+    for (const std::string& key : layerKeys(other.value)) {
+      if (std::find(own.begin(), own.end(), key) == own.end()) users[key].push_back(other.name);
+    }
+  }
+  std::map<std::string, std::string> hints;
+  for (const auto& [key, types] : users) {
+    hints[key] = "it is for " + listNames(types) + " layers";
+  }
+  return hints;
+}
+
+const std::vector<std::string> kMapOutputKeys = {
+    "map",     "file", "size",  "width", "height", "margin",    "padding",
+    "samples", "uv",   "green", "tile",  "format", "bit_depth", "alpha"};
+const std::vector<std::string> kCornersOutputKeys = {"map", "file"};
+
+// ---- Parsing each part -------------------------------------------------------------------------
+
+SceneSubdivision parseSubdivision(const json& value) {
+  const ObjectReader reader(value, "subdivision", "the subdivision block");
+  reader.checkKeys(kSubdivisionKeys);
+  SceneSubdivision subdivision;
+  subdivision.present = true;
+  if (reader.has("level")) {
+    const json& level = reader.at("level");
+    if (level.is_string()) {
+      if (level.get<std::string>() != "limit") {
+        fail(reader.where(), "level " + describeValue(level) + " must be \"limit\" or a number");
+      }
+      subdivision.limit = true;
+    } else {
+      subdivision.level = reader.smallInteger("level", 0, 6);
+    }
+  }
+  reader.optionalName("uv_smooth", kUvSmooths, subdivision.uvSmooth);
+  reader.optionalName("boundary", kBoundaries, subdivision.boundary);
+  return subdivision;
+}
+
+SceneMask parseMask(const json& value, const std::string& where, const std::filesystem::path& base,
+                    int defaultUv) {
+  SceneMask mask;
+  mask.uvSet = defaultUv;
+  if (value.is_string()) {
+    if (value.get<std::string>().empty()) fail(where, "'mask' is empty");
+    mask.image = resolvePath(base, value.get<std::string>());
+    return mask;
+  }
+  const ObjectReader reader(value, where, "a mask");
+  reader.checkKeys(kMaskKeys);
+  reader.require("image");
+  mask.image = pathValue(reader, "image", base);
+  if (reader.has("uv")) mask.uvSet = reader.smallInteger("uv", 0, kMaxUvSets - 1);
+  if (reader.has("tiling")) mask.tiling = reader.vec2("tiling");
+  if (reader.has("offset")) mask.offset = reader.vec2("offset");
+  reader.optionalName("filter", kFilters, mask.filter);
+  return mask;
+}
+
+SceneLayer parseLayer(const json& value, const std::string& where,
+                      const std::filesystem::path& base, int defaultUv) {
+  SceneLayer layer;
+  {
+    const ObjectReader probe(value, where, "a layer");
+    probe.require("type");
+    layer.type = probe.name("type", kLayerTypes);
+  }
+  const std::string what = "a " + std::string(sceneLayerTypeName(layer.type)) + " layer";
+  const ObjectReader reader(value, where, what);
+  reader.checkKeys(layerKeys(layer.type), layerKeysElsewhere(layer.type));
+
+  layer.uvSet = defaultUv;
+  if (reader.has("name")) layer.name = reader.string("name");
+  if (reader.has("weight")) layer.weight = reader.number("weight");
+
+  if (layer.hasImage()) {
+    reader.require("image");
+    layer.image = pathValue(reader, "image", base);
+    reader.optionalName("filter", kFilters, layer.filter);
+    reader.optionalName("wrap", kWraps, layer.wrap);
+    if (reader.has("tiling")) layer.tiling = reader.vec2("tiling");
+    if (reader.has("offset")) layer.offset = reader.vec2("offset");
+  }
+  if (reader.has("uv")) layer.uvSet = reader.smallInteger("uv", 0, kMaxUvSets - 1);
+  if (reader.has("mask")) {
+    // The mask is looked up on the layer's UV set unless it names its own.
+    layer.mask = parseMask(reader.at("mask"), appendPath(where, "mask"), base, layer.uvSet);
+  }
+  if (reader.has("scale")) layer.scale = reader.number("scale");
+  if (reader.has("strength")) layer.scale = reader.number("strength");
+  reader.optionalName("green", kGreens, layer.green);
+  reader.optionalName("space", kSpaces, layer.space);
+  reader.optionalName("kind", kKinds, layer.kind);
+  reader.optionalName("axis", kAxes, layer.axis);
+  if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
+  if (reader.has("min_weight")) layer.minWeight = reader.numberAtLeast("min_weight", 0, false);
+
+  if (layer.type == SceneLayerType::kVolume) {
+    reader.optionalName("function", kFunctions, layer.function);
+    const bool sine = layer.function == VolumeFunction::kSine;
+    for (const char* key : {"direction", "phase"}) {
+      if (!sine && reader.has(key)) {
+        fail(where, "key " + quote(key) + " does not apply to a noise volume (it is for sine)");
+      }
+    }
+    for (const char* key : {"seed", "octaves"}) {
+      if (sine && reader.has(key)) {
+        fail(where, "key " + quote(key) + " does not apply to a sine volume (it is for noise)");
+      }
+    }
+    if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
+    if (reader.has("frequency")) {
+      layer.frequency = sine ? reader.number("frequency")
+                             : reader.numberAtLeast("frequency", 0, /*exclusive=*/true);
+    }
+    if (reader.has("direction")) layer.direction = reader.vec3("direction");
+    if (reader.has("phase")) layer.phase = reader.number("phase");
+    if (reader.has("seed")) layer.seed = reader.unsignedInteger("seed");
+    if (reader.has("octaves")) layer.octaves = reader.smallInteger("octaves", 1, kMaxNoiseOctaves);
+    reader.optionalName("gradient", kSchemes, layer.gradient);
+    if (reader.has("step")) layer.step = reader.numberAtLeast("step", 0, /*exclusive=*/true);
+  }
+
+  // Combinations the keys alone do not rule out.
+  if (layer.readsNormals() && layer.filter == Filter::kHermite) {
+    fail(where, "filter 'hermite' is only available for height images (use bilinear or bicubic)");
+  }
+  const bool objectSpace =
+      (layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kObject) ||
+      ((layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar) &&
+       layer.kind != ProjectedKind::kTangentNormal);
+  if (objectSpace && reader.has("green")) {
+    fail(where, "key 'green' applies only to tangent-space normal maps");
+  }
+  return layer;
+}
+
+SceneOutput parseOutput(const json& value, const std::string& where,
+                        const std::filesystem::path& outputBase, int defaultUv) {
+  SceneOutput output;
+  output.uvSet = defaultUv;
+  {
+    const ObjectReader probe(value, where, "an output");
+    probe.require("map");
+    const std::string map = probe.string("map");
+    if (map == "corners") {
+      output.kind = OutputKind::kCorners;
+    } else {
+      Result<MapKind> kind = parseMapKind(map);
+      if (!kind) fail(where, unknownNameMessage("map", map, outputMapNames()));
+      output.map = *kind;
+    }
+  }
+  const bool corners = output.kind == OutputKind::kCorners;
+  const ObjectReader reader(value, where, corners ? "a corners output" : "an output");
+  if (corners) {
+    std::map<std::string, std::string> imageOnly;
+    for (const std::string& key : kMapOutputKeys) imageOnly[key] = "it is for image maps";
+    reader.checkKeys(kCornersOutputKeys, imageOnly);
+  } else {
+    reader.checkKeys(kMapOutputKeys);
+  }
+  reader.require("file");
+  output.file = pathValue(reader, "file", outputBase);
+  if (corners) return output;
+
+  if (reader.has("size") && (reader.has("width") || reader.has("height"))) {
+    fail(where, "give either 'size' or 'width'/'height', not both");
+  }
+  if (reader.has("size")) {
+    output.width = output.height = reader.smallInteger("size", 1, kMaxBakeSide);
+  }
+  if (reader.has("width")) output.width = reader.smallInteger("width", 1, kMaxBakeSide);
+  if (reader.has("height")) output.height = reader.smallInteger("height", 1, kMaxBakeSide);
+  if (reader.has("margin")) output.margin = reader.smallInteger("margin", 0, kMaxBakeSide);
+  reader.optionalName("padding", kPaddings, output.padding);
+  if (reader.has("samples")) output.samples = reader.smallInteger("samples", 1, kMaxBakeSamples);
+  if (reader.has("uv")) output.uvSet = reader.smallInteger("uv", 0, kMaxUvSets - 1);
+  reader.optionalName("green", kGreens, output.green);
+  if (reader.has("tile")) {
+    output.tile = reader.smallInteger("tile", kFirstUdimTile, kLastUdimTile);
+  }
+  if (reader.has("format")) {
+    Result<ImageFormat> format = parseImageFormat(reader.string("format"));
+    if (!format) fail(where, format.error().message);
+    output.format = *format;
+  }
+  if (reader.has("bit_depth")) {
+    const json& depth = reader.at("bit_depth");
+    if (depth.is_string() && (depth == "half" || depth == "float")) {
+      output.bitDepth = depth == "half" ? 16 : 32;
+    } else {
+      output.bitDepth = reader.smallInteger("bit_depth", 8, 32);
+    }
+  }
+  if (reader.has("alpha")) output.alpha = reader.boolean("alpha");
+  if (reader.has("green") && output.map != MapKind::kTangentNormal) {
+    fail(where, "key 'green' applies only to tangent-normal maps");
+  }
+  return output;
+}
+
+Scene parseDocument(const json& document, const SceneParseOptions& options) {
+  const ObjectReader top(document, "", "the scene");
+  top.checkKeys(kTopKeys);
+  const std::filesystem::path outputBase =
+      options.outputDir.empty() ? options.baseDir : options.outputDir;
+
+  Scene scene;
+  top.require("mesh");
+  scene.mesh = pathValue(top, "mesh", options.baseDir);
+  if (top.has("uv")) scene.uvSet = top.smallInteger("uv", 0, kMaxUvSets - 1);
+  if (top.has("subdivision")) scene.subdivision = parseSubdivision(top.at("subdivision"));
+
+  if (top.has("layers")) {
+    const json& layers = top.at("layers");
+    if (!layers.is_array()) fail("", "'layers' must be an array, not " + describeType(layers));
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+      scene.layers.push_back(
+          parseLayer(layers[i], "layers[" + std::to_string(i) + "]", options.baseDir, scene.uvSet));
+    }
+  }
+
+  top.require("outputs");
+  const json& outputs = top.at("outputs");
+  if (!outputs.is_array()) fail("", "'outputs' must be an array, not " + describeType(outputs));
+  if (outputs.empty()) fail("", "'outputs' is empty: nothing to bake");
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    scene.outputs.push_back(
+        parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", outputBase, scene.uvSet));
+  }
+  return scene;
+}
+
+/// Parses JSON text, rejecting duplicate keys (nlohmann would keep the last silently).
+json parseJson(std::string_view text) {
+  std::vector<std::set<std::string>> keysPerObject;
+  std::string duplicate;
+  const json::parser_callback_t callback = [&](int /*depth*/, json::parse_event_t event,
+                                               json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        keysPerObject.emplace_back();
+        break;
+      case json::parse_event_t::object_end:
+        if (!keysPerObject.empty()) keysPerObject.pop_back();
+        break;
+      case json::parse_event_t::key:
+        if (!keysPerObject.empty() &&
+            !keysPerObject.back().insert(parsed.get<std::string>()).second && duplicate.empty()) {
+          duplicate = parsed.get<std::string>();
+        }
+        break;
+      default:
+        break;
+    }
+    return true;
+  };
+  json document;
+  try {
+    document = json::parse(text.begin(), text.end(), callback);
+  } catch (const json::parse_error& e) {
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." → keep the part
+    // after the bracketed id.
+    std::string message = e.what();
+    if (const std::size_t end = message.find("] "); end != std::string::npos) {
+      message = message.substr(end + 2);
+    }
+    fail("", "invalid JSON: " + message);
+  }
+  if (!duplicate.empty()) fail("", "duplicate key " + quote(duplicate));
+  return document;
+}
+
+// ---- Value checks shared by parseScene and validateScene ---------------------------------------
+
+/// Why @p value is not finite, or "".
+std::string checkFinite(std::string_view name, double value) {
+  return std::isfinite(value) ? std::string() : std::string(name) + " must be a finite number";
+}
+
+std::string checkLayer(const SceneLayer& layer) {
+  for (const auto& [name, value] : {std::pair<const char*, double>{"weight", layer.weight},
+                                    {"scale", layer.scale},
+                                    {"tiling", layer.tiling.x},
+                                    {"tiling", layer.tiling.y},
+                                    {"offset", layer.offset.x},
+                                    {"offset", layer.offset.y},
+                                    {"amplitude", layer.amplitude},
+                                    {"frequency", layer.frequency},
+                                    {"phase", layer.phase}}) {
+    if (std::string why = checkFinite(name, value); !why.empty()) return why;
+  }
+  if (layer.hasImage() && layer.image.empty()) return "missing key 'image'";
+  if (layer.uvSet < 0 || layer.uvSet >= kMaxUvSets) {
+    return rangeMessage("uv", layer.uvSet, 0, kMaxUvSets - 1);
+  }
+  if (!(layer.sharpness >= 0) || !std::isfinite(layer.sharpness)) {
+    return "sharpness must be a finite number >= 0";
+  }
+  if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
+    return "step must be a finite number > 0";
+  }
+  if (layer.type == SceneLayerType::kVolume && layer.function == VolumeFunction::kNoise) {
+    if (!(layer.frequency > 0)) return "frequency must be greater than 0";
+    if (layer.octaves < 1 || layer.octaves > kMaxNoiseOctaves) {
+      return rangeMessage("octaves", layer.octaves, 1, kMaxNoiseOctaves);
+    }
+  }
+  if (layer.mask && layer.mask->image.empty()) return "mask has no image";
+  return {};
+}
+
+std::string checkOutput(const SceneOutput& output) {
+  if (output.file.empty()) return "missing key 'file'";
+  if (output.kind == OutputKind::kCorners) return {};
+  if (output.width == output.height && (output.width < 1 || output.width > kMaxBakeSide)) {
+    return rangeMessage("size", output.width, 1, kMaxBakeSide);
+  }
+  if (output.width < 1 || output.width > kMaxBakeSide) {
+    return rangeMessage("width", output.width, 1, kMaxBakeSide);
+  }
+  if (output.height < 1 || output.height > kMaxBakeSide) {
+    return rangeMessage("height", output.height, 1, kMaxBakeSide);
+  }
+  if (output.margin < 0 || output.margin > kMaxBakeSide) {
+    return rangeMessage("margin", output.margin, 0, kMaxBakeSide);
+  }
+  if (output.samples < 1 || output.samples > kMaxBakeSamples) {
+    return rangeMessage("samples", output.samples, 1, kMaxBakeSamples);
+  }
+  if (output.uvSet < 0 || output.uvSet >= kMaxUvSets) {
+    return rangeMessage("uv", output.uvSet, 0, kMaxUvSets - 1);
+  }
+  if (output.tile < kFirstUdimTile || output.tile > kLastUdimTile) {
+    return rangeMessage("tile", output.tile, kFirstUdimTile, kLastUdimTile);
+  }
+  ImageFormat format = output.format;
+  if (format == ImageFormat::kAuto) {
+    Result<ImageFormat> fromPath = imageFormatFromPath(output.file);
+    if (!fromPath) return fromPath.error().message;
+    format = *fromPath;
+  }
+  const int depth = output.resolvedBitDepth();
+  if (!formatSupportsBitDepth(format, depth)) {
+    std::string name(imageFormatName(format));
+    for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return "bit_depth " + std::to_string(depth) + " is not available in " + name +
+           (format == ImageFormat::kExr   ? " (16 = half or 32 = float)"
+            : format == ImageFormat::kPng ? " (8 or 16)"
+                                          : " (8, 16 or 32)");
+  }
+  return {};
+}
+
+/// Levenshtein distance, case-insensitive.
+std::size_t editDistance(std::string_view a, std::string_view b) {
+  const auto lower = [](char c) { return std::tolower(static_cast<unsigned char>(c)); };
+  std::vector<std::size_t> previous(b.size() + 1);
+  std::vector<std::size_t> current(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substitute = previous[j - 1] + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, substitute});
+    }
+    std::swap(previous, current);
+  }
+  return previous[b.size()];
+}
+
+}  // namespace
+
+// ---- Public API --------------------------------------------------------------------------------
+
+std::string_view sceneLayerTypeName(SceneLayerType type) {
+  for (const Named<SceneLayerType>& entry : kLayerTypes) {
+    if (entry.value == type) return entry.name;
+  }
+  return "layer";
+}
+
+bool SceneLayer::readsNormals() const {
+  switch (type) {
+    case SceneLayerType::kNormal:
+      return true;
+    case SceneLayerType::kPlanar:
+    case SceneLayerType::kTriplanar:
+      return kind != ProjectedKind::kHeight;
+    case SceneLayerType::kHeight:
+    case SceneLayerType::kVolume:
+      break;
+  }
+  return false;
+}
+
+bool SceneLayer::hasHeight() const {
+  return type == SceneLayerType::kHeight || type == SceneLayerType::kVolume ||
+         ((type == SceneLayerType::kPlanar || type == SceneLayerType::kTriplanar) &&
+          kind == ProjectedKind::kHeight);
+}
+
+ImageFormat SceneOutput::resolvedFormat() const {
+  if (format != ImageFormat::kAuto) return format;
+  Result<ImageFormat> fromPath = imageFormatFromPath(file);
+  return fromPath ? *fromPath : ImageFormat::kAuto;
+}
+
+int SceneOutput::resolvedBitDepth() const {
+  return bitDepth != 0 ? bitDepth : defaultBitDepth(resolvedFormat(), map);
+}
+
+namespace {
+
+/// The scene name of @p value in @p table.
+template <class E, std::size_t N>
+std::string nameIn(const Named<E> (&table)[N], E value) {
+  for (const Named<E>& entry : table) {
+    if (entry.value == value) return entry.name;
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string_view filterName(Filter filter) {
+  for (const Named<Filter>& entry : kFilters) {
+    if (entry.value == filter) return entry.name;
+  }
+  return "?";
+}
+
+std::filesystem::path canonicalPath(const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
+  if (!ec) return canonical;
+  canonical = std::filesystem::absolute(path, ec);
+  return (ec ? path : canonical).lexically_normal();
+}
+
+std::string describeLayer(const SceneLayer& layer) {
+  std::string text;
+  switch (layer.type) {
+    case SceneLayerType::kHeight:
+      text = "height image " + layer.image.string();
+      break;
+    case SceneLayerType::kNormal:
+      text = std::string(layer.space == NormalSpace::kTangent ? "tangent" : "object") +
+             "-space normal map " + layer.image.string();
+      break;
+    case SceneLayerType::kVolume:
+      text = "volume " + nameIn(kFunctions, layer.function);
+      break;
+    case SceneLayerType::kPlanar:
+    case SceneLayerType::kTriplanar:
+      text = std::string(sceneLayerTypeName(layer.type)) + " " + nameIn(kKinds, layer.kind) + " " +
+             layer.image.string();
+      break;
+  }
+  return layer.name.empty() ? text : "'" + layer.name + "', " + text;
+}
+
+std::string layerParametersJson(const SceneLayer& layer) {
+  json j;
+  j["type"] = sceneLayerTypeName(layer.type);
+  j["weight"] = layer.weight;
+  if (layer.mask) {
+    j["mask"] = {{"image", canonicalPath(layer.mask->image).string()},
+                 {"uv", layer.mask->uvSet},
+                 {"tiling", {layer.mask->tiling.x, layer.mask->tiling.y}},
+                 {"offset", {layer.mask->offset.x, layer.mask->offset.y}},
+                 {"filter", filterName(layer.mask->filter)}};
+  }
+  if (layer.hasImage()) {
+    j["image"] = canonicalPath(layer.image).string();
+    j["filter"] = filterName(layer.filter);
+    j["wrap"] = nameIn(kWraps, layer.wrap);
+    j["tiling"] = {layer.tiling.x, layer.tiling.y};
+    j["offset"] = {layer.offset.x, layer.offset.y};
+    j["scale"] = layer.scale;
+  }
+  const bool tangentNormals =
+      (layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent) ||
+      ((layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar) &&
+       layer.kind == ProjectedKind::kTangentNormal);
+  if (tangentNormals) j["green"] = nameIn(kGreens, layer.green);
+  switch (layer.type) {
+    case SceneLayerType::kHeight:
+      j["uv"] = layer.uvSet;
+      break;
+    case SceneLayerType::kNormal:
+      j["uv"] = layer.uvSet;
+      j["space"] = nameIn(kSpaces, layer.space);
+      break;
+    case SceneLayerType::kVolume:
+      j["function"] = nameIn(kFunctions, layer.function);
+      j["amplitude"] = layer.amplitude;
+      j["frequency"] = layer.frequency;
+      if (layer.function == VolumeFunction::kSine) {
+        j["direction"] = {layer.direction.x, layer.direction.y, layer.direction.z};
+        j["phase"] = layer.phase;
+      } else {
+        j["seed"] = layer.seed;
+        j["octaves"] = layer.octaves;
+      }
+      j["gradient"] = nameIn(kSchemes, layer.gradient);
+      j["step"] = layer.step ? json(*layer.step) : json("default");
+      break;
+    case SceneLayerType::kPlanar:
+      j["kind"] = nameIn(kKinds, layer.kind);
+      j["axis"] = nameIn(kAxes, layer.axis);
+      break;
+    case SceneLayerType::kTriplanar:
+      j["kind"] = nameIn(kKinds, layer.kind);
+      j["sharpness"] = layer.sharpness;
+      j["min_weight"] = layer.minWeight;
+      break;
+  }
+  return j.dump();
+}
+
+std::string outputParametersJson(const SceneOutput& output) {
+  json j;
+  if (output.kind == OutputKind::kCorners) {
+    j["map"] = "corners";
+    return j.dump();
+  }
+  j["map"] = mapKindName(output.map);
+  j["width"] = output.width;
+  j["height"] = output.height;
+  j["samples"] = output.samples;
+  j["uv"] = output.uvSet;
+  j["margin"] = output.margin;
+  j["padding"] = nameIn(kPaddings, output.padding);
+  if (output.map == MapKind::kTangentNormal) j["green"] = nameIn(kGreens, output.green);
+  if (!hasUdimToken(output.file.string())) j["tile"] = output.tile;
+  j["format"] = imageFormatName(output.resolvedFormat());
+  j["bit_depth"] = output.resolvedBitDepth();
+  j["alpha"] = output.alpha;
+  return j.dump();
+}
+
+std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
+  if (!subdivision.present) return "null";
+  json j;
+  j["level"] = subdivision.limit ? json("limit") : json(subdivision.level);
+  j["uv_smooth"] = nameIn(kUvSmooths, subdivision.uvSmooth);
+  j["boundary"] = nameIn(kBoundaries, subdivision.boundary);
+  return j.dump();
+}
+
+std::string closestMatch(std::string_view word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t bestDistance = std::numeric_limits<std::size_t>::max();
+  for (const std::string& candidate : candidates) {
+    const std::size_t d = editDistance(word, candidate);
+    if (d < bestDistance) {
+      bestDistance = d;
+      best = candidate;
+    }
+  }
+  const std::size_t limit = std::min<std::size_t>(2, (word.size() + 1) / 2);
+  return bestDistance <= limit ? best : std::string();
+}
+
+Status validateScene(const Scene& scene) {
+  const auto where = [](const char* list, std::size_t i) {
+    return std::string(list) + "[" + std::to_string(i) + "]: ";
+  };
+  if (scene.mesh.empty()) return Error::badInput("missing key 'mesh'");
+  if (scene.uvSet < 0 || scene.uvSet >= kMaxUvSets) {
+    return Error::badInput(rangeMessage("uv", scene.uvSet, 0, kMaxUvSets - 1));
+  }
+  for (std::size_t i = 0; i < scene.layers.size(); ++i) {
+    if (std::string why = checkLayer(scene.layers[i]); !why.empty()) {
+      return Error::badInput(where("layers", i) + why);
+    }
+  }
+  if (scene.outputs.empty()) return Error::badInput("'outputs' is empty: nothing to bake");
+  for (std::size_t i = 0; i < scene.outputs.size(); ++i) {
+    if (std::string why = checkOutput(scene.outputs[i]); !why.empty()) {
+      return Error::badInput(where("outputs", i) + why);
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (scene.outputs[j].file == scene.outputs[i].file) {
+        return Error::badInput(where("outputs", i) + "file '" + scene.outputs[i].file.string() +
+                               "' is also written by outputs[" + std::to_string(j) + "]");
+      }
+    }
+  }
+  return Ok{};
+}
+
+Result<Scene> parseScene(std::string_view text, const SceneParseOptions& options) {
+  const std::string prefix = options.name + ": ";
+  try {
+    Scene scene = parseDocument(parseJson(text), options);
+    if (Status valid = validateScene(scene); !valid) {
+      return Error::badInput(prefix + valid.error().message);
+    }
+    return scene;
+  } catch (const SceneFailure& failure) {
+    return Error::badInput(prefix + (failure.where.empty() ? "" : failure.where + ": ") +
+                           failure.what);
+  } catch (const json::exception& e) {
+    // Every access above checks types first; this is a bug, not bad input.
+    return Error::internal(prefix + "unexpected JSON error: " + e.what());
+  }
+}
+
+Result<Scene> loadScene(const std::filesystem::path& path, const std::filesystem::path& outputDir) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    return Error::badInput(path.string() + ": cannot open scene (no such file)");
+  }
+  if (std::filesystem::is_directory(path, ec)) {
+    return Error::badInput(path.string() + ": cannot read scene (it is a directory)");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error::badInput(path.string() + ": cannot open scene (permission denied?)");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) return Error::badInput(path.string() + ": cannot read scene");
+
+  SceneParseOptions options;
+  options.baseDir = path.parent_path();
+  options.outputDir = outputDir;
+  options.name = path.string();
+  Result<Scene> scene = parseScene(text, options);
+  if (scene) scene->source = path;
+  return scene;
+}
+
+}  // namespace sgbake

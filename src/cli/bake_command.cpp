@@ -1,0 +1,472 @@
+/// @file bake_command.cpp
+/// @brief `sgbake bake SCENE.json` (or the one-map shorthand `sgbake bake --mesh M.obj ... -o
+/// OUT`): plans the scene, explains or runs the plan, reports progress and timings.
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "sgbake/bake/image_output.hpp"
+#include "sgbake/bake/planner.hpp"
+#include "sgbake/bake/scene.hpp"
+
+namespace sgbake::cli {
+namespace {
+
+/// The command line of `sgbake bake`, as CLI11 fills it in.
+struct BakeArguments {
+  std::string scene;   ///< SCENE.json ("" in the one-map form)
+  std::string outDir;  ///< --out-dir
+  bool explain = false;
+  bool force = false;
+  bool noManifest = false;
+  int threads = 0;
+  bool stats = false;
+
+  // One-map form.
+  std::string mesh;
+  std::string output;
+  std::string map = "tangent-normal";
+  int size = kDefaultOutputSize;
+  int margin = kDefaultMargin;
+  std::string padding = "extend";
+  int samples = 1;
+  int uvSet = 0;
+  std::string green = "opengl";
+  std::string heightImage;
+  double heightScale = 1;
+  std::string filter = "bilinear";
+  std::string normalImage;
+  std::string normalSpace = "tangent";
+  std::string normalGreen = "opengl";
+  int bitDepth = 0;
+  bool alpha = false;
+};
+
+constexpr const char* kFooter =
+    "Scene file (JSON; relative paths are relative to the scene file):\n"
+    "  { \"mesh\": \"m.obj\", \"uv\": 0,\n"
+    "    \"layers\": [\n"
+    "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
+    "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
+    "\"opengl\"},\n"
+    "      {\"type\": \"volume\", \"function\": \"noise\", \"amplitude\": 0.01, \"frequency\": "
+    "8},\n"
+    "      {\"type\": \"triplanar\", \"image\": \"t.png\", \"kind\": \"height\", \"scale\": "
+    "0.05}],\n"
+    "    \"outputs\": [\n"
+    "      {\"map\": \"tangent-normal\", \"file\": \"out/n.png\", \"size\": 2048, \"margin\": 16}] "
+    "}\n"
+    "  Layer keys (all layers: type, name, weight = 1, mask = IMAGE or {image, uv, tiling,\n"
+    "  offset, filter}):\n"
+    "    height     image, uv, scale = 1, filter = bilinear|bicubic|hermite, wrap = repeat|clamp,\n"
+    "               tiling = 1 (number or [s, t]), offset = [0, 0]\n"
+    "    normal     image, uv, space = tangent|object, green = opengl|directx, strength = 1,\n"
+    "               filter = bilinear|bicubic, wrap, tiling, offset\n"
+    "    volume     function = sine|noise, amplitude = 1, frequency = 1, direction = [1,0,0] and\n"
+    "               phase = 0 (sine), seed = 0 and octaves = 1 (noise),\n"
+    "               gradient = analytic|central|tetrahedral, step (default 2^-20 of the mesh "
+    "size)\n"
+    "    planar     image, kind = height|tangent-normal|object-normal, axis = x|y|z, scale = 1,\n"
+    "               tiling, offset, filter, wrap, green\n"
+    "    triplanar  image, kind, scale = 1, tiling, offset, sharpness = 4, min_weight = 0.001,\n"
+    "               filter, wrap, green\n"
+    "  Output keys: map (tangent-normal, object-normal, height, derivative, surface-gradient,\n"
+    "    tangent, bitangent, mask, or corners for the per-corner CSV table), file (.png, .exr,\n"
+    "    .tif; '<UDIM>' in the name bakes every UDIM tile the UV set touches),\n"
+    "    size = 1024 (or width and height), margin = 16, padding = extend|push-pull,\n"
+    "    samples = 1 (N x N per texel), uv, green = opengl|directx, tile = 1001,\n"
+    "    format = png|exr|tiff, bit_depth = 8|16|32 (default 16; 8 for masks in PNG/TIFF),\n"
+    "    alpha = false (coverage as alpha).\n"
+    "  Unknown keys are errors; keys starting with '_' are comments.\n"
+    "\n"
+    "Incremental:\n"
+    "  Each output directory gets a .sgbake-manifest.json with hashes of the inputs, the\n"
+    "  parameters and the written files. A re-run bakes only outputs whose inputs, parameters\n"
+    "  or files changed (the others print 'up to date'); --force bakes everything.\n"
+    "  Files are replaced only once complete: a failed run never leaves partial files.\n"
+    "\n"
+    "Examples:\n"
+    "  sgbake bake meshes/default_scene.json --out-dir out\n"
+    "  sgbake bake scene.json --explain\n"
+    "  sgbake bake scene.json --force --threads 4 --stats\n"
+    "  sgbake bake --mesh suzanne.obj --height bumps.png --height-scale 0.05 \\\n"
+    "              --map tangent-normal --size 2048 -o suzanne_normal.png\n"
+    "  sgbake bake --mesh m.obj --normal n_os.png --normal-space object --map tangent-normal \\\n"
+    "              --size 1024 --margin 0 -o n_ts.exr\n"
+    "\n";
+
+/// Options of the one-map form: any of them set means the one-map form.
+const char* const kOneMapOptions[] = {
+    "--mesh",    "--output",       "--map",          "--size",      "--margin",       "--padding",
+    "--samples", "--uv",           "--green",        "--height",    "--height-scale", "--filter",
+    "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha"};
+
+// ---- Progress bar ------------------------------------------------------------------------------
+
+/// A one-line progress bar on standard error, shown only when standard error is a terminal and
+/// the work has lasted longer than kDelay; redrawn by a ticker thread (a single bake gives no
+/// intermediate progress, so the elapsed time keeps moving). Cleared when done.
+class ProgressBar {
+ public:
+  static constexpr std::chrono::milliseconds kDelay{500};
+  static constexpr std::chrono::milliseconds kTick{100};
+
+  ProgressBar() : enabled_(::isatty(STDERR_FILENO) == 1) {
+    if (enabled_) ticker_ = std::thread([this] { run(); });
+  }
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+  ~ProgressBar() { stop(); }
+
+  /// The callback for ExecuteOptions::progress.
+  void update(const BakeProgress& progress) {
+    if (!enabled_) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    done_ = progress.done;
+    total_ = progress.total;
+    what_ = std::string(progress.what);
+  }
+
+  /// Stops the ticker and erases the bar (idempotent).
+  void stop() {
+    if (!ticker_.joinable()) return;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    ticker_.join();
+    if (shown_) std::fputs("\r\033[K", stderr);
+    std::fflush(stderr);
+  }
+
+ private:
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!wake_.wait_for(lock, kTick, [this] { return stopping_; })) {
+      if (std::chrono::steady_clock::now() - start_ < kDelay) continue;
+      draw();
+    }
+  }
+
+  /// Draws the bar; called with mutex_ held.
+  void draw() {
+    constexpr int kBarWidth = 24;
+    static const char kSpinner[] = "|/-\\";
+    int columns = 80;
+    winsize size{};
+    if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 20) columns = size.ws_col;
+    const double fraction =
+        total_ == 0 ? 0.0 : static_cast<double>(done_) / static_cast<double>(total_);
+    const int filled = static_cast<int>(fraction * kBarWidth);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    char head[128];
+    std::snprintf(head, sizeof head, "\r[%-*s] %zu/%zu %c %.1fs ", kBarWidth,
+                  std::string(static_cast<std::size_t>(filled), '#').c_str(), done_, total_,
+                  kSpinner[ticks_++ % 4], seconds);
+    std::string line = head + what_;
+    const auto maxChars = static_cast<std::size_t>(columns - 1) + 1;  // +1 for the '\r'
+    if (line.size() > maxChars) line.resize(maxChars);
+    line += "\033[K";
+    std::fputs(line.c_str(), stderr);
+    std::fflush(stderr);
+    shown_ = true;
+  }
+
+  const bool enabled_;
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread ticker_;
+  bool stopping_ = false;
+  bool shown_ = false;
+  std::size_t done_ = 0, total_ = 0, ticks_ = 0;
+  std::string what_;
+};
+
+// ---- The command -------------------------------------------------------------------------------
+
+/// The scene of the one-map form: one output and the layers its options name.
+Result<Scene> oneMapScene(const BakeArguments& args) {
+  if (args.mesh.empty()) return Error::badInput("bake: --mesh is required without a SCENE file");
+  if (args.output.empty()) return Error::badInput("bake: -o/--output is required with --mesh");
+  const auto parseName = [](const std::string& option, const std::string& value,
+                            std::initializer_list<const char*> names) -> Status {
+    for (const char* name : names) {
+      if (value == name) return Ok{};
+    }
+    std::vector<std::string> list(names.begin(), names.end());
+    std::string message = "bake: " + option + ": unknown value '" + value + "'";
+    const std::string suggestion = closestMatch(value, list);
+    message += suggestion.empty() ? " (expected " : " (did you mean '" + suggestion + "'?; ";
+    if (!suggestion.empty()) message += "expected ";
+    for (std::size_t i = 0; i < list.size(); ++i) message += (i ? ", " : "") + list[i];
+    return Error::badInput(message + ")");
+  };
+
+  Scene scene;
+  scene.mesh = args.mesh;
+  scene.uvSet = args.uvSet;
+  if (!args.heightImage.empty()) {
+    if (Status ok = parseName("--filter", args.filter, {"bilinear", "bicubic", "hermite"}); !ok) {
+      return ok.error();
+    }
+    SceneLayer height;
+    height.type = SceneLayerType::kHeight;
+    height.image = args.heightImage;
+    height.scale = args.heightScale;
+    height.uvSet = args.uvSet;
+    height.filter = args.filter == "bicubic"   ? Filter::kBicubic
+                    : args.filter == "hermite" ? Filter::kHermite
+                                               : Filter::kBilinear;
+    scene.layers.push_back(height);
+  }
+  if (!args.normalImage.empty()) {
+    if (Status ok = parseName("--normal-space", args.normalSpace, {"tangent", "object"}); !ok) {
+      return ok.error();
+    }
+    if (Status ok = parseName("--normal-green", args.normalGreen, {"opengl", "directx"}); !ok) {
+      return ok.error();
+    }
+    SceneLayer normal;
+    normal.type = SceneLayerType::kNormal;
+    normal.image = args.normalImage;
+    normal.uvSet = args.uvSet;
+    normal.space = args.normalSpace == "object" ? NormalSpace::kObject : NormalSpace::kTangent;
+    normal.green =
+        args.normalGreen == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
+    normal.filter = args.filter == "bicubic" ? Filter::kBicubic : Filter::kBilinear;
+    scene.layers.push_back(normal);
+  }
+
+  SceneOutput output;
+  output.file = args.output;
+  if (args.map == "corners") {
+    output.kind = OutputKind::kCorners;
+  } else {
+    Result<MapKind> map = parseMapKind(args.map);
+    if (!map) return Error::badInput("bake: --map: " + map.error().message);
+    output.map = *map;
+    Result<ImageFormat> format = imageFormatFromPath(output.file);
+    if (!format) return Error::badInput("bake: -o: " + format.error().message);
+  }
+  if (Status ok = parseName("--padding", args.padding, {"extend", "push-pull"}); !ok) {
+    return ok.error();
+  }
+  if (Status ok = parseName("--green", args.green, {"opengl", "directx"}); !ok) return ok.error();
+  output.width = output.height = args.size;
+  output.margin = args.margin;
+  output.padding = args.padding == "push-pull" ? PaddingMode::kPushPull : PaddingMode::kExtend;
+  output.samples = args.samples;
+  output.uvSet = args.uvSet;
+  output.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
+  output.bitDepth = args.bitDepth;
+  output.alpha = args.alpha;
+  scene.outputs.push_back(output);
+  if (Status valid = validateScene(scene); !valid) {
+    return Error::badInput("bake: " + valid.error().message);
+  }
+  return scene;
+}
+
+/// Prints what happened to each output on standard output.
+void printOutcome(const ExecuteReport& report) {
+  std::string text;
+  for (const OutputReport& output : report.outputs) {
+    if (!output.baked) {
+      text += "up to date: " + output.file.string() + "\n";
+      continue;
+    }
+    for (const std::filesystem::path& file : output.files) text += "wrote " + file.string() + "\n";
+  }
+  std::fputs(text.c_str(), stdout);
+  std::fflush(stdout);
+}
+
+Status runBake(const BakeArguments& args, const CLI::App& app) {
+  Stopwatch total;
+  const ThreadLimit threadLimit(args.threads);
+
+  bool oneMap = false;
+  for (const char* option : kOneMapOptions) {
+    if (app.count(option) > 0) oneMap = true;
+  }
+  if (oneMap && !args.scene.empty()) {
+    return Error::badInput(
+        "bake: give either a SCENE file or the one-map options (--mesh, "
+        "--map, -o, ...), not both");
+  }
+  if (!oneMap && args.scene.empty()) {
+    return Error::badInput(
+        "bake: give a SCENE file, or --mesh and -o for one map (see 'sgbake "
+        "bake --help')");
+  }
+  if (oneMap && !args.outDir.empty()) {
+    return Error::badInput("bake: --out-dir applies to scene files only");
+  }
+
+  Result<Scene> scene = oneMap ? oneMapScene(args) : loadScene(args.scene, args.outDir);
+  if (!scene) return scene.error();
+
+  PlanOptions planOptions;
+  planOptions.force = args.force;
+  planOptions.useManifest = !args.noManifest;
+  Result<Plan> plan = makePlan(std::move(*scene), planOptions);
+  if (!plan) return plan.error();
+  if (args.explain) {
+    const std::string text = explainPlan(*plan);
+    std::fputs(text.c_str(), stdout);
+    return Ok{};
+  }
+
+  ProgressBar bar;
+  ExecuteOptions executeOptions;
+  executeOptions.threads = args.threads;
+  executeOptions.progress = [&bar](const BakeProgress& progress) { bar.update(progress); };
+  Result<ExecuteReport> report = executePlan(*plan, executeOptions);
+  bar.stop();
+  if (!report) return report.error();
+  printOutcome(*report);
+
+  if (args.stats) {
+    std::size_t baked = 0;
+    for (const OutputReport& output : report->outputs) baked += output.baked ? 1 : 0;
+    const nlohmann::json stats = {
+        {"command", "bake"},
+        {"scene", oneMap ? std::string("-") : args.scene},
+        {"outputs", report->outputs.size()},
+        {"baked", baked},
+        {"up_to_date", report->outputs.size() - baked},
+        {"tiles", report->tilesBaked},
+        {"images_loaded", report->imagesLoaded},
+        {"textures", report->texturesCreated},
+        {"tangents", report->tangentsComputed},
+        {"threads", threadLimit.effectiveThreads()},
+        {"plan_s", plan->planSeconds},
+        {"load_s", report->loadSeconds},
+        {"tangents_s", report->tangentsSeconds},
+        {"bake_s", report->bakeSeconds},
+        {"pad_s", report->padSeconds},
+        {"write_s", report->writeSeconds},
+        {"total_s", total.seconds()},
+    };
+    const std::string line =
+        stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+    std::fputs(line.c_str(), stderr);
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+CommandAction defineBakeCommand(CLI::App& app) {
+  auto args = std::make_shared<BakeArguments>();
+  app.footer(std::string(kFooter) + kExitCodeHelp);
+  app.add_option("SCENE", args->scene, "Scene file (JSON) listing the mesh, layers and outputs")
+      ->type_name("FILE");
+  app.add_flag("--explain", args->explain,
+               "Print the plan (steps with reasons, and what is skipped) and exit without baking");
+  app.add_flag("--force", args->force, "Bake every output, even those that are up to date");
+  app.add_flag("--no-manifest", args->noManifest,
+               "Neither read nor write .sgbake-manifest.json (always bake)");
+  app.add_option("--out-dir", args->outDir,
+                 "Resolve relative output files against DIR instead of the scene's directory")
+      ->type_name("DIR");
+  app.add_option("--threads", args->threads, "Maximum number of threads, 0 = all cores")
+      ->type_name("N")
+      ->check(kNonNegativeInteger)
+      ->capture_default_str();
+  app.add_flag("--stats", args->stats,
+               "Print timings and counts as one line of JSON on standard error");
+
+  const std::string oneMap = "One map without a scene file";
+  app.add_option("--mesh", args->mesh, "Mesh with UVs (.obj, .ply, .off)")
+      ->type_name("FILE")
+      ->group(oneMap);
+  app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif; '<UDIM>' allowed)")
+      ->type_name("FILE")
+      ->group(oneMap);
+  app.add_option("--map", args->map,
+                 "tangent-normal, object-normal, height, derivative, surface-gradient, tangent, "
+                 "bitangent, mask or corners")
+      ->type_name("MAP")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--size", args->size, "Width and height of the map, texels (1 to 65536)")
+      ->type_name("N")
+      ->check(CLI::Range(1, kMaxBakeSide).description(""))
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--margin", args->margin, "Texels of edge padding around the UV islands")
+      ->type_name("N")
+      ->check(CLI::Range(0, kMaxBakeSide).description(""))
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--padding", args->padding, "extend (by --margin) or push-pull (fill all)")
+      ->type_name("MODE")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--samples", args->samples, "N: N x N samples per texel (1 to 16)")
+      ->type_name("N")
+      ->check(CLI::Range(1, kMaxBakeSamples).description(""))
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--uv", args->uvSet, "UV set of the map and its layers (0 = the first)")
+      ->type_name("N")
+      ->check(CLI::Range(0, kMaxUvSets - 1).description(""))
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--green", args->green, "Green channel of a tangent-normal map: opengl or directx")
+      ->type_name("CONVENTION")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--height", args->heightImage, "Height image layer")
+      ->type_name("IMAGE")
+      ->group(oneMap);
+  app.add_option("--height-scale", args->heightScale,
+                 "Object units of height per unit of image value")
+      ->type_name("S")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--filter", args->filter,
+                 "Image filter: bilinear, bicubic or hermite (heights only)")
+      ->type_name("FILTER")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--normal", args->normalImage, "Normal-map layer")
+      ->type_name("IMAGE")
+      ->group(oneMap);
+  app.add_option("--normal-space", args->normalSpace, "Space of --normal: tangent or object")
+      ->type_name("SPACE")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--normal-green", args->normalGreen,
+                 "Green channel of --normal: opengl or directx")
+      ->type_name("CONVENTION")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--bit-depth", args->bitDepth,
+                 "8, 16 or 32 bits per channel (0 = 16; 8 for masks in PNG/TIFF)")
+      ->type_name("N")
+      ->check(CLI::IsMember({0, 8, 16, 32}).description(""))
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_flag("--alpha", args->alpha, "Write the coverage as an alpha channel")->group(oneMap);
+
+  return [args, &app] { return runBake(*args, app); };
+}
+
+}  // namespace sgbake::cli

@@ -1,0 +1,240 @@
+/// @file convert_command.cpp
+/// @brief `sgbake convert IN --mesh M.obj --from object --to tangent -o OUT`: re-expresses a
+/// normal map between object and tangent space with Blender's per-texel frame.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "sgbake/bake/convert.hpp"
+#include "sgbake/bake/image_output.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/image.hpp"
+#include "sgbake/io/atomic_file.hpp"
+#include "sgbake/mesh/io.hpp"
+
+namespace sgbake::cli {
+namespace {
+
+/// The command line of `sgbake convert`, as CLI11 fills it in.
+struct ConvertArguments {
+  std::string input;
+  std::string mesh;
+  std::string output;
+  std::string from;
+  std::string to;
+  int uvSet = 0;
+  std::string green = "opengl";
+  int tile = kFirstUdimTile;
+  int samples = 1;
+  int bitDepth = 0;
+  int threads = 0;
+  bool stats = false;
+};
+
+constexpr const char* kFooter =
+    "What it does:\n"
+    "  Every texel the mesh covers (in the UV set, tile 1001 unless --tile) is decoded as\n"
+    "  n = 2c - 1 and re-expressed in the per-texel MikkTSpace frame Blender's baker uses:\n"
+    "  object -> tangent applies inverse([T B N]); tangent -> object applies x T + y B + z N.\n"
+    "  Texels outside the UV islands keep their input values. The output has the input's size;\n"
+    "  an alpha channel is kept (unassociated), further channels are dropped. The file is\n"
+    "  replaced only once complete.\n"
+    "\n"
+    "Examples:\n"
+    "  sgbake convert --mesh suzanne.obj --from object --to tangent n_os.exr -o n_ts.exr\n"
+    "  sgbake convert --mesh suzanne.obj --from tangent --to object --green directx \\\n"
+    "                 n_ts.png -o n_os.png\n"
+    "\n";
+
+/// The FloatImage (rows top first) of an Image (rows bottom-up), at most three colour channels;
+/// a fourth channel becomes the coverage, to be written back as alpha.
+FloatImage toFloatImage(const Image& image, bool& hasAlpha) {
+  FloatImage out;
+  out.width = image.width();
+  out.height = image.height();
+  out.channels = image.channels();
+  hasAlpha = image.channels() >= 4;
+  out.pixels.resize(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height) *
+                    static_cast<std::size_t>(out.channels));
+  out.coverage.assign(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height),
+                      1.0f);
+  for (int row = 0; row < out.height; ++row) {
+    const int y = image.yFromFileRow(row);
+    for (int x = 0; x < out.width; ++x) {
+      for (int c = 0; c < out.channels; ++c) out.at(x, row, c) = image.at(x, y, c);
+    }
+  }
+  return out;
+}
+
+/// Keeps the first three channels; channel 3 (alpha) moves to the coverage.
+FloatImage toRgb(const FloatImage& image, bool hasAlpha) {
+  if (image.channels <= 3) return image;
+  FloatImage out;
+  out.width = image.width;
+  out.height = image.height;
+  out.channels = 3;
+  const std::size_t texels =
+      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+  out.pixels.resize(texels * 3);
+  out.coverage.resize(texels);
+  for (std::size_t t = 0; t < texels; ++t) {
+    const float* in = &image.pixels[t * static_cast<std::size_t>(image.channels)];
+    for (std::size_t c = 0; c < 3; ++c) out.pixels[t * 3 + c] = in[c];
+    out.coverage[t] = hasAlpha ? in[3] : 1.0f;
+  }
+  return out;
+}
+
+Status runConvert(const ConvertArguments& args) {
+  Stopwatch total;
+  const ThreadLimit threadLimit(args.threads);
+
+  Result<NormalSpace> from = parseNormalSpace(args.from);
+  if (!from) return Error::badInput("convert: --from: " + from.error().message);
+  Result<NormalSpace> to = parseNormalSpace(args.to);
+  if (!to) return Error::badInput("convert: --to: " + to.error().message);
+  if (args.green != "opengl" && args.green != "directx") {
+    return Error::badInput("convert: --green: unknown value '" + args.green +
+                           "' (expected opengl or directx)");
+  }
+  Result<ImageFormat> format = imageFormatFromPath(args.output);
+  if (!format) return format.error();
+  const int bitDepth =
+      args.bitDepth != 0 ? args.bitDepth : defaultBitDepth(*format, MapKind::kTangentNormal);
+  if (!formatSupportsBitDepth(*format, bitDepth)) {
+    return Error::badInput(args.output + ": --bit-depth " + std::to_string(bitDepth) +
+                           " is not available in this format");
+  }
+  // An unwritable destination is reported before any work is done.
+  {
+    Result<AtomicFile> probe = AtomicFile::create(args.output);
+    if (!probe) return probe.error();
+  }
+
+  Stopwatch step;
+  LoadOptions meshOptions;
+  meshOptions.requireUvs = true;
+  Result<Mesh> mesh = loadMesh(args.mesh, meshOptions);
+  if (!mesh) return mesh.error();
+  if (!mesh->hasUvSet(static_cast<std::size_t>(args.uvSet))) {
+    return Error::badInput(args.mesh + ": has " + std::to_string(mesh->uvSets.size()) +
+                           " UV set(s); --uv " + std::to_string(args.uvSet) +
+                           " does not exist (UV sets are numbered from 0)");
+  }
+  Result<Image> image = loadImage(args.input);
+  if (!image) return image.error();
+  if (image->channels() < 3) {
+    return Error::badInput(args.input + ": image has " + std::to_string(image->channels()) +
+                           " channel(s) but a normal map needs 3 (RGB)");
+  }
+  bool hasAlpha = false;
+  const FloatImage input = toFloatImage(*image, hasAlpha);
+  const double loadSeconds = step.lap();
+
+  TangentOptions tangentOptions;
+  tangentOptions.threads = args.threads;
+  Result<CornerTangents> tangents = computeTangents(mesh->view(0), tangentOptions);
+  if (!tangents) {
+    return Error{tangents.error().code, args.mesh + ": " + tangents.error().message};
+  }
+  const double tangentSeconds = step.lap();
+
+  ConvertSettings settings;
+  settings.uvSet = args.uvSet;
+  settings.udimTile = args.tile;
+  settings.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
+  settings.samples = args.samples;
+  settings.threads = args.threads;
+  Result<FloatImage> converted = convertNormalMap(*mesh, *tangents, input, *from, *to, settings);
+  if (!converted) {
+    return Error{converted.error().code, args.input + ": " + converted.error().message};
+  }
+  const double convertSeconds = step.lap();
+
+  ImageWriteOptions writeOptions;
+  writeOptions.format = *format;
+  writeOptions.bitDepth = bitDepth;
+  writeOptions.alpha = hasAlpha;
+  if (Status ok = writeImage(toRgb(*converted, hasAlpha), args.output, writeOptions); !ok) {
+    return ok;
+  }
+  const double writeSeconds = step.lap();
+
+  if (args.stats) {
+    const nlohmann::json stats = {
+        {"command", "convert"},
+        {"input", args.input},
+        {"mesh", args.mesh},
+        {"output", args.output},
+        {"width", input.width},
+        {"height", input.height},
+        {"from", normalSpaceName(*from)},
+        {"to", normalSpaceName(*to)},
+        {"threads", threadLimit.effectiveThreads()},
+        {"load_s", loadSeconds},
+        {"tangents_s", tangentSeconds},
+        {"convert_s", convertSeconds},
+        {"write_s", writeSeconds},
+        {"total_s", total.seconds()},
+    };
+    const std::string line =
+        stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+    std::fputs(line.c_str(), stderr);
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+CommandAction defineConvertCommand(CLI::App& app) {
+  auto args = std::make_shared<ConvertArguments>();
+  app.footer(std::string(kFooter) + kExitCodeHelp);
+  app.add_option("IN", args->input, "Normal map to convert (.png, .exr, .tif, ...)")
+      ->required()
+      ->type_name("IMAGE");
+  app.add_option("--mesh", args->mesh, "Mesh with UVs the map was baked for")
+      ->required()
+      ->type_name("FILE");
+  app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif); same size as IN")
+      ->required()
+      ->type_name("FILE");
+  app.add_option("--from", args->from, "Space of IN: object or tangent")
+      ->required()
+      ->type_name("SPACE");
+  app.add_option("--to", args->to, "Space of the output: object or tangent")
+      ->required()
+      ->type_name("SPACE");
+  app.add_option("--uv", args->uvSet, "UV set that places the mesh in the image")
+      ->type_name("N")
+      ->check(kNonNegativeInteger)
+      ->capture_default_str();
+  app.add_option("--green", args->green,
+                 "Green channel of the tangent-space side: opengl (Y+) or directx (Y-)")
+      ->type_name("CONVENTION")
+      ->capture_default_str();
+  app.add_option("--tile", args->tile, "UDIM tile the image covers (1001 to 2000)")
+      ->type_name("N")
+      ->check(CLI::Range(kFirstUdimTile, kLastUdimTile).description(""))
+      ->capture_default_str();
+  app.add_option("--samples", args->samples, "N: N x N frames per texel, averaged (1 to 16)")
+      ->type_name("N")
+      ->check(CLI::Range(1, kMaxBakeSamples).description(""))
+      ->capture_default_str();
+  app.add_option("--bit-depth", args->bitDepth, "8, 16 or 32 bits per channel (0 = 16)")
+      ->type_name("N")
+      ->check(CLI::IsMember({0, 8, 16, 32}).description(""))
+      ->capture_default_str();
+  app.add_option("--threads", args->threads, "Maximum number of threads, 0 = all cores")
+      ->type_name("N")
+      ->check(kNonNegativeInteger)
+      ->capture_default_str();
+  app.add_flag("--stats", args->stats,
+               "Print timings and sizes as one line of JSON on standard error");
+  return [args] { return runConvert(*args); };
+}
+
+}  // namespace sgbake::cli

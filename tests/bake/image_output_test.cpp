@@ -1,0 +1,307 @@
+/// @file image_output_test.cpp
+/// @brief writeImage: formats, bit depths, orientation, alpha, all-or-nothing files, and the
+/// `<UDIM>` token. Files are read back with OpenImageIO directly (not through sgbake).
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "sgbake/bake/image_output.hpp"
+
+namespace sgbake {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A fresh, empty directory per test, removed afterwards.
+class ImageOutputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("sgbake_image_output_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+};
+
+/// A W×H image whose value at (x, row, c) is distinct and in [0, 1]: (x + 10·row + 100·c) / 1000.
+FloatImage rampImage(int width, int height, int channels) {
+  FloatImage image;
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  image.pixels.resize(static_cast<std::size_t>(width * height * channels));
+  image.coverage.assign(static_cast<std::size_t>(width * height), 1.0f);
+  for (int row = 0; row < height; ++row) {
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < channels; ++c) {
+        image.at(x, row, c) = static_cast<float>(x + 10 * row + 100 * c) / 1000.0f;
+      }
+    }
+  }
+  return image;
+}
+
+/// What OIIO reads from a file: the spec and the pixels as floats (rows top first).
+struct ReadBack {
+  OIIO::ImageSpec spec;
+  std::vector<float> pixels;
+  float at(int x, int row, int c) const {
+    return pixels[(static_cast<std::size_t>(row) * spec.width + x) * spec.nchannels + c];
+  }
+};
+
+ReadBack readBack(const fs::path& path) {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // raw colour, as written
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string(), &config);
+  ReadBack result;
+  if (!in) {
+    ADD_FAILURE() << "cannot open " << path << ": " << OIIO::geterror();
+    return result;
+  }
+  result.spec = in->spec();
+  result.pixels.resize(static_cast<std::size_t>(result.spec.width) * result.spec.height *
+                       result.spec.nchannels);
+  EXPECT_TRUE(
+      in->read_image(0, 0, 0, result.spec.nchannels, OIIO::TypeDesc::FLOAT, result.pixels.data()));
+  in->close();
+  return result;
+}
+
+std::string readBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::set<std::string> listDirectory(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
+  return names;
+}
+
+TEST_F(ImageOutputTest, Png16BitReadsBackTopRowFirst) {
+  const FloatImage image = rampImage(5, 3, 3);
+  const fs::path path = dir_ / "ramp.png";
+  ASSERT_TRUE(writeImage(image, path)) << "default: 16-bit";
+  const ReadBack back = readBack(path);
+  EXPECT_EQ(back.spec.format, OIIO::TypeDesc::UINT16);
+  ASSERT_EQ(back.spec.width, 5);
+  ASSERT_EQ(back.spec.height, 3);
+  ASSERT_EQ(back.spec.nchannels, 3);
+  for (int row = 0; row < 3; ++row) {
+    for (int x = 0; x < 5; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        // 16-bit quantization: within half a code.
+        EXPECT_NEAR(back.at(x, row, c), image.at(x, row, c), 0.5 / 65535 + 1e-7)
+            << "x " << x << " row " << row << " channel " << c;
+      }
+    }
+  }
+  // Orientation spelled out: the file's first row is FloatImage row 0.
+  EXPECT_NEAR(back.at(0, 0, 0), 0.0f, 1e-6);
+  EXPECT_NEAR(back.at(0, 2, 0), 0.020f, 1e-5);
+}
+
+TEST_F(ImageOutputTest, Png8BitIsTheMaskDefault) {
+  EXPECT_EQ(defaultBitDepth(ImageFormat::kPng, MapKind::kMask), 8);
+  EXPECT_EQ(defaultBitDepth(ImageFormat::kPng, MapKind::kTangentNormal), 16);
+  EXPECT_EQ(defaultBitDepth(ImageFormat::kExr, MapKind::kMask), 16);
+  ImageWriteOptions options;
+  options.bitDepth = 8;
+  const FloatImage image = rampImage(4, 4, 1);
+  ASSERT_TRUE(writeImage(image, dir_ / "mask.png", options));
+  const ReadBack back = readBack(dir_ / "mask.png");
+  EXPECT_EQ(back.spec.format, OIIO::TypeDesc::UINT8);
+  EXPECT_EQ(back.spec.nchannels, 1);
+  EXPECT_NEAR(back.at(3, 2, 0), image.at(3, 2, 0), 0.5 / 255 + 1e-7);
+}
+
+TEST_F(ImageOutputTest, IntegerFormatsClampAndWriteNanAsZero) {
+  FloatImage image = rampImage(3, 1, 1);
+  image.pixels = {-0.5f, 2.0f, std::numeric_limits<float>::quiet_NaN()};
+  ASSERT_TRUE(writeImage(image, dir_ / "clamp.png"));
+  const ReadBack back = readBack(dir_ / "clamp.png");
+  EXPECT_EQ(back.at(0, 0, 0), 0.0f);
+  EXPECT_EQ(back.at(1, 0, 0), 1.0f);
+  EXPECT_EQ(back.at(2, 0, 0), 0.0f);
+}
+
+TEST_F(ImageOutputTest, PngAlphaIsUnassociatedCoverage) {
+  FloatImage image = rampImage(2, 2, 3);
+  image.coverage = {0.5f, 1.0f, 0.25f, 0.0f};
+  ImageWriteOptions options;
+  options.alpha = true;
+  ASSERT_TRUE(writeImage(image, dir_ / "alpha.png", options));
+  const ReadBack back = readBack(dir_ / "alpha.png");
+  ASSERT_EQ(back.spec.nchannels, 4);
+  EXPECT_EQ(back.spec.alpha_channel, 3);
+  EXPECT_NEAR(back.at(0, 0, 3), 0.5f, 1e-4);
+  EXPECT_NEAR(back.at(1, 1, 3), 0.0f, 1e-6);
+  // Colour kept as baked: not divided by alpha (0.4 would come back as 0.8) nor multiplied.
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(back.at(0, 0, c), image.at(0, 0, c), 1e-4) << c;
+    EXPECT_NEAR(back.at(0, 1, c), image.at(0, 1, c), 1e-4) << c;
+  }
+}
+
+TEST_F(ImageOutputTest, TwoChannelsArePaddedToRgbInPng) {
+  const FloatImage image = rampImage(2, 2, 2);
+  ASSERT_TRUE(writeImage(image, dir_ / "rg.png"));
+  const ReadBack back = readBack(dir_ / "rg.png");
+  ASSERT_EQ(back.spec.nchannels, 3);
+  EXPECT_NEAR(back.at(1, 1, 1), image.at(1, 1, 1), 1e-4);
+  EXPECT_EQ(back.at(1, 1, 2), 0.0f);
+  // EXR keeps two named channels.
+  ASSERT_TRUE(writeImage(image, dir_ / "rg.exr"));
+  const ReadBack exr = readBack(dir_ / "rg.exr");
+  ASSERT_EQ(exr.spec.nchannels, 2);
+  EXPECT_EQ(exr.spec.channelnames[0], "R");
+  EXPECT_EQ(exr.spec.channelnames[1], "G");
+}
+
+TEST_F(ImageOutputTest, ExrHalfByDefaultAndFloatOnRequest) {
+  FloatImage image = rampImage(3, 2, 3);
+  image.pixels[0] = -3.25f;       // signed values survive (surface gradients)
+  image.pixels[1] = 1.0f / 3.0f;  // not representable in half
+  image.pixels[2] = 1000.5f;      // beyond [0, 1]
+  ASSERT_TRUE(writeImage(image, dir_ / "half.exr"));
+  const ReadBack half = readBack(dir_ / "half.exr");
+  EXPECT_EQ(half.spec.format, OIIO::TypeDesc::HALF);
+  EXPECT_EQ(half.at(0, 0, 0), -3.25f);
+  EXPECT_NEAR(half.at(0, 0, 1), 1.0f / 3.0f, 1.0f / 2048);
+  EXPECT_NE(half.at(0, 0, 1), 1.0f / 3.0f);
+  EXPECT_EQ(half.at(0, 0, 2), 1000.5f);
+  EXPECT_EQ(half.spec.get_string_attribute("compression"), "zip");
+
+  ImageWriteOptions options;
+  options.bitDepth = 32;
+  ASSERT_TRUE(writeImage(image, dir_ / "float.exr", options));
+  const ReadBack full = readBack(dir_ / "float.exr");
+  EXPECT_EQ(full.spec.format, OIIO::TypeDesc::FLOAT);
+  ASSERT_EQ(full.pixels.size(), image.pixels.size());
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    EXPECT_EQ(full.pixels[i], image.pixels[i]) << i;  // bit-exact
+  }
+}
+
+TEST_F(ImageOutputTest, TiffIntegerAndFloat) {
+  const FloatImage image = rampImage(4, 3, 1);
+  ImageWriteOptions options;
+  options.bitDepth = 32;
+  ASSERT_TRUE(writeImage(image, dir_ / "h.tif", options));
+  const ReadBack full = readBack(dir_ / "h.tif");
+  EXPECT_EQ(full.spec.format, OIIO::TypeDesc::FLOAT);
+  EXPECT_EQ(full.at(3, 2, 0), image.at(3, 2, 0));
+  options.bitDepth = 16;
+  ASSERT_TRUE(writeImage(image, dir_ / "h16.TIFF", options));  // extension case-insensitive
+  EXPECT_EQ(readBack(dir_ / "h16.TIFF").spec.format, OIIO::TypeDesc::UINT16);
+}
+
+TEST_F(ImageOutputTest, FormatOptionOverridesTheExtension) {
+  ImageWriteOptions options;
+  options.format = ImageFormat::kExr;
+  ASSERT_TRUE(writeImage(rampImage(2, 2, 1), dir_ / "data.bin", options));
+  const ReadBack back = readBack(dir_ / "data.bin");
+  EXPECT_EQ(back.spec.format, OIIO::TypeDesc::HALF);
+}
+
+TEST_F(ImageOutputTest, FormatNames) {
+  EXPECT_EQ(*imageFormatFromPath("a/b.EXR"), ImageFormat::kExr);
+  EXPECT_EQ(*imageFormatFromPath("b.tif"), ImageFormat::kTiff);
+  EXPECT_EQ(*parseImageFormat("TIFF"), ImageFormat::kTiff);
+  EXPECT_FALSE(parseImageFormat("jpeg"));
+  EXPECT_FALSE(imageFormatFromPath("noextension"));
+  EXPECT_TRUE(formatSupportsBitDepth(ImageFormat::kTiff, 32));
+  EXPECT_FALSE(formatSupportsBitDepth(ImageFormat::kPng, 32));
+  EXPECT_FALSE(formatSupportsBitDepth(ImageFormat::kExr, 8));
+}
+
+TEST_F(ImageOutputTest, UnknownExtensionIsBadInputNamingTheFile) {
+  const fs::path path = dir_ / "normal.jpg";
+  const Status status = writeImage(rampImage(2, 2, 3), path);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().code, ErrorCode::kBadInput);
+  EXPECT_NE(status.error().message.find(path.string()), std::string::npos)
+      << status.error().message;
+  EXPECT_NE(status.error().message.find("'.jpg'"), std::string::npos) << status.error().message;
+  EXPECT_TRUE(listDirectory(dir_).empty());
+}
+
+TEST_F(ImageOutputTest, BitDepthTheFormatCannotStoreIsBadInput) {
+  ImageWriteOptions options;
+  options.bitDepth = 32;
+  const Status png = writeImage(rampImage(2, 2, 3), dir_ / "n.png", options);
+  ASSERT_FALSE(png);
+  EXPECT_EQ(png.error().code, ErrorCode::kBadInput);
+  EXPECT_NE(png.error().message.find("PNG cannot store 32-bit channels"), std::string::npos)
+      << png.error().message;
+  options.bitDepth = 8;
+  const Status exr = writeImage(rampImage(2, 2, 3), dir_ / "n.exr", options);
+  ASSERT_FALSE(exr);
+  EXPECT_NE(exr.error().message.find("EXR cannot store 8-bit"), std::string::npos);
+  EXPECT_TRUE(listDirectory(dir_).empty());
+}
+
+TEST_F(ImageOutputTest, MissingDirectoryIsBadInputNamingTheFile) {
+  const fs::path path = dir_ / "missing" / "n.png";
+  const Status status = writeImage(rampImage(2, 2, 3), path);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().code, ErrorCode::kBadInput);
+  EXPECT_TRUE(status.error().message.starts_with(path.string() + ": cannot create file"))
+      << status.error().message;
+  EXPECT_EQ(status.error().message.find('\n'), std::string::npos);
+}
+
+TEST_F(ImageOutputTest, FailedWriteLeavesTheExistingFileAndNoTemporary) {
+  const fs::path path = dir_ / "n.png";
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "previous content";
+  }
+  FloatImage broken = rampImage(2, 2, 3);
+  broken.pixels.resize(3);  // inconsistent with its size: rejected
+  EXPECT_FALSE(writeImage(broken, path));
+  FloatImage empty;
+  EXPECT_FALSE(writeImage(empty, path));
+  EXPECT_EQ(readBytes(path), "previous content");
+  EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.png"});
+}
+
+TEST_F(ImageOutputTest, SuccessfulWriteReplacesTheFileAndLeavesNoTemporary) {
+  const fs::path path = dir_ / "n.exr";
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "previous content";
+  }
+  ASSERT_TRUE(writeImage(rampImage(3, 3, 3), path));
+  EXPECT_NE(readBytes(path), "previous content");
+  EXPECT_EQ(readBack(path).spec.width, 3);
+  EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.exr"});
+}
+
+TEST(UdimToken, Expansion) {
+  EXPECT_EQ(expandUdimToken("out/n.<UDIM>.png", 1002), "out/n.1002.png");
+  EXPECT_EQ(expandUdimToken("<UDIM>/n_<UDIM>.exr", 1011), "1011/n_1011.exr");
+  EXPECT_EQ(expandUdimToken("out/n.png", 1002), "out/n.png");
+  EXPECT_EQ(expandUdimToken("out/n.<udim>.png", 1002), "out/n.<udim>.png");  // case matters
+  EXPECT_TRUE(hasUdimToken("a.<UDIM>.png"));
+  EXPECT_FALSE(hasUdimToken("a.<UDIM.png"));
+}
+
+}  // namespace
+}  // namespace sgbake

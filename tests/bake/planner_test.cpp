@@ -1,0 +1,474 @@
+/// @file planner_test.cpp
+/// @brief The planner: only the work the outputs need (tangents, layers, images loaded once),
+/// --explain, the manifest (up to date, --force, changed inputs and outputs), execution, and
+/// all-or-nothing outputs on failure.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <set>
+#include <string>
+
+#include "sgbake/bake/image_output.hpp"
+#include "sgbake/bake/planner.hpp"
+#include "sgbake/bake/scene.hpp"
+#include "sgbake/gradient/corners.hpp"
+
+namespace sgbake {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A unit square in the plane z = 0 whose UVs equal its x, y: one quad, normal +Z.
+constexpr const char* kPlaneObj =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "vn 0 0 1\n"
+    "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+
+/// The same square placed in UDIM tile 1002 (u in [1, 2]).
+constexpr const char* kTile1002Obj =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+    "vt 1.25 0.25\nvt 1.75 0.25\nvt 1.75 0.75\nvt 1.25 0.75\n"
+    "f 1/1 2/2 3/3 4/4\n";
+
+constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+std::string readBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::set<std::string> listDirectory(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
+  return names;
+}
+
+/// A W×H single-channel image: a ramp in x plus @p bias.
+FloatImage heightImage(int size, float bias = 0) {
+  FloatImage image;
+  image.channels = 1;
+  image.width = image.height = size;
+  image.pixels.resize(static_cast<std::size_t>(size * size));
+  image.coverage.assign(image.pixels.size(), 1.0f);
+  for (int row = 0; row < size; ++row) {
+    for (int x = 0; x < size; ++x) {
+      image.at(x, row, 0) = bias + 0.5f * static_cast<float>(x) / static_cast<float>(size);
+    }
+  }
+  return image;
+}
+
+/// A flat tangent-space normal map (0.5, 0.5, 1).
+FloatImage flatNormalImage(int size) {
+  FloatImage image;
+  image.width = image.height = size;
+  image.channels = 3;
+  image.pixels.resize(static_cast<std::size_t>(size * size * 3));
+  for (std::size_t i = 0; i < image.pixels.size(); i += 3) {
+    image.pixels[i] = 0.5f;
+    image.pixels[i + 1] = 0.5f;
+    image.pixels[i + 2] = 1.0f;
+  }
+  image.coverage.assign(static_cast<std::size_t>(size * size), 1.0f);
+  return image;
+}
+
+/// A directory with a plane mesh, a height map and a normal map; scenes are written into it.
+class PlannerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("sgbake_planner_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    writeText(dir_ / "plane.obj", kPlaneObj);
+    writeText(dir_ / "tile1002.obj", kTile1002Obj);
+    writeText(dir_ / "nouv.obj", kNoUvObj);
+    ASSERT_TRUE(writeImage(heightImage(16), dir_ / "h.png"));
+    ASSERT_TRUE(writeImage(flatNormalImage(16), dir_ / "n.png"));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Parses @p json as the scene file dir_/scene.json.
+  Scene scene(const std::string& json) {
+    writeText(dir_ / "scene.json", json);
+    Result<Scene> parsed = loadScene(dir_ / "scene.json");
+    EXPECT_TRUE(parsed) << parsed.error().message;
+    return parsed ? *parsed : Scene{};
+  }
+
+  Plan plan(const std::string& json, const PlanOptions& options = {}) {
+    Result<Plan> planned = makePlan(scene(json), options);
+    EXPECT_TRUE(planned) << planned.error().message;
+    return planned ? *planned : Plan{};
+  }
+
+  /// Plans and runs @p json; returns the report.
+  ExecuteReport bake(const std::string& json, const PlanOptions& options = {}) {
+    Result<Plan> planned = makePlan(scene(json), options);
+    EXPECT_TRUE(planned) << planned.error().message;
+    if (!planned) return {};
+    Result<ExecuteReport> report = executePlan(*planned);
+    EXPECT_TRUE(report) << report.error().message;
+    return report ? *report : ExecuteReport{};
+  }
+
+  fs::path dir_;
+};
+
+/// A scene of the plane with @p layers and @p outputs (JSON array contents).
+std::string planeScene(const std::string& layers, const std::string& outputs,
+                       const std::string& mesh = "plane.obj") {
+  return R"({"mesh": ")" + mesh + R"(", "layers": [)" + layers + R"(], "outputs": [)" + outputs +
+         "]}";
+}
+
+constexpr const char* kHeightLayer = R"({"type": "height", "image": "h.png", "scale": 0.1})";
+constexpr const char* kNormalLayer = R"({"type": "normal", "image": "n.png"})";
+
+TEST(Hash, Fnv1a64KnownValues) {
+  EXPECT_EQ(fnv1a64(""), 0xcbf29ce484222325ULL);
+  EXPECT_EQ(fnv1a64("a"), 0xaf63dc4c8601ec8cULL);
+  EXPECT_EQ(fnv1a64("foobar"), 0x85944171f73967e8ULL);
+  // Incremental use gives the same hash as one call.
+  EXPECT_EQ(fnv1a64("bar", fnv1a64("foo")), fnv1a64("foobar"));
+}
+
+TEST_F(PlannerTest, NoTangentsForHeightAndObjectNormalMaps) {
+  const Plan p = plan(planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
+                                               {"map": "object-normal", "file": "o.png", "size": 8})"));
+  EXPECT_TRUE(p.loadMesh);
+  EXPECT_FALSE(p.computeTangents);
+  const std::string text = explainPlan(p);
+  EXPECT_NE(text.find("tangent frames (MikkTSpace): no map to bake is tangent-normal"),
+            std::string::npos)
+      << text;
+  const ExecuteReport report =
+      bake(planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8})"));
+  EXPECT_FALSE(report.tangentsComputed);
+}
+
+TEST_F(PlannerTest, TangentsForTangentNormalMapsAndTangentSpaceLayers) {
+  EXPECT_TRUE(plan(planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "n_out.png"})"))
+                  .computeTangents);
+  EXPECT_TRUE(plan(planeScene("", R"({"map": "bitangent", "file": "b.png"})")).computeTangents);
+  // A tangent-space normal map on UV set 0 is decoded in the MikkTSpace frame.
+  const Plan p = plan(planeScene(kNormalLayer, R"({"map": "object-normal", "file": "o.png"})"));
+  EXPECT_TRUE(p.computeTangents);
+  EXPECT_NE(explainPlan(p).find("layers[0], a tangent-space normal map on UV set 0, is decoded"),
+            std::string::npos);
+  // ... but not an object-space one.
+  EXPECT_FALSE(plan(planeScene(R"({"type": "normal", "image": "n.png", "space": "object"})",
+                               R"({"map": "object-normal", "file": "o.png"})"))
+                   .computeTangents);
+  const ExecuteReport report =
+      bake(planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "t.png", "size": 8})"));
+  EXPECT_TRUE(report.tangentsComputed);
+}
+
+TEST_F(PlannerTest, MaskAndTangentMapsReadNoLayers) {
+  const Plan mask = plan(planeScene(std::string(kHeightLayer) + "," + kNormalLayer,
+                                    R"({"map": "mask", "file": "m.png"})"));
+  EXPECT_TRUE(mask.layers.empty());
+  EXPECT_TRUE(mask.images.empty());
+  EXPECT_FALSE(mask.computeTangents);
+  const std::string text = explainPlan(mask);
+  EXPECT_NE(text.find("skipped:"), std::string::npos);
+  EXPECT_NE(text.find("layers[0] (height image"), std::string::npos) << text;
+  EXPECT_NE(text.find("and its image: no output to bake reads it: mask maps read no layers"),
+            std::string::npos)
+      << text;
+
+  const Plan tangent =
+      plan(planeScene(kHeightLayer, R"({"map": "tangent", "file": "t.png", "size": 4})"));
+  EXPECT_TRUE(tangent.layers.empty());
+  EXPECT_TRUE(tangent.images.empty());
+  EXPECT_TRUE(tangent.computeTangents);
+  const ExecuteReport report =
+      bake(planeScene(kHeightLayer, R"({"map": "mask", "file": "m.png", "size": 4})"));
+  EXPECT_EQ(report.imagesLoaded, 0u);
+}
+
+TEST_F(PlannerTest, HeightMapsSkipNormalLayersAndZeroWeights) {
+  const Plan p = plan(planeScene(std::string(kHeightLayer) + "," + kNormalLayer +
+                                     R"(, {"type": "volume", "function": "sine", "weight": 0})",
+                                 R"({"map": "height", "file": "h.exr"})"));
+  ASSERT_EQ(p.layers.size(), 1u);
+  EXPECT_EQ(p.layers[0].sceneLayer, 0u);
+  ASSERT_EQ(p.images.size(), 1u);
+  EXPECT_EQ(p.images[0].path.filename(), "h.png");
+  const std::string text = explainPlan(p);
+  EXPECT_NE(text.find("height maps read only layers with a height"), std::string::npos) << text;
+  EXPECT_NE(text.find("layers[2] (volume sine): no output to bake reads it: weight 0"),
+            std::string::npos)
+      << text;
+}
+
+TEST_F(PlannerTest, AnImageUsedByTwoLayersIsLoadedOnce) {
+  // The same file under three spellings (one through a symbolic link), two filters: one load,
+  // two textures.
+  fs::create_symlink("h.png", dir_ / "alias.png");
+  const std::string layers =
+      R"({"type": "height", "image": "h.png", "filter": "bicubic"},
+         {"type": "triplanar", "image": "./sub/../h.png", "kind": "height"},
+         {"type": "height", "image": "alias.png", "filter": "bicubic", "tiling": 3})";
+  const Plan p =
+      plan(planeScene(layers, R"({"map": "object-normal", "file": "o.png", "size": 8})"));
+  ASSERT_EQ(p.images.size(), 1u);
+  EXPECT_EQ(p.images[0].users.size(), 3u);
+  EXPECT_EQ(p.textures.size(), 2u) << "bicubic and bilinear";
+  EXPECT_EQ(p.layers[0].texture, p.layers[2].texture);
+  const ExecuteReport report =
+      bake(planeScene(layers, R"({"map": "object-normal", "file": "o.png", "size": 8})"));
+  EXPECT_EQ(report.imagesLoaded, 1u);
+  EXPECT_EQ(report.texturesCreated, 2u);
+  // A normal-map use of the same file needs its RGB channels: a second, different load.
+  const Plan both = plan(
+      planeScene(R"({"type": "height", "image": "n.png"}, {"type": "normal", "image": "n.png"})",
+                 R"({"map": "object-normal", "file": "o.png"})"));
+  EXPECT_EQ(both.images.size(), 2u);
+}
+
+TEST_F(PlannerTest, ExplainListsStepsAndSkippedWork) {
+  const Plan p = plan(planeScene(
+      std::string(kHeightLayer) + R"(, {"type": "triplanar", "image": "h.png", "kind": "height"})",
+      R"({"map": "tangent-normal", "file": "n_out.png", "size": 64, "margin": 4},
+         {"map": "mask", "file": "m.png", "size": 64})"));
+  const std::string text = explainPlan(p);
+  EXPECT_TRUE(text.starts_with("plan for ")) << text;
+  EXPECT_NE(text.find("2 of 2 outputs to bake"), std::string::npos) << text;
+  EXPECT_NE(text.find("1. load mesh "), std::string::npos) << text;
+  EXPECT_NE(text.find("load image "), std::string::npos) << text;
+  EXPECT_NE(text.find("compute MikkTSpace tangent frames of UV set 0 (the tangent-normal map "),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("pad "), std::string::npos) << text;
+  EXPECT_NE(text.find("skipped:\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("texels outside the UV islands"), std::string::npos) << text;
+  EXPECT_NE(text.find("triplanar planes of layers[1] with blend weight below 0.001"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("for " + (dir_ / "m.png").string() + ": mask maps read no layers"),
+            std::string::npos)
+      << text;
+  // Explaining writes nothing.
+  EXPECT_FALSE(fs::exists(dir_ / "n_out.png"));
+}
+
+TEST_F(PlannerTest, SubdivisionIsNotSupportedYet) {
+  Result<Plan> p = makePlan(scene(R"({"mesh": "plane.obj", "subdivision": {"level": "limit"},
+                                      "outputs": [{"map": "mask", "file": "m.png"}]})"));
+  ASSERT_FALSE(p);
+  EXPECT_EQ(p.error().code, ErrorCode::kBadInput);
+  EXPECT_NE(p.error().message.find("subdivision is not supported yet"), std::string::npos)
+      << p.error().message;
+}
+
+TEST_F(PlannerTest, MissingInputsAreNamed) {
+  Result<Plan> image = makePlan(scene(planeScene(R"({"type": "height", "image": "missing.png"})",
+                                                 R"({"map": "height", "file": "h.exr"})")));
+  ASSERT_FALSE(image);
+  EXPECT_EQ(image.error().code, ErrorCode::kBadInput);
+  EXPECT_NE(image.error().message.find("layers[0]: image " + (dir_ / "missing.png").string() +
+                                       " does not exist"),
+            std::string::npos)
+      << image.error().message;
+  // Without the manifest the check happens as well.
+  PlanOptions noManifest;
+  noManifest.useManifest = false;
+  EXPECT_FALSE(makePlan(scene(planeScene(R"({"type": "height", "image": "missing.png"})",
+                                         R"({"map": "height", "file": "h.exr"})")),
+                        noManifest));
+  Result<Plan> mesh =
+      makePlan(scene(planeScene("", R"({"map": "mask", "file": "m.png"})", "x.obj")));
+  ASSERT_FALSE(mesh);
+  EXPECT_NE(mesh.error().message.find("x.obj does not exist"), std::string::npos);
+  EXPECT_TRUE(listDirectory(dir_).count("m.png") == 0);
+}
+
+TEST_F(PlannerTest, ExecutionWritesEveryMapAtItsSize) {
+  const ExecuteReport report = bake(planeScene(
+      std::string(kHeightLayer) + R"(, {"type": "volume", "function": "noise", "amplitude": 0.01,
+                                        "frequency": 4})",
+      R"({"map": "tangent-normal", "file": "out/n.png", "size": 32},
+         {"map": "height", "file": "out/h.exr", "width": 16, "height": 8, "padding": "push-pull"},
+         {"map": "derivative", "file": "out/d.tif", "size": 8, "bit_depth": 32, "alpha": true},
+         {"map": "corners", "file": "out/corners.csv"})"));
+  ASSERT_EQ(report.outputs.size(), 4u);
+  for (const OutputReport& output : report.outputs) EXPECT_TRUE(output.baked) << output.file;
+  EXPECT_EQ(report.imagesLoaded, 1u);
+
+  const auto spec = [](const fs::path& path) {
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
+    EXPECT_TRUE(in) << path;
+    return in ? in->spec() : OIIO::ImageSpec();
+  };
+  const OIIO::ImageSpec normal = spec(dir_ / "out/n.png");
+  EXPECT_EQ(normal.width, 32);
+  EXPECT_EQ(normal.nchannels, 3);
+  EXPECT_EQ(normal.format, OIIO::TypeDesc::UINT16);
+  const OIIO::ImageSpec height = spec(dir_ / "out/h.exr");
+  EXPECT_EQ(height.width, 16);
+  EXPECT_EQ(height.height, 8);
+  EXPECT_EQ(height.format, OIIO::TypeDesc::HALF);
+  const OIIO::ImageSpec derivative = spec(dir_ / "out/d.tif");
+  EXPECT_EQ(derivative.format, OIIO::TypeDesc::FLOAT);
+  EXPECT_EQ(derivative.nchannels, 4) << "R, G, zero B, alpha";
+  const std::string csv = readBytes(dir_ / "out/corners.csv");
+  EXPECT_TRUE(csv.starts_with(std::string(kCornerTableHeader) + "\n")) << csv;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / kManifestName));
+}
+
+TEST_F(PlannerTest, UdimFileNamesBakeEveryTouchedTile) {
+  const ExecuteReport report =
+      bake(planeScene("", R"({"map": "mask", "file": "m.<UDIM>.png", "size": 8})", "tile1002.obj"));
+  ASSERT_EQ(report.outputs.size(), 1u);
+  ASSERT_EQ(report.outputs[0].files.size(), 1u);
+  EXPECT_EQ(report.outputs[0].files[0], dir_ / "m.1002.png");
+  EXPECT_TRUE(fs::exists(dir_ / "m.1002.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "m.1001.png"));
+  // The manifest knows the tile files: a second run is up to date.
+  EXPECT_TRUE(
+      plan(planeScene("", R"({"map": "mask", "file": "m.<UDIM>.png", "size": 8})", "tile1002.obj"))
+          .outputs[0]
+          .upToDate);
+}
+
+TEST_F(PlannerTest, ManifestMakesTheSecondRunBakeNothing) {
+  const std::string json =
+      planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
+                       {"map": "mask", "file": "m.png", "size": 8})");
+  const ExecuteReport first = bake(json);
+  EXPECT_TRUE(first.outputs[0].baked);
+  const std::string bytes = readBytes(dir_ / "h.exr");
+  const auto written = fs::last_write_time(dir_ / "h.exr");
+
+  const Plan second = plan(json);
+  EXPECT_EQ(second.outputsToBake(), 0u);
+  EXPECT_FALSE(second.loadMesh);
+  EXPECT_TRUE(second.images.empty());
+  EXPECT_NE(explainPlan(second).find("up to date"), std::string::npos);
+  Result<ExecuteReport> report = executePlan(second);
+  ASSERT_TRUE(report);
+  EXPECT_FALSE(report->outputs[0].baked);
+  EXPECT_FALSE(report->outputs[1].baked);
+  EXPECT_EQ(report->tilesBaked, 0u);
+  EXPECT_EQ(readBytes(dir_ / "h.exr"), bytes);
+  EXPECT_EQ(fs::last_write_time(dir_ / "h.exr"), written);
+
+  // --force bakes everything again.
+  PlanOptions force;
+  force.force = true;
+  EXPECT_EQ(plan(json, force).outputsToBake(), 2u);
+  // Without the manifest, everything is baked.
+  PlanOptions noManifest;
+  noManifest.useManifest = false;
+  EXPECT_EQ(plan(json, noManifest).outputsToBake(), 2u);
+}
+
+TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
+  const std::string json =
+      planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
+                       {"map": "mask", "file": "m.png", "size": 8})");
+  bake(json);
+  ASSERT_EQ(plan(json).outputsToBake(), 0u);
+
+  // A changed image re-bakes the output that reads it, not the mask (which reads no layers).
+  ASSERT_TRUE(writeImage(heightImage(16, 0.25f), dir_ / "h.png"));
+  Plan touched = plan(json);
+  EXPECT_FALSE(touched.outputs[0].upToDate);
+  EXPECT_TRUE(touched.outputs[1].upToDate);
+  ASSERT_TRUE(executePlan(touched));
+  EXPECT_EQ(plan(json).outputsToBake(), 0u);
+
+  // A changed parameter.
+  const std::string wider =
+      planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8, "margin": 2},
+                       {"map": "mask", "file": "m.png", "size": 8})");
+  EXPECT_EQ(plan(wider).outputsToBake(), 1u);
+
+  // A deleted output, and an output changed by someone else.
+  fs::remove(dir_ / "m.png");
+  EXPECT_FALSE(plan(json).outputs[1].upToDate);
+  bake(json);
+  writeText(dir_ / "h.exr", "edited");
+  EXPECT_FALSE(plan(json).outputs[0].upToDate);
+  EXPECT_TRUE(plan(json).outputs[1].upToDate);
+
+  // A changed mesh re-bakes everything.
+  bake(json);
+  writeText(dir_ / "plane.obj", std::string(kPlaneObj) + "# edited\n");
+  EXPECT_EQ(plan(json).outputsToBake(), 2u);
+
+  // A corrupt manifest counts as empty.
+  bake(json);
+  writeText(dir_ / kManifestName, "{ not json");
+  EXPECT_EQ(plan(json).outputsToBake(), 2u);
+}
+
+TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
+  writeText(dir_ / "n_out.png", "previous output");
+  const std::set<std::string> before = listDirectory(dir_);
+  // A mesh without UVs fails at execution, after planning.
+  Result<Plan> p = makePlan(scene(
+      planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "n_out.png"})", "nouv.obj")));
+  ASSERT_TRUE(p) << p.error().message;
+  Result<ExecuteReport> report = executePlan(*p);
+  ASSERT_FALSE(report);
+  EXPECT_EQ(report.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(readBytes(dir_ / "n_out.png"), "previous output");
+  std::set<std::string> after = listDirectory(dir_);
+  after.erase("scene.json");
+  std::set<std::string> expected = before;
+  expected.erase("scene.json");
+  EXPECT_EQ(after, expected) << "no temporary files, no manifest";
+
+  // A UV set the mesh does not have.
+  Result<Plan> uv = makePlan(
+      scene(planeScene(kHeightLayer, R"({"map": "height", "file": "n_out.png", "uv": 1})")));
+  ASSERT_TRUE(uv);
+  Result<ExecuteReport> failed = executePlan(*uv);
+  ASSERT_FALSE(failed);
+  EXPECT_NE(failed.error().message.find("has 1 UV set(s) but outputs[0] uses UV set 1"),
+            std::string::npos)
+      << failed.error().message;
+  EXPECT_EQ(readBytes(dir_ / "n_out.png"), "previous output");
+}
+
+TEST_F(PlannerTest, ProgressIsReported) {
+  Result<Plan> p =
+      makePlan(scene(planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
+                       {"map": "mask", "file": "m.png", "size": 8})")));
+  ASSERT_TRUE(p);
+  std::size_t calls = 0;
+  std::size_t lastDone = 0, lastTotal = 0;
+  ExecuteOptions options;
+  options.threads = 1;
+  options.progress = [&](const BakeProgress& progress) {
+    ++calls;
+    EXPECT_LE(progress.done, progress.total);
+    EXPECT_GE(progress.done, lastDone);
+    lastDone = progress.done;
+    lastTotal = progress.total;
+  };
+  ASSERT_TRUE(executePlan(*p, options));
+  EXPECT_GE(calls, 4u);
+  EXPECT_EQ(lastDone, lastTotal);
+  EXPECT_EQ(lastTotal, 4u) << "mesh, image, two outputs";
+}
+
+}  // namespace
+}  // namespace sgbake

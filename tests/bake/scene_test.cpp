@@ -1,0 +1,378 @@
+/// @file scene_test.cpp
+/// @brief The scene parser: the issue's example, defaults, paths, and one-line errors that name
+/// the key, its place and a suggestion.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "sgbake/bake/scene.hpp"
+
+namespace sgbake {
+namespace {
+
+/// The example scene of the issue, verbatim apart from picking one value per alternative.
+constexpr const char* kIssueScene = R"({ "mesh": "m.obj", "uv": 0,
+  "subdivision": {"level": "limit", "uv_smooth": "keep-boundaries", "boundary": "all"},
+  "layers": [
+    {"type": "height", "image": "h.exr", "scale": 0.1, "filter": "bicubic", "uv": 0, "weight": 1},
+    {"type": "normal", "image": "n.png", "space": "tangent", "green": "directx", "uv": 0},
+    {"type": "volume", "function": "sine", "amplitude": 1, "frequency": 1, "direction": [1,0,0],
+     "phase": 0, "gradient": "tetrahedral", "step": 0.001},
+    {"type": "triplanar", "image": "t.png", "kind": "tangent-normal",
+     "scale": 0.1, "tiling": 1, "sharpness": 4} ],
+  "outputs": [ {"map": "tangent-normal", "file": "out/n.png", "size": 2048, "margin": 16,
+                "samples": 1, "green": "opengl"} ] })";
+
+SceneParseOptions options(const std::string& base = "scenes") {
+  SceneParseOptions o;
+  o.baseDir = base;
+  o.name = "scene.json";
+  return o;
+}
+
+/// Parses @p text, expecting failure; returns the message.
+std::string parseError(const std::string& text) {
+  Result<Scene> scene = parseScene(text, options());
+  if (scene) {
+    ADD_FAILURE() << "parsed: " << text;
+    return {};
+  }
+  EXPECT_EQ(scene.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(scene.error().message.find('\n'), std::string::npos) << "one line";
+  EXPECT_TRUE(scene.error().message.starts_with("scene.json: ")) << scene.error().message;
+  return scene.error().message;
+}
+
+/// A valid scene with @p output as its only output (and no layers).
+std::string withOutput(const std::string& output) {
+  return R"({"mesh": "m.obj", "outputs": [)" + output + "]}";
+}
+
+/// A valid scene with @p layer as its only layer.
+std::string withLayer(const std::string& layer) {
+  return R"({"mesh": "m.obj", "layers": [)" + layer +
+         R"(], "outputs": [{"map": "height", "file": "h.exr"}]})";
+}
+
+TEST(Scene, ParsesTheIssueExample) {
+  Result<Scene> parsed = parseScene(kIssueScene, options());
+  ASSERT_TRUE(parsed) << parsed.error().message;
+  const Scene& scene = *parsed;
+  EXPECT_EQ(scene.mesh, std::filesystem::path("scenes/m.obj"));
+  EXPECT_TRUE(scene.subdivision.present);
+  EXPECT_TRUE(scene.subdivision.limit);
+  EXPECT_TRUE(scene.subdivision.requested());
+  EXPECT_EQ(scene.subdivision.uvSmooth, SubdivisionUvSmooth::kKeepBoundaries);
+  ASSERT_EQ(scene.layers.size(), 4u);
+
+  const SceneLayer& height = scene.layers[0];
+  EXPECT_EQ(height.type, SceneLayerType::kHeight);
+  EXPECT_EQ(height.image, std::filesystem::path("scenes/h.exr"));
+  EXPECT_EQ(height.scale, 0.1);
+  EXPECT_EQ(height.filter, Filter::kBicubic);
+  EXPECT_TRUE(height.hasHeight());
+
+  const SceneLayer& normal = scene.layers[1];
+  EXPECT_EQ(normal.type, SceneLayerType::kNormal);
+  EXPECT_EQ(normal.space, NormalSpace::kTangent);
+  EXPECT_EQ(normal.green, NormalMapGreen::kDirectX);
+  EXPECT_TRUE(normal.readsNormals());
+  EXPECT_FALSE(normal.hasHeight());
+
+  const SceneLayer& volume = scene.layers[2];
+  EXPECT_EQ(volume.type, SceneLayerType::kVolume);
+  EXPECT_EQ(volume.function, VolumeFunction::kSine);
+  EXPECT_EQ(volume.gradient, GradientScheme::kTetrahedral);
+  ASSERT_TRUE(volume.step.has_value());
+  EXPECT_EQ(*volume.step, 0.001);
+  EXPECT_EQ(volume.direction, (Vec3d{1, 0, 0}));
+
+  const SceneLayer& triplanar = scene.layers[3];
+  EXPECT_EQ(triplanar.kind, ProjectedKind::kTangentNormal);
+  EXPECT_EQ(triplanar.tiling, (Vec2d{1, 1}));
+  EXPECT_EQ(triplanar.sharpness, 4.0);
+
+  ASSERT_EQ(scene.outputs.size(), 1u);
+  const SceneOutput& output = scene.outputs[0];
+  EXPECT_EQ(output.kind, OutputKind::kMap);
+  EXPECT_EQ(output.map, MapKind::kTangentNormal);
+  EXPECT_EQ(output.file, std::filesystem::path("scenes/out/n.png"));
+  EXPECT_EQ(output.width, 2048);
+  EXPECT_EQ(output.height, 2048);
+  EXPECT_EQ(output.margin, 16);
+  EXPECT_EQ(output.resolvedFormat(), ImageFormat::kPng);
+  EXPECT_EQ(output.resolvedBitDepth(), 16);
+}
+
+TEST(Scene, DefaultsAndTopLevelUvSet) {
+  Result<Scene> scene = parseScene(
+      R"({"mesh": "m.obj", "uv": 1, "layers": [{"type": "height", "image": "h.png"},
+          {"type": "height", "image": "h.png", "uv": 2, "mask": "m.png"},
+          {"type": "volume", "mask": "m.png"}],
+          "outputs": [{"map": "mask", "file": "mask.png"}]})",
+      options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->layers[0].uvSet, 1);
+  EXPECT_EQ(scene->layers[0].weight, 1.0);
+  EXPECT_EQ(scene->layers[0].filter, Filter::kBilinear);
+  ASSERT_TRUE(scene->layers[1].mask.has_value());
+  EXPECT_EQ(scene->layers[1].mask->uvSet, 2) << "a mask follows its layer's UV set";
+  EXPECT_EQ(scene->layers[2].mask->uvSet, 1) << "... or the scene's";
+  const SceneOutput& output = scene->outputs[0];
+  EXPECT_EQ(output.uvSet, 1);
+  EXPECT_EQ(output.width, kDefaultOutputSize);
+  EXPECT_EQ(output.margin, kDefaultMargin);
+  EXPECT_EQ(output.padding, PaddingMode::kExtend);
+  EXPECT_EQ(output.samples, 1);
+  EXPECT_EQ(output.tile, kFirstUdimTile);
+  EXPECT_EQ(output.resolvedBitDepth(), 8) << "masks are 8-bit in PNG";
+  EXPECT_FALSE(scene->subdivision.present);
+}
+
+TEST(Scene, ExtendedKeys) {
+  Result<Scene> scene = parseScene(
+      R"({"mesh": "/abs/m.obj", "_comment": "ignored",
+          "layers": [{"type": "height", "image": "h.png", "tiling": [2, 3], "offset": [0.5, 0],
+                      "wrap": "clamp", "weight": -0.5,
+                      "mask": {"image": "mask.png", "uv": 1, "tiling": 4, "filter": "bicubic"}},
+                     {"type": "volume", "function": "noise", "seed": 42, "octaves": 3,
+                      "frequency": 8, "gradient": "central", "_note": "comment"},
+                     {"type": "planar", "image": "p.png", "axis": "x", "kind": "object-normal"},
+                     {"type": "normal", "image": "os.png", "space": "object", "strength": 0.5,
+                      "mask": "m2.png"}],
+          "outputs": [{"map": "derivative", "file": "d.<UDIM>.exr", "width": 300, "height": 200,
+                       "padding": "push-pull", "bit_depth": "float", "alpha": true},
+                      {"map": "corners", "file": "corners.csv"},
+                      {"map": "height", "file": "h.tif", "format": "tiff", "bit_depth": 32,
+                       "tile": 1002}]})",
+      options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->mesh, std::filesystem::path("/abs/m.obj"));
+  const SceneLayer& height = scene->layers[0];
+  EXPECT_EQ(height.tiling, (Vec2d{2, 3}));
+  EXPECT_EQ(height.offset, (Vec2d{0.5, 0}));
+  EXPECT_EQ(height.wrap, Wrap::kClamp);
+  EXPECT_EQ(height.weight, -0.5);
+  ASSERT_TRUE(height.mask.has_value());
+  EXPECT_EQ(height.mask->image, std::filesystem::path("scenes/mask.png"));
+  EXPECT_EQ(height.mask->uvSet, 1);
+  EXPECT_EQ(height.mask->tiling, (Vec2d{4, 4}));
+  const SceneLayer& noise = scene->layers[1];
+  EXPECT_EQ(noise.function, VolumeFunction::kNoise);
+  EXPECT_EQ(noise.seed, 42u);
+  EXPECT_EQ(noise.octaves, 3);
+  EXPECT_FALSE(noise.step.has_value());
+  EXPECT_EQ(scene->layers[2].axis, ProjectionAxis::kX);
+  EXPECT_EQ(scene->layers[3].space, NormalSpace::kObject);
+  EXPECT_EQ(scene->layers[3].scale, 0.5);
+  ASSERT_TRUE(scene->layers[3].mask.has_value());
+  EXPECT_EQ(scene->layers[3].mask->image, std::filesystem::path("scenes/m2.png"));
+
+  const SceneOutput& derivative = scene->outputs[0];
+  EXPECT_EQ(derivative.width, 300);
+  EXPECT_EQ(derivative.height, 200);
+  EXPECT_EQ(derivative.padding, PaddingMode::kPushPull);
+  EXPECT_EQ(derivative.resolvedBitDepth(), 32);
+  EXPECT_TRUE(derivative.alpha);
+  EXPECT_EQ(scene->outputs[1].kind, OutputKind::kCorners);
+  EXPECT_EQ(scene->outputs[2].tile, 1002);
+  EXPECT_EQ(scene->outputs[2].resolvedFormat(), ImageFormat::kTiff);
+}
+
+TEST(Scene, OutputDirectoryMovesOnlyOutputs) {
+  SceneParseOptions o = options();
+  o.outputDir = "elsewhere";
+  Result<Scene> scene = parseScene(withOutput(R"({"map": "mask", "file": "sub/m.png"})"), o);
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->outputs[0].file, std::filesystem::path("elsewhere/sub/m.png"));
+  EXPECT_EQ(scene->mesh, std::filesystem::path("scenes/m.obj"));
+}
+
+TEST(Scene, TypoedKeyNamesItsPlaceAndTheClosestKey) {
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "sise": 4})")),
+            "scene.json: outputs[0]: unknown key 'sise' (did you mean 'size'?)");
+  EXPECT_EQ(parseError(R"({"mehs": "m.obj", "outputs": []})"),
+            "scene.json: unknown key 'mehs' (did you mean 'mesh'?)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "scael": 2})")),
+            "scene.json: layers[0]: unknown key 'scael' (did you mean 'scale'?)");
+  const std::string far = parseError(withOutput(R"({"map": "mask", "file": "m.png", "xyz": 1})"));
+  EXPECT_NE(far.find("unknown key 'xyz' (expected map, file, size"), std::string::npos) << far;
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "height", "image": "h.png", "mask": {"image": "m.png", "uvs": 1}})")),
+            "scene.json: layers[0].mask: unknown key 'uvs' (did you mean 'uv'?)");
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj", "subdivision": {"levle": 2}, "outputs": []})"),
+            "scene.json: subdivision: unknown key 'levle' (did you mean 'level'?)");
+}
+
+TEST(Scene, KeyOfAnotherLayerTypeSaysWhereItBelongs) {
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "amplitude": 2})")),
+            "scene.json: layers[0]: key 'amplitude' does not apply to a height layer (it is for "
+            "volume layers)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "noise", "phase": 1})")),
+            "scene.json: layers[0]: key 'phase' does not apply to a noise volume (it is for sine)");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "corners", "file": "c.csv", "size": 4})")),
+            "scene.json: outputs[0]: key 'size' does not apply to a corners output (it is for "
+            "image maps)");
+}
+
+TEST(Scene, SizeOutOfRange) {
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 0})")),
+            "scene.json: outputs[0]: size 0 is out of range 1..65536");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 100000})")),
+            "scene.json: outputs[0]: size 100000 is out of range 1..65536");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "width": -3})")),
+            "scene.json: outputs[0]: width -3 is out of range 1..65536");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "samples": 17})")),
+            "scene.json: outputs[0]: samples 17 is out of range 1..16");
+  EXPECT_EQ(
+      parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 18446744073709551615})")),
+      "scene.json: outputs[0]: size 18446744073709551615 is out of range 1..65536");
+  EXPECT_NE(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 1e20})"))
+                .find("out of range 1..65536"),
+            std::string::npos);
+}
+
+TEST(Scene, UnknownMapAndNames) {
+  EXPECT_EQ(parseError(withOutput(R"({"map": "tangent-normals", "file": "n.png"})")),
+            "scene.json: outputs[0]: unknown map 'tangent-normals' (did you mean "
+            "'tangent-normal'?)");
+  const std::string far = parseError(withOutput(R"({"map": "albedo", "file": "n.png"})"));
+  EXPECT_NE(far.find("unknown map 'albedo' (expected tangent-normal, object-normal"),
+            std::string::npos)
+      << far;
+  EXPECT_NE(far.find("or corners)"), std::string::npos) << far;
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "filter": "bicubc"})")),
+            "scene.json: layers[0]: unknown filter 'bicubc' (did you mean 'bicubic'?)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "hieght", "image": "h.png"})")),
+            "scene.json: layers[0]: unknown type 'hieght' (did you mean 'height'?)");
+}
+
+TEST(Scene, WrongTypes) {
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": "big"})")),
+            "scene.json: outputs[0]: 'size' must be an integer, not a string");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 20.5})")),
+            "scene.json: outputs[0]: 'size' must be an integer, not 20.5");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "scale": [1]})")),
+            "scene.json: layers[0]: 'scale' must be a number, not an array");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": 3})")),
+            "scene.json: layers[0]: 'image' must be a string, not 3");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "alpha": 1})")),
+            "scene.json: outputs[0]: 'alpha' must be true or false, not 1");
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj", "layers": {}, "outputs": []})"),
+            "scene.json: 'layers' must be an array, not an object");
+  EXPECT_EQ(parseError(R"([1, 2])"), "scene.json: expected an object for the scene, not an array");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "direction": [1, 0]})")),
+            "scene.json: layers[0]: 'direction' must be an array of 3 numbers, not an array");
+}
+
+TEST(Scene, MissingAndEmpty) {
+  EXPECT_EQ(parseError(R"({"outputs": [{"map": "mask", "file": "m.png"}]})"),
+            "scene.json: missing key 'mesh' in the scene");
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj"})"), "scene.json: missing key 'outputs' in the scene");
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj", "outputs": []})"),
+            "scene.json: 'outputs' is empty: nothing to bake");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask"})")),
+            "scene.json: outputs[0]: missing key 'file' in an output");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height"})")),
+            "scene.json: layers[0]: missing key 'image' in a height layer");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": ""})")),
+            "scene.json: outputs[0]: 'file' is empty");
+}
+
+TEST(Scene, SyntaxErrorsAndDuplicates) {
+  const std::string syntax = parseError("{\"mesh\": \"m.obj\",\n \"outputs\": [}");
+  EXPECT_NE(syntax.find("invalid JSON"), std::string::npos) << syntax;
+  EXPECT_NE(syntax.find("line 2"), std::string::npos) << syntax;
+  EXPECT_EQ(parseError(R"({"mesh": "a.obj", "mesh": "b.obj", "outputs": []})"),
+            "scene.json: duplicate key 'mesh'");
+}
+
+TEST(Scene, FormatsAndBitDepths) {
+  const std::string jpg = parseError(withOutput(R"({"map": "tangent-normal", "file": "n.jpg"})"));
+  EXPECT_NE(jpg.find("outputs[0]: scenes/n.jpg: unknown image format '.jpg'"), std::string::npos)
+      << jpg;
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "bit_depth": 32})")),
+            "scene.json: outputs[0]: bit_depth 32 is not available in PNG (8 or 16)");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.exr", "bit_depth": 8})")),
+            "scene.json: outputs[0]: bit_depth 8 is not available in EXR (16 = half or 32 = "
+            "float)");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "format": "jpeg"})")),
+            "scene.json: outputs[0]: unknown image format 'jpeg' (use exr, png or tiff)");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "green": "directx"})")),
+            "scene.json: outputs[0]: key 'green' applies only to tangent-normal maps");
+}
+
+TEST(Scene, InvalidCombinations) {
+  EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "filter": "hermite"})")),
+            "scene.json: layers[0]: filter 'hermite' is only available for height images (use "
+            "bilinear or bicubic)");
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "normal", "image": "n.png", "space": "object", "green": "opengl"})")),
+            "scene.json: layers[0]: key 'green' applies only to tangent-space normal maps");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "noise", "frequency": 0})")),
+            "scene.json: layers[0]: frequency 0 must be greater than 0");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "step": -1})")),
+            "scene.json: layers[0]: step -1 must be greater than 0");
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj", "outputs": [{"map": "mask", "file": "m.png"},
+                                                        {"map": "height", "file": "m.png"}]})"),
+            "scene.json: outputs[1]: file 'scenes/m.png' is also written by outputs[0]");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 4, "width": 4})")),
+            "scene.json: outputs[0]: give either 'size' or 'width'/'height', not both");
+}
+
+TEST(Scene, SubdivisionIsParsedAndValidated) {
+  Result<Scene> scene = parseScene(
+      R"({"mesh": "m.obj", "subdivision": {"level": 2, "uv_smooth": "keep-corners",
+          "boundary": "keep-corners"}, "outputs": [{"map": "mask", "file": "m.png"}]})",
+      options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->subdivision.level, 2);
+  EXPECT_FALSE(scene->subdivision.limit);
+  EXPECT_EQ(scene->subdivision.uvSmooth, SubdivisionUvSmooth::kKeepCorners);
+  EXPECT_EQ(scene->subdivision.boundary, SubdivisionBoundary::kKeepCorners);
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj", "subdivision": {"uv_smooth": "keep"},
+                            "outputs": [{"map": "mask", "file": "m.png"}]})"),
+            "scene.json: subdivision: unknown uv_smooth 'keep' (expected none, keep-corners, "
+            "keep-corners-junctions, keep-corners-junctions-concave, keep-boundaries or all)");
+  EXPECT_EQ(parseError(R"({"mesh": "m.obj", "subdivision": {"level": "max"},
+                            "outputs": [{"map": "mask", "file": "m.png"}]})"),
+            "scene.json: subdivision: level 'max' must be \"limit\" or a number");
+  Result<Scene> none = parseScene(
+      R"({"mesh": "m.obj", "subdivision": {"level": 0}, "outputs": [{"map": "mask", "file": "m.png"}]})",
+      options());
+  ASSERT_TRUE(none);
+  EXPECT_FALSE(none->subdivision.requested());
+}
+
+TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
+  Scene scene;
+  scene.mesh = "m.obj";
+  SceneOutput output;
+  output.file = "n.png";
+  output.width = output.height = 0;
+  scene.outputs.push_back(output);
+  Status status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message, "outputs[0]: size 0 is out of range 1..65536");
+  scene.outputs[0].width = scene.outputs[0].height = 64;
+  EXPECT_TRUE(validateScene(scene));
+  SceneLayer layer;
+  layer.image = "h.png";
+  layer.weight = std::numeric_limits<double>::infinity();
+  scene.layers.push_back(layer);
+  status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message, "layers[0]: weight must be a finite number");
+}
+
+TEST(Scene, ClosestMatch) {
+  const std::vector<std::string> keys{"size", "samples", "margin", "map"};
+  EXPECT_EQ(closestMatch("sise", keys), "size");
+  EXPECT_EQ(closestMatch("SIZE", keys), "size");
+  EXPECT_EQ(closestMatch("margn", keys), "margin");
+  EXPECT_EQ(closestMatch("zzzzzz", keys), "");
+  EXPECT_EQ(closestMatch("x", keys), "");
+}
+
+}  // namespace
+}  // namespace sgbake

@@ -1,0 +1,399 @@
+/// @file bake_cli_test.cpp
+/// @brief `sgbake bake` and `sgbake convert` as users run them: exit codes, one-line errors that
+/// name the culprit, no output on failure, --explain, the manifest, the one-map shorthand,
+/// --stats, and the default scene.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "run_process.hpp"
+
+namespace sgbake {
+namespace {
+
+namespace fs = std::filesystem;
+using test::ProcessResult;
+
+/// A unit square, z = 0, UVs = (x, y).
+constexpr const char* kPlaneObj =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "vn 0 0 1\n"
+    "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void writeFile(const fs::path& path, const std::string& content) {
+  std::ofstream out(path, std::ios::binary);
+  out << content;
+  ASSERT_TRUE(out.good()) << path;
+}
+
+std::set<std::string> listDirectory(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
+  return names;
+}
+
+void expectOneErrorLine(const ProcessResult& r) {
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(r.err.starts_with("sgbake: error: ")) << r.err;
+}
+
+/// Writes a W×H image with OIIO: channel c of texel (x, row) = values[c] (+ x/W on channel 0
+/// when @p ramp).
+void writeTestImage(const fs::path& path, int size, std::vector<float> values, bool ramp) {
+  const int channels = static_cast<int>(values.size());
+  std::vector<float> pixels(static_cast<std::size_t>(size * size * channels));
+  for (int row = 0; row < size; ++row) {
+    for (int x = 0; x < size; ++x) {
+      for (int c = 0; c < channels; ++c) {
+        float v = values[static_cast<std::size_t>(c)];
+        if (ramp && c == 0) v += 0.5f * static_cast<float>(x) / static_cast<float>(size);
+        pixels[(static_cast<std::size_t>(row) * size + x) * channels + c] = v;
+      }
+    }
+  }
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path.string());
+  ASSERT_TRUE(out);
+  OIIO::ImageSpec spec(size, size, channels, OIIO::TypeDesc::UINT16);
+  ASSERT_TRUE(out->open(path.string(), spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+  ASSERT_TRUE(out->close());
+}
+
+/// A working directory with a plane, a mesh without UVs, a height map and a normal map.
+class BakeCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("sgbake_bake_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    writeFile(dir_ / "plane.obj", kPlaneObj);
+    writeFile(dir_ / "nouv.obj", kNoUvObj);
+    writeTestImage(dir_ / "h.png", 16, {0.25f}, true);
+    writeTestImage(dir_ / "n.png", 16, {0.5f, 0.5f, 1.0f}, false);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  ProcessResult run(std::vector<std::string> args) {
+    args.insert(args.begin(), SGBAKE_CLI);
+    return test::runProcess(args);
+  }
+
+  /// Writes dir_/scene.json and runs `sgbake bake scene.json extra...`.
+  ProcessResult bakeScene(const std::string& json, std::vector<std::string> extra = {}) {
+    writeFile(dir_ / "scene.json", json);
+    std::vector<std::string> args{"bake", (dir_ / "scene.json").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  }
+
+  fs::path dir_;
+};
+
+std::string planeScene(const std::string& layers, const std::string& outputs,
+                       const std::string& mesh = "plane.obj") {
+  return R"({"mesh": ")" + mesh + R"(", "layers": [)" + layers + R"(], "outputs": [)" + outputs +
+         "]}";
+}
+
+constexpr const char* kHeightLayer = R"({"type": "height", "image": "h.png", "scale": 0.1})";
+
+/// Checks that a bad scene exits 2 with one line containing @p expected, creating no file.
+void expectBadScene(const ProcessResult& r, const std::string& expected,
+                    const std::set<std::string>& before, const fs::path& dir) {
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  expectOneErrorLine(r);
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  EXPECT_EQ(listDirectory(dir), before) << "no output, no temporary, no manifest";
+}
+
+TEST_F(BakeCliTest, BadScenesExitTwoNamingTheProblemAndCreateNothing) {
+  writeFile(dir_ / "scene.json", "{}");
+  const std::set<std::string> before = listDirectory(dir_);
+  const std::string out = R"("map": "tangent-normal", "file": "out.png")";
+  expectBadScene(bakeScene(planeScene(kHeightLayer, "{" + std::string(out) + R"(, "sise": 64})")),
+                 "outputs[0]: unknown key 'sise' (did you mean 'size'?)", before, dir_);
+  expectBadScene(bakeScene(planeScene(kHeightLayer, "{" + std::string(out) + R"(, "size": 0})")),
+                 "outputs[0]: size 0 is out of range 1..65536", before, dir_);
+  expectBadScene(
+      bakeScene(planeScene(kHeightLayer, "{" + std::string(out) + R"(, "size": 100000})")),
+      "outputs[0]: size 100000 is out of range 1..65536", before, dir_);
+  expectBadScene(bakeScene(planeScene(kHeightLayer, R"({"map": "albedo", "file": "out.png"})")),
+                 "outputs[0]: unknown map 'albedo'", before, dir_);
+  expectBadScene(bakeScene(planeScene(R"({"type": "height", "image": "nothere.png"})",
+                                      "{" + std::string(out) + "}")),
+                 "layers[0]: image " + (dir_ / "nothere.png").string() + " does not exist", before,
+                 dir_);
+  expectBadScene(bakeScene(planeScene(kHeightLayer, "{" + std::string(out) + "}", "nouv.obj")),
+                 "nouv.obj", before, dir_);
+  expectBadScene(bakeScene(R"({"mesh": "plane.obj", "subdivision": {"level": 2},
+                              "outputs": [{"map": "mask", "file": "m.png"}]})"),
+                 "subdivision is not supported yet", before, dir_);
+  expectBadScene(bakeScene("{\"mesh\": "), "invalid JSON", before, dir_);
+  // The scene file itself.
+  const ProcessResult missing = run({"bake", (dir_ / "none.json").string()});
+  EXPECT_EQ(missing.exitCode, 2);
+  expectOneErrorLine(missing);
+  EXPECT_NE(missing.err.find("none.json: cannot open scene (no such file)"), std::string::npos);
+}
+
+TEST_F(BakeCliTest, UnreadableImageExitsTwoAndCreatesNothing) {
+  writeFile(dir_ / "broken.png", "this is not a png");
+  writeFile(dir_ / "scene.json", "{}");
+  const std::set<std::string> before = listDirectory(dir_);
+  expectBadScene(bakeScene(planeScene(R"({"type": "height", "image": "broken.png"})",
+                                      R"({"map": "height", "file": "h.exr", "size": 8})")),
+                 "broken.png", before, dir_);
+}
+
+TEST_F(BakeCliTest, FailingBakeLeavesTheExistingOutputByteIdentical) {
+  writeFile(dir_ / "out.png", "the previous bake");
+  writeFile(dir_ / "scene.json", "{}");
+  const std::set<std::string> before = listDirectory(dir_);
+  const ProcessResult r = bakeScene(planeScene(
+      kHeightLayer, R"({"map": "tangent-normal", "file": "out.png", "size": 8})", "nouv.obj"));
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_EQ(readFile(dir_ / "out.png"), "the previous bake");
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
+TEST_F(BakeCliTest, BakesAScene) {
+  const ProcessResult r = bakeScene(planeScene(
+      kHeightLayer, R"({"map": "tangent-normal", "file": "out/n.png", "size": 32, "margin": 2},
+                       {"map": "mask", "file": "out/m.png", "size": 32})"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "") << "silent on a pipe: no progress bar";
+  EXPECT_NE(r.out.find("wrote " + (dir_ / "out/n.png").string()), std::string::npos) << r.out;
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open((dir_ / "out/n.png").string());
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().width, 32);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::UINT16);
+  std::unique_ptr<OIIO::ImageInput> mask = OIIO::ImageInput::open((dir_ / "out/m.png").string());
+  ASSERT_TRUE(mask);
+  EXPECT_EQ(mask->spec().format, OIIO::TypeDesc::UINT8);
+  EXPECT_EQ(listDirectory(dir_ / "out"),
+            (std::set<std::string>{"n.png", "m.png", ".sgbake-manifest.json"}));
+}
+
+TEST_F(BakeCliTest, ManifestUpToDateForceAndTouchedInputs) {
+  const std::string json =
+      planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
+                                                       {"map": "mask", "file": "m.png", "size": 8})");
+  ASSERT_EQ(bakeScene(json).exitCode, 0);
+  const std::string bytes = readFile(dir_ / "h.exr");
+
+  const ProcessResult again = bakeScene(json);
+  ASSERT_EQ(again.exitCode, 0) << again.err;
+  EXPECT_EQ(again.out, "up to date: " + (dir_ / "h.exr").string() +
+                           "\nup to date: " + (dir_ / "m.png").string() + "\n");
+  EXPECT_EQ(readFile(dir_ / "h.exr"), bytes);
+
+  const ProcessResult forced = bakeScene(json, {"--force"});
+  ASSERT_EQ(forced.exitCode, 0) << forced.err;
+  EXPECT_NE(forced.out.find("wrote " + (dir_ / "h.exr").string()), std::string::npos);
+  EXPECT_NE(forced.out.find("wrote " + (dir_ / "m.png").string()), std::string::npos);
+
+  // Touching the height image re-bakes the height map only.
+  writeTestImage(dir_ / "h.png", 16, {0.5f}, true);
+  const ProcessResult touched = bakeScene(json);
+  ASSERT_EQ(touched.exitCode, 0) << touched.err;
+  EXPECT_NE(touched.out.find("wrote " + (dir_ / "h.exr").string()), std::string::npos);
+  EXPECT_NE(touched.out.find("up to date: " + (dir_ / "m.png").string()), std::string::npos);
+  EXPECT_NE(readFile(dir_ / "h.exr"), bytes);
+
+  // A deleted output is baked again.
+  fs::remove(dir_ / "m.png");
+  const ProcessResult deleted = bakeScene(json);
+  EXPECT_NE(deleted.out.find("wrote " + (dir_ / "m.png").string()), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "m.png"));
+}
+
+TEST_F(BakeCliTest, ExplainPrintsThePlanAndBakesNothing) {
+  const ProcessResult r =
+      bakeScene(planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
+                                  {"map": "mask", "file": "m.png", "size": 8})"),
+                {"--explain"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("steps:\n  1. load mesh "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("skipped:\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tangent frames (MikkTSpace): no map to bake"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mask maps read no layers"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir_ / "h.exr"));
+  EXPECT_FALSE(fs::exists(dir_ / ".sgbake-manifest.json"));
+}
+
+TEST_F(BakeCliTest, OutDirMovesRelativeOutputs) {
+  const ProcessResult r =
+      bakeScene(planeScene("", R"({"map": "mask", "file": "m.png", "size": 4})"),
+                {"--out-dir", (dir_ / "elsewhere").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "elsewhere" / "m.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "m.png"));
+}
+
+TEST_F(BakeCliTest, StatsPrintOneJsonLineOfTimings) {
+  const ProcessResult r = bakeScene(
+      planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "n.png", "size": 8})"),
+      {"--stats", "--threads", "2"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  ASSERT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const nlohmann::json stats = nlohmann::json::parse(r.err);
+  for (const char* key : {"load_s", "tangents_s", "bake_s", "pad_s", "write_s", "total_s"}) {
+    ASSERT_TRUE(stats.contains(key)) << key;
+    EXPECT_GE(stats[key].get<double>(), 0.0) << key;
+  }
+  EXPECT_EQ(stats["command"], "bake");
+  EXPECT_EQ(stats["baked"], 1);
+  EXPECT_EQ(stats["tangents"], true);
+  EXPECT_EQ(stats["images_loaded"], 1);
+  EXPECT_LE(stats["threads"].get<int>(), 2);
+}
+
+TEST_F(BakeCliTest, OneMapShorthand) {
+  const fs::path out = dir_ / "short.png";
+  const ProcessResult r =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--height", (dir_ / "h.png").string(),
+           "--height-scale", "0.1", "--map", "tangent-normal", "--size", "16", "--margin", "0",
+           "--filter", "bicubic", "-o", out.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(out.string());
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().width, 16);
+  EXPECT_EQ(in->spec().height, 16);
+
+  const ProcessResult normal =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--normal", (dir_ / "n.png").string(),
+           "--normal-space", "tangent", "--map", "object-normal", "--size", "8", "--padding",
+           "push-pull", "-o", (dir_ / "os.exr").string()});
+  ASSERT_EQ(normal.exitCode, 0) << normal.err;
+  EXPECT_TRUE(fs::exists(dir_ / "os.exr"));
+}
+
+TEST_F(BakeCliTest, OneMapShorthandErrors) {
+  const std::string mesh = (dir_ / "plane.obj").string();
+  const std::set<std::string> before = listDirectory(dir_);
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"bake", "--mesh", mesh, "--size", "0", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--size", "100000", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "albedo", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "-o", (dir_ / "o.jpg").string()},
+           {"bake", "--mesh", mesh},
+           {"bake", "--mesh", mesh, "--height", (dir_ / "nothere.png").string(), "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", (dir_ / "nouv.obj").string(), "-o", (dir_ / "o.png").string()},
+           {"bake", (dir_ / "scene.json").string(), "--mesh", mesh},
+           {"bake"},
+           {"bake", "--mesh", mesh, "--padding", "extnd", "-o", (dir_ / "o.png").string()},
+       }) {
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args.back() << ": " << r.err;
+    expectOneErrorLine(r);
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+  const ProcessResult map =
+      run({"bake", "--mesh", mesh, "--map", "tangent-normals", "-o", (dir_ / "o.png").string()});
+  EXPECT_NE(map.err.find("unknown map"), std::string::npos) << map.err;
+  const ProcessResult padding =
+      run({"bake", "--mesh", mesh, "--padding", "extnd", "-o", (dir_ / "o.png").string()});
+  EXPECT_NE(padding.err.find("did you mean 'extend'?"), std::string::npos) << padding.err;
+}
+
+TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
+  // An object-space map of the flat plane: every texel (0, 0, 1) → tangent space (0, 0, 1).
+  writeTestImage(dir_ / "os.png", 8, {0.5f, 0.5f, 1.0f}, false);
+  const ProcessResult r =
+      run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "object", "--to",
+           "tangent", (dir_ / "os.png").string(), "-o", (dir_ / "ts.exr").string(), "--stats"});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(r.err).contains("total_s"));
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open((dir_ / "ts.exr").string());
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().width, 8) << "output size = input size";
+  EXPECT_EQ(in->spec().height, 8);
+  std::vector<float> pixels(8 * 8 * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, pixels.data()));
+  EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 0], 0.5f, 2e-3);
+  EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 1], 0.5f, 2e-3);
+  EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 2], 1.0f, 2e-3);
+
+  const ProcessResult back =
+      run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "tangent", "--to",
+           "object", (dir_ / "ts.exr").string(), "-o", (dir_ / "os2.png").string()});
+  ASSERT_EQ(back.exitCode, 0) << back.err;
+  EXPECT_TRUE(fs::exists(dir_ / "os2.png"));
+}
+
+TEST_F(BakeCliTest, ConvertErrors) {
+  const std::string mesh = (dir_ / "plane.obj").string();
+  const std::set<std::string> before = listDirectory(dir_);
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"convert", "--mesh", mesh, "--from", "object", (dir_ / "n.png").string(), "-o",
+            (dir_ / "o.png").string()},
+           {"convert", "--mesh", mesh, "--from", "objekt", "--to", "tangent",
+            (dir_ / "n.png").string(), "-o", (dir_ / "o.png").string()},
+           {"convert", "--mesh", mesh, "--from", "object", "--to", "tangent",
+            (dir_ / "none.png").string(), "-o", (dir_ / "o.png").string()},
+           {"convert", "--mesh", mesh, "--from", "object", "--to", "tangent",
+            (dir_ / "h.png").string(), "-o", (dir_ / "o.png").string()},
+           {"convert", "--mesh", (dir_ / "nouv.obj").string(), "--from", "object", "--to",
+            "tangent", (dir_ / "n.png").string(), "-o", (dir_ / "o.png").string()},
+           {"convert", "--mesh", mesh, "--from", "object", "--to", "tangent",
+            (dir_ / "n.png").string(), "-o", (dir_ / "missing" / "o.png").string()},
+       }) {
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args.back() << ": " << r.err;
+    expectOneErrorLine(r);
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
+TEST_F(BakeCliTest, HelpTexts) {
+  const ProcessResult bake = run({"bake", "--help"});
+  EXPECT_EQ(bake.exitCode, 0);
+  for (const char* text : {"Examples:", "--explain", "--force", "SCENE", "--height-scale",
+                           "Output keys:", "Exit codes:", ".sgbake-manifest.json"}) {
+    EXPECT_NE(bake.out.find(text), std::string::npos) << text;
+  }
+  const ProcessResult convert = run({"convert", "--help"});
+  EXPECT_EQ(convert.exitCode, 0);
+  EXPECT_NE(convert.out.find("Examples:"), std::string::npos);
+  const ProcessResult top = run({"--help"});
+  EXPECT_NE(top.out.find("bake"), std::string::npos);
+  EXPECT_NE(top.out.find("convert"), std::string::npos);
+}
+
+TEST(DefaultScene, ExplainsWithoutErrors) {
+  const std::string scene = std::string(SGBAKE_MESHES) + "/default_scene.json";
+  const ProcessResult r =
+      test::runProcess({SGBAKE_CLI, "bake", scene, "--explain", "--no-manifest", "--out-dir",
+                        (fs::temp_directory_path() / "sgbake_default_scene_explain").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("4 of 4 outputs to bake"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("load image "), std::string::npos) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n') > 5, true);
+  // The bundled height map stays small.
+  EXPECT_LT(fs::file_size(std::string(SGBAKE_MESHES) + "/height.png"), 300u * 1024u);
+}
+
+}  // namespace
+}  // namespace sgbake
