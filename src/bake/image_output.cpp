@@ -250,6 +250,9 @@ Status writeImage(const FloatImage& image, const std::filesystem::path& path,
   spec.alpha_channel = options.alpha ? layout.fileChannels - 1 : -1;
   if (options.alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
   if (format != ImageFormat::kPng) spec.attribute("compression", "zip");
+  // Blender's default PNG compression ("15%") is zlib level 1: several times faster to write
+  // than zlib's default 6, for files about 10-20% larger.
+  if (format == ImageFormat::kPng) spec.attribute("png:compressionLevel", kPngCompressionLevel);
   spec.attribute("Software", "sgbake");
 
   std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(oiioFormatName(format));

@@ -48,6 +48,9 @@ int defaultBitDepth(ImageFormat format, MapKind map);
 bool formatSupportsBitDepth(ImageFormat format, int bitDepth);
 
 /// @brief Options of writeImage.
+/// zlib level of PNG files: Blender's default PNG compression ("15%") is level 1.
+inline constexpr int kPngCompressionLevel = 1;
+
 struct ImageWriteOptions {
   ImageFormat format = ImageFormat::kAuto;  ///< kAuto: from the file name's extension
   /// Bits per channel: 8, 16 or 32; 0 = 16. EXR: 16 = half, 32 = float; PNG: 8 or 16-bit
