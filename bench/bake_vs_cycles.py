@@ -1,0 +1,242 @@
+#!/usr/bin/env python3
+"""Times a 4096^2 tangent-space normal bake: Blender's Cycles against `sgbake bake`.
+
+    python3 bench/bake_vs_cycles.py --cli build/src/sgbake [--check] [--size 4096]
+        [--margin 16] [--height-size 2048] [--format png] [--bit-depth 8] [--runs 3]
+        [--cycles-runs 1]
+        [--blender blender] [--blender-threads N] [--work-dir DIR]
+    ninja -C build bench_bake_vs_cycles        # the same with --check
+
+The scene (tests/blender/bake_scene.py, case "suzanne2"): Suzanne, Subdivision Surface level 2
+applied, smooth - meshes/suzanne.obj's recipe, 7,872 quads - with a Bump node (Strength 1,
+Distance 0.1) fed by a procedural float height image (--height-size^2, Linear) into a Diffuse
+BSDF.
+
+1. Blender half (inside Blender): builds the scene, writes mesh.obj and height.exr, and times
+   bpy.ops.object.bake(type NORMAL, TANGENT space, margin --margin EXTEND) on the CPU with
+   samples = 1 and denoising off, best of --cycles-runs. Only the operator is timed: Blender's
+   start-up, scene building and saving the image are not counted (in Cycles' favour). Blender
+   uses all cores unless --blender-threads; the thread count and the CPU/wall ratio of the
+   bake are reported.
+2. sgbake: `sgbake bake --mesh mesh.obj --height height.exr --height-scale 0.1
+   --filter bilinear --map tangent-normal --size N --margin M --samples 1 -o OUT.FORMAT
+   --stats`, the process's whole wall time (start, mesh and height loading, tangents, bake,
+   padding, writing), best of --runs; write_s is taken from the --stats JSON line (stderr),
+   i.e. the time OIIO needed to write that same image. The same again with --threads 1 and
+   --threads 2. The output is an 8-bit PNG by default (how normal maps usually ship);
+   --bit-depth 16 (sgbake's own default for PNG) makes zlib's serial write ~4.5x slower
+   (4096^2: 8.8 s against 1.95 s on the 2-core development machine), --format exr --bit-depth
+   16 writes half floats with OIIO's threaded EXR writer.
+
+Prints one JSON line:
+  cycles_s, cycles_threads, cycles_cpu_over_wall, sgbake_s (all cores), speedup = cycles_s /
+  sgbake_s (target >= 25), write_s, total_over_write = sgbake_s / write_s (target <= 2),
+  t1_s, t2_s (wall, --threads 1 / 2), t1_compute_s, t2_compute_s, scaling = t1_compute_s /
+  t2_compute_s (target >= 1.8), plus size, margin, format, bit_depth, faces, height_size,
+  the 1-minute load average before and after (measure on an idle machine: with the load above
+  the core count the figures, above all the scaling, are meaningless) and sgbake's stats of
+  the best all-core run.
+"compute" is the work without file I/O: tangents_s + bake_s + pad_s from --stats (else wall -
+load_s - write_s). The scaling target is about the compute: writing a PNG is serial zlib, and
+as total_over_write <= 2 lets writing be up to half the wall time, whole-process scaling could
+never reach 1.8 (wall_scaling is reported too).
+sgbake runs with --no-manifest: otherwise its incremental manifest would skip every run after
+the first as "up to date".
+With --check the exit status is 1 when a target is missed (or write_s is not reported).
+Exit 2 on usage errors or a failed run, 77 when Blender is not installed.
+"""
+
+import argparse
+import importlib.util
+import json
+import os
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "blender"))
+import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
+
+RESULT_TAG = "BLENDER_RESULT "
+CASE = "suzanne2"
+TARGET_SPEEDUP = 25.0
+TARGET_TOTAL_OVER_WRITE = 2.0
+TARGET_SCALING = 1.8
+
+
+# ---------------------------------------------------------------------------------------------
+# Blender half
+
+
+def blender_main(argv):
+    """Inside Blender: argv = [WORK_DIR, SIZE, MARGIN, HEIGHT_SIZE, RUNS]."""
+    import bpy
+    import bake_scene
+
+    work, size, margin, height_size, runs = argv[0], int(argv[1]), int(argv[2]), int(argv[3]), \
+        int(argv[4])
+    scene = bpy.context.scene
+    bc.setup_cycles(scene, samples=1)  # keeps Blender's thread setting (-t N or all cores)
+    entry = bake_scene.build_case(CASE, work, size=size, passes=("tangent",), margin=margin,
+                                  height_size=height_size, save_bakes=False, runs=runs)
+    entry["cycles_threads"] = scene.render.threads
+    entry["blender_version"] = bpy.app.version_string
+    print(RESULT_TAG + json.dumps(entry), flush=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# Driver half
+
+
+def run_blender_half(args, work):
+    options = ["-t", str(args.blender_threads)] if args.blender_threads else []
+    proc = objio.run_blender(args.blender, os.path.abspath(__file__),
+                             [work, str(args.size), str(args.margin), str(args.height_size),
+                              str(args.cycles_runs)],
+                             blender_options=options, capture_output=True, text=True)
+    for line in proc.stdout.splitlines():
+        if line.startswith(RESULT_TAG):
+            return json.loads(line[len(RESULT_TAG):])
+    print(f"error: Blender failed (exit {proc.returncode}):\n{proc.stdout[-3000:]}\n"
+          f"{proc.stderr[-3000:]}", file=sys.stderr)
+    return None
+
+
+def time_sgbake(args, work, scale, threads):
+    """Runs the bake --runs times; returns (best wall s, stats of that run) or None."""
+    out = os.path.join(work, f"sgbake_t{threads or 'all'}.{args.format}")
+    cmd = [args.cli, "bake", "--mesh", os.path.join(work, "mesh.obj"),
+           "--height", os.path.join(work, "height.exr"), "--height-scale", repr(scale),
+           "--filter", "bilinear", "--map", "tangent-normal", "--size", str(args.size),
+           "--margin", str(args.margin), "--samples", "1", "-o", out, "--stats",
+           "--no-manifest"]  # the manifest would make every run after the first "up to date"
+    cmd += ["--bit-depth", str(args.bit_depth)]
+    if threads:
+        cmd += ["--threads", str(threads)]
+    best = None
+    for _ in range(args.runs):
+        t0 = time.perf_counter()
+        proc = bc.run_tool(cmd, timeout=900)
+        wall = time.perf_counter() - t0
+        if proc is None or proc.returncode != 0:
+            return None
+        if best is None or wall < best[0]:
+            best = (wall, bc.parse_stats(proc.stderr) or {})
+    return best
+
+
+def compute_s(wall, stats):
+    """The computing part of a run, without file I/O (see the module docstring), or None."""
+    parts = [stats.get(k) for k in ("tangents_s", "bake_s", "pad_s")]
+    if all(isinstance(p, (int, float)) for p in parts):
+        return float(sum(parts))
+    io = [stats.get(k) for k in ("load_s", "write_s")]
+    if all(isinstance(p, (int, float)) for p in io):
+        return wall - float(sum(io))
+    return None
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
+    parser.add_argument("--check", action="store_true", help="exit 1 when a target is missed")
+    parser.add_argument("--size", type=int, default=4096)
+    parser.add_argument("--margin", type=int, default=16, help="margin in texels, both bakers")
+    parser.add_argument("--height-size", type=int, default=2048, help="height image size")
+    parser.add_argument("--format", default="png", choices=("png", "exr", "tif"),
+                        help="sgbake's output format (default png)")
+    parser.add_argument("--bit-depth", type=int, default=8, choices=(0, 8, 16, 32),
+                        help="sgbake --bit-depth (default 8; 0 = sgbake's own default, 16)")
+    parser.add_argument("--runs", type=int, default=3, help="sgbake runs per setting (best of)")
+    parser.add_argument("--cycles-runs", type=int, default=1, help="Cycles bakes (best of)")
+    parser.add_argument("--blender", default="blender", help="Blender executable")
+    parser.add_argument("--blender-threads", type=int, help="start Blender with -t N")
+    parser.add_argument("--work-dir", help="keep the mesh, height and outputs here")
+    args = parser.parse_args()
+    if args.runs < 1 or args.cycles_runs < 1:
+        parser.error("--runs and --cycles-runs must be at least 1")
+
+    args.blender = bc.find_blender(args.blender) or ""
+    if not args.blender:
+        print("SKIP: blender is not on PATH", file=sys.stderr)
+        return bc.SKIP
+    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
+        print(f"error: {args.cli} is not an executable file", file=sys.stderr)
+        return 2
+    if not bc.cli_has_command(args.cli, "bake"):
+        print(f"error: `{args.cli} --help` lists no `bake` command", file=sys.stderr)
+        return 2
+
+    load_before = os.getloadavg()[0]
+    with tempfile.TemporaryDirectory(prefix="sgbake-bench-bake-") as tmp:
+        work = os.path.abspath(args.work_dir or tmp)
+        os.makedirs(work, exist_ok=True)
+        blender = run_blender_half(args, work)
+        if blender is None:
+            return 2
+        scale = blender["scale"]
+        timed = {}
+        for threads in (None, 1, 2):
+            result = time_sgbake(args, work, scale, threads)
+            if result is None:
+                return 2
+            timed[threads] = result
+
+    sgbake_s, stats = timed[None]
+    write_s = stats.get("write_s")
+    t1, t2 = timed[1], timed[2]
+    c1, c2 = compute_s(*t1), compute_s(*t2)
+    cycles_s = blender["bake_s"]["tangent"]
+    result = {
+        "cycles_s": cycles_s,
+        "cycles_threads": blender["cycles_threads"],
+        "cycles_cpu_over_wall": blender["bake_cpu"]["tangent"],
+        "sgbake_s": sgbake_s,
+        "speedup": cycles_s / sgbake_s,
+        "write_s": write_s,
+        "total_over_write": sgbake_s / write_s if write_s else None,
+        "t1_s": t1[0], "t2_s": t2[0],
+        "t1_compute_s": c1, "t2_compute_s": c2,
+        "scaling": c1 / c2 if c1 and c2 else None,
+        "wall_scaling": t1[0] / t2[0],
+        "size": args.size, "margin": args.margin, "format": args.format,
+        "bit_depth": args.bit_depth,
+        "height_size": args.height_size, "faces": blender["faces"],
+        "cores": os.cpu_count(), "blender_version": blender["blender_version"],
+        # 1-minute load averages: above the core count, other processes competed for the CPU
+        # and every figure (above all the thread scaling) is unreliable.
+        "loadavg_before": load_before, "loadavg_after": os.getloadavg()[0],
+        "sgbake_stats": stats,
+    }
+    print(json.dumps(result))
+    if not args.check:
+        return 0
+    misses = []
+    if result["speedup"] < TARGET_SPEEDUP:
+        misses.append(f"speedup {result['speedup']:.1f} < {TARGET_SPEEDUP}")
+    if result["total_over_write"] is None:
+        misses.append("sgbake --stats reports no write_s")
+    elif result["total_over_write"] > TARGET_TOTAL_OVER_WRITE:
+        misses.append(f"total/write {result['total_over_write']:.2f} > {TARGET_TOTAL_OVER_WRITE}")
+    if result["scaling"] is None:
+        misses.append("no compute time for the 1/2-thread scaling")
+    elif result["scaling"] < TARGET_SCALING:
+        misses.append(f"1->2 thread scaling {result['scaling']:.2f} < {TARGET_SCALING}")
+    for miss in misses:
+        print("FAIL: " + miss, file=sys.stderr)
+    return 1 if misses else 0
+
+
+def running_in_blender():
+    """True inside Blender, whose Python has the bpy module."""
+    return importlib.util.find_spec("bpy") is not None
+
+
+if __name__ == "__main__":
+    if running_in_blender():
+        blender_main(sys.argv[sys.argv.index("--") + 1:])
+    else:
+        sys.exit(main())

@@ -1,0 +1,293 @@
+"""Helpers shared by sgbake's baking oracle tests and the Cycles benchmark.
+
+Imported both by plain python3 drivers (bake_oracle.py, bake_orientation.py,
+bench/bake_vs_cycles.py: the pyenv python3 first on PATH has no numpy) and by the scripts
+that run inside Blender (bake_scene.py, bake_compare.py and the Blender halves of the others;
+Blender's Python has numpy). Everything that needs numpy or bpy imports it inside the function,
+so importing this module never does.
+
+Plain-Python part
+    find_blender, run_tool, parse_stats, cli_has_command, read_png (a small PNG decoder using
+    only zlib, so that a driver can look at the bytes sgbake wrote without Blender or numpy).
+
+Blender part (numpy and bpy)
+    setup_cycles, reset_scene, new_float_image, image_array, save_exr, load_raw,
+    decode_normals, angle_deg, erode, angle_stats.
+
+Conventions (docs: /work/shared/CONVENTIONS.md)
+    Arrays are (H, W, C) float32 with rows TOP FIRST, i.e. in file order: element [r, x] is the
+    texel at column x, file row r, whose centre is u = (x + 0.5) / W, v = 1 - (r + 0.5) / H.
+    Blender's image.pixels is bottom row first; image_array / new_float_image flip it.
+    Normal maps store n / 2 + 0.5 (R = +T, G = +B, B = +N in tangent space).
+"""
+
+import json
+import os
+import shutil
+import struct
+import subprocess
+import zlib
+
+SKIP = 77  # exit status CTest treats as "skipped" (SKIP_RETURN_CODE)
+
+
+# ---------------------------------------------------------------------------------------------
+# Plain Python (drivers)
+
+
+def find_blender(name):
+    """Absolute path of the Blender executable `name` (a path or a name on PATH), or None."""
+    return shutil.which(name)
+
+
+def run_tool(cmd, timeout=600, quiet=False):
+    """Runs a command, capturing its output. Returns the CompletedProcess, or None when it could
+    not be started or timed out (after printing why). Prints the command's output when it
+    fails, unless quiet."""
+    try:
+        proc = subprocess.run([str(c) for c in cmd], capture_output=True, text=True,
+                              timeout=timeout, check=False)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        print(f"error: `{' '.join(map(str, cmd))}`: {exc}")
+        return None
+    if proc.returncode != 0 and not quiet:
+        print(f"error: `{' '.join(map(str, cmd))}` exited with {proc.returncode}\n"
+              f"{proc.stdout[-3000:]}{proc.stderr[-3000:]}")
+    return proc
+
+
+def parse_stats(stderr):
+    """The last line of `stderr` that parses as a JSON object (sgbake --stats), or None."""
+    for line in reversed(stderr.splitlines()):
+        line = line.strip()
+        if line.startswith("{"):
+            try:
+                value = json.loads(line)
+            except ValueError:
+                continue
+            if isinstance(value, dict):
+                return value
+    return None
+
+
+def cli_has_command(cli, command):
+    """True when `cli --help` lists `command` among its subcommands."""
+    proc = run_tool([cli, "--help"], timeout=30, quiet=True)
+    if proc is None:
+        return False
+    for line in (proc.stdout + proc.stderr).splitlines():
+        words = line.split()
+        if words and words[0] == command:
+            return True
+    return False
+
+
+def _paeth(a, b, c):
+    p = a + b - c
+    pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+    if pa <= pb and pa <= pc:
+        return a
+    return b if pb <= pc else c
+
+
+def read_png(path):
+    """Decodes a non-interlaced 8- or 16-bit grey/grey-alpha/RGB/RGBA PNG with zlib only.
+
+    Returns (width, height, channels, bit_depth, rows): rows[r][x] is a tuple of `channels`
+    floats in [0, 1] (value / 255 or / 65535), rows in FILE order (row 0 = top). Raises
+    ValueError for anything else (palette images, interlacing, a corrupt file).
+    """
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError(f"{path}: not a PNG file")
+    pos, idat, header = 8, [], None
+    while pos + 8 <= len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat.append(body)
+        elif kind == b"IEND":
+            break
+    if header is None:
+        raise ValueError(f"{path}: no IHDR chunk")
+    width, height, depth, colour, _, _, interlace = header
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}.get(colour)
+    if channels is None or depth not in (8, 16) or interlace != 0:
+        raise ValueError(f"{path}: unsupported PNG (colour type {colour}, depth {depth}, "
+                         f"interlace {interlace})")
+    raw = zlib.decompress(b"".join(idat))
+    bpp = channels * depth // 8  # bytes per pixel
+    stride = width * bpp
+    prev = bytearray(stride)
+    rows, off = [], 0
+    scale = 255.0 if depth == 8 else 65535.0
+    for _ in range(height):
+        ftype = raw[off]
+        line = bytearray(raw[off + 1:off + 1 + stride])
+        off += 1 + stride
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b = prev[i]
+            c = prev[i - bpp] if i >= bpp else 0
+            if ftype == 1:
+                line[i] = (line[i] + a) & 255
+            elif ftype == 2:
+                line[i] = (line[i] + b) & 255
+            elif ftype == 3:
+                line[i] = (line[i] + ((a + b) >> 1)) & 255
+            elif ftype == 4:
+                line[i] = (line[i] + _paeth(a, b, c)) & 255
+            elif ftype != 0:
+                raise ValueError(f"{path}: bad filter type {ftype}")
+        prev = line
+        if depth == 8:
+            values = list(line)
+        else:
+            values = [(line[i] << 8) | line[i + 1] for i in range(0, stride, 2)]
+        rows.append([tuple(v / scale for v in values[x * channels:(x + 1) * channels])
+                     for x in range(width)])
+    return width, height, channels, depth, rows
+
+
+# ---------------------------------------------------------------------------------------------
+# Inside Blender (numpy, bpy)
+
+
+def setup_cycles(scene, samples=1, threads=None):
+    """Cycles on the CPU, `samples` AA samples, denoising OFF (Debian's Cycles has no denoiser:
+    with denoising on, bake() reports FINISHED and writes nothing), bake margin 0.
+    threads=None keeps Blender's automatic thread count (all cores)."""
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.render.bake.margin = 0
+    if threads:
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = threads
+
+
+def reset_scene():
+    """Removes every object, mesh, material and image (so each case starts empty)."""
+    import bpy
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob, do_unlink=True)
+    for coll in (bpy.data.meshes, bpy.data.materials, bpy.data.images):
+        for item in list(coll):
+            coll.remove(item)
+
+
+def new_float_image(name, width, height, array=None, colour=(0.0, 0.0, 0.0, 1.0)):
+    """A 32-bit float, Non-Color (is_data) RGBA image. `array` (H, W, 1..4), rows top first,
+    fills it (missing channels: RGB repeat the first, alpha 1); otherwise the flat `colour`."""
+    import bpy
+    import numpy as np
+    img = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True, is_data=True)
+    img.colorspace_settings.name = "Non-Color"
+    if array is None:
+        img.generated_color = colour
+        return img
+    array = np.asarray(array, dtype=np.float32)
+    if array.ndim == 2:
+        array = array[..., None]
+    rgba = np.empty((height, width, 4), np.float32)
+    rgba[..., 3] = 1.0
+    for c in range(3):
+        rgba[..., c] = array[..., min(c, array.shape[2] - 1)]
+    if array.shape[2] == 4:
+        rgba[..., 3] = array[..., 3]
+    img.pixels.foreach_set(rgba[::-1].ravel())  # Blender stores the bottom row first
+    img.update()
+    return img
+
+
+def image_array(img):
+    """The raw pixels of a Blender image as (H, W, 4) float32, rows top first."""
+    import numpy as np
+    w, h = img.size
+    buf = np.empty(w * h * 4, np.float32)
+    img.pixels.foreach_get(buf)
+    return buf.reshape(h, w, 4)[::-1].copy()
+
+
+def load_raw(path):
+    """Loads an image file with Blender as Non-Color data; returns (H, W, 4) float32 rows top
+    first (byte images come back as value / 255, 16-bit PNG as value / 65535)."""
+    import bpy
+    img = bpy.data.images.load(os.path.abspath(path), check_existing=False)
+    img.colorspace_settings.name = "Non-Color"
+    try:
+        return image_array(img)
+    finally:
+        bpy.data.images.remove(img)
+
+
+def save_exr(img, path, verify=True):
+    """Saves a float Non-Color image as an RGB 32-bit float, ZIP-compressed OpenEXR with its raw
+    values (Image.save_render with the scene's output settings; a Non-Color image gets no
+    view transform, whatever the scene's view is), and with verify=True reloads the file and
+    requires bit-identical RGB. (Image.save() would write uncompressed RGBA.)"""
+    import bpy
+    import numpy as np
+    expected = image_array(img) if verify else None
+    scene = bpy.context.scene
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR"
+    settings.color_mode = "RGB"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    img.save_render(os.path.abspath(path), scene=scene)
+    if verify:
+        back = load_raw(path)
+        if back.shape != expected.shape or not np.array_equal(back[..., :3], expected[..., :3]):
+            diff = (np.abs(back[..., :3] - expected[..., :3]).max()
+                    if back.shape == expected.shape else "shape")
+            raise RuntimeError(f"{path}: EXR round trip is not exact (max diff {diff})")
+
+
+def decode_normals(array):
+    """(H, W, >=3) encoded normal map -> (H, W, 3) float64 unit vectors (n = 2c - 1)."""
+    import numpy as np
+    n = np.asarray(array, dtype=np.float64)[..., :3] * 2.0 - 1.0
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    return n / np.maximum(length, 1e-30)
+
+
+def angle_deg(a, b):
+    """Per-texel angle in degrees between two unit-vector arrays, atan2(|a x b|, a . b)
+    (accurate for tiny angles, unlike acos)."""
+    import numpy as np
+    cross = np.linalg.norm(np.cross(a, b), axis=-1)
+    return np.degrees(np.arctan2(cross, np.sum(a * b, axis=-1)))
+
+
+def erode(mask, texels=1):
+    """Keeps the True texels whose (2k+1)^2 neighbourhood is all True; texels within k of the
+    image border are dropped."""
+    import numpy as np
+    out = np.asarray(mask, dtype=bool).copy()
+    for _ in range(texels):
+        m = out
+        inner = np.zeros_like(m)
+        inner[1:-1, 1:-1] = True
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                inner[1:-1, 1:-1] &= m[1 + dy:m.shape[0] - 1 + dy, 1 + dx:m.shape[1] - 1 + dx]
+        out = inner
+    return out
+
+
+def angle_stats(angles):
+    """Median, 99th percentile, max (degrees) and count of a 1-D array of angles."""
+    import numpy as np
+    angles = np.asarray(angles, dtype=np.float64)
+    if angles.size == 0:
+        return {"median_deg": None, "p99_deg": None, "max_deg": None, "texels": 0}
+    return {"median_deg": float(np.median(angles)),
+            "p99_deg": float(np.percentile(angles, 99)),
+            "max_deg": float(angles.max()),
+            "texels": int(angles.size)}

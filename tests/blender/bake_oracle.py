@@ -1,0 +1,276 @@
+#!/usr/bin/env python3
+"""The BlenderBakeOracle test: sgbake's normal maps against Cycles' bakes of the same scenes.
+
+    python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
+        [--keep DIR] [--cases suzanne,sphere,cube_flat] [--sabotage green|scale|input]
+
+1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
+   once, smooth, 512^2; a UV sphere, smooth, 256^2; a flat-shaded cube, 512^2), gives it a
+   Bump node fed by a procedural height image (32-bit float EXR, Non-Color, bilinear) with
+   Distance = S, and bakes with Cycles (1 sample, denoising off, margin 0): NORMAL in OBJECT
+   and in TANGENT space (+X +Y +Z) and an EMIT coverage mask. It writes mesh.obj (objio, exact
+   floats), height.exr and Blender's bakes as raw float EXRs.
+2. For each case this runs the sgbake CLI:
+     sgbake convert --mesh mesh.obj --from object --to tangent blender_object.exr
+                    --bit-depth 32 -o ours_convert.exr
+     sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
+                 --map tangent-normal --size N --margin 0 --samples 1 --bit-depth 32
+                 --no-manifest -o ours_bake.exr
+     sgbake bake scene.json         (the same bake as a JSON scene -> ours_bake_json.exr)
+     sgbake bake ... --height-scale 2S -o ours_bake_x2.exr   (negative control)
+     sgbake bake --mesh mesh.obj --map mask --size N --margin 0 -o ours_mask.exr
+3. bake_compare.py (inside Blender, as the EXR reader) measures the angles between our
+   normals and Cycles' tangent-space bake over the covered texels minus a one-texel border.
+
+Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
+  (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
+      (both go through the same per-texel frame: only float rounding and the odd texel whose
+      centre lies on a triangle edge differ); outside the islands the input is kept
+      (|diff| <= 1e-6 at texels two or more texels away from any island);
+  (b) bake vs Blender's tangent bake: median <= 1 deg (Cycles' Bump is a finite difference
+      over about half a texel; sgbake differentiates the filtered height exactly); the JSON
+      scene gives the same image (|diff| <= 1e-6); background (0.5, 0.5, 1) outside islands;
+  (c) mask: at most 0.1 % of Blender's covered texels (and at least 5 texels of slack) differ;
+  negative controls: our maps with the green channel flipped, and the bake with twice the
+  scale, must FAIL (a) / (b) - otherwise the comparison could not tell right from wrong.
+Prints one line per check with median, p99, max and the number of texels compared.
+
+--sabotage makes sgbake produce a wrong answer on purpose, to see the test fail: `green` bakes
+with --green directx, `scale` with 1.5 S, `input` hands convert Blender's tangent-space map
+instead of the object-space one. --keep DIR keeps every file for inspection.
+
+Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed
+(CTest: SKIP_RETURN_CODE 77). Takes ~15 s (Blender starts twice).
+"""
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
+sys.path.insert(0, HERE)
+import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
+
+CONVERT_MEDIAN_DEG = 0.05
+CONVERT_P99_DEG = 0.5
+BAKE_MEDIAN_DEG = 1.0
+SAME_IMAGE_ABS = 1e-6
+BACKGROUND_ABS = 1e-4
+MASK_MISMATCH_FRACTION = 1e-3
+MASK_MISMATCH_SLACK = 5
+SGBAKE_TIMEOUT = 120
+
+
+def run_blender_script(blender, script, args):
+    proc = objio.run_blender(blender, os.path.join(HERE, script), args, capture_output=True,
+                             text=True, timeout=240)
+    if proc.returncode != 0:
+        print(f"error: Blender running {script} exited with {proc.returncode}\n"
+              f"{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+        return False
+    return True
+
+
+def run_sgbake(cli, args, log):
+    """Runs sgbake; returns True on success. Records the command in `log`."""
+    cmd = [cli] + [str(a) for a in args]
+    log.append(" ".join(cmd))
+    proc = bc.run_tool(cmd, timeout=SGBAKE_TIMEOUT)
+    return proc is not None and proc.returncode == 0
+
+
+def sgbake_case(cli, entry, sabotage, threads):
+    """Runs every sgbake command of one case; returns a list of failed command lines."""
+    d = entry["dir"]
+    p = lambda name: os.path.join(d, name)  # noqa: E731
+    scale, size = entry["scale"], entry["size"]
+    # 32-bit float EXRs (sgbake's default 16 = half floats moves convert's median from 0.0025 to
+    # 0.016 deg on Suzanne, a third of the 0.05 deg budget), and
+    # no .sgbake-manifest.json (it would let a re-run in a kept directory skip the bake).
+    common = ["--margin", 0, "--samples", 1, "--bit-depth", 32, "--no-manifest"]
+    if threads:
+        common += ["--threads", threads]
+    failed, log = [], []
+
+    convert_input = p("blender_tangent.exr" if sabotage == "input" else "blender_object.exr")
+    if not run_sgbake(cli, ["convert", "--mesh", p("mesh.obj"), "--from", "object", "--to",
+                            "tangent", convert_input, "-o", p("ours_convert.exr"),
+                            "--bit-depth", 32] + (["--threads", threads] if threads else []),
+                      log):
+        failed.append(log[-1])
+
+    bake_scale = scale * (1.5 if sabotage == "scale" else 1.0)
+    green = "directx" if sabotage == "green" else "opengl"
+    bake = ["bake", "--mesh", p("mesh.obj"), "--height", p("height.exr"), "--filter",
+            entry["filter"], "--map", "tangent-normal", "--size", size, "--green", green] + common
+    if not run_sgbake(cli, bake + ["--height-scale", repr(bake_scale), "-o", p("ours_bake.exr")],
+                      log):
+        failed.append(log[-1])
+    if not run_sgbake(cli, bake + ["--height-scale", repr(2 * scale), "-o",
+                                   p("ours_bake_x2.exr")], log):
+        failed.append(log[-1])
+
+    scene = {
+        "mesh": p("mesh.obj"),
+        "layers": [{"type": "height", "image": p("height.exr"), "scale": bake_scale,
+                    "filter": entry["filter"], "uv": 0, "weight": 1.0}],
+        "outputs": [{"map": "tangent-normal", "file": p("ours_bake_json.exr"), "size": size,
+                     "margin": 0, "samples": 1, "green": green, "bit_depth": 32}],
+    }
+    with open(p("scene.json"), "w", encoding="ascii") as f:
+        json.dump(scene, f, indent=1)
+    if not run_sgbake(cli, ["bake", p("scene.json"), "--no-manifest"]
+                      + (["--threads", threads] if threads else []), log):
+        failed.append(log[-1])
+
+    if not run_sgbake(cli, ["bake", "--mesh", p("mesh.obj"), "--map", "mask", "--size", size,
+                            "-o", p("ours_mask.exr")] + common, log):
+        failed.append(log[-1])
+    return failed
+
+
+def fmt(stats):
+    if not stats or stats.get("median_deg") is None:
+        return "no texels"
+    return (f"median {stats['median_deg']:.4f} deg, p99 {stats['p99_deg']:.4f} deg, "
+            f"max {stats['max_deg']:.3f} deg, {stats['texels']} texels")
+
+
+def passes_convert(s):
+    return s["median_deg"] <= CONVERT_MEDIAN_DEG and s["p99_deg"] <= CONVERT_P99_DEG
+
+
+def passes_bake(s):
+    return s["median_deg"] <= BAKE_MEDIAN_DEG
+
+
+def evaluate(name, r):
+    """Prints the figures of one case; returns a list of failure descriptions."""
+    fails = []
+    print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {r['covered']} covered texels, "
+          f"{r['compared']} compared; bump tilt from +Z: {fmt(r['tilt'])}")
+
+    def missing(key, what):
+        if key not in r:
+            fails.append(f"{name}: no {what} output to compare")
+            return True
+        if "error" in r[key]:
+            fails.append(f"{name}: {what}: {r[key]['error']}")
+            return True
+        return False
+
+    if not missing("convert", "convert"):
+        s = r["convert"]
+        ok = passes_convert(s)
+        print(f"  (a) convert vs Blender tangent: {fmt(s)} worst at (x, row) {s.get('worst_at')}"
+              f" -> {'ok' if ok else 'FAIL'} (median <= {CONVERT_MEDIAN_DEG}, p99 <= "
+              f"{CONVERT_P99_DEG})")
+        if not ok:
+            fails.append(f"{name}: convert differs from Blender's tangent bake: {fmt(s)}")
+        if s["outside_max_abs"] > SAME_IMAGE_ABS:
+            fails.append(f"{name}: convert changed texels outside the islands "
+                         f"(max |diff| {s['outside_max_abs']:.3g})")
+        if passes_convert(s["flipped_green"]):
+            fails.append(f"{name}: negative control: convert with green flipped still passes "
+                         f"({fmt(s['flipped_green'])})")
+    if not missing("bake", "bake"):
+        s = r["bake"]
+        ok = passes_bake(s)
+        print(f"  (b) bake vs Blender tangent:    {fmt(s)} worst at (x, row) {s.get('worst_at')}"
+              f" -> {'ok' if ok else 'FAIL'} (median <= {BAKE_MEDIAN_DEG})")
+        if not ok:
+            fails.append(f"{name}: bake differs from Blender's tangent bake: {fmt(s)}")
+        if s["outside_max_abs"] > BACKGROUND_ABS:
+            fails.append(f"{name}: bake background is not (0.5, 0.5, 1) outside the islands "
+                         f"(max |diff| {s['outside_max_abs']:.3g})")
+        print(f"      control, green flipped:     {fmt(s['flipped_green'])}")
+        if passes_bake(s["flipped_green"]):
+            fails.append(f"{name}: negative control: bake with green flipped still passes")
+    if not missing("bake_json", "JSON-scene bake"):
+        s = r["bake_json"]
+        same = s.get("json_vs_flags_max_abs")
+        print(f"  (b) JSON scene bake:            {fmt(s)}; max |JSON - flags| = {same}")
+        if not passes_bake(s):
+            fails.append(f"{name}: JSON-scene bake differs from Blender's: {fmt(s)}")
+        if same is None or same > SAME_IMAGE_ABS:
+            fails.append(f"{name}: the JSON scene and the flags give different images "
+                         f"(max |diff| {same})")
+    if not missing("bake_x2", "2x-scale bake"):
+        s = r["bake_x2"]
+        print(f"      control, scale x2:          {fmt(s)}")
+        if passes_bake(s):
+            fails.append(f"{name}: negative control: the bake with twice the scale still passes"
+                         f" ({fmt(s)})")
+    if not missing("mask", "mask"):
+        m = r["mask"]
+        limit = max(MASK_MISMATCH_SLACK, MASK_MISMATCH_FRACTION * m["covered"])
+        ok = m["mismatched"] <= limit
+        print(f"  (c) mask vs Blender EMIT:       {m['mismatched']} texels differ "
+              f"({m['ours_only']} only ours, {m['blender_only']} only Blender's) of "
+              f"{m['covered']} -> {'ok' if ok else 'FAIL'} (<= {limit:.0f})")
+        if not ok:
+            fails.append(f"{name}: coverage differs on {m['mismatched']} texels")
+    return fails
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
+    parser.add_argument("--blender", default="blender", help="Blender executable")
+    parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
+    parser.add_argument("--cases", default="suzanne,sphere,cube_flat")
+    parser.add_argument("--threads", type=int, help="pass --threads N to sgbake")
+    parser.add_argument("--sabotage", choices=("green", "scale", "input"),
+                        help="make sgbake answer wrongly on purpose (the test must fail)")
+    args = parser.parse_args()
+
+    blender = bc.find_blender(args.blender)
+    if blender is None:
+        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
+        return bc.SKIP
+    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
+        print(f"error: {args.cli} is not an executable file (build sgbake_cli first)")
+        return 2
+    for command in ("bake", "convert"):
+        if not bc.cli_has_command(args.cli, command):
+            print(f"FAIL: `{args.cli} --help` lists no `{command}` command")
+            return 1
+
+    with tempfile.TemporaryDirectory(prefix="sgbake-bake-oracle-") as tmp:
+        work = os.path.abspath(args.keep or tmp)
+        os.makedirs(work, exist_ok=True)
+        if not run_blender_script(blender, "bake_scene.py", [work, "--cases", args.cases]):
+            return 1
+        with open(os.path.join(work, "cases.json"), encoding="ascii") as f:
+            entries = json.load(f)
+        failures = []
+        for entry in entries:
+            for cmd in sgbake_case(args.cli, entry, args.sabotage, args.threads):
+                failures.append(f"{entry['name']}: command failed: {cmd}")
+        if not run_blender_script(blender, "bake_compare.py", [work]):
+            return 1
+        with open(os.path.join(work, "results.json"), encoding="ascii") as f:
+            results = json.load(f)
+        for entry in entries:
+            print(f"blender: {entry['name']}: {entry['faces']} faces, scale {entry['scale']}, "
+                  f"bakes {', '.join(f'{k} {v:.2f} s' for k, v in entry['bake_s'].items())}")
+        for entry in entries:
+            failures += evaluate(entry["name"], results[entry["name"]])
+        if args.keep:
+            print(f"files kept in {work}")
+
+    if failures:
+        print(f"FAIL: {len(failures)} problem(s):")
+        for line in failures:
+            print("  " + line)
+        return 1
+    print("PASS")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

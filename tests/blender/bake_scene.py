@@ -1,0 +1,288 @@
+"""Builds bump-mapped test scenes in Blender and bakes them with Cycles (runs inside Blender).
+
+    blender -b --factory-startup --python-exit-code 1 \\
+        --python tests/blender/bake_scene.py -- OUT_DIR [--cases NAME,...] [--size N]
+        [--passes object,tangent,mask] [--margin M] [--height-size H] [--samples S]
+
+Used by bake_oracle.py (the BlenderBakeOracle test) and, as a module, by
+bench/bake_vs_cycles.py. For every case it builds one object at the origin (identity
+transform, so object space = world space), gives it the material
+
+    Image Texture (height.exr, Non-Color, Linear, Repeat) --Color--> Bump.Height
+    Bump (Strength 1, Distance = the case's scale S, not inverted) --Normal--> Diffuse BSDF.Normal
+    Add Shader(Diffuse BSDF, Emission(white, strength 1)) --> Material Output.Surface
+
+and bakes with Cycles on the CPU (1 sample, denoising off, margin 0 unless --margin):
+  blender_object.exr   NORMAL, normal_space OBJECT,  channels POS_X / POS_Y / POS_Z
+  blender_tangent.exr  NORMAL, normal_space TANGENT, channels POS_X / POS_Y / POS_Z
+  blender_mask.exr     EMIT of the white emission: 1 where a triangle covers the texel centre
+Texels no triangle covers keep the image's initial (0, 0, 0). Each bake goes into a 32-bit
+float Non-Color image whose raw pixels are saved as OpenEXR and checked bit for bit after
+reloading. The case directory OUT_DIR/NAME also receives
+  mesh.obj    the baked mesh, written by objio.write_obj (every float exact)
+  height.exr  the height image, h in R = G = B (see below), A = 1
+and OUT_DIR/cases.json lists the cases: name, dir, size, scale, filter, faces, corners,
+covered texels, bake seconds per pass, Blender version and Cycles thread count.
+
+What we learnt about Cycles' bake (Blender 3.4.1), checked with a plane and linear/sine heights:
+- Bump Distance is exactly sgbake's --height-scale: Cycles computes
+  N' = normalize(|det| N - sign(det) Distance surfgrad) with the unnormalised surface gradient,
+  i.e. N - Distance * (object-space gradient of h). A linear h = 0.3 u on a 2 x 2 plane baked to
+  a tangent-space slope of 0.01498 for Distance 0.1 (analytic 0.015).
+- The Height socket takes the image's Color output converted to a float by LUMINANCE
+  (0.2126 R + 0.7152 G + 0.0722 B): a height in R alone bakes 0.2126x too flat. So the height
+  is written into R, G and B (the weights sum to 1); sgbake reads the same value from any channel.
+- The bump's finite difference is isotropic and about half a texel long: Blender passes
+  half-texel UV differentials to Cycles, which keeps only their mean length and re-derives two
+  orthonormal directions in the tangent plane (not u and v). On the plane the effective step
+  along u is 0.355 texel (0.5 / sqrt 2). That is the "finite-difference noise" relative to
+  sgbake's exact derivative.
+- With 1 sample each texel is shaded exactly at its centre (no jitter): two bakes agree to
+  2e-5 deg (float rounding between threads). 4 samples jitter inside the texel and move the
+  sphere's tangent bake by a median 0.075 deg (p99 0.33 deg).
+- The per-texel frame (CONVENTIONS.md) is built on Blender's looptris: quads split on the
+  0-2 diagonal (1-3 only for folded quads). A numpy re-implementation with that split
+  reproduced Blender's object -> tangent conversion to a median 0.0025 deg; splitting on 1-3
+  instead gave a median 0.65 deg, p99 8.3 deg on Suzanne, and using the transpose of
+  [T B N] instead of its inverse a median 0.24 deg, p99 3.3 deg: test (a) catches both.
+- The shading normal is passed through ensure_valid_reflection(Ng, I = Ng, N): normals more
+  than ~44.7 deg from the geometric (flat) normal are bent back. The scales below keep the
+  bumps well under that.
+- Uncovered texels are left untouched with margin 0 (use_clear=False).
+"""
+
+import json
+import math
+import os
+import sys
+import time
+
+import bpy
+
+sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bake_common  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
+
+RESULT_TAG = "BAKE_SCENE_RESULT "
+HEIGHT_SIZE = 512
+
+# name -> (builder, bake size, Bump Distance = sgbake --height-scale)
+# Scales chosen so the median bump tilt is ~5-10 deg and the 99th percentile stays < 35 deg.
+CASES = {}
+
+
+def case(name, size, scale):
+    def register(fn):
+        CASES[name] = (fn, size, scale)
+        return fn
+    return register
+
+
+def set_smooth(ob, smooth):
+    ob.data.polygons.foreach_set("use_smooth", [smooth] * len(ob.data.polygons))
+    ob.data.update()
+
+
+def apply_subdivision(ob, levels):
+    mod = ob.modifiers.new("Subdivision", "SUBSURF")
+    mod.levels = levels
+    mod.render_levels = levels
+    bpy.ops.object.modifier_apply(modifier=mod.name)
+
+
+@case("suzanne", 512, 0.1)
+def build_suzanne():
+    """Suzanne with its UVs (two mirrored halves: both bitangent signs), Subdivision Surface
+    level 1 applied, smooth: 1,968 quads."""
+    bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
+    ob = bpy.context.object
+    apply_subdivision(ob, 1)
+    set_smooth(ob, True)
+    return ob
+
+
+@case("suzanne2", 4096, 0.1)
+def build_suzanne2():
+    """meshes/suzanne.obj's recipe (meshes/make_meshes.py): Suzanne, Subdivision Surface level
+    2 applied, smooth: 7,872 quads. The benchmark's mesh; not part of the test."""
+    bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
+    ob = bpy.context.object
+    apply_subdivision(ob, 2)
+    set_smooth(ob, True)
+    return ob
+
+
+@case("sphere", 256, 0.1)
+def build_sphere():
+    """UV sphere (32 segments, 16 rings, radius 1), smooth: triangle fans at the poles, a UV
+    seam, tangents that degenerate towards the poles."""
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=1.0, calc_uvs=True)
+    ob = bpy.context.object
+    set_smooth(ob, True)
+    return ob
+
+
+@case("cube_flat", 512, 0.25)
+def build_cube_flat():
+    """Default cube (size 2) with its cross-shaped UV layout, FLAT shading: the per-texel frame
+    uses the face normal, and neighbouring faces in one UV island have different normals."""
+    bpy.ops.mesh.primitive_cube_add(size=2.0, calc_uvs=True)
+    ob = bpy.context.object
+    set_smooth(ob, False)
+    return ob
+
+
+def height_field(size):
+    """The height image, (size, size) float32 rows top first: smooth, periodic in u and v (so
+    the Repeat extension and any wrap mode agree), values in [0.1, 0.9]."""
+    import numpy as np
+    c = (np.arange(size, dtype=np.float64) + 0.5) / size
+    u = c[None, :]
+    v = 1.0 - c[:, None]  # file row r has v = 1 - (r + 0.5) / H
+    h = (0.5 + 0.25 * np.sin(2 * math.pi * 3 * u) * np.cos(2 * math.pi * 2 * v)
+         + 0.15 * np.sin(2 * math.pi * (5 * u + 7 * v)))
+    return h.astype(np.float32)
+
+
+def make_material(height_image, scale):
+    """The material described in the module docstring; returns (material, bake target node)."""
+    mat = bpy.data.materials.new("bump")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nodes = nt.nodes
+    for node in list(nodes):
+        nodes.remove(node)
+    out = nodes.new("ShaderNodeOutputMaterial")
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    emission = nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    emission.inputs["Strength"].default_value = 1.0
+    add = nodes.new("ShaderNodeAddShader")
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = height_image
+    tex.interpolation = "Linear"  # bilinear = sgbake --filter bilinear
+    tex.extension = "REPEAT"
+    bump = nodes.new("ShaderNodeBump")
+    bump.invert = False
+    bump.inputs["Strength"].default_value = 1.0
+    bump.inputs["Distance"].default_value = scale
+    nt.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    nt.links.new(bump.outputs["Normal"], diffuse.inputs["Normal"])
+    nt.links.new(diffuse.outputs["BSDF"], add.inputs[0])
+    nt.links.new(emission.outputs["Emission"], add.inputs[1])
+    nt.links.new(add.outputs["Shader"], out.inputs["Surface"])
+    target = nodes.new("ShaderNodeTexImage")  # the bake target: the active Image Texture node
+    target.name = "bake_target"
+    return mat, target
+
+
+def bake_pass(ob, mat, target, image, kind, margin):
+    """Bakes one pass of `ob` into `image`; returns the seconds bpy.ops.object.bake took.
+    kind: "object" / "tangent" (NORMAL in that space, +X +Y +Z) or "mask" (EMIT)."""
+    target.image = image
+    mat.node_tree.nodes.active = target
+    bpy.ops.object.select_all(action="DESELECT")
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    kwargs = dict(margin=margin, margin_type="EXTEND", use_clear=False, target="IMAGE_TEXTURES",
+                  save_mode="INTERNAL", use_selected_to_active=False)
+    if kind == "mask":
+        kwargs["type"] = "EMIT"
+    else:
+        kwargs.update(type="NORMAL", normal_space=kind.upper(), normal_r="POS_X",
+                      normal_g="POS_Y", normal_b="POS_Z")
+    t0 = time.perf_counter()
+    result = bpy.ops.object.bake(**kwargs)
+    seconds = time.perf_counter() - t0
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"bake {kind} returned {result}")
+    return seconds
+
+
+def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), margin=0,
+               height_size=HEIGHT_SIZE, save_bakes=True, runs=1):
+    """Builds case `name`, writes mesh.obj and height.exr into out_dir, bakes `passes`
+    (saved as blender_PASS.exr when save_bakes); returns the case's manifest entry. With
+    runs > 1 every pass is baked that many times and bake_s keeps the fastest run; bake_cpu
+    is the process CPU time over wall time of that run (how many cores Cycles kept busy)."""
+    import numpy as np
+    builder, default_size, scale = CASES[name]
+    size = size or default_size
+    bake_common.reset_scene()
+    os.makedirs(out_dir, exist_ok=True)
+    ob = builder()
+    me = ob.data
+    if len(me.uv_layers) == 0:
+        raise RuntimeError(f"case {name}: no UV map")
+    me.calc_normals_split()
+    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me),
+                    comment=f"bake oracle case {name} (Blender {bpy.app.version_string})")
+
+    height = bake_common.new_float_image("height", height_size, height_size,
+                                         height_field(height_size))
+    height_path = os.path.join(out_dir, "height.exr")
+    bake_common.save_exr(height, height_path)
+    mat, target = make_material(height, scale)
+    me.materials.clear()
+    me.materials.append(mat)
+
+    entry = {"name": name, "dir": os.path.abspath(out_dir), "size": size, "scale": scale,
+             "filter": "bilinear", "height_size": height_size, "margin": margin,
+             "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {}}
+    for kind in passes:
+        img = bake_common.new_float_image(f"blender_{kind}", size, size)
+        for _ in range(runs):
+            cpu0 = time.process_time()
+            seconds = bake_pass(ob, mat, target, img, kind, margin)
+            cpu = time.process_time() - cpu0
+            if kind not in entry["bake_s"] or seconds < entry["bake_s"][kind]:
+                entry["bake_s"][kind] = seconds
+                entry["bake_cpu"][kind] = cpu / seconds if seconds > 0 else 0.0
+        if kind == "mask":
+            mask = bake_common.image_array(img)[..., 0]
+            entry["covered"] = int(np.count_nonzero(mask > 0.5))
+            entry["mask_values"] = sorted(set(np.unique(mask).tolist()))[:8]
+        if save_bakes:
+            bake_common.save_exr(img, os.path.join(out_dir, f"blender_{kind}.exr"))
+        bpy.data.images.remove(img)
+    return entry
+
+
+def parse_args(argv):
+    import argparse
+    parser = argparse.ArgumentParser(prog="bake_scene.py")
+    parser.add_argument("out_dir")
+    parser.add_argument("--cases", default="suzanne,sphere,cube_flat")
+    parser.add_argument("--size", type=int, help="bake size (default: per case)")
+    parser.add_argument("--passes", default="object,tangent,mask")
+    parser.add_argument("--margin", type=int, default=0)
+    parser.add_argument("--height-size", type=int, default=HEIGHT_SIZE)
+    parser.add_argument("--samples", type=int, default=1)
+    parser.add_argument("--threads", type=int, help="Cycles threads (default: all cores)")
+    return parser.parse_args(argv)
+
+
+def main(argv):
+    args = parse_args(argv)
+    scene = bpy.context.scene
+    bake_common.setup_cycles(scene, samples=args.samples, threads=args.threads)
+    os.makedirs(args.out_dir, exist_ok=True)
+    entries = []
+    for name in args.cases.split(","):
+        if name not in CASES:
+            raise SystemExit(f"unknown case {name!r} (known: {', '.join(CASES)})")
+        entry = build_case(name, os.path.join(args.out_dir, name), size=args.size,
+                           passes=args.passes.split(","), margin=args.margin,
+                           height_size=args.height_size)
+        entry["blender_version"] = bpy.app.version_string
+        entry["cycles_threads"] = scene.render.threads
+        entry["samples"] = args.samples
+        entries.append(entry)
+        print(RESULT_TAG + json.dumps(entry), flush=True)
+    with open(os.path.join(args.out_dir, "cases.json"), "w", encoding="ascii") as f:
+        json.dump(entries, f, indent=1)
+
+
+if __name__ == "__main__":
+    main(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
