@@ -13,11 +13,13 @@
 #include <cassert>
 #include <cmath>
 #include <cstdlib>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <new>
-#include <type_traits>
 #include <span>
+#include <type_traits>
+#include <utility>
 
 #include <sys/mman.h>
 
@@ -147,34 +149,48 @@ std::uint64_t mix(std::uint64_t h, std::uint32_t w) {
   return h ^ (h >> 29);
 }
 
-// What welding compares: position, normal and UV, with -0 folded onto +0.
-struct WeldKey {
-  std::array<std::uint32_t, 8> bits;
-  friend bool operator==(const WeldKey&, const WeldKey&) = default;
-};
+// Welding keys: float bits with -0 folded onto +0.
+template <std::size_t N>
+using Key = std::array<std::uint32_t, N>;
 
-WeldKey weldKey(const Input& in, std::size_t s) {
-  const Vec3f p = in.position[s], n = in.normal[s];
-  const Vec2f t = in.uv[s];
-  WeldKey key;
+template <std::size_t N>
+Key<N> keyOf(std::initializer_list<float> values) {
+  Key<N> key{};
   std::size_t i = 0;
-  for (float x : {p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y}) key.bits[i++] = canonicalBits(x);
+  for (float x : values) key[i++] = canonicalBits(x);
   return key;
 }
 
-std::uint64_t hashKey(const WeldKey& key) {
+// What welding compares: position, normal and UV.
+Key<8> weldKey(const Input& in, std::size_t s) {
+  const Vec3f p = in.position[s], n = in.normal[s];
+  const Vec2f t = in.uv[s];
+  return keyOf<8>({p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y});
+}
+
+// What welding compares of slots at one position: normal and UV.
+Key<5> attributeKey(const Input& in, std::size_t s) {
+  const Vec3f n = in.normal[s];
+  const Vec2f t = in.uv[s];
+  return keyOf<5>({n.x, n.y, n.z, t.x, t.y});
+}
+
+template <std::size_t N>
+std::uint64_t hashKey(const Key<N>& key) {
   std::uint64_t h = 0x9e3779b97f4a7c15ull;
-  for (std::uint32_t w : key.bits) h = mix(h, w);
+  for (std::uint32_t w : key) h = mix(h, w);
   return h ^ (h >> 32);
 }
 
-ParallelArray<std::uint32_t> weld(const Input& in) {
-  const std::size_t n = in.position.size();
+// rep[i] = the smallest j <= i with key(j) == key(i), for i < n.
+template <class KeyFn>
+ParallelArray<std::uint32_t> weldByHash(std::size_t n, KeyFn key) {
+  using K = decltype(key(std::size_t{0}));
   ParallelArray<std::uint64_t> hash(n);
-  parallelFor(n, [&](std::size_t s) { hash[s] = hashKey(weldKey(in, s)); });
+  parallelFor(n, [&](std::size_t s) { hash[s] = hashKey(key(s)); });
 
-  // Partition slots by the top bits of their hash (a stable counting sort, so each bucket lists
-  // its slots in ascending order), then weld each bucket with its own small hash table over a
+  // Partition items by the top bits of their hash (a stable counting sort, so each bucket lists
+  // its items in ascending order), then weld each bucket with its own small hash table over a
   // copy of its keys, so that a bucket touches only its own memory.
   constexpr int kBucketBits = 8;
   constexpr std::size_t kBuckets = std::size_t{1} << kBucketBits;
@@ -192,13 +208,13 @@ ParallelArray<std::uint32_t> weld(const Input& in) {
   tbb::parallel_for(std::size_t{0}, kBuckets, [&](std::size_t b) {
     const std::uint32_t begin = bucketStart[b], size = bucketStart[b + 1] - begin;
     if (size == 0) return;
-    std::vector<WeldKey> keys(size);
-    for (std::uint32_t k = 0; k < size; ++k) keys[k] = weldKey(in, order[begin + k]);
+    std::vector<K> keys(size);
+    for (std::uint32_t k = 0; k < size; ++k) keys[k] = key(order[begin + k]);
     const std::size_t capacity = std::bit_ceil(std::size_t{2} * size);
     const std::size_t mask = capacity - 1;
     struct Entry {
       std::uint64_t hash;
-      std::uint32_t first = kNone;  // bucket-local index of the first slot of a distinct vertex
+      std::uint32_t first = kNone;  // bucket-local index of the first item of a distinct key
     };
     std::vector<Entry> table(capacity);
     for (std::uint32_t k = 0; k < size; ++k) {
@@ -219,6 +235,79 @@ ParallelArray<std::uint32_t> weld(const Input& in) {
     }
   });
   return rep;
+}
+
+// Welding with vertex ids: positions are hashed once per used vertex, and each slot is compared
+// (normal and UV) only with the slots of vertices at its position, a handful on most meshes.
+ParallelArray<std::uint32_t> weldByVertex(const Input& in) {
+  const std::size_t n = in.position.size();
+  assert(in.vertex.size() == n);
+  // The used vertices in ascending order, each with one of its slots (all share its position).
+  std::vector<std::uint32_t> slotOf(in.numVertices, kNone);
+  for (std::size_t s = 0; s < n; ++s) slotOf[in.vertex[s]] = static_cast<std::uint32_t>(s);
+  std::vector<std::uint32_t> used;     // used vertex index → a slot of it
+  std::vector<std::uint32_t> usedIndex(in.numVertices, kNone);  // vertex → used vertex index
+  used.reserve(in.numVertices);
+  for (std::uint32_t v = 0; v < in.numVertices; ++v) {
+    if (slotOf[v] == kNone) continue;
+    usedIndex[v] = static_cast<std::uint32_t>(used.size());
+    used.push_back(slotOf[v]);
+  }
+  // Position classes: the smallest used vertex index at the same position.
+  const ParallelArray<std::uint32_t> positionClass = weldByHash(used.size(), [&](std::size_t u) {
+    const Vec3f p = in.position[used[u]];
+    return keyOf<3>({p.x, p.y, p.z});
+  });
+  ParallelArray<std::uint32_t> classOf(n);
+  parallelFor(n, [&](std::size_t s) { classOf[s] = positionClass[usedIndex[in.vertex[s]]]; });
+
+  // Slots by position class (a stable counting sort: each class lists its slots ascending).
+  std::vector<std::uint32_t> start(used.size() + 1, 0);
+  for (std::size_t s = 0; s < n; ++s) ++start[classOf[s] + 1];
+  for (std::size_t c = 0; c < used.size(); ++c) start[c + 1] += start[c];
+  ParallelArray<std::uint32_t> order(n);
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t s = 0; s < n; ++s) order[fill[classOf[s]]++] = static_cast<std::uint32_t>(s);
+  }
+
+  // Within a class, each slot welds to the first earlier slot with the same normal and UV.
+  ParallelArray<std::uint32_t> rep(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    constexpr std::uint32_t kLinearScan = 32;  // longer classes sort their keys instead
+    std::vector<std::pair<Key<5>, std::uint32_t>> sorted;
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      const std::uint32_t begin = start[c], size = start[c + 1] - begin;
+      const std::uint32_t* slots = order.begin() + begin;
+      if (size <= kLinearScan) {
+        std::array<Key<5>, kLinearScan> keys;
+        for (std::uint32_t k = 0; k < size; ++k) {
+          keys[k] = attributeKey(in, slots[k]);
+          std::uint32_t j = 0;
+          while (keys[j] != keys[k]) ++j;  // stops at k at the latest
+          rep[slots[k]] = slots[j];        // ascending order: the first is the smallest
+        }
+        continue;
+      }
+      sorted.clear();
+      for (std::uint32_t k = 0; k < size; ++k) sorted.emplace_back(attributeKey(in, slots[k]), slots[k]);
+      std::sort(sorted.begin(), sorted.end());
+      for (std::size_t k = 0; k < sorted.size(); ++k) {
+        const bool sameAsPrevious = k > 0 && sorted[k - 1].first == sorted[k].first;
+        rep[sorted[k].second] = sameAsPrevious ? rep[sorted[k - 1].second] : sorted[k].second;
+      }
+    }
+  });
+  return rep;
+}
+
+// rep[s] = the smallest slot whose position, normal and UV equal slot s's exactly. Both ways
+// give the same result; vertex ids pay off when vertices are shared by several corners.
+ParallelArray<std::uint32_t> weld(const Input& in) {
+  const bool shared = std::size_t{2} * in.numVertices <= in.position.size();
+  if (!in.vertex.empty() && shared) return weldByVertex(in);
+  return weldByHash(in.position.size(), [&](std::size_t s) { return weldKey(in, s); });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -568,6 +657,20 @@ class Engine {
       return;
     }
     for (std::uint32_t j = 0; j < k; ++j) m[j].ot = projectNormalized(tris_[sc.faces[j]].ot, n);
+    auto linked = [&](std::uint32_t j, std::uint32_t l) {
+      return m[j].any || m[l].any || m[j].face == m[l].face ||
+             (dot(m[j].os, m[l].os) > kThresholdCos && dot(m[j].ot, m[l].ot) > kThresholdCos);
+    };
+
+    // The common case: every pair is linked, so every sub-group is the whole group.
+    bool allLinked = true;
+    for (std::uint32_t j = 0; j < k && allLinked; ++j)
+      for (std::uint32_t l = j + 1; l < k && allLinked; ++l) allLinked = linked(j, l);
+    if (allLinked) {
+      const Vec3f tangent = subgroupTangent(m, k, [](std::uint32_t) { return true; });
+      for (std::uint32_t j = 0; j < k; ++j) output(j, tangent);
+      return;
+    }
 
     const std::uint32_t words = (k + 63) / 64;
     if (sc.masks.size() < std::size_t{k} * words) sc.masks.resize(std::size_t{k} * words);
@@ -577,8 +680,7 @@ class Engine {
     for (std::uint32_t j = 0; j < k; ++j) {
       set(j, j);
       for (std::uint32_t l = j + 1; l < k; ++l) {
-        if (m[j].any || m[l].any || m[j].face == m[l].face ||
-            (dot(m[j].os, m[l].os) > kThresholdCos && dot(m[j].ot, m[l].ot) > kThresholdCos)) {
+        if (linked(j, l)) {
           set(j, l);
           set(l, j);
         }

@@ -5,7 +5,9 @@
 /// The algorithm, in the order the implementation runs it:
 ///  1. Faces (triangles or quads) are gathered into flat per-corner arrays ("slots").
 ///  2. Slots are welded: two slots are the same vertex only when position, normal and UV are
-///     exactly equal (float ==, so -0 equals +0).
+///     exactly equal (float ==, so -0 equals +0). When the adapter names each corner's mesh
+///     vertex, positions are compared once per vertex and slots only against the slots of
+///     vertices at the same position; the result is the same as comparing all slots.
 ///  3. Quads are split on the shorter UV diagonal (ties: the shorter position diagonal, then 0-2).
 ///  4. Triangles with two coincident positions are degenerate: they take no part and inherit their
 ///     frames afterwards from welded neighbours (or from the other half of their quad).
@@ -46,12 +48,23 @@ concept Adapter = requires(const A& a, int f, int v) {
   { a.uv(f, v) } -> std::convertible_to<Vec2f>;
 };
 
+/// @brief An adapter that also names the mesh vertex of each corner, with
+/// `position(f, v)` a function of `vertex(f, v)` alone. Optional: it only makes welding cheaper.
+template <class A>
+concept VertexAdapter = Adapter<A> && requires(const A& a, int f, int v) {
+  { a.numVertices() } -> std::convertible_to<std::uint32_t>;
+  { a.vertex(f, v) } -> std::convertible_to<std::uint32_t>;  ///< < numVertices()
+};
+
 /// @brief The algorithm's input as flat per-slot arrays (one slot per face corner).
 struct Input {
   std::vector<std::uint32_t> faceStart{0};  ///< #faces+1, face f owns slots [faceStart[f], faceStart[f+1])
   std::vector<Vec3f> position;              ///< #slots
   std::vector<Vec3f> normal;                ///< #slots, unit
   std::vector<Vec2f> uv;                    ///< #slots
+  /// #slots, or empty: a vertex id per slot, slots with the same id having bit-identical positions
+  std::vector<std::uint32_t> vertex;
+  std::uint32_t numVertices = 0;  ///< ids in `vertex` are below this
 };
 
 /// @brief Per slot: the unit tangent and whether the frame preserves orientation (sign +1).
@@ -80,6 +93,11 @@ Input gather(const A& adapter) {
   in.position.resize(slots);
   in.normal.resize(slots);
   in.uv.resize(slots);
+  constexpr bool kHasVertices = VertexAdapter<A>;
+  if constexpr (kHasVertices) {
+    in.vertex.resize(slots);
+    in.numVertices = static_cast<std::uint32_t>(adapter.numVertices());
+  }
   tbb::parallel_for(tbb::blocked_range<int>(0, nf, 1024), [&](const tbb::blocked_range<int>& r) {
     for (int f = r.begin(); f != r.end(); ++f) {
       const std::uint32_t s0 = in.faceStart[static_cast<std::size_t>(f)];
@@ -88,6 +106,7 @@ Input gather(const A& adapter) {
         in.position[s0 + v] = adapter.position(f, v);
         in.normal[s0 + v] = adapter.normal(f, v);
         in.uv[s0 + v] = adapter.uv(f, v);
+        if constexpr (kHasVertices) in.vertex[s0 + v] = static_cast<std::uint32_t>(adapter.vertex(f, v));
       }
     }
   });

@@ -54,7 +54,9 @@ class MeshViewAdapter {
     return faceStart_.empty() ? mesh_.faceStart[static_cast<std::size_t>(f)] + static_cast<std::uint32_t>(v)
                               : corner_[faceStart_[static_cast<std::size_t>(f)] + static_cast<std::uint32_t>(v)];
   }
-  Vec3f position(int f, int v) const { return mesh_.positions[mesh_.cornerVertex[meshCorner(f, v)]]; }
+  std::uint32_t numVertices() const { return static_cast<std::uint32_t>(mesh_.positions.size()); }
+  std::uint32_t vertex(int f, int v) const { return mesh_.cornerVertex[meshCorner(f, v)]; }
+  Vec3f position(int f, int v) const { return mesh_.positions[vertex(f, v)]; }
   Vec3f normal(int f, int v) const { return mesh_.cornerNormals[meshCorner(f, v)]; }
   Vec2f uv(int f, int v) const { return mesh_.cornerUvs[meshCorner(f, v)]; }
   bool identity() const { return faceStart_.empty(); }
@@ -64,7 +66,7 @@ class MeshViewAdapter {
   std::vector<std::uint32_t> faceStart_;  // empty when faces map one to one
   std::vector<std::uint32_t> corner_;
 };
-static_assert(mikk::Adapter<MeshViewAdapter>);
+static_assert(mikk::VertexAdapter<MeshViewAdapter>);
 
 }  // namespace
 
