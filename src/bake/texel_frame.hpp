@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "sgbake/core/math.hpp"
@@ -51,6 +52,15 @@ void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
                          const std::array<std::uint32_t, 3>& corners, int bakeUvSet,
                          ShadingTriangle& tri);
 
+/// @brief normalizeOr(a, fallback) bit for bit, with its common case (finite, nonzero squared
+/// length) inlined: the compiler keeps normalizeOr itself out of line, and the shaders call it
+/// two or three times per texel. The rescaling and fallback cases go through normalizeOr.
+inline Vec3d unitOr(const Vec3d& a, const Vec3d& fallback) {
+  const double len2 = lengthSquared(a);
+  if (len2 > 0 && std::isfinite(len2)) [[likely]] return (1 / std::sqrt(len2)) * a;
+  return normalizeOr(a, fallback);
+}
+
 /// @brief The per-texel frame at barycentrics b: T, N interpolated and not renormalized,
 /// sign = Σ bi·si < 0 ? −1 : +1, B = sign·N×T.
 struct TexelFrame {
@@ -69,7 +79,7 @@ inline TexelFrame texelFrame(const ShadingTriangle& t, const Vec3d& b) {
 
 /// @brief The unit shading normal normalize(Σ bi·Ni), or the face normal when that vanishes.
 inline Vec3d unitNormal(const ShadingTriangle& t, const TexelFrame& f) {
-  return normalizeOr(f.normal, t.faceNormal);
+  return unitOr(f.normal, t.faceNormal);
 }
 
 /// @brief Sets the fields of @p p that are constant over triangle @p t (UV derivatives, number of
@@ -118,13 +128,13 @@ inline Vec3d objectToTangent(const TexelFrame& f, const Vec3d& n) {
   if (!(std::abs(det) > kMinDet * lengthSquared(T) * lengthSquared(N))) return flat;
   // normalize(M⁻¹ n) = normalize(sign(det) · adj(M) n): only the sign of 1/det survives.
   const double s = det < 0 ? -1.0 : 1.0;
-  return normalizeOr(Vec3d{s * dot(r0, n), s * dot(r1, n), s * dot(r2, n)}, flat);
+  return unitOr(Vec3d{s * dot(r0, n), s * dot(r1, n), s * dot(r2, n)}, flat);
 }
 
 /// @brief Tangent → object space: normalize(x·T + y·B + z·N), the forward map of Blender's
 /// Normal Map node; normalize(N) (then the face normal) when that vanishes.
 inline Vec3d tangentToObject(const ShadingTriangle& t, const TexelFrame& f, const Vec3d& n) {
-  return normalizeOr(n.x * f.tangent + n.y * f.bitangent + n.z * f.normal, unitNormal(t, f));
+  return unitOr(n.x * f.tangent + n.y * f.bitangent + n.z * f.normal, unitNormal(t, f));
 }
 
 /// @brief A unit vector as a normal-map colour: n/2 + 0.5 per channel.

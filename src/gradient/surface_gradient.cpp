@@ -4,38 +4,13 @@
 #include <cmath>
 #include <limits>
 
+#include "gradient/prepared_uv_frame.hpp"
 #include "sgbake/core/math.hpp"
 
 namespace sgbake {
-namespace {
-
-/// Smallest tolerance any relative guard is allowed to take: a caller passing 0 (or a negative
-/// or NaN value) gets machine epsilon, so divisions by the guarded quantity stay finite.
-constexpr double kToleranceFloor = std::numeric_limits<double>::epsilon();
-
-double guardedTolerance(double tolerance) {
-  return tolerance > kToleranceFloor ? tolerance : kToleranceFloor;  // NaN → floor
-}
-
-/// Length of @p a and its unit direction, without overflow or underflow for any finite input
-/// (the vector is scaled by its largest component first). Returns 0 (and a zero unit vector)
-/// for a zero or non-finite vector.
-double unitAndLength(Vec3d a, Vec3d& unit) {
-  const double m = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)});
-  if (!(m > 0) || !std::isfinite(m)) {
-    unit = {};
-    return 0;
-  }
-  const Vec3d scaled = (1 / m) * a;
-  const double l = std::sqrt(lengthSquared(scaled));
-  unit = (1 / l) * scaled;
-  return m * l;
-}
-
-/// Γ as computed, or 0 when it overflowed (absurd scales) or met a NaN input.
-Vec3d finiteOrZero(Vec3d gamma) { return isFinite(gamma) ? gamma : Vec3d{}; }
-
-}  // namespace
+using gradient_detail::finiteOrZero;
+using gradient_detail::guardedTolerance;
+using gradient_detail::unitAndLength;
 
 double determinant(const Mat3& m) { return dot(cross(m.col[0], m.col[1]), m.col[2]); }
 
@@ -46,16 +21,8 @@ Mat3 cofactor(const Mat3& m) {
 
 Vec3d gradientFromUvDerivatives(const UvFrame& frame, Vec3d normal, Vec2d dhduv,
                                 double minFrameSine) {
-  Vec3d t, b;
-  const double lengthT = unitAndLength(frame.dPdu, t);
-  const double lengthB = unitAndLength(frame.dPdv, b);
-  if (lengthT == 0 || lengthB == 0) return {};
-  // ⟨T̂ × B̂, N⟩: sine of the angle between the derivatives times the cosine to N (scale-free).
-  const double det = dot(cross(t, b), normal);
-  if (!(std::abs(det) >= guardedTolerance(minFrameSine))) return {};
-  // Eq. 31 with T = |T|·T̂, B = |B|·B̂: the lengths cancel into the derivatives.
-  const double du = dhduv.x / lengthT, dv = dhduv.y / lengthB;
-  return finiteOrZero((1 / det) * (du * cross(b, normal) + dv * cross(normal, t)));
+  return gradient_detail::gradientFromPreparedUvFrame(gradient_detail::prepareUvFrame(frame), normal,
+                                                      dhduv, minFrameSine);
 }
 
 Vec2d slopesFromTangentNormal(Vec3d n, double minNormalZ) {
