@@ -363,9 +363,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
         {"write_s", report->writeSeconds},
         {"total_s", total.seconds()},
     };
-    const std::string line =
-        stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-    std::fputs(line.c_str(), stderr);
+    printStats(stats);
   }
   return Ok{};
 }

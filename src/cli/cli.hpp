@@ -14,6 +14,7 @@
 #include <string_view>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
 #include "sgbake/core/result.hpp"
@@ -34,6 +35,10 @@ ExitCode exitCodeFor(ErrorCode code);
 /// @brief Prints `sgbake: error: <message>` as exactly one line on stderr (line breaks in
 /// @p message become spaces).
 void printError(std::string_view message);
+
+/// Prints @p stats as one line of JSON on standard error (--stats). Paths need not be UTF-8:
+/// invalid bytes are replaced rather than thrown on.
+void printStats(const nlohmann::json& stats);
 
 /// @brief What a subcommand does once its command line has been parsed.
 using CommandAction = std::function<Status()>;

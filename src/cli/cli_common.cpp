@@ -54,6 +54,12 @@ void printError(std::string_view message) {
   std::fflush(stderr);
 }
 
+void printStats(const nlohmann::json& stats) {
+  const std::string line =
+      stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  std::fputs(line.c_str(), stderr);
+}
+
 // ---- Thread cap -------------------------------------------------------------------------------
 
 ThreadLimit::ThreadLimit(int threads) {

@@ -181,9 +181,7 @@ Status runConvert(const ConvertArguments& args) {
         {"write_s", writeSeconds},
         {"total_s", total.seconds()},
     };
-    const std::string line =
-        stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-    std::fputs(line.c_str(), stderr);
+    printStats(stats);
   }
   return Ok{};
 }

@@ -182,10 +182,7 @@ Status runTangents(const TangentsArguments& args) {
         {"write_s", writeSeconds},
         {"total_s", total.seconds()},
     };
-    // Paths need not be UTF-8: replace invalid bytes rather than throw.
-    const std::string line =
-        stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-    std::fputs(line.c_str(), stderr);
+    printStats(stats);
   }
   return Ok{};
 }
