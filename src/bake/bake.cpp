@@ -389,6 +389,9 @@ Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings)
     job.samples = settings.samples;
     job.udimTile = settings.udimTile;
     job.threads = settings.threads;
+    if (settings.onRowsFinal) {
+      job.onRowsFinal = [&](int rowsFinal) { settings.onRowsFinal(image, rowsFinal); };
+    }
 
     bake_detail::BakeShaderBase base;
     base.mesh = &mesh;

@@ -4,15 +4,25 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cctype>
-#include <cmath>
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
+#include <thread>
+#include <type_traits>
 #include <vector>
 
+#include "bake/raster.hpp"
 #include "sgbake/io/atomic_file.hpp"
 
 namespace sgbake {
@@ -82,25 +92,29 @@ OIIO::TypeDesc pixelType(ImageFormat format, int bitDepth) {
 }
 
 /// Integer code of @p value in [0, 1] scaled to [0, maxCode], rounded to nearest; NaN → 0.
+/// value·maxCode is exact in double (24 × 16 significant bits), so adding 0.5 and truncating is
+/// lround's round-half-away-from-zero without its library call.
 template <class T>
-T quantize(float value, float maxCode) {
+T quantize(float value, double maxCode) {
   if (!(value > 0.0f)) return 0;  // also NaN
   if (value >= 1.0f) return static_cast<T>(maxCode);
-  return static_cast<T>(std::lround(static_cast<double>(value) * maxCode));
+  return static_cast<T>(static_cast<double>(value) * maxCode + 0.5);
 }
 
-/// The file's channels, interleaved, as floats: the image's channels (two padded to three for
-/// PNG/TIFF) and the coverage as alpha.
+/// The file's channels: the image's channels (two padded to three for PNG/TIFF) and the
+/// coverage as alpha.
 struct FileLayout {
+  int imageChannels = 0;   ///< channels of the strips given to writeRows
   int colourChannels = 0;  ///< channels taken from the image (padded with zeros)
   int fileChannels = 0;    ///< colourChannels + alpha
   std::vector<std::string> names;
 };
 
-FileLayout fileLayout(const FloatImage& image, ImageFormat format, bool alpha) {
+FileLayout fileLayout(int imageChannels, ImageFormat format, bool alpha) {
   FileLayout layout;
-  layout.colourChannels = image.channels;
-  if (image.channels == 2 && format != ImageFormat::kExr) layout.colourChannels = 3;
+  layout.imageChannels = imageChannels;
+  layout.colourChannels = imageChannels;
+  if (imageChannels == 2 && format != ImageFormat::kExr) layout.colourChannels = 3;
   layout.fileChannels = layout.colourChannels + (alpha ? 1 : 0);
   static const char* const kColour[] = {"R", "G", "B"};
   if (layout.colourChannels == 1) {
@@ -112,49 +126,47 @@ FileLayout fileLayout(const FloatImage& image, ImageFormat format, bool alpha) {
   return layout;
 }
 
-/// The value of file channel @p c at texel @p texel.
-float fileValue(const FloatImage& image, const FileLayout& layout, std::size_t texel, int c) {
-  if (c < image.channels) {
-    return image
-        .pixels[texel * static_cast<std::size_t>(image.channels) + static_cast<std::size_t>(c)];
-  }
-  if (c < layout.colourChannels) return 0.0f;  // padding of a two-channel image
-  return image.coverage[texel];                // alpha
-}
-
-/// Converts the image to the file's layout and pixel type. Integer types are quantized here
-/// (clamp, round, NaN → 0) rather than by OIIO, so the rule is ours and documented.
+/// Converts @p texels texels (image channels in @p pixels, alpha from @p coverage) to the file's
+/// layout and pixel type T at @p out. Integer types are quantized here (clamp, round, NaN → 0)
+/// rather than by OIIO, so the rule is ours and documented.
 template <class T>
-std::vector<T> convertPixels(const FloatImage& image, const FileLayout& layout, float maxCode) {
-  const std::size_t texels =
-      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-  std::vector<T> out(texels * static_cast<std::size_t>(layout.fileChannels));
-  std::size_t i = 0;
+void convertTexels(const float* pixels, const float* coverage, std::size_t texels,
+                   const FileLayout& layout, double maxCode, T* out) {
+  const std::size_t in = static_cast<std::size_t>(layout.imageChannels);
   for (std::size_t t = 0; t < texels; ++t) {
     for (int c = 0; c < layout.fileChannels; ++c) {
-      const float v = fileValue(image, layout, t, c);
+      float v = 0.0f;  // padding of a two-channel image
+      if (c < layout.imageChannels) {
+        v = pixels[t * in + static_cast<std::size_t>(c)];
+      } else if (c >= layout.colourChannels) {
+        v = coverage[t];  // alpha
+      }
       if constexpr (std::is_same_v<T, float>) {
-        out[i++] = v;
+        *out++ = v;
       } else {
-        out[i++] = quantize<T>(v, maxCode);
+        *out++ = quantize<T>(v, maxCode);
       }
     }
   }
-  return out;
 }
 
 /// Checks the image's shape before anything touches the disk.
-Status checkImage(const FloatImage& image, const std::filesystem::path& path, bool alpha) {
-  if (image.width <= 0 || image.height <= 0) {
+Status checkShape(int width, int height, int channels, const std::filesystem::path& path) {
+  if (width <= 0 || height <= 0) {
     return fileError(ErrorCode::kBadInput, path,
-                     "cannot write an empty image (" + std::to_string(image.width) + "x" +
-                         std::to_string(image.height) + ")");
+                     "cannot write an empty image (" + std::to_string(width) + "x" +
+                         std::to_string(height) + ")");
   }
-  if (image.channels < 1 || image.channels > 3) {
+  if (channels < 1 || channels > 3) {
     return fileError(ErrorCode::kInternal, path,
-                     "cannot write an image with " + std::to_string(image.channels) +
+                     "cannot write an image with " + std::to_string(channels) +
                          " channels (1 to 3 are supported)");
   }
+  return Ok{};
+}
+
+Status checkImage(const FloatImage& image, const std::filesystem::path& path, bool alpha) {
+  if (Status ok = checkShape(image.width, image.height, image.channels, path); !ok) return ok;
   const std::size_t texels =
       static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   if (image.pixels.size() != texels * static_cast<std::size_t>(image.channels)) {
@@ -167,7 +179,250 @@ Status checkImage(const FloatImage& image, const std::filesystem::path& path, bo
   return Ok{};
 }
 
+/// Strips writeRows may queue ahead of the writer's thread before it waits.
+constexpr std::size_t kMaxQueuedStrips = 3;
+/// Rows per strip writeImage hands to an ImageFileWriter.
+constexpr int kWriteImageStripRows = 64;
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 }  // namespace
+
+/// Everything an ImageFileWriter owns; the writer's thread reads the queue and the OIIO output.
+struct ImageFileWriter::State {
+  std::filesystem::path path;
+  AtomicFile file;
+  std::unique_ptr<OIIO::ImageOutput> out;
+  FileLayout layout;
+  /// Pixel type of the strips' data: the file's integer type, or FLOAT for float and half files
+  /// (OIIO converts float to half, rounding to nearest even).
+  OIIO::TypeDesc stripType;
+  int width = 0, height = 0, threads = 0;
+  int nextRow = 0;  ///< first row writeRows expects next
+
+  struct Strip {
+    int row = 0, rows = 0;
+    std::vector<std::byte> data;
+  };
+  std::mutex mutex;
+  std::condition_variable changed;  ///< queue, failure or stop changed
+  std::deque<Strip> queue;
+  std::vector<std::vector<std::byte>> spare;  ///< written strips' buffers, for reuse
+  bool stop = false;      ///< no more strips: the thread exits once the queue is empty
+  bool failed = false;    ///< a strip failed to write (the rest are dropped)
+  std::string failure;    ///< OIIO's reason, one line
+  double fileSeconds = 0; ///< time inside OIIO (guarded by mutex)
+  double waitSeconds = 0; ///< caller's time waiting for the thread
+  std::thread thread;
+
+  explicit State(AtomicFile f) : file(std::move(f)) {}
+
+  void run() {
+    std::unique_lock lock(mutex);
+    for (;;) {
+      changed.wait(lock, [&] { return stop || !queue.empty(); });
+      if (queue.empty()) return;  // stop, and nothing left
+      Strip strip = std::move(queue.front());
+      queue.pop_front();
+      const bool skip = failed;
+      lock.unlock();
+      changed.notify_all();  // room in the queue
+      bool ok = true;
+      const Clock::time_point start = Clock::now();
+      if (!skip) {
+        ok = out->write_scanlines(strip.row, strip.row + strip.rows, 0, stripType, strip.data.data());
+      }
+      const double seconds = secondsSince(start);
+      lock.lock();
+      fileSeconds += seconds;
+      spare.push_back(std::move(strip.data));
+      if (!ok && !failed) {
+        failed = true;
+        failure = oneLineReason(out->geterror());
+      }
+      changed.notify_all();
+    }
+  }
+
+  /// Stops the thread after the queued strips and waits for it.
+  void join() {
+    if (!thread.joinable()) return;
+    const Clock::time_point start = Clock::now();
+    {
+      std::lock_guard lock(mutex);
+      stop = true;
+    }
+    changed.notify_all();
+    thread.join();
+    waitSeconds += secondsSince(start);
+  }
+
+  Error writeFailure() const {
+    return fileError(ErrorCode::kInternal, path, "cannot write image (" + failure + ")");
+  }
+};
+
+ImageFileWriter::ImageFileWriter(std::unique_ptr<State> state) : state_(std::move(state)) {}
+ImageFileWriter::ImageFileWriter(ImageFileWriter&&) noexcept = default;
+ImageFileWriter& ImageFileWriter::operator=(ImageFileWriter&&) noexcept = default;
+
+ImageFileWriter::~ImageFileWriter() {
+  if (!state_) return;
+  state_->join();
+  if (state_->out) state_->out->close();
+  // state_->file is discarded by its destructor: the temporary goes, the target stays.
+}
+
+Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path, int width,
+                                              int height, int channels,
+                                              const ImageWriteOptions& options) {
+  ImageFormat format = options.format;
+  if (format == ImageFormat::kAuto) {
+    Result<ImageFormat> fromPath = imageFormatFromPath(path);
+    if (!fromPath) return fromPath.error();
+    format = *fromPath;
+  }
+  const int bitDepth = options.bitDepth == 0 ? 16 : options.bitDepth;
+  if (!formatSupportsBitDepth(format, bitDepth)) {
+    return fileError(ErrorCode::kBadInput, path,
+                     upperName(format) + " cannot store " + std::to_string(bitDepth) +
+                         "-bit channels (use " + supportedDepths(format) + ")");
+  }
+  if (Status ok = checkShape(width, height, channels, path); !ok) return ok.error();
+
+  // The temporary file first: an unwritable destination fails before any conversion work.
+  Result<AtomicFile> file = AtomicFile::create(path);
+  if (!file) return file.error();
+  auto state = std::make_unique<State>(std::move(*file));
+  state->path = path;
+  state->width = width;
+  state->height = height;
+  state->threads = options.threads;
+  state->layout = fileLayout(channels, format, options.alpha);
+  const OIIO::TypeDesc fileType = pixelType(format, bitDepth);
+  state->stripType = fileType == OIIO::TypeDesc::HALF ? OIIO::TypeDesc::FLOAT : fileType;
+  const FileLayout& layout = state->layout;
+
+  OIIO::ImageSpec spec(width, height, layout.fileChannels, fileType);
+  spec.channelnames = layout.names;
+  spec.alpha_channel = options.alpha ? layout.fileChannels - 1 : -1;
+  if (options.alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
+  if (format != ImageFormat::kPng) spec.attribute("compression", "zip");
+  // Blender's default PNG compression ("15%") is zlib level 1: several times faster to write
+  // than zlib's default 6, for files about 10-20% larger.
+  if (format == ImageFormat::kPng) spec.attribute("png:compressionLevel", kPngCompressionLevel);
+  spec.attribute("Software", "sgbake");
+
+  state->out = OIIO::ImageOutput::create(oiioFormatName(format));
+  if (!state->out) {
+    return fileError(ErrorCode::kInternal, path,
+                     "OpenImageIO cannot write " + upperName(format) + " (" +
+                         oneLineReason(OIIO::geterror()) + ")");
+  }
+  // OIIO opens the temporary by name (truncating the empty file AtomicFile created); the
+  // format is chosen above, so the temporary's odd extension does not matter.
+  if (!state->out->open(state->file.tempPath().string(), spec)) {
+    const std::string reason = oneLineReason(state->out->geterror());
+    state->out.reset();
+    return fileError(ErrorCode::kInternal, path, "cannot write image (" + reason + ")");
+  }
+  State* raw = state.get();
+  state->thread = std::thread([raw] { raw->run(); });
+  return ImageFileWriter(std::move(state));
+}
+
+Status ImageFileWriter::writeRows(int row, int rows, std::span<const float> pixels,
+                                  std::span<const float> coverage) {
+  State& s = *state_;
+  const FileLayout& layout = s.layout;
+  const std::size_t width = static_cast<std::size_t>(s.width);
+  const std::size_t texels = static_cast<std::size_t>(std::max(rows, 0)) * width;
+  const bool alpha = layout.fileChannels > layout.colourChannels;
+  if (row != s.nextRow || rows < 0 || row + rows > s.height ||
+      pixels.size() != texels * static_cast<std::size_t>(layout.imageChannels) ||
+      (alpha && coverage.size() != texels)) {
+    return fileError(ErrorCode::kInternal, s.path,
+                     "rows " + std::to_string(row) + " to " + std::to_string(row + rows) +
+                         " do not continue the image or have the wrong size");
+  }
+  if (rows == 0) return Ok{};
+  s.nextRow = row + rows;
+
+  State::Strip strip;
+  strip.row = row;
+  strip.rows = rows;
+  const std::size_t values = texels * static_cast<std::size_t>(layout.fileChannels);
+  {
+    std::lock_guard lock(s.mutex);  // a buffer the thread is done with: no fresh pages to fault in
+    if (!s.spare.empty()) {
+      strip.data = std::move(s.spare.back());
+      s.spare.pop_back();
+    }
+  }
+  try {
+    strip.data.resize(values * s.stripType.size());
+  } catch (const std::bad_alloc&) {
+    return fileError(ErrorCode::kInternal, s.path, "out of memory while converting the image");
+  }
+  // Convert row by row in parallel (the file's thread meanwhile compresses earlier strips).
+  const std::size_t fileRowValues = width * static_cast<std::size_t>(layout.fileChannels);
+  const std::size_t imageRowValues = width * static_cast<std::size_t>(layout.imageChannels);
+  auto convertRow = [&](std::size_t r) {
+    const float* in = pixels.data() + r * imageRowValues;
+    const float* cov = alpha ? coverage.data() + r * width : nullptr;
+    std::byte* out = strip.data.data() + r * fileRowValues * s.stripType.size();
+    if (s.stripType == OIIO::TypeDesc::UINT8) {
+      convertTexels(in, cov, width, layout, 255.0, reinterpret_cast<std::uint8_t*>(out));
+    } else if (s.stripType == OIIO::TypeDesc::UINT16) {
+      convertTexels(in, cov, width, layout, 65535.0, reinterpret_cast<std::uint16_t*>(out));
+    } else {
+      convertTexels(in, cov, width, layout, 1.0, reinterpret_cast<float*>(out));
+    }
+  };
+  bake_detail::runWithThreads(s.threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, static_cast<std::size_t>(rows), 4),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t r = range.begin(); r != range.end(); ++r) convertRow(r);
+                      });
+  });
+  const Clock::time_point start = Clock::now();
+  std::unique_lock lock(s.mutex);
+  s.changed.wait(lock, [&] { return s.failed || s.queue.size() < kMaxQueuedStrips; });
+  s.waitSeconds += secondsSince(start);
+  if (s.failed) return s.writeFailure();
+  s.queue.push_back(std::move(strip));
+  lock.unlock();
+  s.changed.notify_all();
+  return Ok{};
+}
+
+Status ImageFileWriter::commit() {
+  State& s = *state_;
+  s.join();
+  if (s.failed) return s.writeFailure();
+  if (s.nextRow != s.height) {
+    return fileError(ErrorCode::kInternal, s.path,
+                     "only " + std::to_string(s.nextRow) + " of " + std::to_string(s.height) +
+                         " rows were written");
+  }
+  const bool closed = s.out->close();
+  if (!closed) {
+    return fileError(ErrorCode::kInternal, s.path,
+                     "cannot write image (" + oneLineReason(s.out->geterror()) + ")");
+  }
+  return s.file.commit();  // on failure the temporary is removed and the target untouched
+}
+
+double ImageFileWriter::fileSeconds() const {
+  std::lock_guard lock(state_->mutex);
+  return state_->fileSeconds;
+}
+
+double ImageFileWriter::waitSeconds() const { return state_->waitSeconds; }
+
 
 Result<ImageFormat> parseImageFormat(std::string_view name) {
   const std::string lower = toLower(name);
@@ -225,71 +480,27 @@ bool formatSupportsBitDepth(ImageFormat format, int bitDepth) {
 
 Status writeImage(const FloatImage& image, const std::filesystem::path& path,
                   const ImageWriteOptions& options) {
-  ImageFormat format = options.format;
-  if (format == ImageFormat::kAuto) {
-    Result<ImageFormat> fromPath = imageFormatFromPath(path);
-    if (!fromPath) return fromPath.error();
-    format = *fromPath;
-  }
-  const int bitDepth = options.bitDepth == 0 ? 16 : options.bitDepth;
-  if (!formatSupportsBitDepth(format, bitDepth)) {
-    return fileError(ErrorCode::kBadInput, path,
-                     upperName(format) + " cannot store " + std::to_string(bitDepth) +
-                         "-bit channels (use " + supportedDepths(format) + ")");
-  }
+  if (Status ok = checkShape(image.width, image.height, image.channels, path); !ok) return ok;
+  // Format and depth are checked (by open) before the image's contents, as documented.
+  Result<ImageFileWriter> writer =
+      ImageFileWriter::open(path, image.width, image.height, image.channels, options);
+  if (!writer) return writer.error();
   if (Status ok = checkImage(image, path, options.alpha); !ok) return ok;
-
-  // The temporary file first: an unwritable destination fails before any conversion work.
-  Result<AtomicFile> file = AtomicFile::create(path);
-  if (!file) return file.error();
-
-  const FileLayout layout = fileLayout(image, format, options.alpha);
-  const OIIO::TypeDesc type = pixelType(format, bitDepth);
-  OIIO::ImageSpec spec(image.width, image.height, layout.fileChannels, type);
-  spec.channelnames = layout.names;
-  spec.alpha_channel = options.alpha ? layout.fileChannels - 1 : -1;
-  if (options.alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
-  if (format != ImageFormat::kPng) spec.attribute("compression", "zip");
-  // Blender's default PNG compression ("15%") is zlib level 1: several times faster to write
-  // than zlib's default 6, for files about 10-20% larger.
-  if (format == ImageFormat::kPng) spec.attribute("png:compressionLevel", kPngCompressionLevel);
-  spec.attribute("Software", "sgbake");
-
-  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(oiioFormatName(format));
-  if (!out) {
-    return fileError(ErrorCode::kInternal, path,
-                     "OpenImageIO cannot write " + upperName(format) + " (" +
-                         oneLineReason(OIIO::geterror()) + ")");
-  }
-  // OIIO opens the temporary by name (truncating the empty file AtomicFile created); the
-  // format is chosen above, so the temporary's odd extension does not matter.
-  if (!out->open(file->tempPath().string(), spec)) {
-    return fileError(ErrorCode::kInternal, path,
-                     "cannot write image (" + oneLineReason(out->geterror()) + ")");
-  }
-  bool written = false;
-  try {
-    if (type == OIIO::TypeDesc::UINT8) {
-      const std::vector<std::uint8_t> data = convertPixels<std::uint8_t>(image, layout, 255.0f);
-      written = out->write_image(OIIO::TypeDesc::UINT8, data.data());
-    } else if (type == OIIO::TypeDesc::UINT16) {
-      const std::vector<std::uint16_t> data = convertPixels<std::uint16_t>(image, layout, 65535.0f);
-      written = out->write_image(OIIO::TypeDesc::UINT16, data.data());
-    } else {
-      // OIIO converts float to half (round to nearest even).
-      const std::vector<float> data = convertPixels<float>(image, layout, 1.0f);
-      written = out->write_image(OIIO::TypeDesc::FLOAT, data.data());
+  const std::size_t rowTexels = static_cast<std::size_t>(image.width);
+  const std::size_t rowValues = rowTexels * static_cast<std::size_t>(image.channels);
+  const std::span<const float> pixels(image.pixels), coverage(image.coverage);
+  for (int row = 0; row < image.height; row += kWriteImageStripRows) {
+    const int rows = std::min(kWriteImageStripRows, image.height - row);
+    const std::size_t r = static_cast<std::size_t>(row), n = static_cast<std::size_t>(rows);
+    const std::span<const float> stripCoverage =
+        options.alpha ? coverage.subspan(r * rowTexels, n * rowTexels) : std::span<const float>{};
+    if (Status ok = writer->writeRows(row, rows, pixels.subspan(r * rowValues, n * rowValues),
+                                      stripCoverage);
+        !ok) {
+      return ok;
     }
-  } catch (const std::bad_alloc&) {
-    out->close();
-    return fileError(ErrorCode::kInternal, path, "out of memory while converting the image");
   }
-  const bool closed = out->close();
-  if (!written || !closed) {
-    return fileError(ErrorCode::kInternal, path,
-                     "cannot write image (" + oneLineReason(out->geterror()) + ")");
-  }
-  return file->commit();  // on failure the temporary is removed and the target untouched
+  return writer->commit();
 }
 
 bool hasUdimToken(std::string_view path) { return path.find(kUdimToken) != std::string_view::npos; }

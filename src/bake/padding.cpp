@@ -123,6 +123,34 @@ void extendMargin(FloatImage& image, int margin, int threads) {
   }
 }
 
+int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
+                     FloatImage& window, int threads) {
+  rowBegin = std::clamp(rowBegin, 0, std::max(image.height, 0));
+  rowEnd = std::clamp(rowEnd, rowBegin, std::max(image.height, 0));
+  margin = std::max(margin, 0);
+  // The rows the strip's padding depends on, clipped to the image (whose edges the window then
+  // shares, so the padding there is the same too).
+  const int windowBegin = std::max(0, rowBegin - margin);
+  const int windowEnd = std::min(image.height, rowEnd + margin);
+  window.width = image.width;
+  window.height = windowEnd - windowBegin;
+  window.channels = image.channels;
+  if (!imageIsValid(image) || window.height == 0) {
+    window.pixels.clear();
+    window.coverage.clear();
+    return rowBegin - windowBegin;
+  }
+  const auto texels = static_cast<std::ptrdiff_t>(image.width);
+  const auto values = texels * image.channels;
+  const auto begin = static_cast<std::ptrdiff_t>(windowBegin);
+  const auto end = static_cast<std::ptrdiff_t>(windowEnd);
+  window.pixels.assign(image.pixels.begin() + begin * values, image.pixels.begin() + end * values);
+  window.coverage.assign(image.coverage.begin() + begin * texels,
+                         image.coverage.begin() + end * texels);
+  extendMargin(window, margin, threads);
+  return rowBegin - windowBegin;
+}
+
 namespace {
 
 /// One coarse level of the push-pull pyramid (level 0 is the image itself, with weight 1 where

@@ -816,14 +816,74 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
   return result;
 }
 
-/// Applies the output's padding to a baked tile.
-void pad(const SceneOutput& output, FloatImage& image, int threads) {
-  if (output.map == MapKind::kMask) return;  // padding would overwrite the coverage it shows
-  if (output.padding == PaddingMode::kPushPull) {
-    pushPullFill(image, threads);
-  } else if (output.margin > 0) {
-    extendMargin(image, output.margin, threads);
+/// Bakes one image tile into @p file and adds its timings to @p report. The image is padded
+/// and handed to an ImageFileWriter strip by strip as the bake finishes its rows (top first), so
+/// the file is compressed and written while the rest is baked. Extend padding of a strip needs
+/// `margin` rows below it (extendMarginRows); push-pull needs the whole image, which is then
+/// padded and written after the bake. Masks are not padded (padding would overwrite the
+/// coverage they show).
+Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneOutput& output,
+                     const fs::path& file, int threads, ExecuteReport& report) {
+  using Clock = std::chrono::steady_clock;
+  ImageWriteOptions writeOptions;
+  writeOptions.format = output.resolvedFormat();
+  writeOptions.bitDepth = output.resolvedBitDepth();
+  writeOptions.alpha = output.alpha;
+  writeOptions.threads = threads;
+  Result<ImageFileWriter> writer = ImageFileWriter::open(file, settings.width, settings.height,
+                                                        mapChannels(settings.map), writeOptions);
+  if (!writer) return writer.error();
+
+  const bool isMask = output.map == MapKind::kMask;
+  const bool pushPull = !isMask && output.padding == PaddingMode::kPushPull;
+  const int margin = isMask || pushPull ? 0 : std::max(output.margin, 0);
+  int rowsWritten = 0;
+  Status written = Ok{};
+  double padSeconds = 0, convertSeconds = 0;
+  FloatImage window;  // the padded rows and their halo, reused from strip to strip
+  // Pads and queues the rows whose padding is final: all of them once the image is complete.
+  auto writeFinalRows = [&](const FloatImage& image, int rowsFinal) {
+    if (!written) return;
+    const int ready = rowsFinal == image.height ? image.height : rowsFinal - margin;
+    if (ready <= rowsWritten) return;
+    const std::size_t rows = static_cast<std::size_t>(ready - rowsWritten);
+    Clock::time_point start = Clock::now();
+    const std::size_t first = static_cast<std::size_t>(
+        extendMarginRows(image, margin, rowsWritten, ready, window, threads));
+    padSeconds += secondsSince(start);
+    start = Clock::now();
+    const std::size_t rowTexels = static_cast<std::size_t>(image.width);
+    const std::size_t rowValues = rowTexels * static_cast<std::size_t>(image.channels);
+    written = writer->writeRows(
+        rowsWritten, ready - rowsWritten,
+        std::span<const float>(window.pixels).subspan(first * rowValues, rows * rowValues),
+        std::span<const float>(window.coverage).subspan(first * rowTexels, rows * rowTexels));
+    convertSeconds += secondsSince(start);
+    rowsWritten = ready;
+  };
+  if (!pushPull) settings.onRowsFinal = writeFinalRows;
+
+  const Clock::time_point start = Clock::now();
+  Result<FloatImage> image = bakeMap(input, settings);
+  if (!image) return Error{image.error().code, file.string() + ": " + image.error().message};
+  report.bakeSeconds += secondsSince(start) - padSeconds - convertSeconds;
+  if (pushPull) {
+    const Clock::time_point padStart = Clock::now();
+    pushPullFill(*image, threads);
+    padSeconds += secondsSince(padStart);
+    writeFinalRows(*image, image->height);
   }
+  if (!written) return written;
+  const double queueWaits = writer->waitSeconds();  // inside writeRows: the queue was full
+  const Clock::time_point commitStart = Clock::now();
+  if (Status ok = writer->commit(); !ok) return ok;
+  const double finalWait = writer->waitSeconds() - queueWaits;  // commit waiting for the queue
+  const double closeSeconds = secondsSince(commitStart) - finalWait;
+  report.padSeconds += padSeconds;
+  report.convertSeconds += convertSeconds - queueWaits;
+  report.writeSeconds += writer->fileSeconds() + closeSeconds;
+  report.writeWaitSeconds += queueWaits + finalWait;
+  return Ok{};
 }
 
 /// Creates the directory of @p file when it is missing.
@@ -963,21 +1023,10 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         settings.udimTile = tile;
         settings.green = output.green;
         settings.threads = options.threads;
-        Result<FloatImage> image = bakeMap(input, settings);
-        if (!image) {
-          return Error{image.error().code, file.string() + ": " + image.error().message};
+        if (Status ok = bakeImageTile(input, settings, output, file, options.threads, report);
+            !ok) {
+          return ok.error();
         }
-        report.bakeSeconds += secondsSince(start);
-        start = Clock::now();
-        pad(output, *image, options.threads);
-        report.padSeconds += secondsSince(start);
-        start = Clock::now();
-        ImageWriteOptions writeOptions;
-        writeOptions.format = output.resolvedFormat();
-        writeOptions.bitDepth = output.resolvedBitDepth();
-        writeOptions.alpha = output.alpha;
-        if (Status ok = writeImage(*image, file, writeOptions); !ok) return ok.error();
-        report.writeSeconds += secondsSince(start);
       }
       outputReport.files.push_back(file);
       ++report.tilesBaked;

@@ -29,6 +29,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -80,7 +81,15 @@ struct RasterJob {
   std::span<const std::array<std::uint32_t, 3>> triangles;  ///< global corner indices
   std::span<const Vec2f> uvs;  ///< #C corner UVs of the UV set that places the texels
   int width = 0, height = 0, samples = 1, udimTile = kFirstUdimTile, threads = 0;
+  /// Optional: rasterize() then works in bands of kBlocksPerBand row blocks from the top of the
+  /// image down and calls it after each band with the number of final rows from the top
+  /// (BakeSettings::onRowsFinal).
+  std::function<void(int rowsFinal)> onRowsFinal;
 };
+
+/// Row blocks per band when RasterJob::onRowsFinal is set: 256 rows, so a 4096² bake reports 16
+/// times (each band ends with a wait for its slowest block, so bands are not made smaller).
+inline constexpr int kBlocksPerBand = 32;
 
 /// @brief Triangles overlapping each block of kRowsPerBlock rows, in ascending triangle order
 /// (compressed rows: the triangles of block k are index[start[k] .. start[k+1])).
@@ -249,12 +258,24 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
     }
   };
 
-  runWithThreads(job.threads, [&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, numBlocks, 1),
-                      [&](const tbb::blocked_range<int>& r) {
-                        for (int b = r.begin(); b != r.end(); ++b) processBlock(b);
-                      });
-  });
+  auto processBlocks = [&](int first, int end) {
+    runWithThreads(job.threads, [&] {
+      tbb::parallel_for(tbb::blocked_range<int>(first, end, 1),
+                        [&](const tbb::blocked_range<int>& r) {
+                          for (int b = r.begin(); b != r.end(); ++b) processBlock(b);
+                        });
+    });
+  };
+  if (!job.onRowsFinal) {
+    processBlocks(0, numBlocks);
+    return;
+  }
+  // Bands from the top of the image (the highest blocks: y is up, rows are top first) down.
+  for (int end = numBlocks; end > 0; end -= kBlocksPerBand) {
+    const int first = std::max(0, end - kBlocksPerBand);
+    processBlocks(first, end);
+    job.onRowsFinal(H - first * kRowsPerBlock);
+  }
 }
 
 }  // namespace sgbake::bake_detail

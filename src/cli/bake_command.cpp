@@ -360,7 +360,9 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
         {"tangents_s", report->tangentsSeconds},
         {"bake_s", report->bakeSeconds},
         {"pad_s", report->padSeconds},
+        {"convert_s", report->convertSeconds},
         {"write_s", report->writeSeconds},
+        {"write_wait_s", report->writeWaitSeconds},
         {"total_s", total.seconds()},
     };
     printStats(stats);

@@ -7,12 +7,14 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <memory>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -292,6 +294,92 @@ TEST_F(ImageOutputTest, SuccessfulWriteReplacesTheFileAndLeavesNoTemporary) {
   EXPECT_NE(readBytes(path), "previous content");
   EXPECT_EQ(readBack(path).spec.width, 3);
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.exr"});
+}
+
+TEST_F(ImageOutputTest, IntegerCodesRoundHalfAwayFromZero) {
+  // Codes are lround(v · (2^bits − 1)): check the values next to every rounding boundary of
+  // 8-bit codes and a sweep of 16-bit ones.
+  FloatImage image;
+  image.width = 0;
+  image.height = 1;
+  image.channels = 1;
+  for (int code = 0; code < 255; ++code) {
+    const float boundary = static_cast<float>((code + 0.5) / 255.0);
+    for (const float v : {std::nextafter(boundary, 0.0f), boundary, std::nextafter(boundary, 1.0f)})
+      image.pixels.push_back(v);
+  }
+  for (int k = 0; k <= 1000; ++k) image.pixels.push_back(static_cast<float>(k) / 1000.0f);
+  image.width = static_cast<int>(image.pixels.size());
+  image.coverage.assign(image.pixels.size(), 1.0f);
+  for (const int bits : {8, 16}) {
+    const fs::path path = dir_ / ("codes" + std::to_string(bits) + ".png");
+    ImageWriteOptions options;
+    options.bitDepth = bits;
+    ASSERT_TRUE(writeImage(image, path, options));
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
+    ASSERT_TRUE(in);
+    std::vector<std::uint16_t> codes(image.pixels.size());
+    ASSERT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT16, codes.data()));
+    const double maxCode = bits == 8 ? 255.0 : 65535.0;
+    const double scale = 65535.0 / maxCode;  // OIIO reads an 8-bit code c as 257·c
+    for (std::size_t i = 0; i < codes.size(); ++i) {
+      const long expected = std::lround(static_cast<double>(image.pixels[i]) * maxCode);
+      ASSERT_EQ(codes[i], static_cast<std::uint16_t>(static_cast<double>(expected) * scale)) << bits << " bits, value " << image.pixels[i];
+    }
+  }
+}
+
+TEST_F(ImageOutputTest, StripsWrittenInTurnEqualTheWholeImage) {
+  const FloatImage image = rampImage(7, 9, 3);
+  ASSERT_TRUE(writeImage(image, dir_ / "whole.png"));
+  ImageWriteOptions options;
+  options.alpha = true;
+  Result<ImageFileWriter> writer = ImageFileWriter::open(dir_ / "strips.png", 7, 9, 3, options);
+  ASSERT_TRUE(writer.ok());
+  EXPECT_EQ(listDirectory(dir_).count("strips.png"), 0u);  // nothing at the target yet
+  const std::span<const float> pixels(image.pixels), coverage(image.coverage);
+  int row = 0;
+  for (const int rows : {2, 0, 4, 3}) {
+    ASSERT_TRUE(writer->writeRows(row, rows, pixels.subspan(std::size_t(row) * 21, std::size_t(rows) * 21),
+                                  coverage.subspan(std::size_t(row) * 7, std::size_t(rows) * 7)));
+    row += rows;
+  }
+  ASSERT_TRUE(writer->commit());
+  EXPECT_GE(writer->fileSeconds(), 0.0);
+  const ReadBack whole = readBack(dir_ / "whole.png"), strips = readBack(dir_ / "strips.png");
+  ASSERT_EQ(strips.spec.nchannels, 4);
+  for (int r = 0; r < 9; ++r)
+    for (int x = 0; x < 7; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(strips.at(x, r, c), whole.at(x, r, c)) << x << "," << r;
+}
+
+TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
+  const fs::path path = dir_ / "n.png";
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "previous content";
+  }
+  const FloatImage image = rampImage(4, 4, 1);
+  const std::span<const float> pixels(image.pixels);
+  {
+    Result<ImageFileWriter> writer = ImageFileWriter::open(path, 4, 4, 1);
+    ASSERT_TRUE(writer.ok());
+    ASSERT_TRUE(writer->writeRows(0, 1, pixels.subspan(0, 4), {}));
+    const Status gap = writer->writeRows(2, 1, pixels.subspan(8, 4), {});  // row 1 skipped
+    ASSERT_FALSE(gap);
+    EXPECT_EQ(gap.error().code, ErrorCode::kInternal);
+    EXPECT_FALSE(writer->writeRows(1, 1, pixels.subspan(0, 3), {}));  // wrong size
+    const Status incomplete = writer->commit();  // rows 1 to 3 missing
+    ASSERT_FALSE(incomplete);
+    EXPECT_TRUE(incomplete.error().message.starts_with(path.string() + ": ")) << incomplete.error().message;
+  }
+  {
+    Result<ImageFileWriter> abandoned = ImageFileWriter::open(path, 4, 4, 1);
+    ASSERT_TRUE(abandoned.ok());
+    ASSERT_TRUE(abandoned->writeRows(0, 4, pixels, {}));
+  }  // destroyed without commit
+  EXPECT_EQ(readBytes(path), "previous content");
+  EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.png"});
 }
 
 TEST(UdimToken, Expansion) {

@@ -3,7 +3,10 @@
 // hand-built triangle with hand-made tangents.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "bake_test_util.hpp"
 #include "support/parametric_mesh.hpp"
@@ -325,6 +328,34 @@ TEST(Maps, SupersampledNormalsAreTheMeanOfEncodedSamples) {
     }
   }
   EXPECT_GT(checked, 100);
+}
+
+TEST(Maps, RowsReportedAsFinalAreFinalAndTheImageIsTheSame) {
+  // With onRowsFinal the raster works in bands from the top down and reports them; the image is
+  // the same bit for bit, and every row reported final already has its final value.
+  const HandTriangle h = handTriangle();
+  BakeSettings s;
+  s.map = MapKind::kTangent;
+  s.width = 37;
+  s.height = 600;  // more than one band of rows
+  const Result<FloatImage> plain = bakeMap({&h.mesh, &h.tangents, {}}, s);
+  ASSERT_TRUE(plain.ok());
+  std::vector<int> reports;
+  bool rowsWereFinal = true;
+  s.onRowsFinal = [&](const FloatImage& image, int rowsFinal) {
+    reports.push_back(rowsFinal);
+    const std::size_t values = static_cast<std::size_t>(rowsFinal) * 37 * 3;
+    rowsWereFinal = rowsWereFinal &&
+                    std::memcmp(image.pixels.data(), plain->pixels.data(), values * sizeof(float)) == 0;
+  };
+  const Result<FloatImage> banded = bakeMap({&h.mesh, &h.tangents, {}}, s);
+  ASSERT_TRUE(banded.ok());
+  EXPECT_EQ(banded->pixels, plain->pixels);
+  EXPECT_EQ(banded->coverage, plain->coverage);
+  ASSERT_GE(reports.size(), 2u);
+  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  EXPECT_EQ(reports.back(), 600);
+  EXPECT_TRUE(rowsWereFinal);
 }
 
 TEST(Maps, BadInputIsAnErrorValue) {

@@ -2,6 +2,7 @@
 // 2/1 weights; push-pull fills every hole and keeps covered texels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -96,6 +97,47 @@ TEST(ExtendMargin, ThreadsGiveIdenticalBits) {
   extendMargin(a, 7, 1);
   extendMargin(b, 7, 2);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)), 0);
+}
+
+TEST(ExtendMargin, StripsFromTheirHaloAloneEqualTheWholeImage) {
+  // extendMarginRows pads a strip from `margin` rows either side of it; every strip, near the
+  // image's edges or not, must equal those rows of the whole image's padding bit for bit.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> value(0, 1);
+  FloatImage image = holes(97, 130, 3);
+  for (int k = 0; k < 60; ++k) {  // small islands, a few texels each, with gaps between
+    const int x0 = static_cast<int>(rng() % 95), r0 = static_cast<int>(rng() % 128);
+    for (int r = r0; r < r0 + 2; ++r)
+      for (int x = x0; x < x0 + 3; ++x) cover(image, x, r, {value(rng), value(rng), value(rng)});
+  }
+  for (const int margin : {1, 4, 9}) {
+    FloatImage whole = image;
+    extendMargin(whole, margin);
+    FloatImage window;  // reused from strip to strip, as the baker does
+    for (const int rows : {1, 7, 33}) {
+      for (int begin = 0; begin < image.height; begin += rows) {
+        const int end = std::min(image.height, begin + rows);
+        const int first = extendMarginRows(image, margin, begin, end, window);
+        ASSERT_EQ(window.width, image.width);
+        ASSERT_GE(window.height, first + end - begin);
+        const std::size_t rowValues = static_cast<std::size_t>(image.width) * 3;
+        ASSERT_EQ(std::memcmp(window.pixels.data() + static_cast<std::size_t>(first) * rowValues,
+                              whole.pixels.data() + static_cast<std::size_t>(begin) * rowValues,
+                              static_cast<std::size_t>(end - begin) * rowValues * sizeof(float)),
+                  0)
+            << "margin " << margin << ", rows " << begin << " to " << end;
+      }
+    }
+  }
+  // The test can fail: a strip padded without its halo differs from the whole image.
+  FloatImage whole = image;
+  extendMargin(whole, 9);
+  FloatImage window;
+  const int first = extendMarginRows(image, 0, 40, 50, window);
+  extendMargin(window, 9);
+  EXPECT_NE(std::memcmp(window.pixels.data() + static_cast<std::size_t>(first) * 97 * 3,
+                        whole.pixels.data() + std::size_t{40} * 97 * 3, std::size_t{10} * 97 * 3 * sizeof(float)),
+            0);
 }
 
 TEST(PushPullFill, FillsEveryHoleAndKeepsCoveredTexels) {

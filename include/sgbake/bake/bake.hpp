@@ -53,6 +53,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -116,6 +117,12 @@ struct BakeSettings {
   int udimTile = 1001;    ///< which UDIM tile (1001 = [0,1)²), kFirstUdimTile … kLastUdimTile
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< kDirectX flips G of kTangentNormal
   int threads = 0;        ///< 0 = all cores; the result does not depend on it
+  /// Optional: called on bakeMap's thread each time more rows are final, with the image being
+  /// baked and the number of final rows counted from the top (file order). Rows are baked top
+  /// first in bands, and the last call has rowsFinal == height, so a caller can pad and write
+  /// the top of the image while the rest is baked (see ImageFileWriter). The image's rows below
+  /// rowsFinal must not be read. The result does not depend on it.
+  std::function<void(const FloatImage& image, int rowsFinal)> onRowsFinal;
 };
 
 /// @brief Everything a bake reads: the mesh, its tangent frames (may be null when no map or
@@ -161,6 +168,17 @@ std::vector<int> udimTiles(const Mesh& mesh, int uvSet);
 /// stays the geometric coverage, e.g. for an alpha channel). Parallel, deterministic.
 /// @param[in] threads 0 = all cores; the result does not depend on it
 void extendMargin(FloatImage& image, int margin, int threads = 0);
+
+/// @brief Rows [rowBegin, rowEnd) of extendMargin(image, margin), bit for bit, computed from rows
+/// [rowBegin − margin, rowEnd + margin) of @p image alone: a texel's padded value depends on
+/// nothing farther than @p margin rows. This pads a strip of an image whose lower rows are
+/// still being baked.
+/// @param[out] window receives those rows of @p image (clipped to it), padded; its buffers are
+///             reused from one call to the next
+/// @param[in] threads 0 = all cores; the result does not depend on it
+/// @return the row of @p window that holds row @p rowBegin of the image
+int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
+                     FloatImage& window, int threads = 0);
 
 /// @brief Fills every uncovered texel (coverage 0) by push-pull (Gortler et al. 1996): a
 /// pyramid of 2×2 weighted averages of the covered texels (weights clamped to 1), then, from

@@ -12,6 +12,8 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -59,6 +61,9 @@ struct ImageWriteOptions {
   /// Append FloatImage::coverage as an alpha channel (unassociated: colour is not divided or
   /// multiplied by it; PNG gets `oiio:UnassociatedAlpha = 1`).
   bool alpha = false;
+  /// Most threads converting pixels to the file's type (0 = all cores). The file itself is
+  /// written by one thread of its own (see ImageFileWriter).
+  int threads = 0;
 };
 
 /// @brief Writes @p image to @p path, all or nothing.
@@ -77,6 +82,57 @@ struct ImageWriteOptions {
 /// On any failure the target is left as it was and no temporary file remains.
 Status writeImage(const FloatImage& image, const std::filesystem::path& path,
                   const ImageWriteOptions& options = {});
+
+/// @brief An image file written strip by strip while the caller computes the next strips, all or
+/// nothing (the rules, formats and errors of writeImage, which is built on it).
+///
+/// writeRows converts a strip of rows to the file's pixel type (in parallel) and queues it; a
+/// thread of the writer's own compresses and writes the queued strips in order (PNG's zlib, for
+/// one, is serial), so a caller that bakes strip k+1 while strip k is written overlaps the two.
+/// At most a few strips wait in the queue: writeRows blocks while it is full. commit() waits for
+/// the queue, closes the file and renames it over the target; a writer destroyed without a
+/// successful commit removes its temporary and leaves the target as it was.
+///
+///     Result<ImageFileWriter> out = ImageFileWriter::open("n.png", 4096, 4096, 3, options);
+///     for (each strip of rows, top first) out->writeRows(row, rows, pixels, coverage);
+///     Status done = out->commit();
+class ImageFileWriter {
+ public:
+  /// @brief Creates the temporary file and opens it for a width × height image whose strips have
+  /// @p channels channels (1 to 3, laid out as in writeImage).
+  /// @return the errors of writeImage for the format, bit depth, size and directory
+  static Result<ImageFileWriter> open(const std::filesystem::path& path, int width, int height,
+                                      int channels, const ImageWriteOptions& options = {});
+
+  ImageFileWriter(ImageFileWriter&&) noexcept;
+  ImageFileWriter& operator=(ImageFileWriter&&) noexcept;
+  ImageFileWriter(const ImageFileWriter&) = delete;
+  ImageFileWriter& operator=(const ImageFileWriter&) = delete;
+  ~ImageFileWriter();
+
+  /// @brief Queues file rows [row, row + rows) (top first; strips must follow each other without
+  /// gaps). @p pixels has rows·width·channels values, @p coverage rows·width (read only for the
+  /// alpha channel; may be empty otherwise).
+  /// @return an earlier write failure (kInternal, naming the file), or kInternal for a strip out
+  /// of order or of the wrong size
+  Status writeRows(int row, int rows, std::span<const float> pixels,
+                   std::span<const float> coverage);
+
+  /// @brief Waits for the queued strips, closes the file and renames it over the target.
+  /// @return kInternal naming the file when a strip failed to write, rows are missing or the
+  /// rename fails; the target is then untouched
+  Status commit();
+
+  /// Seconds the writer's thread spent inside OpenImageIO (compressing and writing) so far.
+  double fileSeconds() const;
+  /// Seconds writeRows and commit spent waiting for the writer's thread so far.
+  double waitSeconds() const;
+
+ private:
+  struct State;
+  explicit ImageFileWriter(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
 
 /// The token an output file name carries to be baked once per UDIM tile.
 inline constexpr std::string_view kUdimToken = "<UDIM>";

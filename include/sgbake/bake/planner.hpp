@@ -172,12 +172,19 @@ struct ExecuteReport {
   double tangentsSeconds = 0;  ///< MikkTSpace frames
   double bakeSeconds = 0;      ///< bakeMap and the corner table
   double padSeconds = 0;       ///< margins
-  double writeSeconds = 0;     ///< image and CSV files, output hashes, manifests
+  double convertSeconds = 0;   ///< converting pixels to the files' types
+  /// Image files inside OpenImageIO (compressing, writing; on the writer's own thread, while
+  /// the next rows are baked), CSV files, output hashes, manifests
+  double writeSeconds = 0;
+  /// The part of the image writing the bake waited for (not overlapped with baking)
+  double writeWaitSeconds = 0;
 };
 
 /// @brief Runs @p plan: loads the mesh (it must have UVs) and images, computes tangents if
 /// needed, bakes each output that is not up to date (every UDIM tile of a `<UDIM>` file name,
-/// else its tile), pads it, writes it all or nothing, and records it in the manifest.
+/// else its tile), pads it, writes it all or nothing, and records it in the manifest. An image
+/// is padded and written strip by strip while its lower rows are still baked (push-pull
+/// padding, which needs the whole image, waits for the bake).
 ///
 /// Everything is loaded and checked before the first file is written, so bad input (an
 /// unreadable image, a mesh without UVs or without a UV set an output or layer names) leaves
