@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -917,14 +918,20 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   // 1. Everything is loaded and checked before the first output is written.
   auto start = Clock::now();
   progress.start("loading " + s.mesh.string());
-  LoadOptions meshOptions;
-  meshOptions.requireUvs = true;
-  Result<Mesh> mesh = loadMesh(s.mesh, meshOptions);
+  // The mesh is parsed on a thread of its own while the images are decoded here: the two are
+  // independent, and each is mostly serial. A bad mesh is still reported before a bad image.
+  std::future<Result<Mesh>> meshLoad = std::async(std::launch::async, [&s] {
+    LoadOptions meshOptions;
+    meshOptions.requireUvs = true;
+    return loadMesh(s.mesh, meshOptions);
+  });
+  const Status textures = loadTextures(plan, loaded, progress, report);
+  Result<Mesh> mesh = meshLoad.get();
   if (!mesh) return mesh.error();
   loaded.mesh = std::move(*mesh);
   progress.finishOne();
   if (Status ok = checkUvSets(plan, loaded.mesh); !ok) return ok.error();
-  if (Status ok = loadTextures(plan, loaded, progress, report); !ok) return ok.error();
+  if (!textures) return textures.error();
   const double objectSize = boundingBoxDiagonal(loaded.mesh);
   for (const PlannedLayer& planned : plan.layers) {
     Result<Layer> layer = makeLayer(plan, planned, loaded, objectSize);
