@@ -381,14 +381,8 @@ Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings)
     bake_detail::allocateImage(image, settings.width, settings.height, mapChannels(settings.map),
                                settings.threads);
 
-    bake_detail::RasterJob job;
-    job.triangles = triangles;
-    job.uvs = mesh.uvSets[static_cast<std::size_t>(settings.uvSet)].uvs;
-    job.width = settings.width;
-    job.height = settings.height;
-    job.samples = settings.samples;
-    job.udimTile = settings.udimTile;
-    job.threads = settings.threads;
+    bake_detail::RasterJob job =
+        bake_detail::rasterJobFor(mesh, triangles, settings, settings.width, settings.height);
     if (settings.onRowsFinal) {
       job.onRowsFinal = [&](int rowsFinal) { settings.onRowsFinal(image, rowsFinal); };
     }

@@ -112,14 +112,8 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
           [&] { output.coverage.resize(texels); });
     });
 
-    bake_detail::RasterJob job;
-    job.triangles = triangles;
-    job.uvs = mesh.uvSets[static_cast<std::size_t>(settings.uvSet)].uvs;
-    job.width = input.width;
-    job.height = input.height;
-    job.samples = settings.samples;
-    job.udimTile = settings.udimTile;
-    job.threads = settings.threads;
+    const bake_detail::RasterJob job =
+        bake_detail::rasterJobFor(mesh, triangles, settings, input.width, input.height);
 
     bake_detail::ConvertShader shader;
     shader.mesh = &mesh;

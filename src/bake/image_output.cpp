@@ -46,40 +46,39 @@ Error fileError(ErrorCode code, const std::filesystem::path& path, std::string_v
   return {code, path.string() + ": " + std::string(what)};
 }
 
-/// The name ImageOutput::create knows the format by.
+/// What this file knows of each format it writes.
+struct FormatInfo {
+  ImageFormat format;
+  std::string_view name;      ///< imageFormatName: "exr", "png", "tiff"
+  const char* oiioName;       ///< the name ImageOutput::create knows it by
+  std::string_view upper;     ///< display name in messages
+  std::string_view depths;    ///< the bit depths it stores, for messages
+};
+
+constexpr FormatInfo kFormats[] = {
+    {ImageFormat::kExr, "exr", "openexr", "EXR", "16 (half) or 32 (float)"},
+    {ImageFormat::kPng, "png", "png", "PNG", "8 or 16"},
+    {ImageFormat::kTiff, "tiff", "tiff", "TIFF", "8, 16 or 32 (float)"},
+};
+
+/// The entry of @p format, or nullptr for kAuto.
+const FormatInfo* formatInfo(ImageFormat format) {
+  for (const FormatInfo& info : kFormats)
+    if (info.format == format) return &info;
+  return nullptr;
+}
+
 const char* oiioFormatName(ImageFormat format) {
-  switch (format) {
-    case ImageFormat::kExr:
-      return "openexr";
-    case ImageFormat::kPng:
-      return "png";
-    case ImageFormat::kTiff:
-      return "tiff";
-    case ImageFormat::kAuto:
-      break;
-  }
-  return "";
+  const FormatInfo* info = formatInfo(format);
+  return info ? info->oiioName : "";
 }
-
-/// Display name in messages: "EXR", "PNG", "TIFF".
 std::string upperName(ImageFormat format) {
-  std::string name(imageFormatName(format));
-  for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return name;
+  const FormatInfo* info = formatInfo(format);
+  return std::string(info ? info->upper : "AUTO");
 }
-
 std::string supportedDepths(ImageFormat format) {
-  switch (format) {
-    case ImageFormat::kExr:
-      return "16 (half) or 32 (float)";
-    case ImageFormat::kPng:
-      return "8 or 16";
-    case ImageFormat::kTiff:
-      return "8, 16 or 32 (float)";
-    case ImageFormat::kAuto:
-      break;
-  }
-  return "";
+  const FormatInfo* info = formatInfo(format);
+  return std::string(info ? info->depths : "");
 }
 
 /// OIIO's pixel type for @p bitDepth in @p format (formatSupportsBitDepth holds).
@@ -433,17 +432,8 @@ Result<ImageFormat> parseImageFormat(std::string_view name) {
 }
 
 std::string_view imageFormatName(ImageFormat format) {
-  switch (format) {
-    case ImageFormat::kExr:
-      return "exr";
-    case ImageFormat::kPng:
-      return "png";
-    case ImageFormat::kTiff:
-      return "tiff";
-    case ImageFormat::kAuto:
-      break;
-  }
-  return "auto";
+  const FormatInfo* info = formatInfo(format);
+  return info ? info->name : "auto";
 }
 
 Result<ImageFormat> imageFormatFromPath(const std::filesystem::path& path) {

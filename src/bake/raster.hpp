@@ -35,6 +35,7 @@
 
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/core/vec.hpp"
+#include "sgbake/mesh/mesh.hpp"
 
 namespace sgbake::bake_detail {
 
@@ -90,6 +91,23 @@ struct RasterJob {
 /// Row blocks per band when RasterJob::onRowsFinal is set: 256 rows, so a 4096² bake reports 16
 /// times (each band ends with a wait for its slowest block, so bands are not made smaller).
 inline constexpr int kBlocksPerBand = 32;
+
+/// @brief The RasterJob of a bake or a conversion (BakeSettings, ConvertSettings): @p triangles
+/// (loopTriangles(mesh), which must outlive the job) placed by UV set settings.uvSet in a
+/// @p width × @p height image of UDIM tile settings.udimTile.
+template <class Settings>
+RasterJob rasterJobFor(const Mesh& mesh, std::span<const std::array<std::uint32_t, 3>> triangles,
+                       const Settings& settings, int width, int height) {
+  RasterJob job;
+  job.triangles = triangles;
+  job.uvs = mesh.uvSets[static_cast<std::size_t>(settings.uvSet)].uvs;
+  job.width = width;
+  job.height = height;
+  job.samples = settings.samples;
+  job.udimTile = settings.udimTile;
+  job.threads = settings.threads;
+  return job;
+}
 
 /// @brief Triangles overlapping each block of kRowsPerBlock rows, in ascending triangle order
 /// (compressed rows: the triangles of block k are index[start[k] .. start[k+1])).

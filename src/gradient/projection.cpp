@@ -113,52 +113,53 @@ TriplanarWeights triplanarWeights(Vec3d normal, double sharpness, double minWeig
   return result;
 }
 
-Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptions& options,
-                              const SurfacePoint& point) {
+namespace {
+
+/// Σ over the planes with a nonzero triplanar weight w of plane(mapping, st, w · scale), st being
+/// the point's texture coordinates in that plane: the loop the three triplanar kinds share.
+/// Planes below the weight threshold are not sampled at all.
+template <class PlaneTerm>
+Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
+                    const PlaneTerm& plane) {
   const TriplanarWeights weights =
       triplanarWeights(point.normal, options.sharpness, options.minWeight);
-  Vec3d volumeGradient{};
+  Vec3d sum{};
   for (const ProjectionAxis axis : kAxes) {
     const double w = weights.w[index(axis)];
-    if (w == 0) continue;  // below the threshold: not sampled
+    if (w == 0) continue;
     const PlanarMapping mapping{axis, options.tiling, options.offset};
-    const ScalarSample h = texture.sample(planarTextureCoordinates(point.position, mapping));
-    volumeGradient += planeVolumeGradient(h.gradient, mapping, w * options.scale);
+    sum += plane(mapping, planarTextureCoordinates(point.position, mapping), w * options.scale);
   }
+  return sum;
+}
+
+}  // namespace
+
+Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptions& options,
+                              const SurfacePoint& point) {
+  const Vec3d volumeGradient = sumOverPlanes(
+      options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
+        return planeVolumeGradient(texture.sample(st).gradient, mapping, weightedScale);
+      });
   return finiteOrZero(projectOntoTangentPlane(volumeGradient, point.normal));
 }
 
 Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
                                      const SurfacePoint& point) {
-  const TriplanarWeights weights =
-      triplanarWeights(point.normal, options.sharpness, options.minWeight);
-  Vec3d volumeGradient{};
-  for (const ProjectionAxis axis : kAxes) {
-    const double w = weights.w[index(axis)];
-    if (w == 0) continue;
-    const PlanarMapping mapping{axis, options.tiling, options.offset};
-    const Vec2d slopes =
-        planeSlopes(texture, planarTextureCoordinates(point.position, mapping), options.normal);
-    volumeGradient += planeVolumeGradient(slopes, mapping, w * options.scale);
-  }
+  const Vec3d volumeGradient = sumOverPlanes(
+      options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
+        return planeVolumeGradient(planeSlopes(texture, st, options.normal), mapping, weightedScale);
+      });
   return finiteOrZero(projectOntoTangentPlane(volumeGradient, point.normal));
 }
 
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
                                     const SurfacePoint& point) {
-  const TriplanarWeights weights =
-      triplanarWeights(point.normal, options.sharpness, options.minWeight);
-  Vec3d gamma{};
-  for (const ProjectionAxis axis : kAxes) {
-    const double w = weights.w[index(axis)];
-    if (w == 0) continue;
-    const PlanarMapping mapping{axis, options.tiling, options.offset};
-    const Vec3d n =
-        decodeNormalTexel(texture.sample(planarTextureCoordinates(point.position, mapping)));
-    gamma +=
-        (w * options.scale) * gradientFromObjectNormal(n, point.normal, options.normal.minCosine);
-  }
-  return finiteOrZero(gamma);
+  return finiteOrZero(sumOverPlanes(
+      options, point, [&](const PlanarMapping&, Vec2d st, double weightedScale) {
+        const Vec3d n = decodeNormalTexel(texture.sample(st));
+        return weightedScale * gradientFromObjectNormal(n, point.normal, options.normal.minCosine);
+      }));
 }
 
 }  // namespace sgbake
