@@ -93,7 +93,8 @@ class ThreadLimit {
 };
 
 /// @brief Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGQUIT that remove the temporary
-/// files of unfinished Outputs before the process dies. Call once, early in main.
+/// files of every unfinished AtomicFile (Outputs and the images the library writes) before the
+/// process dies. Call once, early in main.
 void installSignalCleanup();
 
 /// @brief Where a command writes its main result: standard output, or a file that appears

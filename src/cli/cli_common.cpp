@@ -77,67 +77,21 @@ int ThreadLimit::effectiveThreads() const {
 }
 
 // ---- Removing temporary files when a signal ends the process ---------------------------------
-//
-// A fixed table of paths that a signal handler may read: registering copies the path and then
-// publishes the slot; the handler only calls unlink(2), which is async-signal-safe.
 
 namespace {
 
-constexpr std::size_t kMaxPendingFiles = 8;
-constexpr std::size_t kMaxPathBytes = 4096;
-
-struct PendingFile {
-  volatile std::sig_atomic_t used = 0;
-  char path[kMaxPathBytes] = {};
-};
-
-PendingFile g_pendingFiles[kMaxPendingFiles];
-
-extern "C" void removePendingFilesAndDie(int signal) {
-  for (PendingFile& file : g_pendingFiles) {
-    if (file.used) ::unlink(file.path);
-  }
+extern "C" void removeTemporariesAndDie(int signal) {
+  removeTemporaryFiles();  // every unfinished AtomicFile's, the library's included
   // The handler was installed with SA_RESETHAND: re-raising runs the default action (the
   // process dies of this signal, as the parent expects) once the handler returns.
   ::raise(signal);
-}
-
-/// Registers @p path for removal on a fatal signal; returns its slot, or -1 when the table is
-/// full or the path too long (then the file is merely not cleaned up after a signal).
-int registerPendingFile(const std::filesystem::path& path) {
-  const std::string& text = path.native();
-  if (text.size() >= kMaxPathBytes) return -1;
-  for (std::size_t i = 0; i < kMaxPendingFiles; ++i) {
-    PendingFile& file = g_pendingFiles[i];
-    if (file.used) continue;
-    std::memcpy(file.path, text.c_str(), text.size() + 1);
-    std::atomic_signal_fence(std::memory_order_seq_cst);  // the path is complete before use
-    file.used = 1;
-    return static_cast<int>(i);
-  }
-  return -1;
-}
-
-void unregisterPendingFile(int slot) {
-  if (slot >= 0) g_pendingFiles[slot].used = 0;
-}
-
-/// Slot of each open Output's temporary file; Outputs are few and short-lived, so a linear
-/// lookup by path keeps Output itself free of signal bookkeeping.
-int findPendingFile(const std::filesystem::path& path) {
-  for (std::size_t i = 0; i < kMaxPendingFiles; ++i) {
-    if (g_pendingFiles[i].used && path.native() == g_pendingFiles[i].path) {
-      return static_cast<int>(i);
-    }
-  }
-  return -1;
 }
 
 }  // namespace
 
 void installSignalCleanup() {
   struct sigaction action {};
-  action.sa_handler = removePendingFilesAndDie;
+  action.sa_handler = removeTemporariesAndDie;
   sigemptyset(&action.sa_mask);
   action.sa_flags = SA_RESETHAND;
   for (const int signal : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
@@ -147,17 +101,12 @@ void installSignalCleanup() {
 
 // ---- Output -----------------------------------------------------------------------------------
 
-Output::Output(std::optional<AtomicFile> file) : file_(std::move(file)) {
-  if (file_) registerPendingFile(file_->tempPath());
-}
+Output::Output(std::optional<AtomicFile> file) : file_(std::move(file)) {}
 
 Output::Output(Output&& other) noexcept : file_(std::exchange(other.file_, std::nullopt)) {}
 
 Output::~Output() {
-  if (file_) {
-    unregisterPendingFile(findPendingFile(file_->tempPath()));
-    file_->discard();
-  }
+  if (file_) file_->discard();
 }
 
 Result<Output> Output::open(const std::string& path) {
@@ -185,10 +134,7 @@ Status Output::write(std::string_view bytes) {
 
 Status Output::finish() {
   if (!file_) return Ok{};
-  const int slot = findPendingFile(file_->tempPath());
-  Status committed = file_->commit();
-  unregisterPendingFile(slot);
-  return committed;
+  return file_->commit();
 }
 
 }  // namespace sgbake::cli

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -64,7 +65,57 @@ int syncDirectory(const std::filesystem::path& dir) {
   return err;
 }
 
+// ---- The temporaries removeTemporaryFiles() removes --------------------------------------------
+//
+// A fixed table a signal handler may read: a slot is claimed (free → busy), filled, then
+// published (busy → holds a path); the handler only reads published slots and calls unlink(2),
+// which is async-signal-safe. Lock-free atomics keep the claiming safe across threads.
+
+constexpr std::size_t kMaxTrackedTemporaries = 64;
+constexpr std::size_t kMaxTrackedPathBytes = 4096;
+
+enum SlotState : int { kFree = 0, kBusy = 1, kHoldsPath = 2 };
+
+struct TrackedTemporary {
+  std::atomic<int> state{kFree};
+  char path[kMaxTrackedPathBytes] = {};
+};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+
+TrackedTemporary g_tracked[kMaxTrackedTemporaries];
+
+/// @return the slot now holding @p path, or -1 when the table is full or the path too long
+int trackTemporary(const std::filesystem::path& path) {
+  const std::string& text = path.native();
+  if (text.size() >= kMaxTrackedPathBytes) return -1;
+  for (std::size_t i = 0; i < kMaxTrackedTemporaries; ++i) {
+    int expected = kFree;
+    if (!g_tracked[i].state.compare_exchange_strong(expected, kBusy)) continue;
+    std::memcpy(g_tracked[i].path, text.c_str(), text.size() + 1);
+    g_tracked[i].state.store(kHoldsPath, std::memory_order_release);
+    return static_cast<int>(i);
+  }
+  return -1;
+}
+
 }  // namespace
+
+void removeTemporaryFiles() noexcept {
+  for (TrackedTemporary& tracked : g_tracked) {
+    if (tracked.state.load(std::memory_order_acquire) == kHoldsPath) ::unlink(tracked.path);
+  }
+}
+
+AtomicFile::AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd,
+                       bool durable)
+    : target_(std::move(target)), temp_(std::move(temp)), fd_(fd), durable_(durable) {
+  slot_ = trackTemporary(temp_);
+}
+
+void AtomicFile::forgetTemporary() noexcept {
+  if (slot_ >= 0) g_tracked[slot_].state.store(kFree, std::memory_order_release);
+  slot_ = -1;
+}
 
 Result<AtomicFile> AtomicFile::create(const std::filesystem::path& target,
                                       const AtomicFileOptions& options) {
@@ -98,7 +149,8 @@ AtomicFile::AtomicFile(AtomicFile&& other) noexcept
     : target_(std::move(other.target_)),
       temp_(std::move(other.temp_)),
       fd_(std::exchange(other.fd_, -1)),
-      durable_(other.durable_) {}
+      durable_(other.durable_),
+      slot_(std::exchange(other.slot_, -1)) {}
 
 AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
   if (this != &other) {
@@ -107,6 +159,7 @@ AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
     temp_ = std::move(other.temp_);
     fd_ = std::exchange(other.fd_, -1);
     durable_ = other.durable_;
+    slot_ = std::exchange(other.slot_, -1);
   }
   return *this;
 }
@@ -118,6 +171,7 @@ void AtomicFile::discard() noexcept {
   ::close(fd_);
   fd_ = -1;
   ::unlink(temp_.c_str());
+  forgetTemporary();
 }
 
 Status AtomicFile::write(std::string_view bytes) {
@@ -147,13 +201,15 @@ Status AtomicFile::commit() {
   if (closeResult != 0 && errno != EINTR) {
     const int err = errno;
     ::unlink(temp_.c_str());
+    forgetTemporary();
     return ioError(ErrorCode::kInternal, target_, "cannot write", err);
   }
-  if (::rename(temp_.c_str(), target_.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(temp_.c_str());
-    return ioError(ErrorCode::kInternal, target_, "cannot replace file", err);
-  }
+  const int renamed = ::rename(temp_.c_str(), target_.c_str());
+  const int renameError = errno;
+  if (renamed != 0) ::unlink(temp_.c_str());
+  // Only now: a signal before the rename must still find the temporary to remove.
+  forgetTemporary();
+  if (renamed != 0) return ioError(ErrorCode::kInternal, target_, "cannot replace file", renameError);
   if (durable_) {
     if (const int err = syncDirectory(parentDirectory(target_)); err != 0) {
       return ioError(ErrorCode::kInternal, target_, "cannot sync directory", err);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "sgbake/bake/image_output.hpp"
+#include "sgbake/io/atomic_file.hpp"
 
 namespace sgbake {
 namespace {
@@ -380,6 +381,22 @@ TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
   }  // destroyed without commit
   EXPECT_EQ(readBytes(path), "previous content");
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.png"});
+}
+
+TEST_F(ImageOutputTest, RemoveTemporaryFilesTakesOnlyUnfinishedTemporaries) {
+  // What a signal handler calls: the temporaries of open AtomicFiles (the CLI's and an image
+  // writer's) go; committed files stay.
+  Result<AtomicFile> open = AtomicFile::create(dir_ / "open.txt");
+  ASSERT_TRUE(open.ok());
+  ASSERT_TRUE(writeFileAtomically(dir_ / "done.txt", "done"));
+  Result<ImageFileWriter> image = ImageFileWriter::open(dir_ / "n.png", 4, 4, 1);
+  ASSERT_TRUE(image.ok());
+  EXPECT_EQ(listDirectory(dir_).size(), 3u);  // done.txt and two temporaries
+  removeTemporaryFiles();
+  EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"done.txt"});
+  EXPECT_EQ(readBytes(dir_ / "done.txt"), "done");
+  EXPECT_FALSE(open->commit());  // its temporary is gone: nothing appears at the target
+  EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"done.txt"});
 }
 
 TEST(UdimToken, Expansion) {

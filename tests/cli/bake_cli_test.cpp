@@ -2,7 +2,11 @@
 /// @brief `sgbake bake` and `sgbake convert` as users run them: exit codes, one-line errors that
 /// name the culprit, no output on failure, --explain, the manifest, the one-map shorthand,
 /// --stats, and the default scene.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
@@ -175,6 +179,42 @@ TEST_F(BakeCliTest, FailingBakeLeavesTheExistingOutputByteIdentical) {
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_EQ(readFile(dir_ / "out.png"), "the previous bake");
   EXPECT_EQ(listDirectory(dir_), before);
+}
+
+TEST_F(BakeCliTest, InterruptedBakeLeavesNoTemporaryAndNoOutput) {
+  // A long bake (8192², 4×4 samples) is interrupted with SIGINT once its image's temporary
+  // exists: the process dies of the signal and removes the temporary the library was writing.
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  const std::vector<std::string> args = {SGBAKE_CLI, "bake", "--mesh", (dir_ / "plane.obj").string(),
+                                         "--map", "object-normal", "--size", "8192", "--samples",
+                                         "4", "--no-manifest", "-o", (out / "n.exr").string()};
+  std::vector<char*> argv;
+  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  ASSERT_EQ(::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+
+  // Wait (up to 30 s) for the image's temporary, then a little longer: well inside the bake.
+  bool sawTemporary = false;
+  for (int i = 0; i < 3000 && !sawTemporary; ++i) {
+    for (const std::string& name : listDirectory(out))
+      sawTemporary = sawTemporary || name.find(".tmp-") != std::string::npos;
+    if (!sawTemporary) ::usleep(10000);
+  }
+  ::usleep(300000);
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(sawTemporary);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the bake finished before the signal";
+  EXPECT_EQ(WTERMSIG(status), SIGINT);
+  EXPECT_EQ(listDirectory(out), std::set<std::string>{});  // no temporary, no output
 }
 
 TEST_F(BakeCliTest, BakesAScene) {

@@ -68,14 +68,22 @@ class AtomicFile {
   const std::filesystem::path& tempPath() const { return temp_; }
 
  private:
-  AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd, bool durable)
-      : target_(std::move(target)), temp_(std::move(temp)), fd_(fd), durable_(durable) {}
+  AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd, bool durable);
+  void forgetTemporary() noexcept;
 
   std::filesystem::path target_;
   std::filesystem::path temp_;
   int fd_ = -1;  ///< open descriptor of temp_, or -1 once committed or discarded
   bool durable_ = false;
+  int slot_ = -1;  ///< temp_'s entry in the table removeTemporaryFiles reads, or -1
 };
+
+/// @brief Removes the temporary file of every AtomicFile that is neither committed nor discarded
+/// (in any thread). Async-signal-safe: meant for a handler of SIGINT/SIGTERM, which cannot run
+/// destructors, so that an interrupted program leaves no temporaries behind. The AtomicFiles
+/// themselves stay as they are (their commits will fail).
+/// @note Up to 64 temporaries, of paths up to 4095 bytes, are tracked; others are not removed.
+void removeTemporaryFiles() noexcept;
 
 /// @brief Writes @p bytes to @p target all-or-nothing (AtomicFile::create, write, commit).
 Status writeFileAtomically(const std::filesystem::path& target, std::string_view bytes,
