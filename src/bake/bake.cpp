@@ -397,6 +397,7 @@ Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings)
     static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
     static constexpr float kZero[3] = {0, 0, 0};
     bake_detail::RasterOutput output{kZero, false};
+    output.blank = true;  // allocateImage zero-fills
     using namespace bake_detail;
     switch (settings.map) {
       case MapKind::kTangentNormal:

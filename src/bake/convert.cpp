@@ -126,6 +126,7 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
 
     bake_detail::RasterOutput rasterOutput;
     rasterOutput.keepUncovered = true;
+    rasterOutput.blank = true;  // the coverage was just zero-filled
     bake_detail::rasterize(job, shader, rasterOutput, output);
     return output;
   } catch (const std::bad_alloc&) {

@@ -152,6 +152,10 @@ struct RasterOutput {
   /// Leave the pixels of uncovered texels as they are (convertNormalMap) instead of writing the
   /// background (their coverage is still set to 0).
   bool keepUncovered = false;
+  /// The image was just allocated: its coverage is all +0, and so are its pixels unless
+  /// keepUncovered, so rasterize() writes neither again (one pass over hundreds of MB less) and
+  /// the background only when it is not zero.
+  bool blank = false;
 };
 
 /// @brief Rasterizes @p job into @p image (already sized width × height × image.channels with
@@ -169,6 +173,10 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
   const TriangleBins bins = binTriangles(job);
   const int numBlocks = (H + kRowsPerBlock - 1) / kRowsPerBlock;
 
+  // +0 only: a blank image holds +0, and −0 must still be written.
+  const bool backgroundIsZero =
+      std::all_of(output.background.begin(), output.background.begin() + kC,
+                  [](float v) { return v == 0 && !std::signbit(v); });
   std::vector<double> offsets(static_cast<std::size_t>(N));
   for (int i = 0; i < N; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / N;
 
@@ -188,10 +196,12 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
     };
 
     // Start from "nothing covered": background (unless kept) and coverage 0.
-    for (int y = yBegin; y < yEnd; ++y) {
+    const bool writeCoverage = !output.blank;
+    const bool writeBackground = !output.keepUncovered && !(output.blank && backgroundIsZero);
+    for (int y = yBegin; y < yEnd && (writeCoverage || writeBackground); ++y) {
       for (int x = 0; x < W; ++x) {
-        coverageAt(x, y) = 0;
-        if (!output.keepUncovered) {
+        if (writeCoverage) coverageAt(x, y) = 0;
+        if (writeBackground) {
           float* pixel = pixelAt(x, y);
           for (int c = 0; c < kC; ++c) pixel[c] = output.background[static_cast<std::size_t>(c)];
         }
