@@ -173,8 +173,10 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
   const TriangleBins bins = binTriangles(job);
   const int numBlocks = (H + kRowsPerBlock - 1) / kRowsPerBlock;
 
-  // +0 only: a blank image holds +0, and −0 must still be written.
+  // +0 only: a blank image holds +0, and −0 must still be written. (keepUncovered jobs have no
+  // background.)
   const bool backgroundIsZero =
+      !output.keepUncovered &&
       std::all_of(output.background.begin(), output.background.begin() + kC,
                   [](float v) { return v == 0 && !std::signbit(v); });
   std::vector<double> offsets(static_cast<std::size_t>(N));
