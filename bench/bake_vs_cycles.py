@@ -22,7 +22,8 @@ BSDF.
    --filter bilinear --map tangent-normal --size N --margin M --samples 1 -o OUT.FORMAT
    --stats`, the process's whole wall time (start, mesh and height loading, tangents, bake,
    padding, writing), best of --runs; write_s is taken from the --stats JSON line (stderr),
-   i.e. the time OIIO needed to write that same image. The same again with --threads 1 and
+   i.e. the time OIIO needed to write that same image (on sgbake's writer thread, which
+   compresses the top of the image while the rest is baked). The same again with --threads 1 and
    --threads 2. The output is an 8-bit PNG by default (how normal maps usually ship);
    --bit-depth 16 (sgbake's own default for PNG) makes zlib's serial write ~4.5x slower
    (4096^2: 8.8 s against 1.95 s on the 2-core development machine), --format exr --bit-depth
@@ -36,10 +37,13 @@ Prints one JSON line:
   the 1-minute load average before and after (measure on an idle machine: with the load above
   the core count the figures, above all the scaling, are meaningless) and sgbake's stats of
   the best all-core run.
-"compute" is the work without file I/O: tangents_s + bake_s + pad_s from --stats (else wall -
-load_s - write_s). The scaling target is about the compute: writing a PNG is serial zlib, and
-as total_over_write <= 2 lets writing be up to half the wall time, whole-process scaling could
-never reach 1.8 (wall_scaling is reported too).
+"compute" is the work without file I/O: tangents_s + bake_s + pad_s + convert_s from --stats
+(else wall - load_s - write_s); bake_s excludes the waits for the writer thread. The scaling
+target is about the compute: writing a PNG is serial zlib, and as total_over_write <= 2 lets
+writing be up to half the wall time, whole-process scaling could never reach 1.8
+(wall_scaling is reported too). With two cores the writer thread shares them with the
+compute, so the 2-thread compute gets less than two cores; the library benchmark
+`sgbake_bench_bake` (BM_TangentNormal/threads:1 vs 2, no I/O) measures the kernel alone.
 sgbake runs with --no-manifest: otherwise its incremental manifest would skip every run after
 the first as "up to date".
 With --check the exit status is 1 when a target is missed (or write_s is not reported).
@@ -130,7 +134,8 @@ def time_sgbake(args, work, scale, threads):
 
 def compute_s(wall, stats):
     """The computing part of a run, without file I/O (see the module docstring), or None."""
-    parts = [stats.get(k) for k in ("tangents_s", "bake_s", "pad_s")]
+    parts = [stats.get(k, 0.0 if k == "convert_s" else None)
+             for k in ("tangents_s", "bake_s", "pad_s", "convert_s")]
     if all(isinstance(p, (int, float)) for p in parts):
         return float(sum(parts))
     io = [stats.get(k) for k in ("load_s", "write_s")]

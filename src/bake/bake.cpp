@@ -29,14 +29,15 @@ struct MapInfo {
   std::string_view name;
   int channels;
   bool needsTangents;
+  bool isSigned = false;
 };
 
 constexpr std::array<MapInfo, 8> kMaps{{
     {MapKind::kTangentNormal, "tangent-normal", 3, true},
     {MapKind::kObjectNormal, "object-normal", 3, false},
     {MapKind::kHeight, "height", 1, false},
-    {MapKind::kDerivative, "derivative", 2, false},
-    {MapKind::kSurfaceGradient, "surface-gradient", 3, false},
+    {MapKind::kDerivative, "derivative", 2, false, true},
+    {MapKind::kSurfaceGradient, "surface-gradient", 3, false, true},
     {MapKind::kTangent, "tangent", 3, true},
     {MapKind::kBitangent, "bitangent", 3, true},
     {MapKind::kMask, "mask", 1, false},
@@ -63,6 +64,7 @@ Result<MapKind> parseMapKind(std::string_view name) {
 std::string_view mapKindName(MapKind kind) { return info(kind).name; }
 int mapChannels(MapKind kind) { return info(kind).channels; }
 bool mapNeedsTangents(MapKind kind) { return info(kind).needsTangents; }
+bool isSignedMap(MapKind kind) { return info(kind).isSigned; }
 
 // ---------------------------------------------------------------------------------------------
 // Per-triangle data and heights

@@ -838,6 +838,7 @@ Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneO
   const bool isMask = output.map == MapKind::kMask;
   const bool pushPull = !isMask && output.padding == PaddingMode::kPushPull;
   const int margin = isMask || pushPull ? 0 : std::max(output.margin, 0);
+  const bool signedRange = output.storesSignedRange();
   int rowsWritten = 0;
   Status written = Ok{};
   double padSeconds = 0, convertSeconds = 0;
@@ -855,6 +856,11 @@ Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneO
     start = Clock::now();
     const std::size_t rowTexels = static_cast<std::size_t>(image.width);
     const std::size_t rowValues = rowTexels * static_cast<std::size_t>(image.channels);
+    if (signedRange) {  // [−range, range] → [0, 1] for the integer file
+      const double scale = 0.5 / output.range;
+      for (std::size_t i = first * rowValues; i < (first + rows) * rowValues; ++i)
+        window.pixels[i] = static_cast<float>(scale * window.pixels[i] + 0.5);
+    }
     written = writer->writeRows(
         rowsWritten, ready - rowsWritten,
         std::span<const float>(window.pixels).subspan(first * rowValues, rows * rowValues),

@@ -386,7 +386,7 @@ std::map<std::string, std::string> layerKeysElsewhere(SceneLayerType type) {
 
 const std::vector<std::string> kMapOutputKeys = {
     "map",     "file", "size",  "width", "height", "margin",    "padding",
-    "samples", "uv",   "green", "tile",  "format", "bit_depth", "alpha"};
+    "samples", "uv",   "green", "tile",  "format", "bit_depth", "alpha", "range"};
 const std::vector<std::string> kCornersOutputKeys = {"map", "file"};
 
 // ---- Parsing each part -------------------------------------------------------------------------
@@ -569,8 +569,12 @@ SceneOutput parseOutput(const json& value, const std::string& where,
     }
   }
   if (reader.has("alpha")) output.alpha = reader.boolean("alpha");
+  if (reader.has("range")) output.range = reader.numberAtLeast("range", 0, true);
   if (reader.has("green") && output.map != MapKind::kTangentNormal) {
     fail(where, "key 'green' applies only to tangent-normal maps");
+  }
+  if (reader.has("range") && !isSignedMap(output.map)) {
+    fail(where, "key 'range' applies only to derivative and surface-gradient maps");
   }
   return output;
 }
@@ -701,6 +705,9 @@ std::string checkOutput(const SceneOutput& output) {
   if (output.margin < 0 || output.margin > kMaxBakeSide) {
     return rangeMessage("margin", output.margin, 0, kMaxBakeSide);
   }
+  if (!(output.range > 0) || !std::isfinite(output.range)) {
+    return "range must be a positive number";
+  }
   if (output.samples < 1 || output.samples > kMaxBakeSamples) {
     return rangeMessage("samples", output.samples, 1, kMaxBakeSamples);
   }
@@ -784,6 +791,12 @@ ImageFormat SceneOutput::resolvedFormat() const {
 
 int SceneOutput::resolvedBitDepth() const {
   return bitDepth != 0 ? bitDepth : defaultBitDepth(resolvedFormat(), map);
+}
+
+bool SceneOutput::storesSignedRange() const {
+  if (kind != OutputKind::kMap || !isSignedMap(map)) return false;
+  const ImageFormat f = resolvedFormat();
+  return f == ImageFormat::kPng || (f == ImageFormat::kTiff && resolvedBitDepth() != 32);
 }
 
 namespace {
@@ -913,6 +926,7 @@ std::string outputParametersJson(const SceneOutput& output) {
   j["format"] = imageFormatName(output.resolvedFormat());
   j["bit_depth"] = output.resolvedBitDepth();
   j["alpha"] = output.alpha;
+  if (output.storesSignedRange()) j["range"] = output.range;
   return j.dump();
 }
 

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -52,6 +53,7 @@ struct BakeArguments {
   std::string normalGreen = "opengl";
   int bitDepth = 0;
   bool alpha = false;
+  std::optional<double> range;
 };
 
 constexpr const char* kFooter =
@@ -88,7 +90,8 @@ constexpr const char* kFooter =
     "    size = 1024 (or width and height), margin = 16, padding = extend|push-pull,\n"
     "    samples = 1 (N x N per texel), uv, green = opengl|directx, tile = 1001,\n"
     "    format = png|exr|tiff, bit_depth = 8|16|32 (default 16; 8 for masks in PNG/TIFF),\n"
-    "    alpha = false (coverage as alpha).\n"
+    "    alpha = false (coverage as alpha), range = 1 (derivative and surface-gradient maps\n"
+    "    in PNG/TIFF integers store v / (2 range) + 0.5; EXR and float TIFF store v).\n"
     "  Unknown keys are errors; keys starting with '_' are comments.\n"
     "\n"
     "Incremental:\n"
@@ -111,7 +114,8 @@ constexpr const char* kFooter =
 const char* const kOneMapOptions[] = {
     "--mesh",    "--output",       "--map",          "--size",      "--margin",       "--padding",
     "--samples", "--uv",           "--green",        "--height",    "--height-scale", "--filter",
-    "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha"};
+    "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
+    "--range"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 
@@ -275,6 +279,12 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   output.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
   output.bitDepth = args.bitDepth;
   output.alpha = args.alpha;
+  if (args.range) {
+    if (!isSignedMap(output.map)) {
+      return Error::badInput("bake: --range applies only to derivative and surface-gradient maps");
+    }
+    output.range = *args.range;
+  }
   scene.outputs.push_back(output);
   if (Status valid = validateScene(scene); !valid) {
     return Error::badInput("bake: " + valid.error().message);
@@ -465,6 +475,10 @@ CommandAction defineBakeCommand(CLI::App& app) {
       ->capture_default_str()
       ->group(oneMap);
   app.add_flag("--alpha", args->alpha, "Write the coverage as an alpha channel")->group(oneMap);
+  app.add_option("--range", args->range,
+                 "Derivative/surface-gradient maps in PNG/TIFF store v / (2 R) + 0.5 (default 1)")
+      ->type_name("R")
+      ->group(oneMap);
 
   return [args, &app] { return runBake(*args, app); };
 }

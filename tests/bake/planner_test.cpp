@@ -332,6 +332,37 @@ TEST_F(PlannerTest, ExecutionWritesEveryMapAtItsSize) {
   EXPECT_TRUE(fs::exists(dir_ / "out" / kManifestName));
 }
 
+TEST_F(PlannerTest, SignedMapsInIntegerFilesAreRemappedByTheirRange) {
+  // h = 0.1 · (0.5·u) on the unit plane: ∂h/∂u = 0.05, ∂h/∂v = 0. A 16-bit PNG with range 0.1
+  // stores 0.05 / 0.2 + 0.5 = 0.75 and 0.5; EXR stores the derivatives themselves.
+  bake(planeScene(kHeightLayer, R"({"map": "derivative", "file": "d.png", "size": 16, "range": 0.1},
+                                   {"map": "derivative", "file": "d.exr", "size": 16,
+                                    "bit_depth": 32})"));
+  const auto read = [](const fs::path& path) {
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
+    std::vector<float> pixels;
+    if (!in) {
+      ADD_FAILURE() << path;
+      return pixels;
+    }
+    pixels.resize(static_cast<std::size_t>(in->spec().image_pixels()) * in->spec().nchannels);
+    EXPECT_TRUE(in->read_image(0, 0, 0, in->spec().nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+    return pixels;
+  };
+  const std::vector<float> png = read(dir_ / "d.png"), exr = read(dir_ / "d.exr");
+  ASSERT_EQ(png.size(), std::size_t{16 * 16 * 3});  // R, G and a zero B
+  ASSERT_EQ(exr.size(), std::size_t{16 * 16 * 2});
+  for (int row = 4; row < 12; ++row) {  // away from the wrap of the ramp at the image's edge
+    for (int x = 4; x < 12; ++x) {
+      const std::size_t t = static_cast<std::size_t>(row * 16 + x);
+      EXPECT_NEAR(exr[t * 2], 0.05, 2e-3);
+      EXPECT_NEAR(exr[t * 2 + 1], 0.0, 1e-6);
+      EXPECT_NEAR(png[t * 3], exr[t * 2] / 0.2 + 0.5, 1e-4);
+      EXPECT_NEAR(png[t * 3 + 1], 0.5, 1e-4);
+    }
+  }
+}
+
 TEST_F(PlannerTest, UdimFileNamesBakeEveryTouchedTile) {
   const ExecuteReport report =
       bake(planeScene("", R"({"map": "mask", "file": "m.<UDIM>.png", "size": 8})", "tile1002.obj"));

@@ -302,6 +302,24 @@ TEST(Scene, FormatsAndBitDepths) {
             "scene.json: outputs[0]: key 'green' applies only to tangent-normal maps");
 }
 
+TEST(Scene, SignedMapsTakeARangeForIntegerFiles) {
+  Result<Scene> scene = parseScene(withOutput(
+      R"({"map": "derivative", "file": "d.png", "range": 0.25},
+         {"map": "surface-gradient", "file": "g.exr"},
+         {"map": "surface-gradient", "file": "g.tif", "bit_depth": 32})"), options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->outputs[0].range, 0.25);
+  EXPECT_TRUE(scene->outputs[0].storesSignedRange());
+  EXPECT_EQ(scene->outputs[1].range, 1.0);
+  EXPECT_FALSE(scene->outputs[1].storesSignedRange());  // EXR stores the values
+  EXPECT_FALSE(scene->outputs[2].storesSignedRange());  // so does float TIFF
+  EXPECT_EQ(parseError(withOutput(R"({"map": "height", "file": "h.png", "range": 2})")),
+            "scene.json: outputs[0]: key 'range' applies only to derivative and surface-gradient "
+            "maps");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "derivative", "file": "d.png", "range": 0})")),
+            "scene.json: outputs[0]: range 0 must be greater than 0");
+}
+
 TEST(Scene, InvalidCombinations) {
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "filter": "hermite"})")),
             "scene.json: layers[0]: filter 'hermite' is only available for height images (use "

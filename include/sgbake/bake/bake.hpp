@@ -88,6 +88,10 @@ int mapChannels(MapKind kind);
 /// kTangentNormal, kTangent, kBitangent.
 bool mapNeedsTangents(MapKind kind);
 
+/// @brief Whether the map's values are signed and unbounded (derivative, surface-gradient): an
+/// integer file stores them remapped by a range (SceneOutput::range), not clamped to [0, 1].
+bool isSignedMap(MapKind kind);
+
 /// @brief A float image in memory, rows top first (as files store them), channels interleaved.
 ///
 /// Row r holds the texels with y = H − 1 − r (y counted up from the bottom, v up).

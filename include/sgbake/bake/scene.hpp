@@ -182,6 +182,12 @@ struct SceneOutput {
   ImageFormat format = ImageFormat::kAuto;  ///< "format": exr | png | tiff (default: extension)
   int bitDepth = 0;                         ///< "bit_depth": 8, 16 or 32; 0 = defaultBitDepth
   bool alpha = false;                       ///< "alpha": write the coverage as alpha
+  /// "range": signed maps (derivative, surface-gradient) in integer files (PNG, TIFF 8/16)
+  /// store v / (2·range) + 0.5, so [−range, range] fills the codes; float files store v.
+  double range = 1;
+
+  /// @brief Whether the file stores this output's values remapped by range (see above).
+  bool storesSignedRange() const;
 
   /// @brief The image format the file is written in (format, else from the extension).
   ImageFormat resolvedFormat() const;
