@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "sgbake/mesh/triangulate.hpp"
@@ -76,6 +77,48 @@ bool setupRasterTriangle(const std::array<Vec2d, 3>& texel, int width, int heigh
   triangle.y0 = clampedFloor(minY, 0, height);
   triangle.y1 = clampedFloor(maxY, -1, height - 1);
   return triangle.x0 <= triangle.x1 && triangle.y0 <= triangle.y1;
+}
+
+void rowSpan(const RasterTriangle& tri, int y, std::span<const double> offsets, int& first,
+             int& last) {
+  first = tri.x0;
+  last = tri.x1;
+  if (offsets.empty()) return;
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+  const double maxPx = tri.x1 + 1.0;
+  // Union over the sample rows of the px interval where every edge may be ≥ 0.
+  double unionLo = INFINITY, unionHi = -INFINITY;
+  for (const double offsetY : offsets) {
+    const double py = y + offsetY;
+    double lo = -INFINITY, hi = INFINITY;
+    bool empty = false;
+    for (const EdgeFunction& e : tri.edge) {
+      const double rest = e.b * py + e.c;  // E(px) = a·px + rest
+      // Bound on the rounding of a·px + b·py + c, as a distance along px.
+      const double slack =
+          1 + 4 * kEpsilon * (std::abs(e.a) * maxPx + std::abs(e.b * py) + std::abs(e.c)) /
+                  std::abs(e.a);
+      if (e.a > 0) {
+        lo = std::max(lo, -rest / e.a - slack);
+      } else if (e.a < 0) {
+        hi = std::min(hi, -rest / e.a + slack);
+      } else if (rest < 0) {
+        empty = true;  // a horizontal edge with the row outside (E = rest exactly)
+      }
+    }
+    if (empty) continue;
+    unionLo = std::min(unionLo, lo);
+    unionHi = std::max(unionHi, hi);
+  }
+  if (!(unionLo <= unionHi)) {  // no sample row can be inside (NaN keeps the whole box)
+    if (!std::isnan(unionLo) && !std::isnan(unionHi)) last = first - 1;
+    return;
+  }
+  // px = x + offset ∈ [x + offsets.front(), x + offsets.back()] meets [unionLo, unionHi].
+  const double xLo = std::floor(unionLo - offsets.back());
+  const double xHi = std::floor(unionHi - offsets.front()) + 1;
+  if (xLo > first) first = xLo > last ? last + 1 : static_cast<int>(xLo);
+  if (xHi < last) last = xHi < first ? first - 1 : static_cast<int>(xHi);
 }
 
 TriangleBins binTriangles(const RasterJob& job) {

@@ -70,6 +70,14 @@ struct RasterTriangle {
 bool setupRasterTriangle(const std::array<Vec2d, 3>& texel, int width, int height,
                          RasterTriangle& triangle);
 
+/// @brief The texels [first, last] of row @p y (within the triangle's bounding box) that may
+/// hold a sample inside @p tri, samples being at x + offsets[i], y + offsets[j]: rasterize()
+/// still tests every sample exactly, this only skips texels where no sample can be inside. The
+/// bounds come from solving E(px) = 0 per edge, widened by a texel plus the rounding error of
+/// evaluating E, so no sample the exact test would accept is ever skipped.
+void rowSpan(const RasterTriangle& tri, int y, std::span<const double> offsets, int& first,
+             int& last);
+
 /// @brief Texel-space position of UV @p uv in a width × height bake of tile @p udimTile.
 inline Vec2d uvToTexel(Vec2f uv, int udimTile, int width, int height) {
   const int index = udimTile - kFirstUdimTile;
@@ -231,7 +239,9 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
       if (ya > yb) continue;
       bool begun = false;  // load the shading data only if a sample is inside
       for (int y = ya; y <= yb; ++y) {
-        for (int x = tri.x0; x <= tri.x1; ++x) {
+        int xFirst = 0, xLast = -1;
+        rowSpan(tri, y, offsets, xFirst, xLast);
+        for (int x = xFirst; x <= xLast; ++x) {
           for (int j = 0; j < N; ++j) {
             const double py = y + offsets[static_cast<std::size_t>(j)];
             for (int i = 0; i < N; ++i) {

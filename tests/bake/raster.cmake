@@ -6,3 +6,5 @@ sgbake_add_gtest(bake_raster_tests
   maps_test.cpp
   convert_test.cpp
   padding_test.cpp)
+# rowSpan, a private helper of the raster, is tested directly against the exact inside test.
+target_include_directories(bake_raster_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <random>
 
+#include "bake/raster.hpp"
 #include "bake_test_util.hpp"
 #include "support/parametric_mesh.hpp"
 #include "sgbake/bake/bake.hpp"
@@ -265,6 +266,56 @@ TEST(Raster, OneAndManyThreadsGiveIdenticalBits) {
       EXPECT_EQ(image->coverage, reference.coverage);
     }
   }
+}
+
+TEST(Raster, RowSpansKeepEverySampleTheExactTestAccepts) {
+  // rowSpan only narrows the texels to test; every sample inside the triangle (by the exact
+  // edge functions) must lie in its row's span, for fat, thin, mirrored and nearly horizontal
+  // triangles and 1 to 3 samples per axis, while the spans skip most of the bounding box of a
+  // thin diagonal sliver.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coordinate(-5.0, 70.0);
+  std::size_t tested = 0, spanTexels = 0, boxTexels = 0;
+  for (int t = 0; t < 400; ++t) {
+    std::array<Vec2d, 3> p{Vec2d{coordinate(rng), coordinate(rng)},
+                           Vec2d{coordinate(rng), coordinate(rng)},
+                           Vec2d{coordinate(rng), coordinate(rng)}};
+    if (t % 4 == 1) p[2] = p[0] + 1e-7 * (p[1] - p[0]) + Vec2d{0, 1e-9};  // sliver
+    if (t % 4 == 2) p[1].y = p[0].y + 1e-12;                              // nearly horizontal
+    if (t % 4 == 3) p = {Vec2d{0.3, 0.2}, Vec2d{63.7, 61.9}, Vec2d{1.1 + 0.01 * t, 0.4}};
+    bake_detail::RasterTriangle tri;
+    if (!bake_detail::setupRasterTriangle(p, 64, 64, tri)) continue;
+    for (const int n : {1, 3}) {
+      std::vector<double> offsets;
+      for (int i = 0; i < n; ++i) offsets.push_back((i + 0.5) / n);
+      for (int y = tri.y0; y <= tri.y1; ++y) {
+        int first = 0, last = -1;
+        bake_detail::rowSpan(tri, y, offsets, first, last);
+        ASSERT_GE(first, tri.x0);
+        ASSERT_LE(last, tri.x1);
+        if (t % 4 == 3 && n == 1) {
+          spanTexels += static_cast<std::size_t>(std::max(0, last - first + 1));
+          boxTexels += static_cast<std::size_t>(tri.x1 - tri.x0 + 1);
+        }
+        for (int x = tri.x0; x <= tri.x1; ++x) {
+          for (const double oy : offsets) {
+            for (const double ox : offsets) {
+              const double px = x + ox, py = y + oy;
+              bool inside = true;
+              for (const bake_detail::EdgeFunction& e : tri.edge) inside = inside && e.inside(e(px, py));
+              if (!inside) continue;
+              ++tested;
+              ASSERT_TRUE(x >= first && x <= last)
+                  << "triangle " << t << ", sample (" << px << ", " << py << ") outside the span ["
+                  << first << ", " << last << "]";
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(tested, 10000u);
+  EXPECT_LT(spanTexels * 4, boxTexels);  // the slivers' spans are a small part of their boxes
 }
 
 }  // namespace
