@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <optional>
+
 
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
@@ -56,6 +58,7 @@ class MeshViewAdapter {
   }
   std::uint32_t numVertices() const { return static_cast<std::uint32_t>(mesh_.positions.size()); }
   std::uint32_t vertex(int f, int v) const { return mesh_.cornerVertex[meshCorner(f, v)]; }
+  Vec3f vertexPosition(std::uint32_t u) const { return mesh_.positions[u]; }
   Vec3f position(int f, int v) const { return mesh_.positions[vertex(f, v)]; }
   Vec3f normal(int f, int v) const { return mesh_.cornerNormals[meshCorner(f, v)]; }
   Vec2f uv(int f, int v) const { return mesh_.cornerUvs[meshCorner(f, v)]; }
@@ -67,6 +70,7 @@ class MeshViewAdapter {
   std::vector<std::uint32_t> corner_;
 };
 static_assert(mikk::VertexAdapter<MeshViewAdapter>);
+
 
 }  // namespace
 
@@ -80,26 +84,27 @@ Result<CornerTangents> computeTangents(const MeshView& mesh, const TangentOption
 
   CornerTangents result;
   auto work = [&] {
-    const MeshViewAdapter adapter(mesh);
-    const mikk::Input input = mikk::gather(adapter);
-    mikk::Output output;
-    mikk::generate(input, output);
     result.tangent.resize(nc);
     result.sign.resize(nc);
+    const MeshViewAdapter adapter(mesh);
     if (adapter.identity()) {
-      // Slots are corners.
-      for (std::size_t c = 0; c < nc; ++c) {
-        result.tangent[c] = output.tangent[c];
-        result.sign[c] = output.orientationPreserving[c] ? 1.0f : -1.0f;
-      }
+      // Triangles and quads only: slots are corners, and the algorithm reads and writes the
+      // mesh's and the result's arrays directly.
+      const mikk::Input input{mesh.faceStart, mesh.cornerVertex, mesh.positions, mesh.cornerNormals,
+                              mesh.cornerUvs};
+      mikk::generate(input, {result.tangent, result.sign});
       return;
     }
+    const mikk::GatheredInput input = mikk::gather(adapter);
+    std::vector<Vec3f> tangent(input.vertex.size());
+    std::vector<float> sign(input.vertex.size());
+    mikk::generate(input.view(), {tangent, sign});
     // N-gon corners may appear in several triangles: the last one wins.
     for (int f = 0, slot = 0; f < adapter.numFaces(); ++f) {
       for (int v = 0; v < adapter.faceSize(f); ++v, ++slot) {
         const std::uint32_t c = adapter.meshCorner(f, v);
-        result.tangent[c] = output.tangent[static_cast<std::size_t>(slot)];
-        result.sign[c] = output.orientationPreserving[static_cast<std::size_t>(slot)] ? 1.0f : -1.0f;
+        result.tangent[c] = tangent[static_cast<std::size_t>(slot)];
+        result.sign[c] = sign[static_cast<std::size_t>(slot)];
       }
     }
   };
