@@ -212,6 +212,7 @@ struct ImageFileWriter::State {
   std::vector<std::vector<std::byte>> spare;  ///< written strips' buffers, for reuse
   bool stop = false;      ///< no more strips: the thread exits once the queue is empty
   bool failed = false;    ///< a strip failed to write (the rest are dropped)
+  bool abandoned = false; ///< the writer is destroyed uncommitted: queued strips are dropped
   std::string failure;    ///< OIIO's reason, one line
   double fileSeconds = 0; ///< time inside OIIO (guarded by mutex)
   double waitSeconds = 0; ///< caller's time waiting for the thread
@@ -226,7 +227,7 @@ struct ImageFileWriter::State {
       if (queue.empty()) return;  // stop, and nothing left
       Strip strip = std::move(queue.front());
       queue.pop_front();
-      const bool skip = failed;
+      const bool skip = failed || abandoned;
       lock.unlock();
       changed.notify_all();  // room in the queue
       bool ok = true;
@@ -270,6 +271,10 @@ ImageFileWriter& ImageFileWriter::operator=(ImageFileWriter&&) noexcept = defaul
 
 ImageFileWriter::~ImageFileWriter() {
   if (!state_) return;
+  {
+    std::lock_guard lock(state_->mutex);
+    state_->abandoned = true;  // no use compressing strips of a file that will be removed
+  }
   state_->join();
   if (state_->out) state_->out->close();
   // state_->file is discarded by its destructor: the temporary goes, the target stays.
