@@ -842,20 +842,26 @@ Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneO
   int rowsWritten = 0;
   Status written = Ok{};
   double padSeconds = 0, convertSeconds = 0;
-  FloatImage window;  // the padded rows and their halo, reused from strip to strip
+  FloatImage window;  // padded rows and their halo, reused from strip to strip
   // Pads and queues the rows whose padding is final: all of them once the image is complete.
   auto writeFinalRows = [&](const FloatImage& image, int rowsFinal) {
     if (!written) return;
     const int ready = rowsFinal == image.height ? image.height : rowsFinal - margin;
     if (ready <= rowsWritten) return;
     const std::size_t rows = static_cast<std::size_t>(ready - rowsWritten);
-    Clock::time_point start = Clock::now();
-    const std::size_t first = static_cast<std::size_t>(
-        extendMarginRows(image, margin, rowsWritten, ready, window, threads));
-    padSeconds += secondsSince(start);
-    start = Clock::now();
     const std::size_t rowTexels = static_cast<std::size_t>(image.width);
     const std::size_t rowValues = rowTexels * static_cast<std::size_t>(image.channels);
+    Clock::time_point start = Clock::now();
+    // The rows as written: straight from the image, or from a padded (or remapped) copy.
+    const FloatImage* source = &image;
+    std::size_t first = static_cast<std::size_t>(rowsWritten);
+    if (margin > 0 || signedRange) {
+      first = static_cast<std::size_t>(
+          extendMarginRows(image, margin, rowsWritten, ready, window, threads));
+      source = &window;
+    }
+    padSeconds += secondsSince(start);
+    start = Clock::now();
     if (signedRange) {  // [−range, range] → [0, 1] for the integer file
       const double scale = 0.5 / output.range;
       for (std::size_t i = first * rowValues; i < (first + rows) * rowValues; ++i)
@@ -863,8 +869,8 @@ Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneO
     }
     written = writer->writeRows(
         rowsWritten, ready - rowsWritten,
-        std::span<const float>(window.pixels).subspan(first * rowValues, rows * rowValues),
-        std::span<const float>(window.coverage).subspan(first * rowTexels, rows * rowTexels));
+        std::span<const float>(source->pixels).subspan(first * rowValues, rows * rowValues),
+        std::span<const float>(source->coverage).subspan(first * rowTexels, rows * rowTexels));
     convertSeconds += secondsSince(start);
     rowsWritten = ready;
   };
