@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "support/files.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/io/atomic_file.hpp"
 
@@ -25,6 +26,9 @@ namespace sgbake {
 namespace {
 
 namespace fs = std::filesystem;
+using test::listDirectory;
+using test::readFile;
+using test::writeFile;
 
 /// A fresh, empty directory per test, removed afterwards.
 class ImageOutputTest : public ::testing::Test {
@@ -84,17 +88,6 @@ ReadBack readBack(const fs::path& path) {
       in->read_image(0, 0, 0, result.spec.nchannels, OIIO::TypeDesc::FLOAT, result.pixels.data()));
   in->close();
   return result;
-}
-
-std::string readBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::set<std::string> listDirectory(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
-  return names;
 }
 
 TEST_F(ImageOutputTest, Png16BitReadsBackTopRowFirst) {
@@ -281,7 +274,7 @@ TEST_F(ImageOutputTest, FailedWriteLeavesTheExistingFileAndNoTemporary) {
   EXPECT_FALSE(writeImage(broken, path));
   FloatImage empty;
   EXPECT_FALSE(writeImage(empty, path));
-  EXPECT_EQ(readBytes(path), "previous content");
+  EXPECT_EQ(readFile(path), "previous content");
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.png"});
 }
 
@@ -292,7 +285,7 @@ TEST_F(ImageOutputTest, SuccessfulWriteReplacesTheFileAndLeavesNoTemporary) {
     out << "previous content";
   }
   ASSERT_TRUE(writeImage(rampImage(3, 3, 3), path));
-  EXPECT_NE(readBytes(path), "previous content");
+  EXPECT_NE(readFile(path), "previous content");
   EXPECT_EQ(readBack(path).spec.width, 3);
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.exr"});
 }
@@ -379,7 +372,7 @@ TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
     ASSERT_TRUE(abandoned.ok());
     ASSERT_TRUE(abandoned->writeRows(0, 4, pixels, {}));
   }  // destroyed without commit
-  EXPECT_EQ(readBytes(path), "previous content");
+  EXPECT_EQ(readFile(path), "previous content");
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.png"});
 }
 
@@ -394,7 +387,7 @@ TEST_F(ImageOutputTest, RemoveTemporaryFilesTakesOnlyUnfinishedTemporaries) {
   EXPECT_EQ(listDirectory(dir_).size(), 3u);  // done.txt and two temporaries
   removeTemporaryFiles();
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"done.txt"});
-  EXPECT_EQ(readBytes(dir_ / "done.txt"), "done");
+  EXPECT_EQ(readFile(dir_ / "done.txt"), "done");
   EXPECT_FALSE(open->commit());  // its temporary is gone: nothing appears at the target
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"done.txt"});
 }

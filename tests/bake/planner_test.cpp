@@ -14,6 +14,7 @@
 #include <set>
 #include <string>
 
+#include "support/files.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/bake/planner.hpp"
 #include "sgbake/bake/scene.hpp"
@@ -23,6 +24,9 @@ namespace sgbake {
 namespace {
 
 namespace fs = std::filesystem;
+using test::listDirectory;
+using test::readFile;
+using test::writeFile;
 
 /// A unit square in the plane z = 0 whose UVs equal its x, y: one quad, normal +Z.
 constexpr const char* kPlaneObj =
@@ -38,22 +42,6 @@ constexpr const char* kTile1002Obj =
     "f 1/1 2/2 3/3 4/4\n";
 
 constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-
-std::string readBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-std::set<std::string> listDirectory(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
-  return names;
-}
 
 /// A W×H single-channel image: a ramp in x plus @p bias.
 FloatImage heightImage(int size, float bias = 0) {
@@ -94,9 +82,9 @@ class PlannerTest : public ::testing::Test {
            ("sgbake_planner_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    writeText(dir_ / "plane.obj", kPlaneObj);
-    writeText(dir_ / "tile1002.obj", kTile1002Obj);
-    writeText(dir_ / "nouv.obj", kNoUvObj);
+    writeFile(dir_ / "plane.obj", kPlaneObj);
+    writeFile(dir_ / "tile1002.obj", kTile1002Obj);
+    writeFile(dir_ / "nouv.obj", kNoUvObj);
     ASSERT_TRUE(writeImage(heightImage(16), dir_ / "h.png"));
     ASSERT_TRUE(writeImage(flatNormalImage(16), dir_ / "n.png"));
   }
@@ -104,7 +92,7 @@ class PlannerTest : public ::testing::Test {
 
   /// Parses @p json as the scene file dir_/scene.json.
   Scene scene(const std::string& json) {
-    writeText(dir_ / "scene.json", json);
+    writeFile(dir_ / "scene.json", json);
     Result<Scene> parsed = loadScene(dir_ / "scene.json");
     EXPECT_TRUE(parsed) << parsed.error().message;
     return parsed ? *parsed : Scene{};
@@ -327,7 +315,7 @@ TEST_F(PlannerTest, ExecutionWritesEveryMapAtItsSize) {
   const OIIO::ImageSpec derivative = spec(dir_ / "out/d.tif");
   EXPECT_EQ(derivative.format, OIIO::TypeDesc::FLOAT);
   EXPECT_EQ(derivative.nchannels, 4) << "R, G, zero B, alpha";
-  const std::string csv = readBytes(dir_ / "out/corners.csv");
+  const std::string csv = readFile(dir_ / "out/corners.csv");
   EXPECT_TRUE(csv.starts_with(std::string(kCornerTableHeader) + "\n")) << csv;
   EXPECT_TRUE(fs::exists(dir_ / "out" / kManifestName));
 }
@@ -384,7 +372,7 @@ TEST_F(PlannerTest, ManifestMakesTheSecondRunBakeNothing) {
                        {"map": "mask", "file": "m.png", "size": 8})");
   const ExecuteReport first = bake(json);
   EXPECT_TRUE(first.outputs[0].baked);
-  const std::string bytes = readBytes(dir_ / "h.exr");
+  const std::string bytes = readFile(dir_ / "h.exr");
   const auto written = fs::last_write_time(dir_ / "h.exr");
 
   const Plan second = plan(json);
@@ -397,7 +385,7 @@ TEST_F(PlannerTest, ManifestMakesTheSecondRunBakeNothing) {
   EXPECT_FALSE(report->outputs[0].baked);
   EXPECT_FALSE(report->outputs[1].baked);
   EXPECT_EQ(report->tilesBaked, 0u);
-  EXPECT_EQ(readBytes(dir_ / "h.exr"), bytes);
+  EXPECT_EQ(readFile(dir_ / "h.exr"), bytes);
   EXPECT_EQ(fs::last_write_time(dir_ / "h.exr"), written);
 
   // --force bakes everything again.
@@ -435,23 +423,23 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   fs::remove(dir_ / "m.png");
   EXPECT_FALSE(plan(json).outputs[1].upToDate);
   bake(json);
-  writeText(dir_ / "h.exr", "edited");
+  writeFile(dir_ / "h.exr", "edited");
   EXPECT_FALSE(plan(json).outputs[0].upToDate);
   EXPECT_TRUE(plan(json).outputs[1].upToDate);
 
   // A changed mesh re-bakes everything.
   bake(json);
-  writeText(dir_ / "plane.obj", std::string(kPlaneObj) + "# edited\n");
+  writeFile(dir_ / "plane.obj", std::string(kPlaneObj) + "# edited\n");
   EXPECT_EQ(plan(json).outputsToBake(), 2u);
 
   // A corrupt manifest counts as empty.
   bake(json);
-  writeText(dir_ / kManifestName, "{ not json");
+  writeFile(dir_ / kManifestName, "{ not json");
   EXPECT_EQ(plan(json).outputsToBake(), 2u);
 }
 
 TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
-  writeText(dir_ / "n_out.png", "previous output");
+  writeFile(dir_ / "n_out.png", "previous output");
   const std::set<std::string> before = listDirectory(dir_);
   // A mesh without UVs fails at execution, after planning.
   Result<Plan> p = makePlan(scene(
@@ -460,7 +448,7 @@ TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
   Result<ExecuteReport> report = executePlan(*p);
   ASSERT_FALSE(report);
   EXPECT_EQ(report.error().code, ErrorCode::kBadInput);
-  EXPECT_EQ(readBytes(dir_ / "n_out.png"), "previous output");
+  EXPECT_EQ(readFile(dir_ / "n_out.png"), "previous output");
   std::set<std::string> after = listDirectory(dir_);
   after.erase("scene.json");
   std::set<std::string> expected = before;
@@ -476,7 +464,7 @@ TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
   EXPECT_NE(failed.error().message.find("has 1 UV set(s) but outputs[0] uses UV set 1"),
             std::string::npos)
       << failed.error().message;
-  EXPECT_EQ(readBytes(dir_ / "n_out.png"), "previous output");
+  EXPECT_EQ(readFile(dir_ / "n_out.png"), "previous output");
 }
 
 TEST_F(PlannerTest, ProgressIsReported) {

@@ -22,12 +22,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/files.hpp"
 #include "run_process.hpp"
 
 namespace sgbake {
 namespace {
 
 namespace fs = std::filesystem;
+using test::listDirectory;
+using test::readFile;
+using test::writeFile;
 using test::ProcessResult;
 
 /// A unit square, z = 0, UVs = (x, y).
@@ -37,23 +41,6 @@ constexpr const char* kPlaneObj =
     "vn 0 0 1\n"
     "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
 constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void writeFile(const fs::path& path, const std::string& content) {
-  std::ofstream out(path, std::ios::binary);
-  out << content;
-  ASSERT_TRUE(out.good()) << path;
-}
-
-std::set<std::string> listDirectory(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
-  return names;
-}
 
 void expectOneErrorLine(const ProcessResult& r) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/files.hpp"
 #include "run_process.hpp"
 #include "sgbake/sgbake.h"
 
@@ -24,6 +25,9 @@ namespace sgbake {
 namespace {
 
 namespace fs = std::filesystem;
+using test::listDirectory;
+using test::readFile;
+using test::writeFile;
 using test::ProcessResult;
 
 /// A quad, a triangle and a pentagon sharing edges, with a UV seam on the pentagon: 12 corners.
@@ -40,24 +44,6 @@ constexpr std::size_t kSmallObjFaces = 3;
 
 /// A valid mesh without texture coordinates: tangents cannot be computed.
 constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void writeFile(const fs::path& path, const std::string& content) {
-  std::ofstream out(path, std::ios::binary);
-  out << content;
-  ASSERT_TRUE(out.good()) << path;
-}
-
-/// The names of the entries of @p dir.
-std::set<std::string> listDirectory(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename());
-  return names;
-}
 
 std::vector<std::string> splitLines(const std::string& text) {
   std::vector<std::string> lines;
