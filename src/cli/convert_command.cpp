@@ -159,6 +159,7 @@ Status runConvert(const ConvertArguments& args) {
   writeOptions.format = *format;
   writeOptions.bitDepth = bitDepth;
   writeOptions.alpha = hasAlpha;
+  writeOptions.threads = args.threads;
   if (Status ok = writeImage(toRgb(*converted, hasAlpha), args.output, writeOptions); !ok) {
     return ok;
   }
