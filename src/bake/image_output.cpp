@@ -164,8 +164,8 @@ Status checkShape(int width, int height, int channels, const std::filesystem::pa
   return Ok{};
 }
 
-Status checkImage(const FloatImage& image, const std::filesystem::path& path, bool alpha) {
-  if (Status ok = checkShape(image.width, image.height, image.channels, path); !ok) return ok;
+/// Checks that the image holds the values its shape (checked by ImageFileWriter::open) needs.
+Status checkContents(const FloatImage& image, const std::filesystem::path& path, bool alpha) {
   const std::size_t texels =
       static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   if (image.pixels.size() != texels * static_cast<std::size_t>(image.channels)) {
@@ -180,8 +180,9 @@ Status checkImage(const FloatImage& image, const std::filesystem::path& path, bo
 
 /// Strips writeRows may queue ahead of the writer's thread before it waits.
 constexpr std::size_t kMaxQueuedStrips = 3;
-/// Rows per strip writeImage hands to an ImageFileWriter.
-constexpr int kWriteImageStripRows = 64;
+/// Rows per strip the writer's thread compresses: writeRows splits larger requests, so that
+/// converting one strip overlaps compressing the one before.
+constexpr int kStripRows = 64;
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point start) {
@@ -259,6 +260,11 @@ struct ImageFileWriter::State {
     thread.join();
     waitSeconds += secondsSince(start);
   }
+
+  /// Converts rows [row, row + rows) (in parallel) and queues them for the thread, waiting
+  /// while the queue is full.
+  Status queueStrip(int row, int rows, std::span<const float> pixels,
+                    std::span<const float> coverage);
 
   Error writeFailure() const {
     return fileError(ErrorCode::kInternal, path, "cannot write image (" + failure + ")");
@@ -355,54 +361,75 @@ Status ImageFileWriter::writeRows(int row, int rows, std::span<const float> pixe
                      "rows " + std::to_string(row) + " to " + std::to_string(row + rows) +
                          " do not continue the image or have the wrong size");
   }
-  if (rows == 0) return Ok{};
   s.nextRow = row + rows;
+  const std::size_t imageRowValues = width * static_cast<std::size_t>(layout.imageChannels);
+  for (int first = row; first < row + rows; first += kStripRows) {
+    const int count = std::min(kStripRows, row + rows - first);
+    const std::size_t skipped = static_cast<std::size_t>(first - row);
+    const std::span<const float> stripCoverage =
+        alpha ? coverage.subspan(skipped * width, static_cast<std::size_t>(count) * width)
+              : std::span<const float>{};
+    if (Status ok = s.queueStrip(first, count,
+                                 pixels.subspan(skipped * imageRowValues,
+                                                static_cast<std::size_t>(count) * imageRowValues),
+                                 stripCoverage);
+        !ok) {
+      return ok;
+    }
+  }
+  return Ok{};
+}
 
-  State::Strip strip;
+Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const float> pixels,
+                                          std::span<const float> coverage) {
+  const std::size_t rowTexels = static_cast<std::size_t>(width);
+  const std::size_t texels = static_cast<std::size_t>(rows) * rowTexels;
+  const bool alpha = layout.fileChannels > layout.colourChannels;
+  Strip strip;
   strip.row = row;
   strip.rows = rows;
   const std::size_t values = texels * static_cast<std::size_t>(layout.fileChannels);
   {
-    std::lock_guard lock(s.mutex);  // a buffer the thread is done with: no fresh pages to fault in
-    if (!s.spare.empty()) {
-      strip.data = std::move(s.spare.back());
-      s.spare.pop_back();
+    std::lock_guard lock(mutex);  // a buffer the thread is done with: no fresh pages to fault in
+    if (!spare.empty()) {
+      strip.data = std::move(spare.back());
+      spare.pop_back();
     }
   }
   try {
-    strip.data.resize(values * s.stripType.size());
+    strip.data.resize(values * stripType.size());
   } catch (const std::bad_alloc&) {
-    return fileError(ErrorCode::kInternal, s.path, "out of memory while converting the image");
+    return fileError(ErrorCode::kInternal, path, "out of memory while converting the image");
   }
   // Convert row by row in parallel (the file's thread meanwhile compresses earlier strips).
-  const std::size_t fileRowValues = width * static_cast<std::size_t>(layout.fileChannels);
-  const std::size_t imageRowValues = width * static_cast<std::size_t>(layout.imageChannels);
+  const std::size_t fileRowValues = rowTexels * static_cast<std::size_t>(layout.fileChannels);
+  const std::size_t imageRowValues = rowTexels * static_cast<std::size_t>(layout.imageChannels);
   auto convertRow = [&](std::size_t r) {
     const float* in = pixels.data() + r * imageRowValues;
-    const float* cov = alpha ? coverage.data() + r * width : nullptr;
-    std::byte* out = strip.data.data() + r * fileRowValues * s.stripType.size();
-    if (s.stripType == OIIO::TypeDesc::UINT8) {
-      convertTexels(in, cov, width, layout, 255.0, reinterpret_cast<std::uint8_t*>(out));
-    } else if (s.stripType == OIIO::TypeDesc::UINT16) {
-      convertTexels(in, cov, width, layout, 65535.0, reinterpret_cast<std::uint16_t*>(out));
+    const float* cov = alpha ? coverage.data() + r * rowTexels : nullptr;
+    std::byte* to = strip.data.data() + r * fileRowValues * stripType.size();
+    if (stripType == OIIO::TypeDesc::UINT8) {
+      convertTexels(in, cov, rowTexels, layout, 255.0, reinterpret_cast<std::uint8_t*>(to));
+    } else if (stripType == OIIO::TypeDesc::UINT16) {
+      convertTexels(in, cov, rowTexels, layout, 65535.0, reinterpret_cast<std::uint16_t*>(to));
     } else {
-      convertTexels(in, cov, width, layout, 1.0, reinterpret_cast<float*>(out));
+      convertTexels(in, cov, rowTexels, layout, 1.0, reinterpret_cast<float*>(to));
     }
   };
-  bake_detail::runWithThreads(s.threads, [&] {
+  bake_detail::runWithThreads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, static_cast<std::size_t>(rows), 4),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t r = range.begin(); r != range.end(); ++r) convertRow(r);
                       });
   });
   const Clock::time_point start = Clock::now();
-  std::unique_lock lock(s.mutex);
-  s.changed.wait(lock, [&] { return s.failed || s.queue.size() < kMaxQueuedStrips; });
-  s.waitSeconds += secondsSince(start);
-  if (s.failed) return s.writeFailure();
-  s.queue.push_back(std::move(strip));
+  std::unique_lock lock(mutex);
+  changed.wait(lock, [&] { return failed || queue.size() < kMaxQueuedStrips; });
+  waitSeconds += secondsSince(start);
+  if (failed) return writeFailure();
+  queue.push_back(std::move(strip));
   lock.unlock();
-  s.changed.notify_all();
+  changed.notify_all();
   return Ok{};
 }
 
@@ -429,7 +456,6 @@ double ImageFileWriter::fileSeconds() const {
 }
 
 double ImageFileWriter::waitSeconds() const { return state_->waitSeconds; }
-
 
 Result<ImageFormat> parseImageFormat(std::string_view name) {
   const std::string lower = toLower(name);
@@ -478,26 +504,14 @@ bool formatSupportsBitDepth(ImageFormat format, int bitDepth) {
 
 Status writeImage(const FloatImage& image, const std::filesystem::path& path,
                   const ImageWriteOptions& options) {
-  if (Status ok = checkShape(image.width, image.height, image.channels, path); !ok) return ok;
-  // Format and depth are checked (by open) before the image's contents, as documented.
+  // Format, depth and shape first (by open), then the image's contents, as documented.
   Result<ImageFileWriter> writer =
       ImageFileWriter::open(path, image.width, image.height, image.channels, options);
   if (!writer) return writer.error();
-  if (Status ok = checkImage(image, path, options.alpha); !ok) return ok;
-  const std::size_t rowTexels = static_cast<std::size_t>(image.width);
-  const std::size_t rowValues = rowTexels * static_cast<std::size_t>(image.channels);
-  const std::span<const float> pixels(image.pixels), coverage(image.coverage);
-  for (int row = 0; row < image.height; row += kWriteImageStripRows) {
-    const int rows = std::min(kWriteImageStripRows, image.height - row);
-    const std::size_t r = static_cast<std::size_t>(row), n = static_cast<std::size_t>(rows);
-    const std::span<const float> stripCoverage =
-        options.alpha ? coverage.subspan(r * rowTexels, n * rowTexels) : std::span<const float>{};
-    if (Status ok = writer->writeRows(row, rows, pixels.subspan(r * rowValues, n * rowValues),
-                                      stripCoverage);
-        !ok) {
-      return ok;
-    }
-  }
+  if (Status ok = checkContents(image, path, options.alpha); !ok) return ok;
+  const std::span<const float> coverage =
+      options.alpha ? std::span<const float>(image.coverage) : std::span<const float>{};
+  if (Status ok = writer->writeRows(0, image.height, image.pixels, coverage); !ok) return ok;
   return writer->commit();
 }
 
