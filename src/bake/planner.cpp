@@ -824,8 +824,9 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
 /// padded and written after the bake. Masks are not padded (padding would overwrite the
 /// coverage they show).
 Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneOutput& output,
-                     const fs::path& file, int threads, ExecuteReport& report) {
+                     const fs::path& file, ExecuteReport& report) {
   using Clock = std::chrono::steady_clock;
+  const int threads = settings.threads;
   ImageWriteOptions writeOptions;
   writeOptions.format = output.resolvedFormat();
   writeOptions.bitDepth = output.resolvedBitDepth();
@@ -1042,8 +1043,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         settings.udimTile = tile;
         settings.green = output.green;
         settings.threads = options.threads;
-        if (Status ok = bakeImageTile(input, settings, output, file, options.threads, report);
-            !ok) {
+        if (Status ok = bakeImageTile(input, settings, output, file, report); !ok) {
           return ok.error();
         }
       }
