@@ -15,6 +15,7 @@
 #include <string>
 
 #include "support/files.hpp"
+#include "support/plane_scene.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/bake/planner.hpp"
 #include "sgbake/bake/scene.hpp"
@@ -26,14 +27,12 @@ namespace {
 namespace fs = std::filesystem;
 using test::listDirectory;
 using test::readFile;
+using test::kHeightLayer;
+using test::kNoUvObj;
+using test::kPlaneObj;
+using test::planeScene;
 using test::writeFile;
 
-/// A unit square in the plane z = 0 whose UVs equal its x, y: one quad, normal +Z.
-constexpr const char* kPlaneObj =
-    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-    "vn 0 0 1\n"
-    "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
 
 /// The same square placed in UDIM tile 1002 (u in [1, 2]).
 constexpr const char* kTile1002Obj =
@@ -41,7 +40,6 @@ constexpr const char* kTile1002Obj =
     "vt 1.25 0.25\nvt 1.75 0.25\nvt 1.75 0.75\nvt 1.25 0.75\n"
     "f 1/1 2/2 3/3 4/4\n";
 
-constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
 /// A W×H single-channel image: a ramp in x plus @p bias.
 FloatImage heightImage(int size, float bias = 0) {
@@ -117,14 +115,6 @@ class PlannerTest : public ::testing::Test {
   fs::path dir_;
 };
 
-/// A scene of the plane with @p layers and @p outputs (JSON array contents).
-std::string planeScene(const std::string& layers, const std::string& outputs,
-                       const std::string& mesh = "plane.obj") {
-  return R"({"mesh": ")" + mesh + R"(", "layers": [)" + layers + R"(], "outputs": [)" + outputs +
-         "]}";
-}
-
-constexpr const char* kHeightLayer = R"({"type": "height", "image": "h.png", "scale": 0.1})";
 constexpr const char* kNormalLayer = R"({"type": "normal", "image": "n.png"})";
 
 TEST(Hash, Fnv1a64KnownValues) {

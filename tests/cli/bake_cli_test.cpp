@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/files.hpp"
+#include "support/plane_scene.hpp"
 #include "run_process.hpp"
 
 namespace sgbake {
@@ -31,16 +32,13 @@ namespace {
 namespace fs = std::filesystem;
 using test::listDirectory;
 using test::readFile;
+using test::kHeightLayer;
+using test::kNoUvObj;
+using test::kPlaneObj;
+using test::planeScene;
 using test::writeFile;
 using test::ProcessResult;
 
-/// A unit square, z = 0, UVs = (x, y).
-constexpr const char* kPlaneObj =
-    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-    "vn 0 0 1\n"
-    "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
-constexpr const char* kNoUvObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
 void expectOneErrorLine(const ProcessResult& r) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -101,13 +99,6 @@ class BakeCliTest : public ::testing::Test {
   fs::path dir_;
 };
 
-std::string planeScene(const std::string& layers, const std::string& outputs,
-                       const std::string& mesh = "plane.obj") {
-  return R"({"mesh": ")" + mesh + R"(", "layers": [)" + layers + R"(], "outputs": [)" + outputs +
-         "]}";
-}
-
-constexpr const char* kHeightLayer = R"({"type": "height", "image": "h.png", "scale": 0.1})";
 
 /// Checks that a bad scene exits 2 with one line containing @p expected, creating no file.
 void expectBadScene(const ProcessResult& r, const std::string& expected,
