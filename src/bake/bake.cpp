@@ -1,9 +1,11 @@
-// bakeMap: the map kinds as shaders over the texel raster (raster.hpp), with Blender's per-texel
-// frame (texel_frame.hpp) and the gradient engine's layers.
+// bakeMap: validation, the row-block raster with one of the shaders of shaders.hpp per map kind,
+// and the per-triangle data and heights the shaders read.
 #include "sgbake/bake/bake.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <new>
 #include <string>
@@ -11,9 +13,11 @@
 
 #include "bake/height.hpp"
 #include "bake/raster.hpp"
+#include "bake/shaders.hpp"
 #include "bake/texel_frame.hpp"
 #include "gradient/prepared_uv_frame.hpp"
 #include "sgbake/core/math.hpp"
+#include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/projection.hpp"
 
 namespace sgbake {
@@ -124,10 +128,6 @@ void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
 
 namespace {
 
-bool hasUvSet(const SurfacePoint& point, int uvSet) {
-  return uvSet >= 0 && uvSet < point.numUvSets && uvSet < kMaxUvSets;
-}
-
 double heightOf(const UvHeightSource& s, const SurfacePoint& p) {
   if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return 0;
   const Vec2d st = textureCoordinates(p.uv[static_cast<std::size_t>(s.uvSet)].uv, s.tiling, s.offset);
@@ -173,156 +173,6 @@ double compositeHeight(std::span<const Layer> layers, const SurfacePoint& point)
   return std::isfinite(h) ? h : 0.0;
 }
 
-// ---------------------------------------------------------------------------------------------
-// Shaders (see raster.hpp for the interface)
-// ---------------------------------------------------------------------------------------------
-
-namespace {
-
-/// State every bake shader shares: the mesh, tangents, layers, and the current triangle.
-struct BakeShaderBase {
-  const Mesh* mesh = nullptr;
-  const CornerTangents* tangents = nullptr;
-  std::span<const Layer> layers;
-  int uvSet = 0;
-  NormalMapGreen green = NormalMapGreen::kOpenGL;
-  ShadingTriangle tri;
-  SurfacePoint point;  ///< constant fields set per triangle, the rest per sample
-
-  /// The current triangle's UV frames with their normal-independent eq. 31 terms (unit ∂P/∂u,
-  /// ∂P/∂v, lengths, T̂ × B̂) computed once, for the UV height layers (see gradient()).
-  std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};
-
-  void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
-    loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
-    beginSurfacePoint(tri, point);
-    for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s)
-      preparedUv[s] = gradient_detail::prepareUvFrame(point.uv[s]);
-  }
-  const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
-    return surfacePointAt(tri, b, f, point);
-  }
-
-  /// Γ of a UV height layer: layerGradient(source, p) bit for bit (gradientFromUvDerivatives is
-  /// prepareUvFrame + gradientFromPreparedUvFrame), with the frame prepared per triangle.
-  Vec3d uvHeightGradient(const UvHeightSource& s, const SurfacePoint& p) const {
-    if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return {};
-    const std::size_t set = static_cast<std::size_t>(s.uvSet);
-    const ScalarSample h = s.texture->sample(textureCoordinates(p.uv[set].uv, s.tiling, s.offset));
-    return gradient_detail::gradientFromPreparedUvFrame(
-        preparedUv[set], p.normal, uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
-  }
-
-  /// compositeGradient(layers, p) bit for bit: the same sum in the same order, with UV height
-  /// layers through uvHeightGradient (no per-texel std::visit, no per-texel frame
-  /// normalizations) and the mask looked up only when the layer has one (factor 1 otherwise).
-  Vec3d gradient(const SurfacePoint& p) const {
-    Vec3d gamma{};
-    for (const Layer& layer : layers) {
-      if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-      const double factor = layer.mask.texture == nullptr
-                                ? layer.weight
-                                : layer.weight * layerMask(layer.mask, p);
-      if (factor == 0) continue;  // masked out: the source is not sampled
-      const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-      gamma += factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
-                                             : layerGradient(layer.source, p));
-    }
-    return isFinite(gamma) ? gamma : Vec3d{};
-  }
-
-  /// perturbedNormal(point, layers) in object space: N' = normalize(N − Γ) (eq. 33 with the
-  /// identity cofactor). Equal to resolveNormal(N, Γ) up to the sign of zero components, without
-  /// its identity matrix products and its fallback normalization (computed for every texel).
-  Vec3d perturbed(const Vec3d& b, const TexelFrame& f) {
-    const SurfacePoint& p = pointAt(b, f);
-    return unitOr(p.normal - gradient(p), p.normal);
-  }
-  static void put(const Vec3d& v, double* out) {
-    out[0] = v.x;
-    out[1] = v.y;
-    out[2] = v.z;
-  }
-};
-
-struct TangentNormalShader : BakeShaderBase {
-  static constexpr int kChannels = 3;
-  /// A positive multiple of perturbed(b, f): objectToTangent normalizes its result, and
-  /// normalize(M⁻¹·normalize(v)) = normalize(M⁻¹·v) up to round-off, so N − Γ is passed on as it
-  /// is (one square root and division less per texel) when its squared length is a normal
-  /// positive number; otherwise (zero, underflow, overflow) perturbed()'s normalization with its
-  /// fallback is kept.
-  Vec3d unnormalizedPerturbed(const Vec3d& b, const TexelFrame& f) {
-    const SurfacePoint& p = pointAt(b, f);
-    const Vec3d v = p.normal - gradient(p);
-    const double len2 = lengthSquared(v);
-    if (len2 >= std::numeric_limits<double>::min() && std::isfinite(len2)) return v;
-    return normalizeOr(v, p.normal);
-  }
-  void shade(const Vec3d& b, int, int, double* out) {
-    const TexelFrame f = texelFrame(tri, b);
-    const Vec3d normal = layers.empty() ? unitNormal(tri, f) : unnormalizedPerturbed(b, f);
-    Vec3d n = objectToTangent(f, normal);
-    if (green == NormalMapGreen::kDirectX) n.y = -n.y;
-    put(encodeNormal(n), out);
-  }
-};
-
-struct ObjectNormalShader : BakeShaderBase {
-  static constexpr int kChannels = 3;
-  void shade(const Vec3d& b, int, int, double* out) {
-    const TexelFrame f = texelFrame(tri, b);
-    put(encodeNormal(layers.empty() ? unitNormal(tri, f) : perturbed(b, f)), out);
-  }
-};
-
-struct HeightShader : BakeShaderBase {
-  static constexpr int kChannels = 1;
-  void shade(const Vec3d& b, int, int, double* out) {
-    const TexelFrame f = texelFrame(tri, b);
-    out[0] = compositeHeight(layers, pointAt(b, f));
-  }
-};
-
-struct DerivativeShader : BakeShaderBase {
-  static constexpr int kChannels = 2;
-  void shade(const Vec3d& b, int, int, double* out) {
-    const TexelFrame f = texelFrame(tri, b);
-    const Vec3d gamma = gradient(pointAt(b, f));
-    out[0] = dot(gamma, tri.bakeDPdu);
-    out[1] = dot(gamma, tri.bakeDPdv);
-  }
-};
-
-struct SurfaceGradientShader : BakeShaderBase {
-  static constexpr int kChannels = 3;
-  void shade(const Vec3d& b, int, int, double* out) {
-    const TexelFrame f = texelFrame(tri, b);
-    put(gradient(pointAt(b, f)), out);
-  }
-};
-
-struct TangentShader : BakeShaderBase {
-  static constexpr int kChannels = 3;
-  void shade(const Vec3d& b, int, int, double* out) {
-    put(encodeNormal(normalizeOr(texelFrame(tri, b).tangent, Vec3d{})), out);
-  }
-};
-
-struct BitangentShader : BakeShaderBase {
-  static constexpr int kChannels = 3;
-  void shade(const Vec3d& b, int, int, double* out) {
-    put(encodeNormal(normalizeOr(texelFrame(tri, b).bitangent, Vec3d{})), out);
-  }
-};
-
-struct MaskShader {
-  static constexpr int kChannels = 1;
-  void beginTriangle(const std::array<std::uint32_t, 3>&) {}
-  void shade(const Vec3d&, int, int, double* out) const { out[0] = 1; }
-};
-
-}  // namespace
 }  // namespace bake_detail
 
 // ---------------------------------------------------------------------------------------------

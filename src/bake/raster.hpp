@@ -16,6 +16,11 @@
 ///
 /// Each row block gets its own copy of the shader (so shaders may keep per-triangle state), and
 /// no shader call is virtual: the per-sample path is inlined into the raster loop.
+///
+/// A shader may also shade samples in batches (BatchShader): it then gets up to
+/// SampleBatch::kMax covered samples of one triangle at a time, in the order shade() would have
+/// seen them, and must give each the values shade() gives it, bit for bit (a batch is only a
+/// way to let the compiler compute several samples with one vector instruction).
 #pragma once
 
 #include <tbb/blocked_range.h>
@@ -84,6 +89,22 @@ inline Vec2d uvToTexel(Vec2f uv, int udimTile, int width, int height) {
   return {(static_cast<double>(uv.x) - static_cast<double>(index % 10)) * width,
           (static_cast<double>(uv.y) - static_cast<double>(index / 10)) * height};
 }
+
+/// @brief Covered samples of one triangle, handed to a BatchShader together: barycentrics and
+/// texel per sample, as separate arrays (so that loops over the samples vectorize).
+struct SampleBatch {
+  static constexpr int kMax = 64;
+  int count = 0;
+  std::array<double, kMax> b0, b1, b2;
+  std::array<int, kMax> x, y;
+};
+
+/// @brief A shader that also has shadeBatch(batch, out): the kChannels values of sample i to
+/// out[i·kChannels …], equal to shade(bary_i, x_i, y_i, …).
+template <class S>
+concept BatchShader = requires(S& shader, const SampleBatch& batch, double* out) {
+  shader.shadeBatch(batch, out);
+};
 
 /// @brief What to rasterize: the triangles, where their corners sit in the image, and how.
 struct RasterJob {
@@ -227,7 +248,31 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
     }
 
     Shader shader = prototype;
-    double value[kC];
+    // A covered sample's values into the image (one sample per texel) or the block's sums.
+    auto store = [&](int x, int y, const double* v) {
+      if (N == 1) {  // each texel has one sample, claimed once: store it
+        float* pixel = pixelAt(x, y);
+        for (int c = 0; c < kC; ++c) pixel[c] = static_cast<float>(v[c]);
+        coverageAt(x, y) = 1;
+      } else {
+        const std::size_t local = static_cast<std::size_t>(y - yBegin) * W + x;
+        for (int c = 0; c < kC; ++c) (*sums)[local * kC + c] += v[c];
+        ++(*counts)[local];
+      }
+    };
+    constexpr bool kBatched = BatchShader<Shader>;
+    SampleBatch batch;
+    std::array<double, kBatched ? SampleBatch::kMax * kC : 1> batchValues;
+    auto flush = [&] {
+      if constexpr (kBatched) {
+        if (batch.count == 0) return;
+        shader.shadeBatch(batch, batchValues.data());
+        for (int i = 0; i < batch.count; ++i)
+          store(batch.x[static_cast<std::size_t>(i)], batch.y[static_cast<std::size_t>(i)],
+                batchValues.data() + static_cast<std::size_t>(i) * kC);
+        batch.count = 0;
+      }
+    };
     for (std::uint32_t k = bins.start[block]; k < bins.start[block + 1]; ++k) {
       const std::array<std::uint32_t, 3>& corners = job.triangles[bins.index[k]];
       RasterTriangle tri;
@@ -261,20 +306,24 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
               const double inv = sum > 0 ? 1 / sum : 0;
               const Vec3d bary = sum > 0 ? Vec3d{e0 * inv, e1 * inv, e2 * inv}
                                          : Vec3d{1.0 / 3, 1.0 / 3, 1.0 / 3};
-              shader.shade(bary, x, y, value);
-              if (N == 1) {  // each texel has one sample, claimed once: store it
-                float* pixel = pixelAt(x, y);
-                for (int c = 0; c < kC; ++c) pixel[c] = static_cast<float>(value[c]);
-                coverageAt(x, y) = 1;
+              if constexpr (kBatched) {
+                const std::size_t lane = static_cast<std::size_t>(batch.count++);
+                batch.b0[lane] = bary.x;
+                batch.b1[lane] = bary.y;
+                batch.b2[lane] = bary.z;
+                batch.x[lane] = x;
+                batch.y[lane] = y;
+                if (batch.count == SampleBatch::kMax) flush();
               } else {
-                const std::size_t local = static_cast<std::size_t>(y - yBegin) * W + x;
-                for (int c = 0; c < kC; ++c) (*sums)[local * kC + c] += value[c];
-                ++(*counts)[local];
+                double value[kC];
+                shader.shade(bary, x, y, value);
+                store(x, y, value);
               }
             }
           }
         }
       }
+      flush();  // the rest of this triangle's samples, before the next triangle begins
     }
 
     if (N > 1) {  // mean of the covered samples, coverage = covered / N²

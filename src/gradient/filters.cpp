@@ -407,28 +407,53 @@ Result<ImageScalarTexture> ImageScalarTexture::createWithDerivatives(
   return texture;
 }
 
+template <class Body>
+void ImageScalarTexture::withKernel(const Body& body) const {
+  switch (filter_) {
+    case Filter::kBilinear:
+      body([this](int cellX, double fx, int cellY, double fy) {
+        return bilinear<1>(plane_.data(), width_, height_, wrap_, cellX, fx, cellY, fy);
+      });
+      break;
+    case Filter::kBicubic:
+      body([this](int cellX, double fx, int cellY, double fy) {
+        return bicubic<1>(plane_.data(), width_, height_, wrap_, cellX, fx, cellY, fy);
+      });
+      break;
+    case Filter::kHermite:
+      body([this](int cellX, double fx, int cellY, double fy) {
+        return hermite(hermite_.data(), width_, height_, wrap_, cellX, fx, cellY, fy);
+      });
+      break;
+  }
+}
+
 ScalarSample ImageScalarTexture::evaluate(int cellX, double fx, double scaleX, int cellY, double fy,
                                           double scaleY) const {
   Filtered<1> f;
-  switch (filter_) {
-    case Filter::kBilinear:
-      f = bilinear<1>(plane_.data(), width_, height_, wrap_, cellX, fx, cellY, fy);
-      break;
-    case Filter::kBicubic:
-      f = bicubic<1>(plane_.data(), width_, height_, wrap_, cellX, fx, cellY, fy);
-      break;
-    case Filter::kHermite:
-      f = hermite(hermite_.data(), width_, height_, wrap_, cellX, fx, cellY, fy);
-      break;
-  }
+  withKernel([&](const auto& kernel) { f = kernel(cellX, fx, cellY, fy); });
   return {f.value[0], {f.du[0] * scaleX, f.dv[0] * scaleY}};
 }
 
 ScalarSample ImageScalarTexture::sample(Vec2d st) const {
-  if (!std::isfinite(st.x) || !std::isfinite(st.y)) return {kNaN, {kNaN, kNaN}};
-  const AxisPosition px = locate(st.x, width_, wrap_);
-  const AxisPosition py = locate(st.y, height_, wrap_);
-  return evaluate(px.cell, px.frac, px.scale, py.cell, py.frac, py.scale);
+  ScalarSample out;
+  sampleMany({&st, 1}, {&out, 1});
+  return out;
+}
+
+void ImageScalarTexture::sampleMany(std::span<const Vec2d> st, std::span<ScalarSample> out) const {
+  withKernel([&](const auto& kernel) {
+    for (std::size_t i = 0; i < st.size() && i < out.size(); ++i) {
+      if (!std::isfinite(st[i].x) || !std::isfinite(st[i].y)) {
+        out[i] = {kNaN, {kNaN, kNaN}};
+        continue;
+      }
+      const AxisPosition px = locate(st[i].x, width_, wrap_);
+      const AxisPosition py = locate(st[i].y, height_, wrap_);
+      const Filtered<1> f = kernel(px.cell, px.frac, py.cell, py.frac);
+      out[i] = {f.value[0], {f.du[0] * px.scale, f.dv[0] * py.scale}};
+    }
+  });
 }
 
 ScalarSample ImageScalarTexture::sampleCell(int cellX, int cellY, Vec2d fraction) const {

@@ -46,6 +46,7 @@
 /// they need at creation (float32); the Image may be destroyed afterwards.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "sgbake/core/result.hpp"
@@ -143,6 +144,11 @@ class ImageScalarTexture final : public ScalarTexture {
   /// @note Non-finite @p st gives a NaN value and gradient.
   ScalarSample sample(Vec2d st) const override;
 
+  /// @brief sample() at every point of @p st into @p out (the same size), bit for bit: one
+  /// dispatch on the filter for the whole batch instead of a virtual call and a switch per point
+  /// (the baker samples a batch of texels at once).
+  void sampleMany(std::span<const Vec2d> st, std::span<ScalarSample> out) const;
+
   /// @brief The polynomial piece of cell (cellX, cellY) at fractional position @p fraction.
   ///
   /// sample() is sampleCell() of the cell containing the point. Evaluating two neighbouring
@@ -169,6 +175,10 @@ class ImageScalarTexture final : public ScalarTexture {
   // where kClamp holds the position at the border).
   ScalarSample evaluate(int cellX, double fx, double scaleX, int cellY, double fy,
                         double scaleY) const;
+  // Calls body(kernel) with kernel(cellX, fx, cellY, fy) the filter's piece of a cell (one
+  // switch on the filter per call; defined and instantiated in filters.cpp only).
+  template <class Body>
+  void withKernel(const Body& body) const;
 
   int width_ = 0;
   int height_ = 0;

@@ -1,0 +1,358 @@
+/// @file shaders.hpp
+/// @brief Private: the map kinds as shaders over the texel raster (raster.hpp), with Blender's
+/// per-texel frame (texel_frame.hpp) and the gradient engine's layers. bakeMap (bake.cpp) runs
+/// them; the raster tests compare the lane-parallel TangentNormalShader::shadeBatch with its
+/// per-sample shade() bit for bit.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <variant>
+
+#include "bake/height.hpp"
+#include "bake/raster.hpp"
+#include "bake/texel_frame.hpp"
+#include "gradient/prepared_uv_frame.hpp"
+#include "sgbake/core/math.hpp"
+#include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/layers.hpp"
+
+namespace sgbake::bake_detail {
+
+/// Whether @p point carries UV set @p uvSet.
+inline bool hasUvSet(const SurfacePoint& point, int uvSet) {
+  return uvSet >= 0 && uvSet < point.numUvSets && uvSet < kMaxUvSets;
+}
+
+/// State every bake shader shares: the mesh, tangents, layers, and the current triangle.
+struct BakeShaderBase {
+  const Mesh* mesh = nullptr;
+  const CornerTangents* tangents = nullptr;
+  std::span<const Layer> layers;
+  int uvSet = 0;
+  NormalMapGreen green = NormalMapGreen::kOpenGL;
+  ShadingTriangle tri;
+  SurfacePoint point;  ///< constant fields set per triangle, the rest per sample
+
+  /// The current triangle's UV frames with their normal-independent eq. 31 terms (unit ∂P/∂u,
+  /// ∂P/∂v, lengths, T̂ × B̂) computed once, for the UV height layers (see gradient()).
+  std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};
+
+  void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
+    loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+    beginSurfacePoint(tri, point);
+    for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s)
+      preparedUv[s] = gradient_detail::prepareUvFrame(point.uv[s]);
+  }
+  const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
+    return surfacePointAt(tri, b, f, point);
+  }
+
+  /// Γ of a UV height layer: layerGradient(source, p) bit for bit (gradientFromUvDerivatives is
+  /// prepareUvFrame + gradientFromPreparedUvFrame), with the frame prepared per triangle.
+  Vec3d uvHeightGradient(const UvHeightSource& s, const SurfacePoint& p) const {
+    if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return {};
+    const std::size_t set = static_cast<std::size_t>(s.uvSet);
+    const ScalarSample h = s.texture->sample(textureCoordinates(p.uv[set].uv, s.tiling, s.offset));
+    return gradient_detail::gradientFromPreparedUvFrame(
+        preparedUv[set], p.normal, uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
+  }
+
+  /// compositeGradient(layers, p) bit for bit: the same sum in the same order, with UV height
+  /// layers through uvHeightGradient (no per-texel std::visit, no per-texel frame
+  /// normalizations) and the mask looked up only when the layer has one (factor 1 otherwise).
+  Vec3d gradient(const SurfacePoint& p) const {
+    Vec3d gamma{};
+    for (const Layer& layer : layers) {
+      if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+      const double factor = layer.mask.texture == nullptr
+                                ? layer.weight
+                                : layer.weight * layerMask(layer.mask, p);
+      if (factor == 0) continue;  // masked out: the source is not sampled
+      const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+      gamma += factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
+                                             : layerGradient(layer.source, p));
+    }
+    return isFinite(gamma) ? gamma : Vec3d{};
+  }
+
+  /// perturbedNormal(point, layers) in object space: N' = normalize(N − Γ) (eq. 33 with the
+  /// identity cofactor). Equal to resolveNormal(N, Γ) up to the sign of zero components, without
+  /// its identity matrix products and its fallback normalization (computed for every texel).
+  Vec3d perturbed(const Vec3d& b, const TexelFrame& f) {
+    const SurfacePoint& p = pointAt(b, f);
+    return unitOr(p.normal - gradient(p), p.normal);
+  }
+  static void put(const Vec3d& v, double* out) {
+    out[0] = v.x;
+    out[1] = v.y;
+    out[2] = v.z;
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Lane-parallel shading (SampleBatch): the scalar shader's arithmetic, the same operations in the
+// same order, on arrays of samples, so that the compiler computes two at a time (SSE) and the
+// per-sample branches become selects. Samples that need a rare fallback (a vector that cannot be
+// normalized the common way) are flagged and shaded again by the scalar shade().
+
+using Lanes = std::array<double, SampleBatch::kMax>;
+/// Per-lane flags as 64-bit integers: as wide as the doubles beside them, so that a loop that
+/// sets flags vectorizes with two lanes per instruction like the arithmetic.
+using LaneFlags = std::array<std::int64_t, SampleBatch::kMax>;
+struct Lanes3 {
+  Lanes x, y, z;
+};
+
+/// x is finite (and not NaN), written so that loops over lanes vectorize. (The lane loops
+/// combine conditions with & and |, not && and ||, for the same reason: no branches.)
+inline bool finiteLane(double x) { return std::abs(x) <= std::numeric_limits<double>::max(); }
+
+/// texelFrame() and unitNormal() of every sample: T, N, B and N̂ = N/|N|; slow[i] when N̂ needs
+/// unitOr's fallback (|N|² zero, subnormal-small or not finite).
+inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, Lanes3& T, Lanes3& N,
+                             Lanes3& B, Lanes3& unitN, LaneFlags& slow) {
+  const Vec3d T0 = t.tangent[0], T1 = t.tangent[1], T2 = t.tangent[2];
+  const Vec3d N0 = t.normal[0], N1 = t.normal[1], N2 = t.normal[2];
+  const double s0 = t.sign[0], s1 = t.sign[1], s2 = t.sign[2];
+  for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i) {
+    const double b0 = s.b0[i], b1 = s.b1[i], b2 = s.b2[i];
+    const double tx = b0 * T0.x + b1 * T1.x + b2 * T2.x;
+    const double ty = b0 * T0.y + b1 * T1.y + b2 * T2.y;
+    const double tz = b0 * T0.z + b1 * T1.z + b2 * T2.z;
+    const double nx = b0 * N0.x + b1 * N1.x + b2 * N2.x;
+    const double ny = b0 * N0.y + b1 * N1.y + b2 * N2.y;
+    const double nz = b0 * N0.z + b1 * N1.z + b2 * N2.z;
+    const double sign = (b0 * s0 + b1 * s1 + b2 * s2) < 0 ? -1.0 : 1.0;
+    T.x[i] = tx;
+    T.y[i] = ty;
+    T.z[i] = tz;
+    N.x[i] = nx;
+    N.y[i] = ny;
+    N.z[i] = nz;
+    B.x[i] = sign * (ny * tz - nz * ty);  // sign · N × T
+    B.y[i] = sign * (nz * tx - nx * tz);
+    B.z[i] = sign * (nx * ty - ny * tx);
+    const double len2 = nx * nx + ny * ny + nz * nz;
+    const double inv = 1 / std::sqrt(len2);
+    unitN.x[i] = inv * nx;
+    unitN.y[i] = inv * ny;
+    unitN.z[i] = inv * nz;
+    slow[i] = !((len2 > 0) & finiteLane(len2));
+  }
+}
+
+/// uvHeightGradient() of an unmasked UV height layer for every sample, added as gamma += factor·Γ.
+inline void batchUvHeightGradient(const ShadingTriangle& t, const SampleBatch& s,
+                                  const UvHeightSource& src,
+                                  const gradient_detail::PreparedUvFrame& frame, double factor,
+                                  const Lanes3& unitN, Lanes3& gamma) {
+  const std::size_t n = static_cast<std::size_t>(s.count);
+  Lanes3 layer{};
+  const bool hasSet = src.texture != nullptr && src.uvSet >= 0 && src.uvSet < t.numUvSets &&
+                      src.uvSet < kMaxUvSets;
+  if (hasSet && frame.valid) {
+    const std::size_t set = static_cast<std::size_t>(src.uvSet);
+    const Vec2d uv0 = t.uv[set][0], uv1 = t.uv[set][1], uv2 = t.uv[set][2];
+    std::array<Vec2d, SampleBatch::kMax> st;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2d uv{s.b0[i] * uv0.x + s.b1[i] * uv1.x + s.b2[i] * uv2.x,
+                     s.b0[i] * uv0.y + s.b1[i] * uv1.y + s.b2[i] * uv2.y};
+      st[i] = textureCoordinates(uv, src.tiling, src.offset);
+    }
+    std::array<ScalarSample, SampleBatch::kMax> h;
+    if (const auto* image = dynamic_cast<const ImageScalarTexture*>(src.texture)) {
+      image->sampleMany({st.data(), n}, {h.data(), n});
+    } else {
+      for (std::size_t i = 0; i < n; ++i) h[i] = src.texture->sample(st[i]);
+    }
+    // gradientFromPreparedUvFrame with dhduv = uvDerivativesFromTexture(h, tiling, scale).
+    const double ku = src.scale * src.tiling.x, kv = src.scale * src.tiling.y;
+    const double tolerance = gradient_detail::guardedTolerance(src.minFrameSine);
+    const Vec3d ft = frame.t, fb = frame.b, tb = frame.tCrossB;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double nx = unitN.x[i], ny = unitN.y[i], nz = unitN.z[i];
+      const double det = tb.x * nx + tb.y * ny + tb.z * nz;
+      const double du = ku * h[i].gradient.x / frame.lengthT;
+      const double dv = kv * h[i].gradient.y / frame.lengthB;
+      const double inv = 1 / det;
+      const double gx = inv * (du * (fb.y * nz - fb.z * ny) + dv * (ny * ft.z - nz * ft.y));
+      const double gy = inv * (du * (fb.z * nx - fb.x * nz) + dv * (nz * ft.x - nx * ft.z));
+      const double gz = inv * (du * (fb.x * ny - fb.y * nx) + dv * (nx * ft.y - ny * ft.x));
+      const bool keep = (std::abs(det) >= tolerance) & finiteLane(gx) & finiteLane(gy) &
+                        finiteLane(gz);
+      layer.x[i] = keep ? gx : 0.0;
+      layer.y[i] = keep ? gy : 0.0;
+      layer.z[i] = keep ? gz : 0.0;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    gamma.x[i] = gamma.x[i] + factor * layer.x[i];
+    gamma.y[i] = gamma.y[i] + factor * layer.y[i];
+    gamma.z[i] = gamma.z[i] + factor * layer.z[i];
+  }
+}
+
+struct TangentNormalShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  /// A positive multiple of perturbed(b, f): objectToTangent normalizes its result, and
+  /// normalize(M⁻¹·normalize(v)) = normalize(M⁻¹·v) up to round-off, so N − Γ is passed on as it
+  /// is (one square root and division less per texel) when its squared length is a normal
+  /// positive number; otherwise (zero, underflow, overflow) perturbed()'s normalization with its
+  /// fallback is kept.
+  Vec3d unnormalizedPerturbed(const Vec3d& b, const TexelFrame& f) {
+    const SurfacePoint& p = pointAt(b, f);
+    const Vec3d v = p.normal - gradient(p);
+    const double len2 = lengthSquared(v);
+    if (len2 >= std::numeric_limits<double>::min() && std::isfinite(len2)) return v;
+    return normalizeOr(v, p.normal);
+  }
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    const Vec3d normal = layers.empty() ? unitNormal(tri, f) : unnormalizedPerturbed(b, f);
+    Vec3d n = objectToTangent(f, normal);
+    if (green == NormalMapGreen::kDirectX) n.y = -n.y;
+    put(encodeNormal(n), out);
+  }
+
+  /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames).
+  void shadeBatch(const SampleBatch& s, double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
+    Lanes3 T, N, B, unitN;
+    LaneFlags slow;
+    batchTexelFrames(tri, s, T, N, B, unitN, slow);
+
+    // The normal to express in tangent space: N̂, or N̂ − Γ (unnormalizedPerturbed).
+    Lanes3 v = unitN;
+    if (!layers.empty()) {
+      Lanes3 gamma{};
+      for (const Layer& layer : layers) {
+        if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+        const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+        if (uvHeight != nullptr && layer.mask.texture == nullptr) {
+          const std::size_t set = static_cast<std::size_t>(std::clamp(uvHeight->uvSet, 0, kMaxUvSets - 1));
+          batchUvHeightGradient(tri, s, *uvHeight, preparedUv[set], layer.weight, unitN, gamma);
+          continue;
+        }
+        // Any other layer: the scalar SurfacePoint path, sample by sample (gradient()'s body).
+        for (std::size_t i = 0; i < n; ++i) {
+          const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
+          const SurfacePoint& p = pointAt(b, texelFrame(tri, b));
+          const double factor = layer.mask.texture == nullptr
+                                    ? layer.weight
+                                    : layer.weight * layerMask(layer.mask, p);
+          if (factor == 0) continue;
+          const Vec3d g = factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
+                                                         : layerGradient(layer.source, p));
+          gamma.x[i] = gamma.x[i] + g.x;
+          gamma.y[i] = gamma.y[i] + g.y;
+          gamma.z[i] = gamma.z[i] + g.z;
+        }
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        const bool finite = finiteLane(gamma.x[i]) & finiteLane(gamma.y[i]) & finiteLane(gamma.z[i]);
+        const double vx = unitN.x[i] - (finite ? gamma.x[i] : 0.0);
+        const double vy = unitN.y[i] - (finite ? gamma.y[i] : 0.0);
+        const double vz = unitN.z[i] - (finite ? gamma.z[i] : 0.0);
+        const double len2 = vx * vx + vy * vy + vz * vz;
+        v.x[i] = vx;
+        v.y[i] = vy;
+        v.z[i] = vz;
+        slow[i] = slow[i] | !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2));
+      }
+    }
+
+    // objectToTangent(f, v), the green convention and encodeNormal.
+    constexpr double kMinDet = kMinTexelFrameSine * kMinTexelFrameSine;
+    const double greenSign = green == NormalMapGreen::kDirectX ? -1.0 : 1.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double tx = T.x[i], ty = T.y[i], tz = T.z[i];
+      const double nx = N.x[i], ny = N.y[i], nz = N.z[i];
+      const double bx = B.x[i], by = B.y[i], bz = B.z[i];
+      const double r0x = by * nz - bz * ny, r0y = bz * nx - bx * nz, r0z = bx * ny - by * nx;
+      const double r1x = ny * tz - nz * ty, r1y = nz * tx - nx * tz, r1z = nx * ty - ny * tx;
+      const double r2x = ty * bz - tz * by, r2y = tz * bx - tx * bz, r2z = tx * by - ty * bx;
+      const double det = tx * r0x + ty * r0y + tz * r0z;
+      const double lenT2 = tx * tx + ty * ty + tz * tz;
+      const double lenN2 = nx * nx + ny * ny + nz * nz;
+      const bool flat = !(std::abs(det) > kMinDet * lenT2 * lenN2);
+      const double sd = det < 0 ? -1.0 : 1.0;
+      const double vx = v.x[i], vy = v.y[i], vz = v.z[i];
+      const double wx = sd * (r0x * vx + r0y * vy + r0z * vz);
+      const double wy = sd * (r1x * vx + r1y * vy + r1z * vz);
+      const double wz = sd * (r2x * vx + r2y * vy + r2z * vz);
+      const double len2 = wx * wx + wy * wy + wz * wz;
+      const double inv = 1 / std::sqrt(len2);
+      slow[i] = slow[i] | (!flat & !((len2 > 0) & finiteLane(len2)));
+      const double ox = flat ? 0.0 : inv * wx;
+      const double oy = flat ? 0.0 : inv * wy;
+      const double oz = flat ? 1.0 : inv * wz;
+      out[3 * i] = 0.5 * ox + 0.5;
+      out[3 * i + 1] = 0.5 * (greenSign * oy) + 0.5;
+      out[3 * i + 2] = 0.5 * oz + 0.5;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 3 * i);
+  }
+};
+
+struct ObjectNormalShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    put(encodeNormal(layers.empty() ? unitNormal(tri, f) : perturbed(b, f)), out);
+  }
+};
+
+struct HeightShader : BakeShaderBase {
+  static constexpr int kChannels = 1;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    out[0] = compositeHeight(layers, pointAt(b, f));
+  }
+};
+
+struct DerivativeShader : BakeShaderBase {
+  static constexpr int kChannels = 2;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    const Vec3d gamma = gradient(pointAt(b, f));
+    out[0] = dot(gamma, tri.bakeDPdu);
+    out[1] = dot(gamma, tri.bakeDPdv);
+  }
+};
+
+struct SurfaceGradientShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    const TexelFrame f = texelFrame(tri, b);
+    put(gradient(pointAt(b, f)), out);
+  }
+};
+
+struct TangentShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    put(encodeNormal(normalizeOr(texelFrame(tri, b).tangent, Vec3d{})), out);
+  }
+};
+
+struct BitangentShader : BakeShaderBase {
+  static constexpr int kChannels = 3;
+  void shade(const Vec3d& b, int, int, double* out) {
+    put(encodeNormal(normalizeOr(texelFrame(tri, b).bitangent, Vec3d{})), out);
+  }
+};
+
+struct MaskShader {
+  static constexpr int kChannels = 1;
+  void beginTriangle(const std::array<std::uint32_t, 3>&) {}
+  void shade(const Vec3d&, int, int, double* out) const { out[0] = 1; }
+};
+
+
+}  // namespace sgbake::bake_detail

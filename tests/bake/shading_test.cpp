@@ -1,0 +1,177 @@
+// The lane-parallel tangent-normal shader (TangentNormalShader::shadeBatch) against its
+// per-sample shade(), bit for bit: random triangles and barycentrics, every kind of layer stack
+// (none, image heights through sampleMany, other height textures, masked and volume layers
+// through the per-sample path, overflowing gradients), both green conventions, and the rare
+// samples that take a fallback (an interpolated normal or tangent that vanishes).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "bake/shaders.hpp"
+#include "bake_test_util.hpp"
+#include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/volume.hpp"
+
+namespace sgbake {
+namespace {
+
+using bake_detail::SampleBatch;
+
+/// Six triangles with random corners, normals and tangents, plus two made to hit fallbacks: one
+/// whose corner normals cancel at the centroid region (N = 0 there) and one whose tangents are
+/// parallel to the normals (a degenerate frame: the flat normal).
+struct Scene {
+  Mesh mesh;
+  CornerTangents tangents;
+};
+
+Scene randomScene(std::mt19937& rng) {
+  std::uniform_real_distribution<float> u(-1, 1), uv(0, 1);
+  std::vector<Vec3f> positions;
+  std::vector<std::vector<std::uint32_t>> faces;
+  std::vector<Vec2f> uvs;
+  std::vector<Vec3f> normals;
+  Scene s;
+  auto unit = [](Vec3f v) { return cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1})); };
+  for (std::uint32_t t = 0; t < 8; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      positions.push_back({u(rng), u(rng), u(rng)});
+      uvs.push_back({uv(rng), uv(rng)});
+      Vec3f n = unit({u(rng), u(rng), 1 + u(rng)});
+      Vec3f tangent = unit({1, u(rng), u(rng)});
+      if (t == 6) n = k == 0 ? Vec3f{0, 0, 1} : Vec3f{0, 0, -1};  // Σ bi·Ni = 0 where b0 = 1/2
+      if (t == 7) tangent = n;                                      // T ∥ N everywhere
+      normals.push_back(n);
+      s.tangents.tangent.push_back(tangent);
+      s.tangents.sign.push_back(k == 2 && t % 2 == 0 ? -1.0f : 1.0f);
+    }
+    faces.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+  }
+  s.mesh = test::polygonMesh(positions, faces, uvs, {0, 0, 1}, normals);
+  return s;
+}
+
+/// Barycentrics of a batch: random, plus exact ones (corners, edge midpoints, b0 = 1/2 where
+/// triangle 6's normal vanishes).
+SampleBatch randomBatch(std::mt19937& rng, int count) {
+  std::uniform_real_distribution<double> u(0, 1);
+  SampleBatch b;
+  b.count = count;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
+    double b0 = u(rng), b1 = u(rng), b2 = u(rng);
+    switch (i % 9) {
+      case 3: b0 = 1, b1 = 0, b2 = 0; break;
+      case 5: b0 = 0.5, b1 = 0.5, b2 = 0; break;
+      case 7: b0 = 0.5, b1 = 0.25, b2 = 0.25; break;
+      default: {
+        const double sum = b0 + b1 + b2;
+        b0 /= sum, b1 /= sum, b2 /= sum;
+      }
+    }
+    b.b0[i] = b0;
+    b.b1[i] = b1;
+    b.b2[i] = b2;
+    b.x[i] = static_cast<int>(i);
+    b.y[i] = 0;
+  }
+  return b;
+}
+
+Image noiseImage(std::mt19937& rng, int size) {
+  std::uniform_real_distribution<float> u(0, 1);
+  Image image(size, size, 1);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) image.at(x, y) = u(rng);
+  return image;
+}
+
+class ShadeBatch : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::mt19937 rng(7);
+    scene = randomScene(rng);
+    const Image noise = noiseImage(rng, 16);
+    bilinear = *ImageScalarTexture::create(noise, {.filter = Filter::kBilinear});
+    bicubic = *ImageScalarTexture::create(noise, {.filter = Filter::kBicubic});
+    sine = *DirectionalSine::create({.amplitude = 0.05, .frequency = 3, .direction = {1, 2, 0.5}});
+  }
+
+  /// shadeBatch of random batches of every size against shade(), sample by sample, bit for bit.
+  void expectBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
+                                const std::string& what) {
+    bake_detail::BakeShaderBase base;
+    base.mesh = &scene.mesh;
+    base.tangents = &scene.tangents;
+    base.layers = layers;
+    base.green = green;
+    bake_detail::TangentNormalShader batchShader{base}, sampleShader{base};
+    std::mt19937 rng(11);
+    int fallbacks = 0;
+    for (std::uint32_t t = 0; t < scene.mesh.numFaces(); ++t) {
+      const std::array<std::uint32_t, 3> corners{3 * t, 3 * t + 1, 3 * t + 2};
+      batchShader.beginTriangle(corners);
+      sampleShader.beginTriangle(corners);
+      for (const int count : {1, 2, 3, 17, SampleBatch::kMax}) {
+        const SampleBatch batch = randomBatch(rng, count);
+        std::vector<double> lanes(static_cast<std::size_t>(count) * 3);
+        batchShader.shadeBatch(batch, lanes.data());
+        for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
+          double one[3];
+          sampleShader.shade({batch.b0[i], batch.b1[i], batch.b2[i]}, batch.x[i], batch.y[i], one);
+          ASSERT_EQ(std::memcmp(one, &lanes[3 * i], sizeof one), 0)
+              << what << ": triangle " << t << ", batch of " << count << ", lane " << i << ": ("
+              << lanes[3 * i] << ", " << lanes[3 * i + 1] << ", " << lanes[3 * i + 2]
+              << ") against (" << one[0] << ", " << one[1] << ", " << one[2] << ")";
+          fallbacks += one[0] == 0.5 && one[1] == 0.5 && one[2] == 1.0;
+        }
+      }
+    }
+    EXPECT_GT(fallbacks, 0) << what << ": no sample took the flat fallback";
+  }
+
+  Scene scene;
+  ImageScalarTexture bilinear = *ImageScalarTexture::create(Image(1, 1, 1));
+  ImageScalarTexture bicubic = *ImageScalarTexture::create(Image(1, 1, 1));
+  DirectionalSine sine = *DirectionalSine::create({});
+  test::LinearHeight linear{0.3, -0.2};
+};
+
+TEST_F(ShadeBatch, WithoutLayers) {
+  expectBatchEqualsSamples({}, NormalMapGreen::kOpenGL, "no layers");
+  expectBatchEqualsSamples({}, NormalMapGreen::kDirectX, "no layers, DirectX");
+}
+
+TEST_F(ShadeBatch, ImageHeightLayers) {
+  const std::vector<Layer> layers{
+      Layer{UvHeightSource{&bilinear, 0, 0.02, {2, 3}, {0.25, -0.5}}, 1.0, {}},
+      Layer{UvHeightSource{&bicubic, 0, 0.05}, -0.5, {}},
+      Layer{UvHeightSource{&bilinear, 0, 0.1}, 0.0, {}},  // weight 0: skipped
+  };
+  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "image heights");
+  expectBatchEqualsSamples(layers, NormalMapGreen::kDirectX, "image heights, DirectX");
+}
+
+TEST_F(ShadeBatch, OtherLayersTakeThePerSamplePath) {
+  const std::vector<Layer> layers{
+      Layer{UvHeightSource{&linear, 0, 0.5}, 1.0, {}},                  // not an image texture
+      Layer{UvHeightSource{&bilinear, 0, 0.03}, 0.7, LayerMask{&bicubic, 0}},  // masked
+      Layer{VolumeSource{&sine, GradientScheme::kAnalytic, 0, 1}, 1.0, {}},
+      Layer{UvHeightSource{&bicubic, 1, 0.1}, 1.0, {}},  // a UV set the mesh does not have
+  };
+  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "mixed layers");
+}
+
+TEST_F(ShadeBatch, OverflowingAndCancellingGradients) {
+  // Γ overflows (dropped as non-finite) or nearly cancels N (N − Γ renormalized the slow way).
+  const std::vector<Layer> layers{
+      Layer{UvHeightSource{&bilinear, 0, 1e306}, 1e3, {}},
+      Layer{UvHeightSource{&bicubic, 0, 40}, 1.0, {}},
+  };
+  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "extreme gradients");
+}
+
+}  // namespace
+}  // namespace sgbake
