@@ -7,6 +7,9 @@
 #include <limits>
 #include <set>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include "sgbake/mesh/triangulate.hpp"
 
 namespace sgbake {
@@ -119,6 +122,30 @@ void rowSpan(const RasterTriangle& tri, int y, std::span<const double> offsets, 
   const double xHi = std::floor(unionHi - offsets.front()) + 1;
   if (xLo > first) first = xLo > last ? last + 1 : static_cast<int>(xLo);
   if (xHi < last) last = xHi < first ? first - 1 : static_cast<int>(xHi);
+}
+
+void prefaultPages(void* data, std::size_t bytes, int pieces) {
+#ifdef MADV_POPULATE_WRITE
+  const long pageSize = ::sysconf(_SC_PAGESIZE);
+  if (data == nullptr || bytes == 0 || pageSize <= 0 || pieces < 1) return;
+  const auto page = static_cast<std::uintptr_t>(pageSize);
+  // Whole pages inside the buffer only: the pages at its ends may hold other allocations.
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + page - 1) / page * page;
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) / page * page;
+  if (end <= begin) return;
+  const std::uintptr_t pages = (end - begin) / page;
+  const auto parts = static_cast<std::uintptr_t>(pieces);
+  tbb::parallel_for(std::uintptr_t{0}, parts, [&](std::uintptr_t k) {
+    const std::uintptr_t first = begin + pages * k / parts * page;
+    const std::uintptr_t last = begin + pages * (k + 1) / parts * page;
+    // Best effort: on failure (an old kernel, no memory right now) the pages fault in later.
+    if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
+  });
+#else
+  (void)data;
+  (void)bytes;
+  (void)pieces;
+#endif
 }
 
 TriangleBins binTriangles(const RasterJob& job) {

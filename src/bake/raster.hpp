@@ -160,17 +160,28 @@ void runWithThreads(int threads, const Work& work) {
   }
 }
 
-/// @brief Sizes @p image (width × height × channels, coverage width × height), allocating the
-/// two buffers concurrently: first-touching hundreds of MB is a serial cost that limits scaling.
-/// Their contents are left to rasterize().
+/// @brief Maps the pages of [data, data + bytes) writable now, in @p pieces concurrent parts
+/// (Linux MADV_POPULATE_WRITE; elsewhere, or when the kernel refuses, nothing happens and the
+/// pages fault in on first touch as usual). One system call per piece instead of one page fault
+/// per 4 KiB page, spread over the threads: a 4096² bake allocates ~270 MB.
+void prefaultPages(void* data, std::size_t bytes, int pieces);
+
+/// @brief Sizes @p image (width × height × channels, coverage width × height), zero-filled. The
+/// pages are mapped first, in parallel (prefaultPages), and the two buffers are zero-filled
+/// concurrently: first-touching hundreds of MB is a serial cost that limits scaling.
 inline void allocateImage(FloatImage& image, int width, int height, int channels, int threads) {
   image.width = width;
   image.height = height;
   image.channels = channels;
   const std::size_t texels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  const std::size_t values = texels * static_cast<std::size_t>(channels);
+  image.pixels.reserve(values);
+  image.coverage.reserve(texels);
   runWithThreads(threads, [&] {
-    tbb::parallel_invoke([&] { image.pixels.resize(texels * static_cast<std::size_t>(channels)); },
-                         [&] { image.coverage.resize(texels); });
+    const int pieces = std::max(1, tbb::this_task_arena::max_concurrency());
+    tbb::parallel_invoke([&] { prefaultPages(image.pixels.data(), values * sizeof(float), pieces); },
+                         [&] { prefaultPages(image.coverage.data(), texels * sizeof(float), pieces); });
+    tbb::parallel_invoke([&] { image.pixels.resize(values); }, [&] { image.coverage.resize(texels); });
   });
 }
 
