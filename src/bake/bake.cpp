@@ -17,7 +17,6 @@
 #include "bake/texel_frame.hpp"
 #include "gradient/prepared_uv_frame.hpp"
 #include "sgbake/core/math.hpp"
-#include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/projection.hpp"
 
 namespace sgbake {

@@ -5,7 +5,6 @@
 /// per-sample shade() bit for bit.
 #pragma once
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -69,15 +68,20 @@ struct BakeShaderBase {
     Vec3d gamma{};
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-      const double factor = layer.mask.texture == nullptr
-                                ? layer.weight
-                                : layer.weight * layerMask(layer.mask, p);
-      if (factor == 0) continue;  // masked out: the source is not sampled
-      const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-      gamma += factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
-                                             : layerGradient(layer.source, p));
+      addLayerGradient(layer, p, gamma);
     }
     return isFinite(gamma) ? gamma : Vec3d{};
+  }
+
+  /// gamma += weight · mask · Γ of one layer (finite, nonzero weight) at @p p: gradient()'s step.
+  void addLayerGradient(const Layer& layer, const SurfacePoint& p, Vec3d& gamma) const {
+    const double factor = layer.mask.texture == nullptr
+                              ? layer.weight
+                              : layer.weight * layerMask(layer.mask, p);
+    if (factor == 0) return;  // masked out: the source is not sampled
+    const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+    gamma += factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
+                                           : layerGradient(layer.source, p));
   }
 
   /// perturbedNormal(point, layers) in object space: N' = normalize(N − Γ) (eq. 33 with the
@@ -146,18 +150,18 @@ inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, Lan
   }
 }
 
-/// uvHeightGradient() of an unmasked UV height layer for every sample, added as gamma += factor·Γ.
-inline void batchUvHeightGradient(const ShadingTriangle& t, const SampleBatch& s,
-                                  const UvHeightSource& src,
-                                  const gradient_detail::PreparedUvFrame& frame, double factor,
-                                  const Lanes3& unitN, Lanes3& gamma) {
+/// shader.uvHeightGradient() of an unmasked UV height layer for every sample of @p s (of the
+/// shader's current triangle), added as gamma += factor·Γ.
+inline void batchUvHeightGradient(const BakeShaderBase& shader, const SampleBatch& s,
+                                  const UvHeightSource& src, double factor, const Lanes3& unitN,
+                                  Lanes3& gamma) {
   const std::size_t n = static_cast<std::size_t>(s.count);
   Lanes3 layer{};
-  const bool hasSet = src.texture != nullptr && src.uvSet >= 0 && src.uvSet < t.numUvSets &&
-                      src.uvSet < kMaxUvSets;
-  if (hasSet && frame.valid) {
-    const std::size_t set = static_cast<std::size_t>(src.uvSet);
-    const Vec2d uv0 = t.uv[set][0], uv1 = t.uv[set][1], uv2 = t.uv[set][2];
+  const std::size_t set = static_cast<std::size_t>(src.uvSet);
+  if (src.texture != nullptr && hasUvSet(shader.point, src.uvSet) && shader.preparedUv[set].valid) {
+    const gradient_detail::PreparedUvFrame& frame = shader.preparedUv[set];
+    const std::array<Vec2d, 3>& uvs = shader.tri.uv[set];
+    const Vec2d uv0 = uvs[0], uv1 = uvs[1], uv2 = uvs[2];
     std::array<Vec2d, SampleBatch::kMax> st;
     for (std::size_t i = 0; i < n; ++i) {
       const Vec2d uv{s.b0[i] * uv0.x + s.b1[i] * uv1.x + s.b2[i] * uv2.x,
@@ -234,23 +238,17 @@ struct TangentNormalShader : BakeShaderBase {
         if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
         const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
         if (uvHeight != nullptr && layer.mask.texture == nullptr) {
-          const std::size_t set = static_cast<std::size_t>(std::clamp(uvHeight->uvSet, 0, kMaxUvSets - 1));
-          batchUvHeightGradient(tri, s, *uvHeight, preparedUv[set], layer.weight, unitN, gamma);
+          batchUvHeightGradient(*this, s, *uvHeight, layer.weight, unitN, gamma);
           continue;
         }
-        // Any other layer: the scalar SurfacePoint path, sample by sample (gradient()'s body).
+        // Any other layer: gradient()'s step on the SurfacePoint, sample by sample.
         for (std::size_t i = 0; i < n; ++i) {
           const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
-          const SurfacePoint& p = pointAt(b, texelFrame(tri, b));
-          const double factor = layer.mask.texture == nullptr
-                                    ? layer.weight
-                                    : layer.weight * layerMask(layer.mask, p);
-          if (factor == 0) continue;
-          const Vec3d g = factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
-                                                         : layerGradient(layer.source, p));
-          gamma.x[i] = gamma.x[i] + g.x;
-          gamma.y[i] = gamma.y[i] + g.y;
-          gamma.z[i] = gamma.z[i] + g.z;
+          Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
+          addLayerGradient(layer, pointAt(b, texelFrame(tri, b)), g);
+          gamma.x[i] = g.x;
+          gamma.y[i] = g.y;
+          gamma.z[i] = g.z;
         }
       }
       for (std::size_t i = 0; i < n; ++i) {
