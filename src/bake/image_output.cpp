@@ -1,8 +1,7 @@
 /// @file image_output.cpp
-/// @brief writeImage through OpenImageIO into an AtomicFile's temporary (see image_output.hpp).
+/// @brief writeImage through the image I/O module into an AtomicFile's temporary (see
+/// image_output.hpp).
 #include "sgbake/bake/image_output.hpp"
-
-#include <OpenImageIO/imageio.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -23,6 +22,7 @@
 #include <vector>
 
 #include "bake/raster.hpp"
+#include "io/image_codec.hpp"
 #include "sgbake/io/atomic_file.hpp"
 
 namespace sgbake {
@@ -34,14 +34,6 @@ std::string toLower(std::string_view text) {
   return lower;
 }
 
-/// An OIIO error text (possibly several lines) as one line.
-std::string oneLineReason(std::string text) {
-  std::replace_if(
-      text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text.empty() ? std::string("unknown error") : text;
-}
-
 Error fileError(ErrorCode code, const std::filesystem::path& path, std::string_view what) {
   return {code, path.string() + ": " + std::string(what)};
 }
@@ -50,7 +42,7 @@ Error fileError(ErrorCode code, const std::filesystem::path& path, std::string_v
 struct FormatInfo {
   ImageFormat format;
   std::string_view name;      ///< imageFormatName: "exr", "png", "tiff"
-  const char* oiioName;       ///< the name ImageOutput::create knows it by
+  const char* codecName;      ///< the image codec's name of the format
   std::string_view upper;     ///< display name in messages
   std::string_view depths;    ///< the bit depths it stores, for messages
 };
@@ -68,9 +60,9 @@ const FormatInfo* formatInfo(ImageFormat format) {
   return nullptr;
 }
 
-const char* oiioFormatName(ImageFormat format) {
+const char* codecFormatName(ImageFormat format) {
   const FormatInfo* info = formatInfo(format);
-  return info ? info->oiioName : "";
+  return info ? info->codecName : "";
 }
 std::string upperName(ImageFormat format) {
   const FormatInfo* info = formatInfo(format);
@@ -81,14 +73,15 @@ std::string supportedDepths(ImageFormat format) {
   return std::string(info ? info->depths : "");
 }
 
-/// OIIO's pixel type for @p bitDepth in @p format (formatSupportsBitDepth holds).
-OIIO::TypeDesc pixelType(ImageFormat format, int bitDepth) {
-  if (format == ImageFormat::kExr) {
-    return bitDepth == 32 ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF;
-  }
-  if (bitDepth == 32) return OIIO::TypeDesc::FLOAT;
-  return bitDepth == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16;
+using io_detail::PixelType;
+
+/// The file's pixel type for @p bitDepth in @p format (formatSupportsBitDepth holds).
+PixelType pixelType(ImageFormat format, int bitDepth) {
+  if (format == ImageFormat::kExr) return bitDepth == 32 ? PixelType::kFloat : PixelType::kHalf;
+  if (bitDepth == 32) return PixelType::kFloat;
+  return bitDepth == 8 ? PixelType::kUint8 : PixelType::kUint16;
 }
+using io_detail::oneLineReason;
 
 /// Integer code of @p value in [0, 1] scaled to [0, maxCode], rounded to nearest; NaN → 0.
 /// value·maxCode is exact in double (24 × 16 significant bits), so adding 0.5 and truncating is
@@ -127,7 +120,7 @@ FileLayout fileLayout(int imageChannels, ImageFormat format, bool alpha) {
 
 /// Converts @p texels texels (image channels in @p pixels, alpha from @p coverage) to the file's
 /// layout and pixel type T at @p out. Integer types are quantized here (clamp, round, NaN → 0)
-/// rather than by OIIO, so the rule is ours and documented.
+/// rather than by the codec, so the rule is ours and documented.
 template <class T>
 void convertTexels(const float* pixels, const float* coverage, std::size_t texels,
                    const FileLayout& layout, double maxCode, T* out) {
@@ -191,15 +184,15 @@ double secondsSince(Clock::time_point start) {
 
 }  // namespace
 
-/// Everything an ImageFileWriter owns; the writer's thread reads the queue and the OIIO output.
+/// Everything an ImageFileWriter owns; the writer's thread reads the queue and the codec's file.
 struct ImageFileWriter::State {
   std::filesystem::path path;
   AtomicFile file;
-  std::unique_ptr<OIIO::ImageOutput> out;
+  std::unique_ptr<io_detail::ImageWriter> out;
   FileLayout layout;
-  /// Pixel type of the strips' data: the file's integer type, or FLOAT for float and half files
-  /// (OIIO converts float to half, rounding to nearest even).
-  OIIO::TypeDesc stripType;
+  /// Pixel type of the strips' data: the file's integer type, or float for float and half files
+  /// (the codec converts float to half, rounding to nearest even).
+  PixelType stripType = PixelType::kFloat;
   int width = 0, height = 0, threads = 0;
   int nextRow = 0;  ///< first row writeRows expects next
 
@@ -214,8 +207,8 @@ struct ImageFileWriter::State {
   bool stop = false;      ///< no more strips: the thread exits once the queue is empty
   bool failed = false;    ///< a strip failed to write (the rest are dropped)
   bool abandoned = false; ///< the writer is destroyed uncommitted: queued strips are dropped
-  std::string failure;    ///< OIIO's reason, one line
-  double fileSeconds = 0; ///< time inside OIIO (guarded by mutex)
+  std::string failure;    ///< the codec's reason, one line
+  double fileSeconds = 0; ///< time inside the codec (guarded by mutex)
   double waitSeconds = 0; ///< caller's time waiting for the thread
   std::thread thread;
 
@@ -234,7 +227,7 @@ struct ImageFileWriter::State {
       bool ok = true;
       const Clock::time_point start = Clock::now();
       if (!skip) {
-        ok = out->write_scanlines(strip.row, strip.row + strip.rows, 0, stripType, strip.data.data());
+        ok = out->writeRows(strip.row, strip.row + strip.rows, stripType, strip.data.data());
       }
       const double seconds = secondsSince(start);
       lock.lock();
@@ -242,7 +235,7 @@ struct ImageFileWriter::State {
       spare.push_back(std::move(strip.data));
       if (!ok && !failed) {
         failed = true;
-        failure = oneLineReason(out->geterror());
+        failure = oneLineReason(out->error());
       }
       changed.notify_all();
     }
@@ -312,35 +305,36 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
   state->height = height;
   state->threads = options.threads;
   state->layout = fileLayout(channels, format, options.alpha);
-  const OIIO::TypeDesc fileType = pixelType(format, bitDepth);
-  state->stripType = fileType == OIIO::TypeDesc::HALF ? OIIO::TypeDesc::FLOAT : fileType;
+  const PixelType fileType = pixelType(format, bitDepth);
+  state->stripType = fileType == PixelType::kHalf ? PixelType::kFloat : fileType;
   const FileLayout& layout = state->layout;
 
-  OIIO::ImageSpec spec(width, height, layout.fileChannels, fileType);
-  spec.channelnames = layout.names;
-  spec.alpha_channel = options.alpha ? layout.fileChannels - 1 : -1;
-  if (options.alpha) spec.attribute("oiio:UnassociatedAlpha", 1);
-  if (format != ImageFormat::kPng) spec.attribute("compression", "zip");
+  io_detail::ImageWriteSpec spec;
+  spec.format = codecFormatName(format);
+  spec.width = width;
+  spec.height = height;
+  spec.channels = layout.fileChannels;
+  spec.type = fileType;
+  spec.channelNames = layout.names;
+  spec.alphaChannel = options.alpha ? layout.fileChannels - 1 : -1;
+  spec.zipCompression = format != ImageFormat::kPng;
   // Blender's default PNG compression ("15%") is zlib level 1: several times faster to write
   // than zlib's default 6, for files about 10-20% larger.
   if (format == ImageFormat::kPng) {
-    spec.attribute("png:compressionLevel", kPngCompressionLevel);
-    spec.attribute("png:filter", kPngFilters);
+    spec.pngCompressionLevel = kPngCompressionLevel;
+    spec.pngFilters = kPngFilters;
   }
-  spec.attribute("Software", "sgbake");
+  spec.software = "sgbake";
 
-  state->out = OIIO::ImageOutput::create(oiioFormatName(format));
+  Result<const io_detail::ImageCodec*> codec = io_detail::imageCodec();
+  if (!codec) return codec.error();
+  // The codec opens the temporary by name (truncating the empty file AtomicFile created); the
+  // format is chosen above, so the temporary's odd extension does not matter.
+  std::string reason;
+  state->out = (*codec)->openWriter(state->file.tempPath(), spec, reason);
   if (!state->out) {
     return fileError(ErrorCode::kInternal, path,
-                     "OpenImageIO cannot write " + upperName(format) + " (" +
-                         oneLineReason(OIIO::geterror()) + ")");
-  }
-  // OIIO opens the temporary by name (truncating the empty file AtomicFile created); the
-  // format is chosen above, so the temporary's odd extension does not matter.
-  if (!state->out->open(state->file.tempPath().string(), spec)) {
-    const std::string reason = oneLineReason(state->out->geterror());
-    state->out.reset();
-    return fileError(ErrorCode::kInternal, path, "cannot write image (" + reason + ")");
+                     "cannot write " + upperName(format) + " image (" + oneLineReason(reason) + ")");
   }
   State* raw = state.get();
   state->thread = std::thread([raw] { raw->run(); });
@@ -397,7 +391,7 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
     }
   }
   try {
-    strip.data.resize(values * stripType.size());
+    strip.data.resize(values * io_detail::pixelTypeSize(stripType));
   } catch (const std::bad_alloc&) {
     return fileError(ErrorCode::kInternal, path, "out of memory while converting the image");
   }
@@ -407,10 +401,10 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
   auto convertRow = [&](std::size_t r) {
     const float* in = pixels.data() + r * imageRowValues;
     const float* cov = alpha ? coverage.data() + r * rowTexels : nullptr;
-    std::byte* to = strip.data.data() + r * fileRowValues * stripType.size();
-    if (stripType == OIIO::TypeDesc::UINT8) {
+    std::byte* to = strip.data.data() + r * fileRowValues * io_detail::pixelTypeSize(stripType);
+    if (stripType == PixelType::kUint8) {
       convertTexels(in, cov, rowTexels, layout, 255.0, reinterpret_cast<std::uint8_t*>(to));
-    } else if (stripType == OIIO::TypeDesc::UINT16) {
+    } else if (stripType == PixelType::kUint16) {
       convertTexels(in, cov, rowTexels, layout, 65535.0, reinterpret_cast<std::uint16_t*>(to));
     } else {
       convertTexels(in, cov, rowTexels, layout, 1.0, reinterpret_cast<float*>(to));
@@ -445,7 +439,7 @@ Status ImageFileWriter::commit() {
   const bool closed = s.out->close();
   if (!closed) {
     return fileError(ErrorCode::kInternal, s.path,
-                     "cannot write image (" + oneLineReason(s.out->geterror()) + ")");
+                     "cannot write image (" + oneLineReason(s.out->error()) + ")");
   }
   return s.file.commit();  // on failure the temporary is removed and the target untouched
 }

@@ -30,6 +30,7 @@
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/volume.hpp"
 #include "sgbake/io/atomic_file.hpp"
+#include "sgbake/io/image_io.hpp"
 #include "sgbake/mesh/io.hpp"
 #include "sgbake/sgbake.h"
 
@@ -923,6 +924,15 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     report.outputs.push_back({s.outputs[output.sceneOutput].file, false, {}});
   }
   if (plan.outputsToBake() == 0) return report;
+
+  // The image codec loads on a thread of its own while the mesh is parsed (image_io.hpp).
+  bool readsOrWritesImages = !plan.images.empty();
+  for (const PlannedOutput& output : plan.outputs) {
+    if (!output.upToDate && s.outputs[output.sceneOutput].kind == OutputKind::kMap) {
+      readsOrWritesImages = true;
+    }
+  }
+  if (readsOrWritesImages) preloadImageIo();
 
   using Clock = std::chrono::steady_clock;
   ProgressReporter progress(options, 1 + plan.images.size() + (plan.computeTangents ? 1 : 0));

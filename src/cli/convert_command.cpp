@@ -13,6 +13,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/image.hpp"
 #include "sgbake/io/atomic_file.hpp"
+#include "sgbake/io/image_io.hpp"
 #include "sgbake/mesh/io.hpp"
 
 namespace sgbake::cli {
@@ -92,6 +93,7 @@ FloatImage toRgb(const FloatImage& image, bool hasAlpha) {
 Status runConvert(const ConvertArguments& args) {
   Stopwatch total;
   const ThreadLimit threadLimit(args.threads);
+  preloadImageIo();  // the image codec loads while the arguments are checked and the mesh read
 
   Result<NormalSpace> from = parseNormalSpace(args.from);
   if (!from) return Error::badInput("convert: --from: " + from.error().message);

@@ -1,8 +1,6 @@
-// Float images and loading them through OpenImageIO (see image.hpp for the conventions).
+// Float images and loading them through the image I/O module (see image.hpp for the conventions).
 
 #include "sgbake/gradient/image.hpp"
-
-#include <OpenImageIO/imageio.h>
 
 #include <cmath>
 #include <cstdint>
@@ -11,6 +9,8 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+
+#include "io/image_codec.hpp"
 
 namespace sgbake {
 
@@ -36,21 +36,6 @@ std::string oneLine(std::string_view text) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
   }
   return out;
-}
-
-// An OIIO error (possibly several lines) as one line: lines joined with "; ".
-std::string oiioReason(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
-  std::string joined;
-  for (char c : text) {
-    if (c == '\n') {
-      joined += "; ";
-    } else {
-      joined += c;
-    }
-  }
-  if (joined.empty()) joined = "unknown error";
-  return oneLine(joined);
 }
 
 std::string channelsText(int n) { return std::to_string(n) + (n == 1 ? " channel" : " channels"); }
@@ -91,18 +76,15 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
     if (!ec && size == 0) return fileError(path, "file is empty");
   }
 
-  // Keep unassociated alpha as stored: by default OIIO premultiplies colour by alpha on read,
-  // which would change the heights/normals of any texel with alpha < 1.
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string(), &config);
-  if (!in) {
-    return fileError(path, "cannot read image (" + oiioReason(OIIO::geterror()) + ")");
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+  Result<const io_detail::ImageCodec*> codec = io_detail::imageCodec();
+  if (!codec) return codec.error();
+  std::string reason;
+  std::unique_ptr<io_detail::ImageReader> in = (*codec)->openReader(path, reason);
+  if (!in) return fileError(path, "cannot read image (" + io_detail::oneLineReason(reason) + ")");
+  const io_detail::ImageHeader spec = in->header();
+  if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0) {
     return fileError(path, "image has zero size (" + std::to_string(spec.width) + "x" +
-                               std::to_string(spec.height) + ", " + channelsText(spec.nchannels) +
+                               std::to_string(spec.height) + ", " + channelsText(spec.channels) +
                                ")");
   }
   if (spec.depth > 1) return fileError(path, "volume images are not supported");
@@ -111,9 +93,9 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
                                std::to_string(spec.height) + "; at most " +
                                std::to_string(kMaxImageSide) + " per side)");
   }
-  const int readChannels = channelsToRead(options.channels, spec.nchannels);
+  const int readChannels = channelsToRead(options.channels, spec.channels);
   if (readChannels < 0) {
-    return fileError(path, "image has " + channelsText(spec.nchannels) + " but 3 are needed (RGB)");
+    return fileError(path, "image has " + channelsText(spec.channels) + " but 3 are needed (RGB)");
   }
 
   const int width = spec.width;
@@ -128,14 +110,13 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
 
   // Read straight into bottom-up order: start at the last stored row (the file's top row) and
   // step backwards one row per scanline.
-  const auto pixelBytes = static_cast<OIIO::stride_t>(sizeof(float)) * readChannels;
-  const OIIO::stride_t rowBytes = pixelBytes * width;
+  const auto pixelBytes = static_cast<std::ptrdiff_t>(sizeof(float)) * readChannels;
+  const std::ptrdiff_t rowBytes = pixelBytes * width;
   float* topRow = &read.at(0, height - 1, 0);
-  if (!in->read_image(0, 0, 0, readChannels, OIIO::TypeDesc::FLOAT, topRow, pixelBytes,
-                      -rowBytes)) {
-    return fileError(path, "cannot read image (" + oiioReason(in->geterror()) + ")");
+  if (!in->readFloat(readChannels, topRow, pixelBytes, -rowBytes)) {
+    return fileError(path, "cannot read image (" + io_detail::oneLineReason(in->error()) + ")");
   }
-  in->close();
+  in.reset();
 
   // Non-finite values (possible in float formats) would poison every filtered sample.
   const std::span<const float> values = read.pixels();

@@ -148,6 +148,23 @@ TEST_F(BakeCliTest, UnreadableImageExitsTwoAndCreatesNothing) {
                  "broken.png", before, dir_);
 }
 
+TEST_F(BakeCliTest, MissingImageModuleIsOneErrorLineNamingItAndWritesNothing) {
+  // The image codec is a module beside libsgbake (sgbake/io/image_io.hpp); a broken install
+  // must say which file is missing, exit 1 (not the input's fault) and write nothing.
+  const fs::path module = dir_ / "nowhere" / "libsgbake_oiio.so";
+  writeFile(dir_ / "scene.json", "{}");
+  const std::set<std::string> before = listDirectory(dir_);
+  ::setenv("SGBAKE_IMAGE_IO_MODULE", module.c_str(), 1);
+  const ProcessResult r = bakeScene(
+      planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "n.png", "size": 8})"));
+  ::unsetenv("SGBAKE_IMAGE_IO_MODULE");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  expectOneErrorLine(r);
+  EXPECT_NE(r.err.find(module.string() + ": cannot load the image I/O module"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(listDirectory(dir_), before) << "no output, no temporary, no manifest";
+}
+
 TEST_F(BakeCliTest, FailingBakeLeavesTheExistingOutputByteIdentical) {
   writeFile(dir_ / "out.png", "the previous bake");
   writeFile(dir_ / "scene.json", "{}");

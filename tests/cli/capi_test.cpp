@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -101,6 +103,19 @@ TEST(CApi, GivesTheSameFramesAsTheCppApi) {
   EXPECT_NEAR(c.tangents[0], 1.0f, 1e-6f);
   EXPECT_NEAR(c.tangents[1], 0.0f, 1e-6f);
   EXPECT_EQ(c.signs[0], 1.0f);
+}
+
+TEST(CApi, DoesNotLoadOpenImageIO) {
+  // A program using only the C ABI (the Blender add-on) must not pull in OpenImageIO and its
+  // ~260 libraries: image I/O is a module loaded on first use (sgbake/io/image_io.hpp).
+  const CallResult c = callC(FlatMesh{});
+  ASSERT_EQ(c.status, SGBAKE_OK) << c.message;
+  std::ifstream maps("/proc/self/maps");
+  std::stringstream text;
+  text << maps.rdbuf();
+  ASSERT_FALSE(text.str().empty());
+  EXPECT_EQ(text.str().find("libOpenImageIO"), std::string::npos);
+  EXPECT_EQ(text.str().find("libsgbake_oiio"), std::string::npos);
 }
 
 TEST(CApi, ThreadCountDoesNotChangeTheResult) {

@@ -1,6 +1,7 @@
 /// @file image_output.hpp
-/// @brief Writing baked maps to image files (EXR, PNG, TIFF through OpenImageIO), all or nothing,
-/// and the `<UDIM>` token of output file names.
+/// @brief Writing baked maps to image files (EXR, PNG, TIFF through OpenImageIO, in the image I/O
+/// module loaded on first use: sgbake/io/image_io.hpp), all or nothing, and the `<UDIM>` token
+/// of output file names.
 ///
 /// Every file is written to a temporary file in the target's directory and renamed over the
 /// target only once it is complete (sgbake/io/atomic_file.hpp): a failed or interrupted write

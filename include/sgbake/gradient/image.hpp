@@ -94,7 +94,8 @@ struct LoadImageOptions {
   ImageChannels channels = ImageChannels::kAll;
 };
 
-/// @brief Reads the first subimage (full resolution) of an image file through OpenImageIO.
+/// @brief Reads the first subimage (full resolution) of an image file through OpenImageIO (in
+/// the image I/O module, loaded on first use: sgbake/io/image_io.hpp).
 ///
 /// Any bit depth: integer formats (8- and 16-bit PNG/TIFF, …) become floats in [0, 1]
 /// (value / (2^bits - 1)); half and float formats (EXR, float TIFF) are kept raw. Alpha is read
@@ -106,7 +107,8 @@ struct LoadImageOptions {
 /// `<path>: cannot open file (no such file)`, `<path>: cannot read image (<reason>)`,
 /// `<path>: image has zero size`, `<path>: image is too large (W×H; at most 65536 per side)`,
 /// `<path>: image has N channels but 3 are needed (RGB)`, `<path>: volume images are not
-/// supported`, ...
+/// supported`, ... A missing or broken image I/O module is ErrorCode::kInternal naming the
+/// module's file.
 ///
 /// @param[in] path    the image file
 /// @param[in] options which channels to keep (ImageChannels)

@@ -1,10 +1,16 @@
 // The C++ side of the consumer: the same triangle through sgbake's C++ API and through its C
 // ABI (c_abi.c); both must agree, bit for bit, and give the obvious frame.
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <string>
 #include <vector>
 
+#include <sgbake/bake/image_output.hpp>
 #include <sgbake/frames/tangents.hpp>
+#include <sgbake/gradient/image.hpp>
 #include <sgbake/mesh/mesh.hpp>
 #include <sgbake/sgbake.h>
 
@@ -61,7 +67,26 @@ int main() {
     check(t.x > 0.999999f && t.y == 0.0f && t.z == 0.0f && signs[c] == 1.0f,
           "tangent is +x with sign +1");
   }
+
+  // Image files go through the installed image I/O module (found beside the installed library).
+  const std::filesystem::path file = std::filesystem::temp_directory_path() /
+                                     ("sgbake_consumer_" + std::to_string(::getpid()) + ".png");
+  sgbake::FloatImage image;
+  image.width = 2;
+  image.height = 1;
+  image.channels = 1;
+  image.pixels = {0.0f, 1.0f};
+  image.coverage = {1.0f, 1.0f};
+  const sgbake::Status written = sgbake::writeImage(image, file);
+  check(written.ok(), "writeImage succeeds through the installed module");
+  if (!written.ok()) std::fprintf(stderr, "consumer: %s\n", written.error().message.c_str());
+  const sgbake::Result<sgbake::Image> read = sgbake::loadImage(file);
+  std::filesystem::remove(file);
+  check(read.ok() && read->width() == 2 && read->at(0, 0) == 0.0f && read->at(1, 0) == 1.0f,
+        "loadImage reads the written PNG back");
+
   if (failures != 0) return 1;
-  std::printf("consumer: sgbake %s: C++ API and C ABI agree\n", sgbake_version());
+  std::printf("consumer: sgbake %s: C++ API and C ABI agree; images round-trip\n",
+              sgbake_version());
   return 0;
 }

@@ -1,0 +1,105 @@
+// Loading the image I/O module (see image_codec.hpp and sgbake/io/image_io.hpp).
+#include "io/image_codec.hpp"
+
+#include <dlfcn.h>
+
+#include <cstdlib>
+#include <future>
+#include <mutex>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include "sgbake/io/image_io.hpp"
+
+namespace sgbake {
+namespace io_detail {
+namespace {
+
+constexpr const char* kModuleFileName = "libsgbake_oiio.so";
+
+struct LoadedModule {
+  const ImageCodec* codec = nullptr;
+  std::string error;  ///< when codec is nullptr
+};
+
+LoadedModule loadModule() {
+  const std::filesystem::path path = imageIoModulePath();
+  const std::string prefix = path.string() + ": cannot load the image I/O module (";
+  // Lazy binding: only the data relocations of OpenImageIO's libraries are resolved now.
+  void* handle = ::dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
+  if (handle == nullptr) {
+    const char* reason = ::dlerror();
+    return {nullptr, prefix + oneLineReason(reason ? reason : "") + ")"};
+  }
+  using Entry = const ImageCodec* (*)(int);
+  // The module stays loaded until the process ends: the codec and its objects live in it.
+  auto entry = reinterpret_cast<Entry>(::dlsym(handle, kImageCodecEntryPoint));
+  if (entry == nullptr) return {nullptr, prefix + "it has no " + kImageCodecEntryPoint + ")"};
+  const ImageCodec* codec = entry(kImageCodecVersion);
+  if (codec == nullptr) {
+    return {nullptr, prefix + "it was built for another version of libsgbake)"};
+  }
+  return {codec, {}};
+}
+
+std::once_flag started;
+std::shared_future<LoadedModule> loading;
+
+/// Starts loadModule on a thread of its own, once; where no thread can be made, the first
+/// waiter runs it.
+void startLoading() {
+  std::call_once(started, [] {
+    try {
+      loading = std::async(std::launch::async, loadModule).share();
+    } catch (const std::system_error&) {
+      loading = std::async(std::launch::deferred, loadModule).share();
+    }
+  });
+}
+
+}  // namespace
+
+Result<const ImageCodec*> imageCodec() {
+  startLoading();
+  const LoadedModule& loaded = loading.get();
+  if (loaded.codec == nullptr) return Error::internal(loaded.error);
+  return loaded.codec;
+}
+
+std::string oneLineReason(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) {
+    text.pop_back();
+  }
+  std::string line;
+  line.reserve(text.size());
+  for (const char c : text) {
+    if (c == '\n') {
+      line += "; ";
+    } else if (c == '\r') {
+      continue;
+    } else {
+      line += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
+    }
+  }
+  return line.empty() ? std::string("unknown error") : line;
+}
+
+}  // namespace io_detail
+
+void preloadImageIo() { io_detail::startLoading(); }
+
+std::filesystem::path imageIoModulePath() {
+  if (const char* path = std::getenv("SGBAKE_IMAGE_IO_MODULE"); path != nullptr && *path != 0) {
+    return path;
+  }
+  // Beside the file this function was loaded from (libsgbake.so, wherever it is installed).
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<const void*>(&imageIoModulePath), &info) != 0 &&
+      info.dli_fname != nullptr && *info.dli_fname != 0) {
+    return std::filesystem::path(info.dli_fname).parent_path() / io_detail::kModuleFileName;
+  }
+  return io_detail::kModuleFileName;  // the dynamic loader's search path
+}
+
+}  // namespace sgbake
