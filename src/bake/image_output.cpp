@@ -85,12 +85,13 @@ using io_detail::oneLineReason;
 
 /// Integer code of @p value in [0, 1] scaled to [0, maxCode], rounded to nearest; NaN → 0.
 /// value·maxCode is exact in double (24 × 16 significant bits), so adding 0.5 and truncating is
-/// lround's round-half-away-from-zero without its library call.
+/// lround's round-half-away-from-zero without its library call. Written with selects only (the
+/// clamp, then one expression), so that conversion loops vectorize.
 template <class T>
 T quantize(float value, double maxCode) {
-  if (!(value > 0.0f)) return 0;  // also NaN
-  if (value >= 1.0f) return static_cast<T>(maxCode);
-  return static_cast<T>(static_cast<double>(value) * maxCode + 0.5);
+  const double v = static_cast<double>(value);
+  const double clamped = v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0;  // NaN compares false: 0
+  return static_cast<T>(clamped * maxCode + 0.5);
 }
 
 /// The file's channels: the image's channels (two padded to three for PNG/TIFF) and the
@@ -125,6 +126,17 @@ template <class T>
 void convertTexels(const float* pixels, const float* coverage, std::size_t texels,
                    const FileLayout& layout, double maxCode, T* out) {
   const std::size_t in = static_cast<std::size_t>(layout.imageChannels);
+  if (layout.fileChannels == layout.imageChannels) {  // no alpha, no padding channel: value by value
+    const std::size_t values = texels * in;
+    for (std::size_t i = 0; i < values; ++i) {
+      if constexpr (std::is_same_v<T, float>) {
+        out[i] = pixels[i];
+      } else {
+        out[i] = quantize<T>(pixels[i], maxCode);
+      }
+    }
+    return;
+  }
   for (std::size_t t = 0; t < texels; ++t) {
     for (int c = 0; c < layout.fileChannels; ++c) {
       float v = 0.0f;  // padding of a two-channel image
