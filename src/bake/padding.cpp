@@ -4,8 +4,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 #include <vector>
 
 #include "bake/raster.hpp"
@@ -47,25 +50,48 @@ void extendMargin(FloatImage& image, int margin, int threads) {
   const int W = image.width, H = image.height, C = image.channels;
   const std::size_t stride = static_cast<std::size_t>(C);
   std::vector<std::uint8_t> filled(image.coverage.size());
-  for (std::size_t i = 0; i < filled.size(); ++i) filled[i] = image.coverage[i] > 0 ? 1 : 0;
+  forRowBlocks(H, threads, [&](int r0, int r1) {
+    // Raw pointers: a store through uint8_t* may alias anything, which would make the compiler
+    // reload the vectors' pointers every iteration instead of vectorizing.
+    const float* coverage = image.coverage.data();
+    std::uint8_t* out = filled.data();
+    const std::size_t end = static_cast<std::size_t>(r1) * W;
+    for (std::size_t i = static_cast<std::size_t>(r0) * W; i < end; ++i) out[i] = coverage[i] > 0 ? 1 : 0;
+  });
 
   auto isFilled = [&](int x, int r) {
     return x >= 0 && x < W && r >= 0 && r < H && filled[static_cast<std::size_t>(r) * W + x] != 0;
   };
-  auto hasFilledEdgeNeighbour = [&](int x, int r) {
-    return isFilled(x - 1, r) || isFilled(x + 1, r) || isFilled(x, r - 1) || isFilled(x, r + 1);
-  };
 
   // Ring 1: every unfilled texel with a filled 4-neighbour, found by a parallel scan whose
-  // per-block lists are concatenated in row order.
+  // per-block lists are concatenated in row order. Per row, a branch-free (vectorized) pass
+  // marks the ring's texels, and a second one collects the marks eight bytes at a time (most
+  // of an image is either inside an island or far from one).
   const int scanBlocks = (H + kScanRows - 1) / kScanRows;
   std::vector<std::vector<std::uint32_t>> found(static_cast<std::size_t>(scanBlocks));
+  const std::vector<std::uint8_t> emptyRow(static_cast<std::size_t>(W), 0);
   forRowBlocks(H, threads, [&](int r0, int r1) {
     std::vector<std::uint32_t>& list = found[static_cast<std::size_t>(r0 / kScanRows)];
-    for (int r = r0; r < r1; ++r)
-      for (int x = 0; x < W; ++x)
-        if (!isFilled(x, r) && hasFilledEdgeNeighbour(x, r))
-          list.push_back(static_cast<std::uint32_t>(static_cast<std::size_t>(r) * W + x));
+    std::vector<std::uint8_t> mark(static_cast<std::size_t>(W) + 8, 0);  // + 8: whole words
+    for (int r = r0; r < r1; ++r) {
+      const std::uint8_t* self = filled.data() + static_cast<std::size_t>(r) * W;
+      const std::uint8_t* up = r > 0 ? self - W : emptyRow.data();
+      const std::uint8_t* down = r + 1 < H ? self + W : emptyRow.data();
+      auto ringMark = [&](int x, std::uint8_t left, std::uint8_t right) {
+        return static_cast<std::uint8_t>((left | right | up[x] | down[x]) & (self[x] ^ 1));
+      };
+      mark[0] = ringMark(0, 0, W > 1 ? self[1] : 0);
+      for (int x = 1; x < W - 1; ++x) mark[static_cast<std::size_t>(x)] = ringMark(x, self[x - 1], self[x + 1]);
+      if (W > 1) mark[static_cast<std::size_t>(W - 1)] = ringMark(W - 1, self[W - 2], 0);
+      const std::size_t rowStart = static_cast<std::size_t>(r) * W;
+      for (int x = 0; x < W; x += 8) {
+        std::uint64_t word = 0;
+        std::memcpy(&word, mark.data() + x, sizeof word);
+        if (word == 0) continue;
+        for (int k = x; k < std::min(W, x + 8); ++k)
+          if (mark[static_cast<std::size_t>(k)] != 0) list.push_back(static_cast<std::uint32_t>(rowStart + k));
+      }
+    }
   });
   std::vector<std::uint32_t> ring;
   for (const std::vector<std::uint32_t>& list : found) ring.insert(ring.end(), list.begin(), list.end());
@@ -78,23 +104,36 @@ void extendMargin(FloatImage& image, int margin, int threads) {
     bake_detail::runWithThreads(threads, [&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ring.size(), 1024),
                         [&](const tbb::blocked_range<std::size_t>& range) {
-        std::vector<double> acc(stride);
-        for (std::size_t k = range.begin(); k != range.end(); ++k) {
-          const int x = static_cast<int>(ring[k] % static_cast<std::uint32_t>(W));
-          const int r = static_cast<int>(ring[k] / static_cast<std::uint32_t>(W));
-          std::fill(acc.begin(), acc.end(), 0.0);
-          double weightSum = 0;
-          for (int dr = -1; dr <= 1; ++dr) {
-            for (int dx = -1; dx <= 1; ++dx) {
-              if ((dx == 0 && dr == 0) || !isFilled(x + dx, r + dr)) continue;
-              const double w = (dx == 0 || dr == 0) ? kEdgeNeighbourWeight : kDiagonalNeighbourWeight;
-              const float* p = image.pixels.data() + (static_cast<std::size_t>(r + dr) * W + (x + dx)) * stride;
-              for (std::size_t c = 0; c < stride; ++c) acc[c] += w * p[c];
-              weightSum += w;
+        // The channel count as a constant for the usual 1–4 channels, so acc lives in registers.
+        auto run = [&]<int kC>(std::integral_constant<int, kC>) {
+          const std::size_t channels = kC > 0 ? static_cast<std::size_t>(kC) : stride;
+          std::array<double, 4> fixedAcc{};
+          std::vector<double> dynamicAcc(kC > 0 ? 0 : stride);
+          double* acc = kC > 0 ? fixedAcc.data() : dynamicAcc.data();
+          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const int x = static_cast<int>(ring[k] % static_cast<std::uint32_t>(W));
+            const int r = static_cast<int>(ring[k] / static_cast<std::uint32_t>(W));
+            for (std::size_t c = 0; c < channels; ++c) acc[c] = 0.0;
+            double weightSum = 0;
+            for (int dr = -1; dr <= 1; ++dr) {
+              for (int dx = -1; dx <= 1; ++dx) {
+                if ((dx == 0 && dr == 0) || !isFilled(x + dx, r + dr)) continue;
+                const double w = (dx == 0 || dr == 0) ? kEdgeNeighbourWeight : kDiagonalNeighbourWeight;
+                const float* p = image.pixels.data() + (static_cast<std::size_t>(r + dr) * W + (x + dx)) * stride;
+                for (std::size_t c = 0; c < channels; ++c) acc[c] += w * p[c];
+                weightSum += w;
+              }
             }
+            for (std::size_t c = 0; c < channels; ++c)
+              values[k * stride + c] = static_cast<float>(acc[c] / weightSum);
           }
-          for (std::size_t c = 0; c < stride; ++c)
-            values[k * stride + c] = static_cast<float>(acc[c] / weightSum);
+        };
+        switch (C) {
+          case 1: run(std::integral_constant<int, 1>{}); break;
+          case 2: run(std::integral_constant<int, 2>{}); break;
+          case 3: run(std::integral_constant<int, 3>{}); break;
+          case 4: run(std::integral_constant<int, 4>{}); break;
+          default: run(std::integral_constant<int, 0>{}); break;
         }
       });
     });
