@@ -6,15 +6,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/mesh/mesh.hpp"
 #include "sgbake/sgbake.h"
+#include "support/files.hpp"
 
 namespace sgbake {
 namespace {
@@ -110,12 +109,10 @@ TEST(CApi, DoesNotLoadOpenImageIO) {
   // ~260 libraries: image I/O is a module loaded on first use (sgbake/io/image_io.hpp).
   const CallResult c = callC(FlatMesh{});
   ASSERT_EQ(c.status, SGBAKE_OK) << c.message;
-  std::ifstream maps("/proc/self/maps");
-  std::stringstream text;
-  text << maps.rdbuf();
-  ASSERT_FALSE(text.str().empty());
-  EXPECT_EQ(text.str().find("libOpenImageIO"), std::string::npos);
-  EXPECT_EQ(text.str().find("libsgbake_oiio"), std::string::npos);
+  const std::string maps = test::readFile("/proc/self/maps");
+  ASSERT_FALSE(maps.empty());
+  EXPECT_EQ(maps.find("libOpenImageIO"), std::string::npos);
+  EXPECT_EQ(maps.find("libsgbake_oiio"), std::string::npos);
 }
 
 TEST(CApi, ThreadCountDoesNotChangeTheResult) {

@@ -6,13 +6,12 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/gradient/image.hpp"
 #include "sgbake/io/image_io.hpp"
+#include "support/files.hpp"
 
 namespace sgbake {
 namespace {
@@ -20,10 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 bool mapped(const std::string& fileName) {
-  std::ifstream maps("/proc/self/maps");
-  std::stringstream text;
-  text << maps.rdbuf();
-  return text.str().find(fileName) != std::string::npos;
+  return test::readFile("/proc/self/maps").find(fileName) != std::string::npos;
 }
 
 // One test: the module can be loaded only once per process, and the test needs the "before".
