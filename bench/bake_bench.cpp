@@ -7,6 +7,9 @@
 // Benchmarks (wall time, milliseconds; the argument is the thread count):
 //   - BM_TangentNormal/threads:N — bakeMap(kTangentNormal, 4096², 1 sample) with a bilinear
 //     2048² height map: the speed target (Blender's Cycles bake takes 25–35 s);
+//   - BM_TangentNormalBands/threads:N — the same map by bakeMapRows (bands of rows in a reused
+//     ring, what the CLI runs), and BM_TangentNormalBandsMargin16/threads:N with each band's
+//     final rows padded (extendMarginRows, margin 16) as the CLI pads them;
 //   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
 //   - BM_Mask/threads:N — the raster and coverage alone (no shading);
 //   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map.
@@ -97,6 +100,33 @@ void BM_TangentNormal(benchmark::State& state) { bake(state, MapKind::kTangentNo
 void BM_TangentNormalNoLayers(benchmark::State& state) { bake(state, MapKind::kTangentNormal, false); }
 void BM_Mask(benchmark::State& state) { bake(state, MapKind::kMask, false); }
 
+/// bakeMapRows of the tangent-normal map; with @p margin > 0 each band's final rows are padded.
+void bakeBands(benchmark::State& state, int margin) {
+  const Scene& s = scene();
+  BakeSettings settings;
+  settings.width = settings.height = kBakeSize;
+  settings.threads = static_cast<int>(state.range(0));
+  const BakeInput input{&s.mesh, &s.tangents, s.layers};
+  FloatImage window;
+  for (auto _ : state) {
+    int rowsPadded = 0;
+    const Status done = bakeMapRows(input, settings, 2 * margin, [&](const ImageRows& rows) {
+      const int ready = rows.end == rows.height ? rows.height : rows.end - margin;
+      if (margin > 0 && ready > rowsPadded) {
+        extendMarginRows(rows, margin, rowsPadded, ready, window, settings.threads);
+        rowsPadded = ready;
+      }
+      benchmark::DoNotOptimize(rows.pixelRow(rows.begin));
+      return Status{Ok{}};
+    });
+    if (!done) state.SkipWithError(done.error().message.c_str());
+  }
+  state.counters["texels"] = double(kBakeSize) * kBakeSize;
+}
+
+void BM_TangentNormalBands(benchmark::State& state) { bakeBands(state, 0); }
+void BM_TangentNormalBandsMargin16(benchmark::State& state) { bakeBands(state, 16); }
+
 const FloatImage& tangentMap() {
   static const FloatImage map = [] {
     const Scene& s = scene();
@@ -134,6 +164,8 @@ void threadArgs(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_TangentNormal)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalBands)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalBandsMargin16)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalNoLayers)->Apply(threadArgs);
 BENCHMARK(BM_Mask)->Apply(threadArgs);
 BENCHMARK(BM_ExtendMargin16)->Apply(threadArgs);

@@ -215,62 +215,94 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
   return validateLayers(input.layers, static_cast<int>(mesh.uvSets.size()));
 }
 
-template <class Shader>
-void runBake(const bake_detail::RasterJob& job, const Shader& shader,
-             const bake_detail::RasterOutput& output, FloatImage& image) {
-  bake_detail::rasterize(job, shader, output, image);
+/// Rasterizes @p job into @p target with the shader of settings.map. @p blank: the target was
+/// just allocated, zero-filled (RasterOutput::blank).
+void runBake(const BakeInput& input, const BakeSettings& settings, const bake_detail::RasterJob& job,
+             const bake_detail::RasterTarget& target, bool blank) {
+  using namespace bake_detail;
+  BakeShaderBase base;
+  base.mesh = input.mesh;
+  base.tangents = input.tangents;
+  base.layers = input.layers;
+  base.uvSet = settings.uvSet;
+  base.green = settings.green;
+
+  static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
+  static constexpr float kZero[3] = {0, 0, 0};
+  RasterOutput output{kZero, false};
+  output.blank = blank;
+  switch (settings.map) {
+    case MapKind::kTangentNormal:
+      output.background = kFlat;
+      rasterize(job, TangentNormalShader{base}, output, target);
+      break;
+    case MapKind::kObjectNormal: rasterize(job, ObjectNormalShader{base}, output, target); break;
+    case MapKind::kHeight: rasterize(job, HeightShader{base}, output, target); break;
+    case MapKind::kDerivative: rasterize(job, DerivativeShader{base}, output, target); break;
+    case MapKind::kSurfaceGradient: rasterize(job, SurfaceGradientShader{base}, output, target); break;
+    case MapKind::kTangent: rasterize(job, TangentShader{base}, output, target); break;
+    case MapKind::kBitangent: rasterize(job, BitangentShader{base}, output, target); break;
+    case MapKind::kMask:
+      output.valueIsCoverage = true;
+      rasterize(job, MaskShader{}, output, target);
+      break;
+  }
+}
+
+Error outOfMemory(const BakeSettings& settings) {
+  return Error::internal("bake: out of memory for a " + std::to_string(settings.width) + "x" +
+                         std::to_string(settings.height) + " map");
 }
 
 }  // namespace
 
 Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings) {
   if (Status s = validateSettings(input, settings); !s) return s.error();
-  const Mesh& mesh = *input.mesh;
   try {
-    const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+    const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(*input.mesh);
     FloatImage image;
     bake_detail::allocateImage(image, settings.width, settings.height, mapChannels(settings.map),
                                settings.threads);
-
-    bake_detail::RasterJob job =
-        bake_detail::rasterJobFor(mesh, triangles, settings, settings.width, settings.height);
-    if (settings.onRowsFinal) {
-      job.onRowsFinal = [&](int rowsFinal) { settings.onRowsFinal(image, rowsFinal); };
-    }
-
-    bake_detail::BakeShaderBase base;
-    base.mesh = &mesh;
-    base.tangents = input.tangents;
-    base.layers = input.layers;
-    base.uvSet = settings.uvSet;
-    base.green = settings.green;
-
-    static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
-    static constexpr float kZero[3] = {0, 0, 0};
-    bake_detail::RasterOutput output{kZero, false};
-    output.blank = true;  // allocateImage zero-fills
-    using namespace bake_detail;
-    switch (settings.map) {
-      case MapKind::kTangentNormal:
-        output.background = kFlat;
-        runBake(job, TangentNormalShader{base}, output, image);
-        break;
-      case MapKind::kObjectNormal: runBake(job, ObjectNormalShader{base}, output, image); break;
-      case MapKind::kHeight: runBake(job, HeightShader{base}, output, image); break;
-      case MapKind::kDerivative: runBake(job, DerivativeShader{base}, output, image); break;
-      case MapKind::kSurfaceGradient: runBake(job, SurfaceGradientShader{base}, output, image); break;
-      case MapKind::kTangent: runBake(job, TangentShader{base}, output, image); break;
-      case MapKind::kBitangent: runBake(job, BitangentShader{base}, output, image); break;
-      case MapKind::kMask:
-        output.valueIsCoverage = true;
-        runBake(job, MaskShader{}, output, image);
-        break;
-    }
+    const bake_detail::RasterJob job =
+        bake_detail::rasterJobFor(*input.mesh, triangles, settings, settings.width, settings.height);
+    runBake(input, settings, job, bake_detail::RasterTarget::of(image), /*blank=*/true);
     return image;
   } catch (const std::bad_alloc&) {
-    return Error::internal("bake: out of memory for a " + std::to_string(settings.width) + "x" +
-                           std::to_string(settings.height) + " map");
+    return outOfMemory(settings);
   }
+}
+
+Status bakeMapRows(const BakeInput& input, const BakeSettings& settings, int keepRows,
+                   const BakedRowsSink& sink) {
+  if (Status s = validateSettings(input, settings); !s) return s;
+  if (keepRows < 0) return Error::badInput("bake: rows to keep must be 0 or more");
+  if (!sink) return Error::badInput("bake: no sink for the baked rows");
+  Status result = Ok{};
+  try {
+    const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(*input.mesh);
+    const int W = settings.width, H = settings.height, C = mapChannels(settings.map);
+    // Bands are at most kBakeBandRows rows, and a call may read keepRows rows above its band.
+    const int ringRows = std::min(H, kBakeBandRows + keepRows);
+    const std::size_t ringTexels = static_cast<std::size_t>(ringRows) * static_cast<std::size_t>(W);
+    std::vector<float> pixels(ringTexels * static_cast<std::size_t>(C));
+    std::vector<float> coverage(ringTexels);
+    const bake_detail::RasterTarget target{pixels.data(), coverage.data(), C, ringRows};
+
+    bake_detail::RasterJob job = bake_detail::rasterJobFor(*input.mesh, triangles, settings, W, H);
+    int previousEnd = 0;
+    job.onRowsFinal = [&](int rowsFinal) {
+      const ImageRows rows{W, H, C, std::max(0, previousEnd - keepRows), rowsFinal, ringRows,
+                           pixels.data(), coverage.data()};
+      previousEnd = rowsFinal;
+      result = sink(rows);
+      return result.ok();
+    };
+    // Not blank: every band's slots still hold the band before, and are reset block by block.
+    runBake(input, settings, job, target, /*blank=*/false);
+  } catch (const std::bad_alloc&) {
+    return outOfMemory(settings);
+  }
+  return result;
 }
 
 }  // namespace sgbake

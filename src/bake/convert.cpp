@@ -127,7 +127,7 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
     bake_detail::RasterOutput rasterOutput;
     rasterOutput.keepUncovered = true;
     rasterOutput.blank = true;  // the coverage was just zero-filled
-    bake_detail::rasterize(job, shader, rasterOutput, output);
+    bake_detail::rasterize(job, shader, rasterOutput, bake_detail::RasterTarget::of(output));
     return output;
   } catch (const std::bad_alloc&) {
     return Error::internal(where + ": out of memory converting a " + std::to_string(input.width) +

@@ -162,32 +162,48 @@ void extendMargin(FloatImage& image, int margin, int threads) {
   }
 }
 
-int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
+int extendMarginRows(const ImageRows& rows, int margin, int rowBegin, int rowEnd,
                      FloatImage& window, int threads) {
-  rowBegin = std::clamp(rowBegin, 0, std::max(image.height, 0));
-  rowEnd = std::clamp(rowEnd, rowBegin, std::max(image.height, 0));
+  const int H = std::max(rows.height, 0);
+  rowBegin = std::clamp(rowBegin, 0, H);
+  rowEnd = std::clamp(rowEnd, rowBegin, H);
   margin = std::max(margin, 0);
   // The rows the strip's padding depends on, clipped to the image (whose edges the window then
   // shares, so the padding there is the same too).
   const int windowBegin = std::max(0, rowBegin - margin);
-  const int windowEnd = std::min(image.height, rowEnd + margin);
-  window.width = image.width;
+  const int windowEnd = std::min(H, rowEnd + margin);
+  window.width = rows.width;
   window.height = windowEnd - windowBegin;
-  window.channels = image.channels;
-  if (!imageIsValid(image) || window.height == 0) {
+  window.channels = rows.channels;
+  if (rows.width <= 0 || rows.channels <= 0 || window.height == 0 || windowBegin < rows.begin ||
+      windowEnd > rows.end) {
+    window.height = 0;
     window.pixels.clear();
     window.coverage.clear();
     return rowBegin - windowBegin;
   }
-  const auto texels = static_cast<std::ptrdiff_t>(image.width);
-  const auto values = texels * image.channels;
-  const auto begin = static_cast<std::ptrdiff_t>(windowBegin);
-  const auto end = static_cast<std::ptrdiff_t>(windowEnd);
-  window.pixels.assign(image.pixels.begin() + begin * values, image.pixels.begin() + end * values);
-  window.coverage.assign(image.coverage.begin() + begin * texels,
-                         image.coverage.begin() + end * texels);
+  const std::size_t rowValues = rows.rowValues();
+  const std::size_t rowTexels = static_cast<std::size_t>(rows.width);
+  window.pixels.resize(static_cast<std::size_t>(window.height) * rowValues);
+  window.coverage.resize(static_cast<std::size_t>(window.height) * rowTexels);
+  for (int r = windowBegin; r < windowEnd;) {  // runs of rows contiguous in the ring
+    const int run = std::min(rows.contiguousRows(r), windowEnd - r);
+    const std::size_t at = static_cast<std::size_t>(r - windowBegin);
+    std::copy_n(rows.pixelRow(r), static_cast<std::size_t>(run) * rowValues,
+                window.pixels.begin() + static_cast<std::ptrdiff_t>(at * rowValues));
+    std::copy_n(rows.coverageRow(r), static_cast<std::size_t>(run) * rowTexels,
+                window.coverage.begin() + static_cast<std::ptrdiff_t>(at * rowTexels));
+    r += run;
+  }
   extendMargin(window, margin, threads);
   return rowBegin - windowBegin;
+}
+
+int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
+                     FloatImage& window, int threads) {
+  ImageRows rows = ImageRows::of(image);
+  if (!imageIsValid(image)) rows.end = 0;  // nothing to read: an empty window
+  return extendMarginRows(rows, margin, rowBegin, rowEnd, window, threads);
 }
 
 namespace {

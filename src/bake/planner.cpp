@@ -818,13 +818,15 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
   return result;
 }
 
-/// Bakes one image tile into @p file and adds its timings to @p report. The image is padded
-/// and handed to an ImageFileWriter strip by strip as the bake finishes its rows (top first), so
-/// the file is compressed and written while the rest is baked. Extend padding of a strip needs
-/// `margin` rows below it (extendMarginRows); push-pull needs the whole image, which is then
-/// padded and written after the bake. Masks are not padded (padding would overwrite the
-/// coverage they show).
-Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneOutput& output,
+/// Bakes one image tile into @p file and adds its timings to @p report. The image is baked band
+/// by band into a small ring of rows (bakeMapRows), and each band's final rows are padded and
+/// handed to an ImageFileWriter, so the file is compressed and written while the rest is baked
+/// and the whole image never exists. Extend padding of a strip needs `margin` rows below it and
+/// above it (extendMarginRows): the rows above are kept in the ring, and the last `margin` rows
+/// of each band wait for the next one. Push-pull needs the whole image, which is then baked,
+/// padded and written in one piece. Masks are not padded (padding would overwrite the coverage
+/// they show).
+Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const SceneOutput& output,
                      const fs::path& file, ExecuteReport& report) {
   using Clock = std::chrono::steady_clock;
   const int threads = settings.threads;
@@ -842,53 +844,71 @@ Status bakeImageTile(const BakeInput& input, BakeSettings settings, const SceneO
   const int margin = isMask || pushPull ? 0 : std::max(output.margin, 0);
   const bool signedRange = output.storesSignedRange();
   int rowsWritten = 0;
-  Status written = Ok{};
   double padSeconds = 0, convertSeconds = 0;
   FloatImage window;  // padded rows and their halo, reused from strip to strip
   // Pads and queues the rows whose padding is final: all of them once the image is complete.
-  auto writeFinalRows = [&](const FloatImage& image, int rowsFinal) {
-    if (!written) return;
-    const int ready = rowsFinal == image.height ? image.height : rowsFinal - margin;
-    if (ready <= rowsWritten) return;
-    const std::size_t rows = static_cast<std::size_t>(ready - rowsWritten);
-    const std::size_t rowTexels = static_cast<std::size_t>(image.width);
-    const std::size_t rowValues = rowTexels * static_cast<std::size_t>(image.channels);
-    Clock::time_point start = Clock::now();
-    // The rows as written: straight from the image, or from a padded (or remapped) copy.
-    const FloatImage* source = &image;
-    std::size_t first = static_cast<std::size_t>(rowsWritten);
-    if (margin > 0 || signedRange) {
-      first = static_cast<std::size_t>(
-          extendMarginRows(image, margin, rowsWritten, ready, window, threads));
-      source = &window;
+  auto writeFinalRows = [&](const ImageRows& rows) -> Status {
+    const int ready = rows.end == rows.height ? rows.height : rows.end - margin;
+    if (ready <= rowsWritten) return Ok{};
+    const std::size_t rowTexels = static_cast<std::size_t>(rows.width);
+    const std::size_t rowValues = rows.rowValues();
+    Status ok = Ok{};
+    if (margin > 0 || signedRange) {  // from a padded (and remapped) copy of the rows
+      Clock::time_point start = Clock::now();
+      const auto first = static_cast<std::size_t>(
+          extendMarginRows(rows, margin, rowsWritten, ready, window, threads));
+      const auto count = static_cast<std::size_t>(ready - rowsWritten);
+      padSeconds += secondsSince(start);
+      start = Clock::now();
+      if (signedRange) {  // [−range, range] → [0, 1] for the integer file
+        const double scale = 0.5 / output.range;
+        for (std::size_t i = first * rowValues; i < (first + count) * rowValues; ++i)
+          window.pixels[i] = static_cast<float>(scale * window.pixels[i] + 0.5);
+      }
+      ok = writer->writeRows(
+          rowsWritten, ready - rowsWritten,
+          std::span<const float>(window.pixels).subspan(first * rowValues, count * rowValues),
+          std::span<const float>(window.coverage).subspan(first * rowTexels, count * rowTexels));
+      convertSeconds += secondsSince(start);
+    } else {  // straight from the baked rows, run by run of rows contiguous in their ring
+      const Clock::time_point start = Clock::now();
+      for (int row = rowsWritten; row < ready && ok;) {
+        const int run = std::min(rows.contiguousRows(row), ready - row);
+        const auto count = static_cast<std::size_t>(run);
+        ok = writer->writeRows(row, run, {rows.pixelRow(row), count * rowValues},
+                               {rows.coverageRow(row), count * rowTexels});
+        row += run;
+      }
+      convertSeconds += secondsSince(start);
     }
-    padSeconds += secondsSince(start);
-    start = Clock::now();
-    if (signedRange) {  // [−range, range] → [0, 1] for the integer file
-      const double scale = 0.5 / output.range;
-      for (std::size_t i = first * rowValues; i < (first + rows) * rowValues; ++i)
-        window.pixels[i] = static_cast<float>(scale * window.pixels[i] + 0.5);
-    }
-    written = writer->writeRows(
-        rowsWritten, ready - rowsWritten,
-        std::span<const float>(source->pixels).subspan(first * rowValues, rows * rowValues),
-        std::span<const float>(source->coverage).subspan(first * rowTexels, rows * rowTexels));
-    convertSeconds += secondsSince(start);
     rowsWritten = ready;
+    return ok;
   };
-  if (!pushPull) settings.onRowsFinal = writeFinalRows;
 
   const Clock::time_point start = Clock::now();
-  Result<FloatImage> image = bakeMap(input, settings);
-  if (!image) return Error{image.error().code, file.string() + ": " + image.error().message};
-  report.bakeSeconds += secondsSince(start) - padSeconds - convertSeconds;
   if (pushPull) {
+    Result<FloatImage> image = bakeMap(input, settings);
+    if (!image) return Error{image.error().code, file.string() + ": " + image.error().message};
+    report.bakeSeconds += secondsSince(start);
     const Clock::time_point padStart = Clock::now();
     pushPullFill(*image, threads);
     padSeconds += secondsSince(padStart);
-    writeFinalRows(*image, image->height);
+    if (Status ok = writeFinalRows(ImageRows::of(*image)); !ok) return ok;
+  } else {
+    // A strip's padding reads `margin` rows above it, which are `margin` rows above the last
+    // rows written: 2·margin rows above the new band.
+    bool writeFailed = false;
+    const Status baked = bakeMapRows(input, settings, 2 * margin, [&](const ImageRows& rows) {
+      Status ok = writeFinalRows(rows);
+      writeFailed = !ok;
+      return ok;
+    });
+    if (!baked) {
+      if (writeFailed) return baked.error();  // the writer's errors name the file already
+      return Error{baked.error().code, file.string() + ": " + baked.error().message};
+    }
+    report.bakeSeconds += secondsSince(start) - padSeconds - convertSeconds;
   }
-  if (!written) return written;
   const double queueWaits = writer->waitSeconds();  // inside writeRows: the queue was full
   const Clock::time_point commitStart = Clock::now();
   if (Status ok = writer->commit(); !ok) return ok;

@@ -112,14 +112,16 @@ struct RasterJob {
   std::span<const Vec2f> uvs;  ///< #C corner UVs of the UV set that places the texels
   int width = 0, height = 0, samples = 1, udimTile = kFirstUdimTile, threads = 0;
   /// Optional: rasterize() then works in bands of kBlocksPerBand row blocks from the top of the
-  /// image down and calls it after each band with the number of final rows from the top
-  /// (BakeSettings::onRowsFinal).
-  std::function<void(int rowsFinal)> onRowsFinal;
+  /// image down and calls it after each band with the number of final rows from the top; it
+  /// returns whether to go on (bakeMapRows).
+  std::function<bool(int rowsFinal)> onRowsFinal;
 };
 
-/// Row blocks per band when RasterJob::onRowsFinal is set: 256 rows, so a 4096² bake reports 16
-/// times (each band ends with a wait for its slowest block, so bands are not made smaller).
-inline constexpr int kBlocksPerBand = 32;
+/// Row blocks per band when RasterJob::onRowsFinal is set: kBakeBandRows rows, so a 4096² bake
+/// reports 16 times (each band ends with a wait for its slowest block, so bands are not made
+/// smaller).
+inline constexpr int kBlocksPerBand = kBakeBandRows / kRowsPerBlock;
+static_assert(kBlocksPerBand * kRowsPerBlock == kBakeBandRows);
 
 /// @brief The RasterJob of a bake or a conversion (BakeSettings, ConvertSettings): @p triangles
 /// (loopTriangles(mesh), which must outlive the job) placed by UV set settings.uvSet in a
@@ -185,6 +187,20 @@ inline void allocateImage(FloatImage& image, int width, int height, int channels
   });
 }
 
+/// @brief Where rasterize() writes: file row r (top first) of the image at slot r % ringRows of
+/// the buffers (ringRows == height: a whole image; fewer: bakeMapRows' reused band ring, whose
+/// slots are reset before a band is baked into them).
+struct RasterTarget {
+  float* pixels = nullptr;    ///< ringRows·width·channels
+  float* coverage = nullptr;  ///< ringRows·width
+  int channels = 0;           ///< ≥ Shader::kChannels
+  int ringRows = 0;
+
+  static RasterTarget of(FloatImage& image) {
+    return {image.pixels.data(), image.coverage.data(), image.channels, image.height};
+  }
+};
+
 /// @brief How rasterize() finishes a texel.
 struct RasterOutput {
   std::span<const float> background;  ///< kChannels values of texels no sample covers
@@ -198,18 +214,18 @@ struct RasterOutput {
   bool blank = false;
 };
 
-/// @brief Rasterizes @p job into @p image (already sized width × height × image.channels with
-/// image.channels ≥ Shader::kChannels, coverage width × height) with @p prototype copied once per
-/// row block. Only channels 0 … kChannels−1 are written.
+/// @brief Rasterizes @p job into @p target (a width × height image of target.channels ≥
+/// Shader::kChannels channels, or a ring of its rows) with @p prototype copied once per row
+/// block. Only channels 0 … kChannels−1 are written.
 ///
 /// Texels with covered samples get the mean of the shader's values over those samples and
 /// coverage = covered / N²; others get @p output.background and coverage 0.
 template <class Shader>
 void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput& output,
-               FloatImage& image) {
+               const RasterTarget& target) {
   constexpr int kC = Shader::kChannels;
   const int W = job.width, H = job.height, N = job.samples;
-  const std::size_t stride = static_cast<std::size_t>(image.channels);
+  const std::size_t stride = static_cast<std::size_t>(target.channels);
   const TriangleBins bins = binTriangles(job);
   const int numBlocks = (H + kRowsPerBlock - 1) / kRowsPerBlock;
 
@@ -230,11 +246,18 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
     const int yBegin = block * kRowsPerBlock;
     const int yEnd = std::min(H, yBegin + kRowsPerBlock);
     const std::size_t blockTexels = static_cast<std::size_t>(yEnd - yBegin) * W;
+    // The block's rows in the target (file row H − 1 − y; a ring wraps between rows).
+    std::array<float*, kRowsPerBlock> pixelRows{}, coverageRows{};
+    for (int y = yBegin; y < yEnd; ++y) {
+      const std::size_t slot = static_cast<std::size_t>((H - 1 - y) % target.ringRows);
+      pixelRows[static_cast<std::size_t>(y - yBegin)] = target.pixels + slot * W * stride;
+      coverageRows[static_cast<std::size_t>(y - yBegin)] = target.coverage + slot * W;
+    }
     auto pixelAt = [&](int x, int y) {
-      return image.pixels.data() + (static_cast<std::size_t>(H - 1 - y) * W + x) * stride;
+      return pixelRows[static_cast<std::size_t>(y - yBegin)] + static_cast<std::size_t>(x) * stride;
     };
     auto coverageAt = [&](int x, int y) -> float& {
-      return image.coverage[static_cast<std::size_t>(H - 1 - y) * W + x];
+      return coverageRows[static_cast<std::size_t>(y - yBegin)][x];
     };
 
     // Start from "nothing covered": background (unless kept) and coverage 0.
@@ -374,7 +397,7 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
   for (int end = numBlocks; end > 0; end -= kBlocksPerBand) {
     const int first = std::max(0, end - kBlocksPerBand);
     processBlocks(first, end);
-    job.onRowsFinal(H - first * kRowsPerBlock);
+    if (!job.onRowsFinal(H - first * kRowsPerBlock)) return;
   }
 }
 

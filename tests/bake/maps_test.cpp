@@ -330,32 +330,76 @@ TEST(Maps, SupersampledNormalsAreTheMeanOfEncodedSamples) {
   EXPECT_GT(checked, 100);
 }
 
-TEST(Maps, RowsReportedAsFinalAreFinalAndTheImageIsTheSame) {
-  // With onRowsFinal the raster works in bands from the top down and reports them; the image is
-  // the same bit for bit, and every row reported final already has its final value.
+TEST(Maps, BandByBandRowsEqualTheWholeImageAndStayReadableForTheirHalo) {
+  // bakeMapRows bakes bands from the top down into a ring of reused rows. Every row a call may
+  // read (the new band and keepRows rows above it) must hold bakeMap's values bit for bit: a
+  // reused slot left uncleared, or a band overwriting the kept rows, shows here.
+  const HandTriangle h = handTriangle();
+  for (const MapKind map : {MapKind::kTangentNormal, MapKind::kTangent, MapKind::kMask}) {
+    for (const int samples : {1, 2}) {
+      BakeSettings s;
+      s.map = map;
+      s.width = 37;
+      s.height = 603;  // three bands, the first of them shorter (603 is not a multiple of 8)
+      s.samples = samples;
+      const Result<FloatImage> plain = bakeMap({&h.mesh, &h.tangents, {}}, s);
+      ASSERT_TRUE(plain.ok());
+      for (const int keep : {0, 5, 40, 1000}) {
+        const std::string what = std::string(mapKindName(map)) + ", samples " +
+                                 std::to_string(samples) + ", keep " + std::to_string(keep);
+        std::vector<int> ends;
+        int rowsChecked = 0;
+        const Status done = bakeMapRows({&h.mesh, &h.tangents, {}}, s, keep, [&](const ImageRows& rows) {
+          const int previousEnd = ends.empty() ? 0 : ends.back();
+          EXPECT_EQ(rows.begin, std::max(0, previousEnd - keep)) << what;
+          EXPECT_GT(rows.end, previousEnd) << what;
+          EXPECT_LE(rows.end - previousEnd, kBakeBandRows) << what;
+          ends.push_back(rows.end);
+          const std::size_t rowValues = rows.rowValues();
+          for (int r = rows.begin; r < rows.end; ++r, ++rowsChecked) {
+            EXPECT_EQ(std::memcmp(rows.pixelRow(r), plain->pixels.data() + static_cast<std::size_t>(r) * rowValues,
+                                  rowValues * sizeof(float)),
+                      0)
+                << what << ", row " << r;
+            EXPECT_EQ(std::memcmp(rows.coverageRow(r), plain->coverage.data() + static_cast<std::size_t>(r) * 37,
+                                  37 * sizeof(float)),
+                      0)
+                << what << ", row " << r;
+          }
+          return Status{Ok{}};
+        });
+        ASSERT_TRUE(done.ok()) << what;
+        ASSERT_EQ(ends.size(), 3u) << what;
+        EXPECT_EQ(ends.back(), 603) << what;
+        EXPECT_GE(rowsChecked, 603) << what;
+      }
+    }
+  }
+}
+
+TEST(Maps, BandByBandStopsAtTheSinksError) {
   const HandTriangle h = handTriangle();
   BakeSettings s;
   s.map = MapKind::kTangent;
-  s.width = 37;
-  s.height = 600;  // more than one band of rows
-  const Result<FloatImage> plain = bakeMap({&h.mesh, &h.tangents, {}}, s);
-  ASSERT_TRUE(plain.ok());
-  std::vector<int> reports;
-  bool rowsWereFinal = true;
-  s.onRowsFinal = [&](const FloatImage& image, int rowsFinal) {
-    reports.push_back(rowsFinal);
-    const std::size_t values = static_cast<std::size_t>(rowsFinal) * 37 * 3;
-    rowsWereFinal = rowsWereFinal &&
-                    std::memcmp(image.pixels.data(), plain->pixels.data(), values * sizeof(float)) == 0;
-  };
-  const Result<FloatImage> banded = bakeMap({&h.mesh, &h.tangents, {}}, s);
-  ASSERT_TRUE(banded.ok());
-  EXPECT_EQ(banded->pixels, plain->pixels);
-  EXPECT_EQ(banded->coverage, plain->coverage);
-  ASSERT_GE(reports.size(), 2u);
-  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
-  EXPECT_EQ(reports.back(), 600);
-  EXPECT_TRUE(rowsWereFinal);
+  s.width = 16;
+  s.height = 600;
+  int calls = 0;
+  const Status done = bakeMapRows({&h.mesh, &h.tangents, {}}, s, 0, [&](const ImageRows&) {
+    ++calls;
+    return Status{Error::internal("disk full")};
+  });
+  ASSERT_FALSE(done.ok());
+  EXPECT_EQ(done.error().message, "disk full");
+  EXPECT_EQ(calls, 1);
+  // Settings are checked as bakeMap checks them, before any band.
+  s.width = 0;
+  const Status bad = bakeMapRows({&h.mesh, &h.tangents, {}}, s, 0, [&](const ImageRows&) {
+    ++calls;
+    return Status{Ok{}};
+  });
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(calls, 1);
 }
 
 TEST(Maps, BadInputIsAnErrorValue) {

@@ -140,6 +140,48 @@ TEST(ExtendMargin, StripsFromTheirHaloAloneEqualTheWholeImage) {
             0);
 }
 
+TEST(ExtendMargin, StripsReadFromARingOfRowsEqualTheWholeImage) {
+  // The baker keeps only a ring of rows (bakeMapRows): file row r in slot r % ringRows, with
+  // the rows a strip reads wrapping around the ring's end. The padded strip must not depend on
+  // where its rows sit.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> value(0, 1);
+  FloatImage image = holes(41, 90, 2);
+  for (int k = 0; k < 30; ++k) {
+    const int x0 = static_cast<int>(rng() % 40), r0 = static_cast<int>(rng() % 89);
+    cover(image, x0, r0, {value(rng), value(rng)});
+  }
+  const int margin = 3, ringRows = 17;
+  FloatImage whole = image;
+  extendMargin(whole, margin);
+  const std::size_t rowValues = 41 * 2;
+  std::vector<float> pixels(ringRows * rowValues, -1.0f), coverage(ringRows * 41, -1.0f);
+  FloatImage window;
+  int checked = 0;
+  for (int begin = 0; begin + 5 <= 90; begin += 5) {
+    const int end = begin + 5;
+    const int from = std::max(0, begin - margin), to = std::min(90, end + margin);
+    for (int r = from; r < to; ++r) {  // the rows the strip needs, at their ring slots
+      std::copy_n(image.pixels.begin() + r * 82, 82, pixels.begin() + (r % ringRows) * 82);
+      std::copy_n(image.coverage.begin() + r * 41, 41, coverage.begin() + (r % ringRows) * 41);
+    }
+    const ImageRows rows{41, 90, 2, from, to, ringRows, pixels.data(), coverage.data()};
+    const int first = extendMarginRows(rows, margin, begin, end, window);
+    ASSERT_EQ(window.height, to - from);
+    EXPECT_EQ(std::memcmp(window.pixels.data() + static_cast<std::size_t>(first) * rowValues,
+                          whole.pixels.data() + static_cast<std::size_t>(begin) * rowValues,
+                          5 * rowValues * sizeof(float)),
+              0)
+        << "rows " << begin << " to " << end;
+    checked += to / ringRows != from / ringRows ? 1 : 0;  // strips whose rows wrap
+  }
+  EXPECT_GE(checked, 4);
+  // Rows the view does not hold give an empty window, not a read outside the ring.
+  const ImageRows partial{41, 90, 2, 10, 20, ringRows, pixels.data(), coverage.data()};
+  extendMarginRows(partial, margin, 10, 20, window);
+  EXPECT_EQ(window.height, 0);
+}
+
 TEST(PushPullFill, FillsEveryHoleAndKeepsCoveredTexels) {
   for (const auto& [w, h] : std::vector<std::array<int, 2>>{{64, 64}, {37, 19}, {1, 9}, {129, 3}}) {
     std::mt19937 rng(11);

@@ -51,7 +51,9 @@
 /// task and its samples are summed in a fixed order, so 1 and N threads give identical bits.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -103,6 +105,33 @@ struct FloatImage {
   float at(int x, int row, int c) const { return pixels[(static_cast<std::size_t>(row) * width + x) * channels + c]; }
 };
 
+/// @brief Read-only view of consecutive rows [begin, end) of an image (rows top first), stored in
+/// a ring of `ringRows` rows: file row r lives in slot r % ringRows. A whole FloatImage is the
+/// view with ringRows == height (of()); bakeMapRows hands out views of its reused band ring.
+struct ImageRows {
+  int width = 0, height = 0, channels = 0;  ///< of the whole image
+  int begin = 0, end = 0;                   ///< the rows that may be read
+  int ringRows = 0;                         ///< rows of storage (≥ end − begin)
+  const float* pixels = nullptr;            ///< ringRows·width·channels
+  const float* coverage = nullptr;          ///< ringRows·width
+
+  /// @brief The view of all rows of @p image.
+  static ImageRows of(const FloatImage& image) {
+    return {image.width, image.height, image.channels, 0, image.height, image.height,
+            image.pixels.data(), image.coverage.data()};
+  }
+  /// The width·channels values of row @p row (begin ≤ row < end).
+  const float* pixelRow(int row) const { return pixels + slot(row) * rowValues(); }
+  /// The width coverage values of row @p row (begin ≤ row < end).
+  const float* coverageRow(int row) const { return coverage + slot(row) * static_cast<std::size_t>(width); }
+  /// Rows from @p row on (≤ end) that follow each other in memory: up to the ring's wrap.
+  int contiguousRows(int row) const { return std::min(end, row - row % ringRows + ringRows) - row; }
+  std::size_t rowValues() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(channels); }
+
+ private:
+  std::size_t slot(int row) const { return static_cast<std::size_t>(row % ringRows); }
+};
+
 /// First UDIM tile number: the tile [0,1)².
 inline constexpr int kFirstUdimTile = 1001;
 /// Last UDIM tile number Blender accepts (u tile 9, v tile 99).
@@ -121,12 +150,6 @@ struct BakeSettings {
   int udimTile = 1001;    ///< which UDIM tile (1001 = [0,1)²), kFirstUdimTile … kLastUdimTile
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< kDirectX flips G of kTangentNormal
   int threads = 0;        ///< 0 = all cores; the result does not depend on it
-  /// Optional: called on bakeMap's thread each time more rows are final, with the image being
-  /// baked and the number of final rows counted from the top (file order). Rows are baked top
-  /// first in bands, and the last call has rowsFinal == height, so a caller can pad and write
-  /// the top of the image while the rest is baked (see ImageFileWriter). The image's rows below
-  /// rowsFinal must not be read. The result does not depend on it.
-  std::function<void(const FloatImage& image, int rowsFinal)> onRowsFinal;
 };
 
 /// @brief Everything a bake reads: the mesh, its tangent frames (may be null when no map or
@@ -149,6 +172,26 @@ struct BakeInput {
 ///         tangents and none (or a wrong number) are given, or validateLayers rejects a layer;
 ///         kInternal when memory runs out.
 Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings);
+
+/// Rows per band of bakeMapRows (the last band, or the first of a height that is not a multiple
+/// of 8, may have fewer).
+inline constexpr int kBakeBandRows = 256;
+
+/// @brief Called by bakeMapRows after each band with the rows that may be read (see there);
+/// returning an error stops the bake, which then returns that error.
+using BakedRowsSink = std::function<Status(const ImageRows& rows)>;
+
+/// @brief bakeMap band by band, without ever holding the whole image: the map is baked in bands
+/// of kBakeBandRows rows from the top of the image (file row 0) down into a ring of
+/// kBakeBandRows + @p keepRows reused rows (capped at the height), and @p sink is called on the
+/// caller's thread after each band. With e the end of the previous call (0 at first), a call
+/// sees rows [max(0, e − keepRows), end): the new band and the @p keepRows rows above it (the
+/// halo a padding of the rows above the band needs). The last call has end == height. Every
+/// value is bit for bit the one bakeMap computes; memory is O(width · (kBakeBandRows +
+/// keepRows)) instead of O(width · height), so a 4096² bake holds ~18 MB instead of ~270 MB.
+/// @return bakeMap's errors, or the first error of @p sink (no later band is baked)
+Status bakeMapRows(const BakeInput& input, const BakeSettings& settings, int keepRows,
+                   const BakedRowsSink& sink);
 
 /// @brief The triangles the baker rasterizes, as global corner indices, face after face (see
 /// "Triangles" in the file comment): #F triangles for a triangle mesh, 2 per quad, k−2 per k-gon.
@@ -174,13 +217,16 @@ std::vector<int> udimTiles(const Mesh& mesh, int uvSet);
 void extendMargin(FloatImage& image, int margin, int threads = 0);
 
 /// @brief Rows [rowBegin, rowEnd) of extendMargin(image, margin), bit for bit, computed from rows
-/// [rowBegin − margin, rowEnd + margin) of @p image alone: a texel's padded value depends on
-/// nothing farther than @p margin rows. This pads a strip of an image whose lower rows are
-/// still being baked.
-/// @param[out] window receives those rows of @p image (clipped to it), padded; its buffers are
+/// [rowBegin − margin, rowEnd + margin) of the image alone (@p rows must hold them, clipped to
+/// the image): a texel's padded value depends on nothing farther than @p margin rows. This pads
+/// a strip of an image whose lower rows are still being baked (bakeMapRows).
+/// @param[out] window receives those rows of the image (clipped to it), padded; its buffers are
 ///             reused from one call to the next
 /// @param[in] threads 0 = all cores; the result does not depend on it
 /// @return the row of @p window that holds row @p rowBegin of the image
+int extendMarginRows(const ImageRows& rows, int margin, int rowBegin, int rowEnd,
+                     FloatImage& window, int threads = 0);
+/// @brief extendMarginRows of a whole image.
 int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
                      FloatImage& window, int threads = 0);
 
