@@ -9,7 +9,7 @@
 //     2048² height map: the speed target (Blender's Cycles bake takes 25–35 s);
 //   - BM_TangentNormalBands/threads:N — the same map by bakeMapRows (bands of rows in a reused
 //     ring, what the CLI runs), and BM_TangentNormalBandsMargin16/threads:N with each band's
-//     final rows padded (extendMarginRows, margin 16) as the CLI pads them;
+//     final rows padded in place (extendMarginRowsInPlace, margin 16) as the CLI pads them;
 //   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
 //   - BM_Mask/threads:N — the raster and coverage alone (no shading);
 //   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map.
@@ -107,13 +107,12 @@ void bakeBands(benchmark::State& state, int margin) {
   settings.width = settings.height = kBakeSize;
   settings.threads = static_cast<int>(state.range(0));
   const BakeInput input{&s.mesh, &s.tangents, s.layers};
-  FloatImage window;
   for (auto _ : state) {
     int rowsPadded = 0;
-    const Status done = bakeMapRows(input, settings, 2 * margin, [&](const ImageRows& rows) {
+    const Status done = bakeMapRows(input, settings, 2 * margin, [&](const MutableImageRows& rows) {
       const int ready = rows.end == rows.height ? rows.height : rows.end - margin;
       if (margin > 0 && ready > rowsPadded) {
-        extendMarginRows(rows, margin, rowsPadded, ready, window, settings.threads);
+        extendMarginRowsInPlace(rows, margin, rowsPadded, ready, settings.threads);
         rowsPadded = ready;
       }
       benchmark::DoNotOptimize(rows.pixelRow(rows.begin));

@@ -291,7 +291,7 @@ Status bakeMapRows(const BakeInput& input, const BakeSettings& settings, int kee
     bake_detail::RasterJob job = bake_detail::rasterJobFor(*input.mesh, triangles, settings, W, H);
     int previousEnd = 0;
     job.onRowsFinal = [&](int rowsFinal) {
-      const ImageRows rows{W, H, C, std::max(0, previousEnd - keepRows), rowsFinal, ringRows,
+      const MutableImageRows rows{W, H, C, std::max(0, previousEnd - keepRows), rowsFinal, ringRows,
                            pixels.data(), coverage.data()};
       previousEnd = rowsFinal;
       result = sink(rows);

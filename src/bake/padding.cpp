@@ -43,20 +43,40 @@ void forRowBlocks(int rows, int threads, const Body& body) {
   });
 }
 
-}  // namespace
+/// Rows 0 … height−1 of the image extendMarginIn pads, wherever they are stored.
+struct PaddedRows {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float*> pixels;          ///< row r's width·channels values
+  std::vector<const float*> coverage;  ///< row r's width coverage values
+};
 
-void extendMargin(FloatImage& image, int margin, int threads) {
-  if (margin <= 0 || !imageIsValid(image)) return;
+/// The rows [begin, end) of @p rows (which must hold them) as PaddedRows.
+PaddedRows paddedRows(const MutableImageRows& rows, int begin, int end) {
+  PaddedRows out;
+  out.width = rows.width;
+  out.height = end - begin;
+  out.channels = rows.channels;
+  for (int r = begin; r < end; ++r) {
+    out.pixels.push_back(rows.pixelRow(r));
+    out.coverage.push_back(rows.coverageRow(r));
+  }
+  return out;
+}
+
+/// extendMargin of the image @p image's rows make up (see bake.hpp). Reads the pixels of filled
+/// texels only: the values uncovered texels start with never matter.
+void extendMarginIn(const PaddedRows& image, int margin, int threads) {
   const int W = image.width, H = image.height, C = image.channels;
   const std::size_t stride = static_cast<std::size_t>(C);
-  std::vector<std::uint8_t> filled(image.coverage.size());
+  std::vector<std::uint8_t> filled(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
   forRowBlocks(H, threads, [&](int r0, int r1) {
-    // Raw pointers: a store through uint8_t* may alias anything, which would make the compiler
-    // reload the vectors' pointers every iteration instead of vectorizing.
-    const float* coverage = image.coverage.data();
-    std::uint8_t* out = filled.data();
-    const std::size_t end = static_cast<std::size_t>(r1) * W;
-    for (std::size_t i = static_cast<std::size_t>(r0) * W; i < end; ++i) out[i] = coverage[i] > 0 ? 1 : 0;
+    for (int r = r0; r < r1; ++r) {
+      // Raw pointers: a store through uint8_t* may alias anything, which would make the
+      // compiler reload the vectors' pointers every iteration instead of vectorizing.
+      const float* coverage = image.coverage[static_cast<std::size_t>(r)];
+      std::uint8_t* out = filled.data() + static_cast<std::size_t>(r) * W;
+      for (int x = 0; x < W; ++x) out[x] = coverage[x] > 0 ? 1 : 0;
+    }
   });
 
   auto isFilled = [&](int x, int r) {
@@ -119,7 +139,7 @@ void extendMargin(FloatImage& image, int margin, int threads) {
               for (int dx = -1; dx <= 1; ++dx) {
                 if ((dx == 0 && dr == 0) || !isFilled(x + dx, r + dr)) continue;
                 const double w = (dx == 0 || dr == 0) ? kEdgeNeighbourWeight : kDiagonalNeighbourWeight;
-                const float* p = image.pixels.data() + (static_cast<std::size_t>(r + dr) * W + (x + dx)) * stride;
+                const float* p = image.pixels[static_cast<std::size_t>(r + dr)] + static_cast<std::size_t>(x + dx) * stride;
                 for (std::size_t c = 0; c < channels; ++c) acc[c] += w * p[c];
                 weightSum += w;
               }
@@ -138,8 +158,8 @@ void extendMargin(FloatImage& image, int margin, int threads) {
       });
     });
     for (std::size_t k = 0; k < ring.size(); ++k) {
-      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(k * stride), stride,
-                  image.pixels.begin() + static_cast<std::ptrdiff_t>(ring[k] * stride));
+      const std::size_t x = ring[k] % static_cast<std::uint32_t>(W), r = ring[k] / static_cast<std::uint32_t>(W);
+      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(k * stride), stride, image.pixels[r] + x * stride);
       filled[ring[k]] = 1;
     }
     if (pass + 1 == margin) break;
@@ -160,6 +180,28 @@ void extendMargin(FloatImage& image, int margin, int threads) {
     }
     ring = std::move(next);
   }
+}
+
+}  // namespace
+
+void extendMargin(FloatImage& image, int margin, int threads) {
+  if (margin <= 0 || !imageIsValid(image)) return;
+  const MutableImageRows rows = MutableImageRows::of(image);
+  extendMarginIn(paddedRows(rows, 0, image.height), margin, threads);
+}
+
+void extendMarginRowsInPlace(const MutableImageRows& rows, int margin, int rowBegin, int rowEnd,
+                             int threads) {
+  const int H = std::max(rows.height, 0);
+  rowBegin = std::clamp(rowBegin, 0, H);
+  rowEnd = std::clamp(rowEnd, rowBegin, H);
+  const int windowBegin = std::max(0, rowBegin - margin);
+  const int windowEnd = std::min(H, rowEnd + margin);
+  if (margin <= 0 || rows.width <= 0 || rows.channels <= 0 || rowBegin == rowEnd ||
+      windowBegin < rows.begin || windowEnd > rows.end) {
+    return;
+  }
+  extendMarginIn(paddedRows(rows, windowBegin, windowEnd), margin, threads);
 }
 
 int extendMarginRows(const ImageRows& rows, int margin, int rowBegin, int rowEnd,

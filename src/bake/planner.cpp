@@ -847,31 +847,32 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const
   double padSeconds = 0, convertSeconds = 0;
   FloatImage window;  // padded rows and their halo, reused from strip to strip
   // Pads and queues the rows whose padding is final: all of them once the image is complete.
-  auto writeFinalRows = [&](const ImageRows& rows) -> Status {
+  auto writeFinalRows = [&](const MutableImageRows& rows) -> Status {
     const int ready = rows.end == rows.height ? rows.height : rows.end - margin;
     if (ready <= rowsWritten) return Ok{};
     const std::size_t rowTexels = static_cast<std::size_t>(rows.width);
     const std::size_t rowValues = rows.rowValues();
     Status ok = Ok{};
-    if (margin > 0 || signedRange) {  // from a padded (and remapped) copy of the rows
+    if (signedRange) {  // from a padded and remapped copy of the rows
       Clock::time_point start = Clock::now();
       const auto first = static_cast<std::size_t>(
           extendMarginRows(rows, margin, rowsWritten, ready, window, threads));
       const auto count = static_cast<std::size_t>(ready - rowsWritten);
       padSeconds += secondsSince(start);
       start = Clock::now();
-      if (signedRange) {  // [−range, range] → [0, 1] for the integer file
-        const double scale = 0.5 / output.range;
-        for (std::size_t i = first * rowValues; i < (first + count) * rowValues; ++i)
-          window.pixels[i] = static_cast<float>(scale * window.pixels[i] + 0.5);
-      }
+      const double scale = 0.5 / output.range;  // [−range, range] → [0, 1] for the integer file
+      for (std::size_t i = first * rowValues; i < (first + count) * rowValues; ++i)
+        window.pixels[i] = static_cast<float>(scale * window.pixels[i] + 0.5);
       ok = writer->writeRows(
           rowsWritten, ready - rowsWritten,
           std::span<const float>(window.pixels).subspan(first * rowValues, count * rowValues),
           std::span<const float>(window.coverage).subspan(first * rowTexels, count * rowTexels));
       convertSeconds += secondsSince(start);
-    } else {  // straight from the baked rows, run by run of rows contiguous in their ring
-      const Clock::time_point start = Clock::now();
+    } else {  // padded in place, written run by run of rows contiguous in their ring
+      Clock::time_point start = Clock::now();
+      extendMarginRowsInPlace(rows, margin, rowsWritten, ready, threads);
+      padSeconds += secondsSince(start);
+      start = Clock::now();
       for (int row = rowsWritten; row < ready && ok;) {
         const int run = std::min(rows.contiguousRows(row), ready - row);
         const auto count = static_cast<std::size_t>(run);
@@ -893,12 +894,12 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const
     const Clock::time_point padStart = Clock::now();
     pushPullFill(*image, threads);
     padSeconds += secondsSince(padStart);
-    if (Status ok = writeFinalRows(ImageRows::of(*image)); !ok) return ok;
+    if (Status ok = writeFinalRows(MutableImageRows::of(*image)); !ok) return ok;
   } else {
     // A strip's padding reads `margin` rows above it, which are `margin` rows above the last
     // rows written: 2·margin rows above the new band.
     bool writeFailed = false;
-    const Status baked = bakeMapRows(input, settings, 2 * margin, [&](const ImageRows& rows) {
+    const Status baked = bakeMapRows(input, settings, 2 * margin, [&](const MutableImageRows& rows) {
       Status ok = writeFinalRows(rows);
       writeFailed = !ok;
       return ok;

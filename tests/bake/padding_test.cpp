@@ -140,6 +140,70 @@ TEST(ExtendMargin, StripsFromTheirHaloAloneEqualTheWholeImage) {
             0);
 }
 
+TEST(ExtendMargin, BandsPaddedInPlaceInARingEqualTheWholeImage) {
+  // What the CLI does: bands of rows arrive top first in a ring of band + 2·margin rows; after
+  // each, the rows at least `margin` above the unbaked part are padded in place, with the rows
+  // above them already padded the same way. Every row must end up as the whole image's padding.
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> value(-1, 1);
+  FloatImage image = holes(53, 211, 3);
+  for (int k = 0; k < 40; ++k) {
+    const int x0 = static_cast<int>(rng() % 51), r0 = static_cast<int>(rng() % 209);
+    for (int r = r0; r < r0 + 2; ++r)
+      for (int x = x0; x < x0 + 2; ++x) cover(image, x, r, {value(rng), value(rng), value(rng)});
+  }
+  const std::size_t rowValues = 53 * 3;
+  for (const int margin : {1, 6, 15}) {
+    for (const int band : {8, 40}) {
+      FloatImage whole = image;
+      extendMargin(whole, margin);
+      const int ringRows = band + 2 * margin;
+      std::vector<float> pixels(static_cast<std::size_t>(ringRows) * rowValues);
+      std::vector<float> coverage(static_cast<std::size_t>(ringRows) * 53);
+      int written = 0, previousEnd = 0;
+      for (int end = std::min(211, band); previousEnd < 211; end = std::min(211, end + band)) {
+        for (int r = previousEnd; r < end; ++r) {  // the new band, as baked
+          std::copy_n(image.pixels.begin() + static_cast<std::ptrdiff_t>(r * rowValues), rowValues,
+                      pixels.begin() + static_cast<std::ptrdiff_t>((r % ringRows) * rowValues));
+          std::copy_n(image.coverage.begin() + r * 53, 53, coverage.begin() + (r % ringRows) * 53);
+        }
+        const MutableImageRows rows{53, 211, 3, std::max(0, previousEnd - 2 * margin), end, ringRows,
+                                    pixels.data(), coverage.data()};
+        previousEnd = end;
+        const int ready = end == 211 ? 211 : end - margin;
+        if (ready <= written) continue;
+        extendMarginRowsInPlace(rows, margin, written, ready);
+        for (int r = written; r < ready; ++r) {
+          ASSERT_EQ(std::memcmp(rows.pixelRow(r), whole.pixels.data() + static_cast<std::size_t>(r) * rowValues,
+                                rowValues * sizeof(float)),
+                    0)
+              << "margin " << margin << ", band " << band << ", row " << r;
+        }
+        written = ready;
+      }
+      EXPECT_EQ(written, 211);
+    }
+  }
+  // A view that holds a strip's halo pads it as the whole image; one that lacks part of the
+  // halo leaves every row as it was.
+  FloatImage whole = image;
+  extendMargin(whole, 15);
+  FloatImage strip = image;
+  MutableImageRows rows = MutableImageRows::of(strip);
+  rows.begin = 100;
+  rows.end = 140;
+  extendMarginRowsInPlace(rows, 15, 115, 125);  // needs rows 100 to 140: held
+  EXPECT_EQ(std::memcmp(strip.pixels.data() + 115 * rowValues, whole.pixels.data() + 115 * rowValues,
+                        10 * rowValues * sizeof(float)),
+            0);
+  FloatImage untouched = image;
+  MutableImageRows partial = MutableImageRows::of(untouched);
+  partial.begin = 110;  // rows 100 to 110 missing
+  partial.end = 140;
+  extendMarginRowsInPlace(partial, 15, 115, 125);
+  EXPECT_EQ(std::memcmp(untouched.pixels.data(), image.pixels.data(), image.pixels.size() * sizeof(float)), 0);
+}
+
 TEST(ExtendMargin, StripsReadFromARingOfRowsEqualTheWholeImage) {
   // The baker keeps only a ring of rows (bakeMapRows): file row r in slot r % ringRows, with
   // the rows a strip reads wrapping around the ring's end. The padded strip must not depend on

@@ -105,25 +105,32 @@ struct FloatImage {
   float at(int x, int row, int c) const { return pixels[(static_cast<std::size_t>(row) * width + x) * channels + c]; }
 };
 
-/// @brief Read-only view of consecutive rows [begin, end) of an image (rows top first), stored in
-/// a ring of `ringRows` rows: file row r lives in slot r % ringRows. A whole FloatImage is the
-/// view with ringRows == height (of()); bakeMapRows hands out views of its reused band ring.
-struct ImageRows {
+/// @brief View of consecutive rows [begin, end) of an image (rows top first), stored in a ring
+/// of `ringRows` rows: file row r lives in slot r % ringRows. A whole FloatImage is the view
+/// with ringRows == height (of()); bakeMapRows hands out views of its reused band ring.
+/// @tparam T `const float` (ImageRows) or `float` (MutableImageRows)
+template <class T>
+struct BasicImageRows {
   int width = 0, height = 0, channels = 0;  ///< of the whole image
   int begin = 0, end = 0;                   ///< the rows that may be read
   int ringRows = 0;                         ///< rows of storage (≥ end − begin)
-  const float* pixels = nullptr;            ///< ringRows·width·channels
-  const float* coverage = nullptr;          ///< ringRows·width
+  T* pixels = nullptr;                      ///< ringRows·width·channels
+  T* coverage = nullptr;                    ///< ringRows·width
 
   /// @brief The view of all rows of @p image.
-  static ImageRows of(const FloatImage& image) {
+  template <class Image>
+  static BasicImageRows of(Image& image) {
     return {image.width, image.height, image.channels, 0, image.height, image.height,
             image.pixels.data(), image.coverage.data()};
   }
+  /// A mutable view is also a read-only one.
+  operator BasicImageRows<const float>() const {
+    return {width, height, channels, begin, end, ringRows, pixels, coverage};
+  }
   /// The width·channels values of row @p row (begin ≤ row < end).
-  const float* pixelRow(int row) const { return pixels + slot(row) * rowValues(); }
+  T* pixelRow(int row) const { return pixels + slot(row) * rowValues(); }
   /// The width coverage values of row @p row (begin ≤ row < end).
-  const float* coverageRow(int row) const { return coverage + slot(row) * static_cast<std::size_t>(width); }
+  T* coverageRow(int row) const { return coverage + slot(row) * static_cast<std::size_t>(width); }
   /// Rows from @p row on (≤ end) that follow each other in memory: up to the ring's wrap.
   int contiguousRows(int row) const { return std::min(end, row - row % ringRows + ringRows) - row; }
   std::size_t rowValues() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(channels); }
@@ -131,6 +138,8 @@ struct ImageRows {
  private:
   std::size_t slot(int row) const { return static_cast<std::size_t>(row % ringRows); }
 };
+using ImageRows = BasicImageRows<const float>;
+using MutableImageRows = BasicImageRows<float>;
 
 /// First UDIM tile number: the tile [0,1)².
 inline constexpr int kFirstUdimTile = 1001;
@@ -177,9 +186,10 @@ Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings)
 /// of 8, may have fewer).
 inline constexpr int kBakeBandRows = 256;
 
-/// @brief Called by bakeMapRows after each band with the rows that may be read (see there);
-/// returning an error stops the bake, which then returns that error.
-using BakedRowsSink = std::function<Status(const ImageRows& rows)>;
+/// @brief Called by bakeMapRows after each band with the rows that may be read (see there). It
+/// may also change them (pad them in place: extendMarginRowsInPlace); the bake never reads them
+/// back. Returning an error stops the bake, which then returns that error.
+using BakedRowsSink = std::function<Status(const MutableImageRows& rows)>;
 
 /// @brief bakeMap band by band, without ever holding the whole image: the map is baked in bands
 /// of kBakeBandRows rows from the top of the image (file row 0) down into a ring of
@@ -226,6 +236,16 @@ void extendMargin(FloatImage& image, int margin, int threads = 0);
 /// @return the row of @p window that holds row @p rowBegin of the image
 int extendMarginRows(const ImageRows& rows, int margin, int rowBegin, int rowEnd,
                      FloatImage& window, int threads = 0);
+/// @brief extendMarginRows without the copy: rows [rowBegin, rowEnd) of @p rows become, in
+/// place, rows [rowBegin, rowEnd) of extendMargin(image, margin), bit for bit, when @p rows
+/// holds rows [rowBegin − margin, rowEnd + margin) of the image (clipped to it) as they were
+/// baked — except that uncovered texels may hold anything, since padding never reads them.
+/// The halo rows are changed too (their uncovered texels near an island get values that are
+/// final only once the halo is padded as a strip of its own), so strips padded top to bottom
+/// this way, each with the rows above it already padded, give the whole image's padding: what
+/// the CLI does band by band. Does nothing when @p rows does not hold those rows.
+void extendMarginRowsInPlace(const MutableImageRows& rows, int margin, int rowBegin, int rowEnd,
+                             int threads = 0);
 /// @brief extendMarginRows of a whole image.
 int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
                      FloatImage& window, int threads = 0);
