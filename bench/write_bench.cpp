@@ -2,6 +2,10 @@
 // memory, in the file's own pixel type) with the settings sgbake writes that format with — the
 // baseline of bench_bake_vs_cycles' total/write target. Best and median of RUNS (default 5)
 // writes to a temporary file beside IMAGE; prints one JSON line.
+// sgbake_bench_write --start-only: exits at once, so that timing the whole process gives what a
+// program writing with OpenImageIO pays before its first write (start-up, loading the ~260
+// libraries Debian's OpenImageIO links); bench_bake_vs_cycles adds it to write_s for a
+// process-to-process comparison.
 #include <OpenImageIO/imageio.h>
 
 #include <unistd.h>
@@ -26,7 +30,11 @@ int fail(const std::string& message) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || argc > 3) return fail("usage: sgbake_bench_write IMAGE [RUNS]");
+  if (argc == 2 && std::string(argv[1]) == "--start-only") {
+    std::printf("{\"oiio_version\": %d}\n", OIIO::openimageio_version());
+    return 0;
+  }
+  if (argc < 2 || argc > 3) return fail("usage: sgbake_bench_write IMAGE [RUNS] | --start-only");
   const std::filesystem::path path = argv[1];
   const int runs = argc == 3 ? std::atoi(argv[2]) : 5;
   if (runs < 1) return fail("RUNS must be at least 1");
