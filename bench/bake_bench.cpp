@@ -10,6 +10,7 @@
 //   - BM_TangentNormalBands/threads:N — the same map by bakeMapRows (bands of rows in a reused
 //     ring, what the CLI runs), and BM_TangentNormalBandsMargin16/threads:N with each band's
 //     final rows padded in place (extendMarginRowsInPlace, margin 16) as the CLI pads them;
+//   - BM_ObjectNormal/threads:N — the object-space map of the same scene (bakeMap);
 //   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
 //   - BM_Mask/threads:N — the raster and coverage alone (no shading);
 //   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map.
@@ -97,6 +98,7 @@ void bake(benchmark::State& state, MapKind kind, bool withLayers) {
 }
 
 void BM_TangentNormal(benchmark::State& state) { bake(state, MapKind::kTangentNormal, true); }
+void BM_ObjectNormal(benchmark::State& state) { bake(state, MapKind::kObjectNormal, true); }
 void BM_TangentNormalNoLayers(benchmark::State& state) { bake(state, MapKind::kTangentNormal, false); }
 void BM_Mask(benchmark::State& state) { bake(state, MapKind::kMask, false); }
 
@@ -165,6 +167,7 @@ void threadArgs(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_TangentNormal)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBands)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBandsMargin16)->Apply(threadArgs);
+BENCHMARK(BM_ObjectNormal)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalNoLayers)->Apply(threadArgs);
 BENCHMARK(BM_Mask)->Apply(threadArgs);
 BENCHMARK(BM_ExtendMargin16)->Apply(threadArgs);

@@ -1,8 +1,8 @@
 /// @file shaders.hpp
 /// @brief Private: the map kinds as shaders over the texel raster (raster.hpp), with Blender's
 /// per-texel frame (texel_frame.hpp) and the gradient engine's layers. bakeMap (bake.cpp) runs
-/// them; the raster tests compare the lane-parallel TangentNormalShader::shadeBatch with its
-/// per-sample shade() bit for bit.
+/// them; the raster tests compare the lane-parallel shadeBatch of TangentNormalShader and
+/// ObjectNormalShader with their per-sample shade() bit for bit.
 #pragma once
 
 #include <array>
@@ -201,6 +201,44 @@ inline void batchUvHeightGradient(const BakeShaderBase& shader, const SampleBatc
   }
 }
 
+/// v = N̂ − Γ of every sample (Γ = shader.gradient() of its SurfacePoint, zero when not finite),
+/// not normalized; slow[i] also when |v|² is not a normal positive number (zero, subnormal,
+/// overflowing), whose normalization takes a fallback. Unmasked UV image heights are computed
+/// lane-parallel, any other layer sample by sample through addLayerGradient, in layer order.
+inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
+                                     Lanes3& v, LaneFlags& slow) {
+  const std::size_t n = static_cast<std::size_t>(s.count);
+  Lanes3 gamma{};
+  for (const Layer& layer : shader.layers) {
+    if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+    const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+    if (uvHeight != nullptr && layer.mask.texture == nullptr) {
+      batchUvHeightGradient(shader, s, *uvHeight, layer.weight, unitN, gamma);
+      continue;
+    }
+    // Any other layer: gradient()'s step on the SurfacePoint, sample by sample.
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
+      Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
+      shader.addLayerGradient(layer, shader.pointAt(b, texelFrame(shader.tri, b)), g);
+      gamma.x[i] = g.x;
+      gamma.y[i] = g.y;
+      gamma.z[i] = g.z;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool finite = finiteLane(gamma.x[i]) & finiteLane(gamma.y[i]) & finiteLane(gamma.z[i]);
+    const double vx = unitN.x[i] - (finite ? gamma.x[i] : 0.0);
+    const double vy = unitN.y[i] - (finite ? gamma.y[i] : 0.0);
+    const double vz = unitN.z[i] - (finite ? gamma.z[i] : 0.0);
+    const double len2 = vx * vx + vy * vy + vz * vz;
+    v.x[i] = vx;
+    v.y[i] = vy;
+    v.z[i] = vz;
+    slow[i] = slow[i] | !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2));
+  }
+}
+
 struct TangentNormalShader : BakeShaderBase {
   static constexpr int kChannels = 3;
   /// A positive multiple of perturbed(b, f): objectToTangent normalizes its result, and
@@ -231,38 +269,9 @@ struct TangentNormalShader : BakeShaderBase {
     batchTexelFrames(tri, s, T, N, B, unitN, slow);
 
     // The normal to express in tangent space: N̂, or N̂ − Γ (unnormalizedPerturbed).
-    Lanes3 v = unitN;
-    if (!layers.empty()) {
-      Lanes3 gamma{};
-      for (const Layer& layer : layers) {
-        if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-        const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-        if (uvHeight != nullptr && layer.mask.texture == nullptr) {
-          batchUvHeightGradient(*this, s, *uvHeight, layer.weight, unitN, gamma);
-          continue;
-        }
-        // Any other layer: gradient()'s step on the SurfacePoint, sample by sample.
-        for (std::size_t i = 0; i < n; ++i) {
-          const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
-          Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
-          addLayerGradient(layer, pointAt(b, texelFrame(tri, b)), g);
-          gamma.x[i] = g.x;
-          gamma.y[i] = g.y;
-          gamma.z[i] = g.z;
-        }
-      }
-      for (std::size_t i = 0; i < n; ++i) {
-        const bool finite = finiteLane(gamma.x[i]) & finiteLane(gamma.y[i]) & finiteLane(gamma.z[i]);
-        const double vx = unitN.x[i] - (finite ? gamma.x[i] : 0.0);
-        const double vy = unitN.y[i] - (finite ? gamma.y[i] : 0.0);
-        const double vz = unitN.z[i] - (finite ? gamma.z[i] : 0.0);
-        const double len2 = vx * vx + vy * vy + vz * vz;
-        v.x[i] = vx;
-        v.y[i] = vy;
-        v.z[i] = vz;
-        slow[i] = slow[i] | !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2));
-      }
-    }
+    Lanes3 perturbedDirections;
+    const Lanes3& v = layers.empty() ? unitN : perturbedDirections;
+    if (!layers.empty()) batchPerturbedDirections(*this, s, unitN, perturbedDirections, slow);
 
     // objectToTangent(f, v), the green convention and encodeNormal.
     constexpr double kMinDet = kMinTexelFrameSine * kMinTexelFrameSine;
@@ -303,6 +312,35 @@ struct ObjectNormalShader : BakeShaderBase {
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
     put(encodeNormal(layers.empty() ? unitNormal(tri, f) : perturbed(b, f)), out);
+  }
+
+  /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames): N̂, or N̂ − Γ
+  /// normalized as perturbed() normalizes it, encoded.
+  void shadeBatch(const SampleBatch& s, double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
+    Lanes3 T, N, B, unitN;
+    LaneFlags slow;
+    batchTexelFrames(tri, s, T, N, B, unitN, slow);
+    Lanes3 perturbedNormals;
+    const Lanes3& v = layers.empty() ? unitN : perturbedNormals;
+    if (!layers.empty()) {
+      Lanes3& w = perturbedNormals;
+      batchPerturbedDirections(*this, s, unitN, w, slow);
+      for (std::size_t i = 0; i < n; ++i) {  // unitOr's common case (slow covers the rest)
+        const double len2 = w.x[i] * w.x[i] + w.y[i] * w.y[i] + w.z[i] * w.z[i];
+        const double inv = 1 / std::sqrt(len2);
+        w.x[i] = inv * w.x[i];
+        w.y[i] = inv * w.y[i];
+        w.z[i] = inv * w.z[i];
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      out[3 * i] = 0.5 * v.x[i] + 0.5;
+      out[3 * i + 1] = 0.5 * v.y[i] + 0.5;
+      out[3 * i + 2] = 0.5 * v.z[i] + 0.5;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 3 * i);
   }
 };
 

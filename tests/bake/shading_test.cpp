@@ -1,4 +1,4 @@
-// The lane-parallel tangent-normal shader (TangentNormalShader::shadeBatch) against its
+// The lane-parallel normal shaders (TangentNormalShader and ObjectNormalShader::shadeBatch) against their
 // per-sample shade(), bit for bit: random triangles and barycentrics, every kind of layer stack
 // (none, image heights through sampleMany, other height textures, masked and volume layers
 // through the per-sample path, overflowing gradients), both green conventions, and the rare
@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <type_traits>
 #include <random>
 #include <string>
 #include <vector>
@@ -99,15 +100,25 @@ class ShadeBatch : public ::testing::Test {
     sine = *DirectionalSine::create({.amplitude = 0.05, .frequency = 3, .direction = {1, 2, 0.5}});
   }
 
-  /// shadeBatch of random batches of every size against shade(), sample by sample, bit for bit.
+  /// shadeBatch of random batches of every size against shade(), sample by sample, bit for bit,
+  /// for the tangent-space and the object-space normal shaders.
   void expectBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
                                 const std::string& what) {
+    expectShaderBatchEqualsSamples<bake_detail::TangentNormalShader>(layers, green, what);
+    expectShaderBatchEqualsSamples<bake_detail::ObjectNormalShader>(layers, green,
+                                                                    what + " (object space)");
+  }
+
+  template <class Shader>
+  void expectShaderBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
+                                      const std::string& what) {
+    constexpr bool kTangentSpace = std::is_same_v<Shader, bake_detail::TangentNormalShader>;
     bake_detail::BakeShaderBase base;
     base.mesh = &scene.mesh;
-    base.tangents = &scene.tangents;
+    base.tangents = kTangentSpace ? &scene.tangents : nullptr;
     base.layers = layers;
     base.green = green;
-    bake_detail::TangentNormalShader batchShader{base}, sampleShader{base};
+    Shader batchShader{base}, sampleShader{base};
     std::mt19937 rng(11);
     int fallbacks = 0;
     for (std::uint32_t t = 0; t < scene.mesh.numFaces(); ++t) {
@@ -125,11 +136,17 @@ class ShadeBatch : public ::testing::Test {
               << what << ": triangle " << t << ", batch of " << count << ", lane " << i << ": ("
               << lanes[3 * i] << ", " << lanes[3 * i + 1] << ", " << lanes[3 * i + 2]
               << ") against (" << one[0] << ", " << one[1] << ", " << one[2] << ")";
-          fallbacks += one[0] == 0.5 && one[1] == 0.5 && one[2] == 1.0;
+          // Tangent space: the flat frame's (0, 0, 1). Object space without layers: the face
+          // normal, taken where Σ bi·Ni vanishes (triangle 6).
+          const Vec3d face = bake_detail::encodeNormal(sampleShader.tri.faceNormal);
+          fallbacks += kTangentSpace ? one[0] == 0.5 && one[1] == 0.5 && one[2] == 1.0
+                                     : one[0] == face.x && one[1] == face.y && one[2] == face.z;
         }
       }
     }
-    EXPECT_GT(fallbacks, 0) << what << ": no sample took the flat fallback";
+    if (kTangentSpace || layers.empty()) {
+      EXPECT_GT(fallbacks, 0) << what << ": no sample took a fallback";
+    }
   }
 
   Scene scene;
