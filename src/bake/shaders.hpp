@@ -201,14 +201,13 @@ inline void batchUvHeightGradient(const BakeShaderBase& shader, const SampleBatc
   }
 }
 
-/// v = N̂ − Γ of every sample (Γ = shader.gradient() of its SurfacePoint, zero when not finite),
-/// not normalized; slow[i] also when |v|² is not a normal positive number (zero, subnormal,
-/// overflowing), whose normalization takes a fallback. Unmasked UV image heights are computed
-/// lane-parallel, any other layer sample by sample through addLayerGradient, in layer order.
-inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
-                                     Lanes3& v, LaneFlags& slow) {
+/// gamma = shader.gradient() of every sample's SurfacePoint (zero when not finite), bit for bit:
+/// unmasked UV image heights lane-parallel (batchUvHeightGradient), any other layer sample by
+/// sample through addLayerGradient, in layer order.
+inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
+                           Lanes3& gamma) {
   const std::size_t n = static_cast<std::size_t>(s.count);
-  Lanes3 gamma{};
+  for (std::size_t i = 0; i < n; ++i) gamma.x[i] = gamma.y[i] = gamma.z[i] = 0.0;
   for (const Layer& layer : shader.layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
     const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
@@ -216,7 +215,6 @@ inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& 
       batchUvHeightGradient(shader, s, *uvHeight, layer.weight, unitN, gamma);
       continue;
     }
-    // Any other layer: gradient()'s step on the SurfacePoint, sample by sample.
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
       Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
@@ -228,9 +226,22 @@ inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& 
   }
   for (std::size_t i = 0; i < n; ++i) {
     const bool finite = finiteLane(gamma.x[i]) & finiteLane(gamma.y[i]) & finiteLane(gamma.z[i]);
-    const double vx = unitN.x[i] - (finite ? gamma.x[i] : 0.0);
-    const double vy = unitN.y[i] - (finite ? gamma.y[i] : 0.0);
-    const double vz = unitN.z[i] - (finite ? gamma.z[i] : 0.0);
+    gamma.x[i] = finite ? gamma.x[i] : 0.0;
+    gamma.y[i] = finite ? gamma.y[i] : 0.0;
+    gamma.z[i] = finite ? gamma.z[i] : 0.0;
+  }
+}
+
+/// v = N̂ − Γ of every sample (batchGradients), not normalized; slow[i] also when |v|² is not a
+/// normal positive number (zero, subnormal, overflowing), whose normalization takes a fallback.
+inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
+                                     Lanes3& v, LaneFlags& slow) {
+  Lanes3 gamma;
+  batchGradients(shader, s, unitN, gamma);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i) {
+    const double vx = unitN.x[i] - gamma.x[i];
+    const double vy = unitN.y[i] - gamma.y[i];
+    const double vz = unitN.z[i] - gamma.z[i];
     const double len2 = vx * vx + vy * vy + vz * vz;
     v.x[i] = vx;
     v.y[i] = vy;
@@ -350,6 +361,49 @@ struct HeightShader : BakeShaderBase {
     const TexelFrame f = texelFrame(tri, b);
     out[0] = compositeHeight(layers, pointAt(b, f));
   }
+
+  /// shade() of every sample of @p s: compositeHeight's sum in its order, with unmasked UV image
+  /// heights sampled for the whole batch (sampleMany) and any other layer sample by sample.
+  void shadeBatch(const SampleBatch& s, double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
+    for (std::size_t i = 0; i < n; ++i) out[i] = 0.0;
+    for (const Layer& layer : layers) {
+      if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+      const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+      const auto* image = uvHeight != nullptr ? dynamic_cast<const ImageScalarTexture*>(uvHeight->texture)
+                                              : nullptr;
+      if (image != nullptr && layer.mask.texture == nullptr) {
+        // factor = weight · layerMask (1 without a mask); layerHeight = scale · value, or 0
+        // when that is not finite (or the UV set is missing).
+        if (!hasUvSet(point, uvHeight->uvSet)) {  // layerHeight 0, still added (the sign of zero)
+          for (std::size_t i = 0; i < n; ++i) out[i] = out[i] + layer.weight * 0.0;
+          continue;
+        }
+        const std::array<Vec2d, 3>& uvs = tri.uv[static_cast<std::size_t>(uvHeight->uvSet)];
+        std::array<Vec2d, SampleBatch::kMax> st;
+        for (std::size_t i = 0; i < n; ++i) {
+          const Vec2d uv{s.b0[i] * uvs[0].x + s.b1[i] * uvs[1].x + s.b2[i] * uvs[2].x,
+                         s.b0[i] * uvs[0].y + s.b1[i] * uvs[1].y + s.b2[i] * uvs[2].y};
+          st[i] = textureCoordinates(uv, uvHeight->tiling, uvHeight->offset);
+        }
+        std::array<ScalarSample, SampleBatch::kMax> h;
+        image->sampleMany({st.data(), n}, {h.data(), n});
+        for (std::size_t i = 0; i < n; ++i) {
+          const double value = uvHeight->scale * h[i].value;
+          out[i] = out[i] + layer.weight * (finiteLane(value) ? value : 0.0);
+        }
+        continue;
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
+        const SurfacePoint& p = pointAt(b, texelFrame(tri, b));
+        const double factor = layer.weight * layerMask(layer.mask, p);
+        if (factor == 0) continue;
+        out[i] = out[i] + factor * layerHeight(layer.source, p);
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) out[i] = finiteLane(out[i]) ? out[i] : 0.0;
+  }
 };
 
 struct DerivativeShader : BakeShaderBase {
@@ -360,6 +414,22 @@ struct DerivativeShader : BakeShaderBase {
     out[0] = dot(gamma, tri.bakeDPdu);
     out[1] = dot(gamma, tri.bakeDPdv);
   }
+
+  /// shade() of every sample of @p s, lane-parallel (batchGradients).
+  void shadeBatch(const SampleBatch& s, double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
+    Lanes3 T, N, B, unitN, gamma;
+    LaneFlags slow;
+    batchTexelFrames(tri, s, T, N, B, unitN, slow);
+    batchGradients(*this, s, unitN, gamma);
+    const Vec3d du = tri.bakeDPdu, dv = tri.bakeDPdv;
+    for (std::size_t i = 0; i < n; ++i) {
+      out[2 * i] = gamma.x[i] * du.x + gamma.y[i] * du.y + gamma.z[i] * du.z;
+      out[2 * i + 1] = gamma.x[i] * dv.x + gamma.y[i] * dv.y + gamma.z[i] * dv.z;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 2 * i);
+  }
 };
 
 struct SurfaceGradientShader : BakeShaderBase {
@@ -367,6 +437,22 @@ struct SurfaceGradientShader : BakeShaderBase {
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
     put(gradient(pointAt(b, f)), out);
+  }
+
+  /// shade() of every sample of @p s, lane-parallel (batchGradients).
+  void shadeBatch(const SampleBatch& s, double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
+    Lanes3 T, N, B, unitN, gamma;
+    LaneFlags slow;
+    batchTexelFrames(tri, s, T, N, B, unitN, slow);
+    batchGradients(*this, s, unitN, gamma);
+    for (std::size_t i = 0; i < n; ++i) {
+      out[3 * i] = gamma.x[i];
+      out[3 * i + 1] = gamma.y[i];
+      out[3 * i + 2] = gamma.z[i];
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 3 * i);
   }
 };
 
