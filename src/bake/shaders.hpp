@@ -150,6 +150,28 @@ inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, Lan
   }
 }
 
+/// The texture samples of UV height layer @p src (non-null texture, UV set on @p tri) at every
+/// sample of @p s: the SurfacePoint's interpolated UV, tiled and offset, through sampleMany for
+/// an image texture (one dispatch on the filter per batch).
+inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& s,
+                                 const UvHeightSource& src,
+                                 std::array<ScalarSample, SampleBatch::kMax>& h) {
+  const std::size_t n = static_cast<std::size_t>(s.count);
+  const std::array<Vec2d, 3>& uvs = tri.uv[static_cast<std::size_t>(src.uvSet)];
+  const Vec2d uv0 = uvs[0], uv1 = uvs[1], uv2 = uvs[2];
+  std::array<Vec2d, SampleBatch::kMax> st;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2d uv{s.b0[i] * uv0.x + s.b1[i] * uv1.x + s.b2[i] * uv2.x,
+                   s.b0[i] * uv0.y + s.b1[i] * uv1.y + s.b2[i] * uv2.y};
+    st[i] = textureCoordinates(uv, src.tiling, src.offset);
+  }
+  if (const auto* image = dynamic_cast<const ImageScalarTexture*>(src.texture)) {
+    image->sampleMany({st.data(), n}, {h.data(), n});
+  } else {
+    for (std::size_t i = 0; i < n; ++i) h[i] = src.texture->sample(st[i]);
+  }
+}
+
 /// shader.uvHeightGradient() of an unmasked UV height layer for every sample of @p s (of the
 /// shader's current triangle), added as gamma += factor·Γ.
 inline void batchUvHeightGradient(const BakeShaderBase& shader, const SampleBatch& s,
@@ -160,20 +182,8 @@ inline void batchUvHeightGradient(const BakeShaderBase& shader, const SampleBatc
   const std::size_t set = static_cast<std::size_t>(src.uvSet);
   if (src.texture != nullptr && hasUvSet(shader.point, src.uvSet) && shader.preparedUv[set].valid) {
     const gradient_detail::PreparedUvFrame& frame = shader.preparedUv[set];
-    const std::array<Vec2d, 3>& uvs = shader.tri.uv[set];
-    const Vec2d uv0 = uvs[0], uv1 = uvs[1], uv2 = uvs[2];
-    std::array<Vec2d, SampleBatch::kMax> st;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2d uv{s.b0[i] * uv0.x + s.b1[i] * uv1.x + s.b2[i] * uv2.x,
-                     s.b0[i] * uv0.y + s.b1[i] * uv1.y + s.b2[i] * uv2.y};
-      st[i] = textureCoordinates(uv, src.tiling, src.offset);
-    }
     std::array<ScalarSample, SampleBatch::kMax> h;
-    if (const auto* image = dynamic_cast<const ImageScalarTexture*>(src.texture)) {
-      image->sampleMany({st.data(), n}, {h.data(), n});
-    } else {
-      for (std::size_t i = 0; i < n; ++i) h[i] = src.texture->sample(st[i]);
-    }
+    batchUvHeightSamples(shader.tri, s, src, h);
     // gradientFromPreparedUvFrame with dhduv = uvDerivativesFromTexture(h, tiling, scale).
     const double ku = src.scale * src.tiling.x, kv = src.scale * src.tiling.y;
     const double tolerance = gradient_detail::guardedTolerance(src.minFrameSine);
@@ -362,32 +372,24 @@ struct HeightShader : BakeShaderBase {
     out[0] = compositeHeight(layers, pointAt(b, f));
   }
 
-  /// shade() of every sample of @p s: compositeHeight's sum in its order, with unmasked UV image
-  /// heights sampled for the whole batch (sampleMany) and any other layer sample by sample.
+  /// shade() of every sample of @p s: compositeHeight's sum in its order, with unmasked UV
+  /// heights sampled for the whole batch (batchUvHeightSamples) and any other layer sample by
+  /// sample.
   void shadeBatch(const SampleBatch& s, double* out) {
     const std::size_t n = static_cast<std::size_t>(s.count);
     for (std::size_t i = 0; i < n; ++i) out[i] = 0.0;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-      const auto* image = uvHeight != nullptr ? dynamic_cast<const ImageScalarTexture*>(uvHeight->texture)
-                                              : nullptr;
-      if (image != nullptr && layer.mask.texture == nullptr) {
+      if (uvHeight != nullptr && layer.mask.texture == nullptr) {
         // factor = weight · layerMask (1 without a mask); layerHeight = scale · value, or 0
-        // when that is not finite (or the UV set is missing).
-        if (!hasUvSet(point, uvHeight->uvSet)) {  // layerHeight 0, still added (the sign of zero)
-          for (std::size_t i = 0; i < n; ++i) out[i] = out[i] + layer.weight * 0.0;
+        // when that is not finite (or there is no texture or UV set).
+        if (uvHeight->texture == nullptr || !hasUvSet(point, uvHeight->uvSet)) {
+          for (std::size_t i = 0; i < n; ++i) out[i] = out[i] + layer.weight * 0.0;  // sign of 0
           continue;
         }
-        const std::array<Vec2d, 3>& uvs = tri.uv[static_cast<std::size_t>(uvHeight->uvSet)];
-        std::array<Vec2d, SampleBatch::kMax> st;
-        for (std::size_t i = 0; i < n; ++i) {
-          const Vec2d uv{s.b0[i] * uvs[0].x + s.b1[i] * uvs[1].x + s.b2[i] * uvs[2].x,
-                         s.b0[i] * uvs[0].y + s.b1[i] * uvs[1].y + s.b2[i] * uvs[2].y};
-          st[i] = textureCoordinates(uv, uvHeight->tiling, uvHeight->offset);
-        }
         std::array<ScalarSample, SampleBatch::kMax> h;
-        image->sampleMany({st.data(), n}, {h.data(), n});
+        batchUvHeightSamples(tri, s, *uvHeight, h);
         for (std::size_t i = 0; i < n; ++i) {
           const double value = uvHeight->scale * h[i].value;
           out[i] = out[i] + layer.weight * (finiteLane(value) ? value : 0.0);
