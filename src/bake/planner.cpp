@@ -821,9 +821,10 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
 /// Bakes one image tile into @p file and adds its timings to @p report. The image is baked band
 /// by band into a small ring of rows (bakeMapRows), and each band's final rows are padded and
 /// handed to an ImageFileWriter, so the file is compressed and written while the rest is baked
-/// and the whole image never exists. Extend padding of a strip needs `margin` rows below it and
-/// above it (extendMarginRows): the rows above are kept in the ring, and the last `margin` rows
-/// of each band wait for the next one. Push-pull needs the whole image, which is then baked,
+/// and the whole image never exists. Extend padding of a strip, done in the ring
+/// (extendMarginRowsInPlace; a copy for signed maps, whose remapped values must not reach the
+/// next strip), needs `margin` rows below it and above it: the rows above are kept in the ring,
+/// and the last `margin` rows of each band wait for the next one. Push-pull needs the whole image, which is then baked,
 /// padded and written in one piece. Masks are not padded (padding would overwrite the coverage
 /// they show).
 Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const SceneOutput& output,
