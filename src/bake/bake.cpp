@@ -282,7 +282,7 @@ Status bakeMapRows(const BakeInput& input, const BakeSettings& settings, int kee
     const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(*input.mesh);
     const int W = settings.width, H = settings.height, C = mapChannels(settings.map);
     // Bands are at most kBakeBandRows rows, and a call may read keepRows rows above its band.
-    const int ringRows = std::min(H, kBakeBandRows + keepRows);
+    const int ringRows = bakeRingRows(H, keepRows);
     const std::size_t ringTexels = static_cast<std::size_t>(ringRows) * static_cast<std::size_t>(W);
     std::vector<float> pixels(ringTexels * static_cast<std::size_t>(C));
     std::vector<float> coverage(ringTexels);

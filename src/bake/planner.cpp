@@ -301,6 +301,19 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       continue;
     }
     const bool udim = hasUdimToken(output.file.string());
+    // Memory of the pixels (float values and coverage): bakeImageTile's ring of bands, or the
+    // whole image for push-pull.
+    const bool pushPull = output.map != MapKind::kMask && output.padding == PaddingMode::kPushPull;
+    const int margin = output.map == MapKind::kMask || pushPull ? 0 : std::max(output.margin, 0);
+    const int rowsHeld = pushPull ? output.height : bakeRingRows(output.height, 2 * margin);
+    const double bytes = static_cast<double>(rowsHeld) * output.width *
+                         (mapChannels(output.map) + 1) * sizeof(float);
+    char megabytes[32];  // one decimal below 10 MB
+    std::snprintf(megabytes, sizeof megabytes, bytes < 1e7 ? "%.1f MB" : "%.0f MB", bytes / 1e6);
+    const std::string memory =
+        pushPull ? "; the whole image in memory for push-pull (" + std::string(megabytes) + ")"
+                 : "; in bands of " + std::to_string(kBakeBandRows) + " rows, " +
+                       std::to_string(rowsHeld) + " rows (" + megabytes + ") in memory at a time";
     plan.steps.push_back(
         {"bake " + output.file.string() + ": " + std::string(mapKindName(output.map)) + " " +
              std::to_string(output.width) + "x" + std::to_string(output.height) + ", " +
@@ -308,7 +321,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
              " samples per texel, UV set " + std::to_string(output.uvSet) + ", " +
              (udim ? "every UDIM tile the UV set touches"
                    : "UDIM tile " + std::to_string(output.tile)),
-         reads});
+         reads + memory});
     if (output.map == MapKind::kMask) {
       // Padding would overwrite the coverage the mask is made of.
     } else if (output.padding == PaddingMode::kPushPull) {

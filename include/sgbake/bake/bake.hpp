@@ -203,6 +203,12 @@ using BakedRowsSink = std::function<Status(const MutableImageRows& rows)>;
 Status bakeMapRows(const BakeInput& input, const BakeSettings& settings, int keepRows,
                    const BakedRowsSink& sink);
 
+/// @brief Rows of the ring bakeMapRows bakes a map of @p height rows into, keeping @p keepRows
+/// rows above each band: min(height, kBakeBandRows + keepRows).
+inline int bakeRingRows(int height, int keepRows) {
+  return std::min(height, kBakeBandRows + std::max(keepRows, 0));
+}
+
 /// @brief The triangles the baker rasterizes, as global corner indices, face after face (see
 /// "Triangles" in the file comment): #F triangles for a triangle mesh, 2 per quad, k−2 per k-gon.
 std::vector<std::array<std::uint32_t, 3>> loopTriangles(const Mesh& mesh);
