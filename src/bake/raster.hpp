@@ -29,6 +29,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
@@ -112,8 +113,10 @@ struct RasterJob {
   std::span<const Vec2f> uvs;  ///< #C corner UVs of the UV set that places the texels
   int width = 0, height = 0, samples = 1, udimTile = kFirstUdimTile, threads = 0;
   /// Optional: rasterize() then works in bands of kBlocksPerBand row blocks from the top of the
-  /// image down and calls it after each band with the number of final rows from the top; it
-  /// returns whether to go on (bakeMapRows).
+  /// image down and calls it after each band with the number of final rows from the top, while
+  /// it bakes the next band (one call at a time, in order, on one of the bake's threads); it
+  /// returns whether to go on (bakeMapRows). The target must hold two bands and what the
+  /// call reads above them.
   std::function<bool(int rowsFinal)> onRowsFinal;
 };
 
@@ -382,23 +385,31 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
   };
 
   auto processBlocks = [&](int first, int end) {
-    runWithThreads(job.threads, [&] {
-      tbb::parallel_for(tbb::blocked_range<int>(first, end, 1),
-                        [&](const tbb::blocked_range<int>& r) {
-                          for (int b = r.begin(); b != r.end(); ++b) processBlock(b);
-                        });
+    tbb::parallel_for(tbb::blocked_range<int>(first, end, 1), [&](const tbb::blocked_range<int>& r) {
+      for (int b = r.begin(); b != r.end(); ++b) processBlock(b);
     });
   };
-  if (!job.onRowsFinal) {
-    processBlocks(0, numBlocks);
-    return;
-  }
-  // Bands from the top of the image (the highest blocks: y is up, rows are top first) down.
-  for (int end = numBlocks; end > 0; end -= kBlocksPerBand) {
-    const int first = std::max(0, end - kBlocksPerBand);
-    processBlocks(first, end);
-    if (!job.onRowsFinal(H - first * kRowsPerBlock)) return;
-  }
+  runWithThreads(job.threads, [&] {
+    if (!job.onRowsFinal) {
+      processBlocks(0, numBlocks);
+      return;
+    }
+    // Bands from the top of the image (the highest blocks: y is up, rows are top first) down.
+    // Each band's rows go to onRowsFinal in a task of their own while the next band is baked,
+    // so its serial parts (and its waits for a writer) overlap the baking; one call at a time,
+    // in order, and never while the band it reads is still being baked.
+    tbb::task_group reporting;
+    bool goOn = true;  // the last call's answer, read once it is done
+    for (int end = numBlocks; end > 0; end -= kBlocksPerBand) {
+      const int first = std::max(0, end - kBlocksPerBand);
+      processBlocks(first, end);
+      reporting.wait();
+      if (!goOn) return;
+      const int rowsFinal = H - first * kRowsPerBlock;
+      reporting.run([&job, &goOn, rowsFinal] { goOn = job.onRowsFinal(rowsFinal); });
+    }
+    reporting.wait();
+  });
 }
 
 }  // namespace sgbake::bake_detail

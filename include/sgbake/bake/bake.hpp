@@ -193,20 +193,22 @@ using BakedRowsSink = std::function<Status(const MutableImageRows& rows)>;
 
 /// @brief bakeMap band by band, without ever holding the whole image: the map is baked in bands
 /// of kBakeBandRows rows from the top of the image (file row 0) down into a ring of
-/// kBakeBandRows + @p keepRows reused rows (capped at the height), and @p sink is called on the
-/// caller's thread after each band. With e the end of the previous call (0 at first), a call
-/// sees rows [max(0, e − keepRows), end): the new band and the @p keepRows rows above it (the
-/// halo a padding of the rows above the band needs). The last call has end == height. Every
-/// value is bit for bit the one bakeMap computes; memory is O(width · (kBakeBandRows +
-/// keepRows)) instead of O(width · height), so a 4096² bake holds ~18 MB instead of ~270 MB.
+/// bakeRingRows(height, keepRows) reused rows, and @p sink is called after each band while the
+/// next band is baked (on one of the bake's threads, one call at a time, in order). With e the
+/// end of the previous call (0 at first), a call sees rows [max(0, e − keepRows), end): the new
+/// band and the @p keepRows rows above it (the halo a padding of the rows above the band
+/// needs). The last call has end == height. Every value is bit for bit the one bakeMap
+/// computes; memory is O(width · (2·kBakeBandRows + keepRows)) instead of O(width · height),
+/// so a 4096² RGB bake holds ~36 MB instead of ~270 MB.
 /// @return bakeMap's errors, or the first error of @p sink (no later band is baked)
 Status bakeMapRows(const BakeInput& input, const BakeSettings& settings, int keepRows,
                    const BakedRowsSink& sink);
 
 /// @brief Rows of the ring bakeMapRows bakes a map of @p height rows into, keeping @p keepRows
-/// rows above each band: min(height, kBakeBandRows + keepRows).
+/// rows above each band: the band a sink call reads, the rows above it, and the next band,
+/// baked meanwhile — min(height, 2·kBakeBandRows + keepRows).
 inline int bakeRingRows(int height, int keepRows) {
-  return std::min(height, kBakeBandRows + std::max(keepRows, 0));
+  return std::min(height, 2 * kBakeBandRows + std::max(keepRows, 0));
 }
 
 /// @brief The triangles the baker rasterizes, as global corner indices, face after face (see
