@@ -116,10 +116,18 @@ struct Lanes3 {
 /// combine conditions with & and |, not && and ||, for the same reason: no branches.)
 inline bool finiteLane(double x) { return std::abs(x) <= std::numeric_limits<double>::max(); }
 
+/// The per-texel frames of a batch (batchTexelFrames) and its slow lanes: those a lane loop
+/// cannot finish the common way, shaded again by shade() (shadeSlowLanes).
+struct BatchFrames {
+  Lanes3 T, N, B, unitN;
+  LaneFlags slow;
+};
+
 /// texelFrame() and unitNormal() of every sample: T, N, B and N̂ = N/|N|; slow[i] when N̂ needs
 /// unitOr's fallback (|N|² zero, subnormal-small or not finite).
-inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, Lanes3& T, Lanes3& N,
-                             Lanes3& B, Lanes3& unitN, LaneFlags& slow) {
+inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, BatchFrames& f) {
+  Lanes3 &T = f.T, &N = f.N, &B = f.B, &unitN = f.unitN;
+  LaneFlags& slow = f.slow;
   const Vec3d T0 = t.tangent[0], T1 = t.tangent[1], T2 = t.tangent[2];
   const Vec3d N0 = t.normal[0], N1 = t.normal[1], N2 = t.normal[2];
   const double s0 = t.sign[0], s1 = t.sign[1], s2 = t.sign[2];
@@ -148,6 +156,13 @@ inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, Lan
     unitN.z[i] = inv * nz;
     slow[i] = !((len2 > 0) & finiteLane(len2));
   }
+}
+
+/// shade() of the lanes flagged slow, over what the lane loops wrote for them.
+template <class Shader>
+void shadeSlowLanes(Shader& shader, const SampleBatch& s, const LaneFlags& slow, double* out) {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i)
+    if (slow[i]) shader.shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + Shader::kChannels * i);
 }
 
 /// The texture samples of UV height layer @p src (non-null texture, UV set on @p tri) at every
@@ -285,22 +300,21 @@ struct TangentNormalShader : BakeShaderBase {
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames).
   void shadeBatch(const SampleBatch& s, double* out) {
     const std::size_t n = static_cast<std::size_t>(s.count);
-    Lanes3 T, N, B, unitN;
-    LaneFlags slow;
-    batchTexelFrames(tri, s, T, N, B, unitN, slow);
+    BatchFrames f;
+    batchTexelFrames(tri, s, f);
 
     // The normal to express in tangent space: N̂, or N̂ − Γ (unnormalizedPerturbed).
     Lanes3 perturbedDirections;
-    const Lanes3& v = layers.empty() ? unitN : perturbedDirections;
-    if (!layers.empty()) batchPerturbedDirections(*this, s, unitN, perturbedDirections, slow);
+    const Lanes3& v = layers.empty() ? f.unitN : perturbedDirections;
+    if (!layers.empty()) batchPerturbedDirections(*this, s, f.unitN, perturbedDirections, f.slow);
 
     // objectToTangent(f, v), the green convention and encodeNormal.
     constexpr double kMinDet = kMinTexelFrameSine * kMinTexelFrameSine;
     const double greenSign = green == NormalMapGreen::kDirectX ? -1.0 : 1.0;
     for (std::size_t i = 0; i < n; ++i) {
-      const double tx = T.x[i], ty = T.y[i], tz = T.z[i];
-      const double nx = N.x[i], ny = N.y[i], nz = N.z[i];
-      const double bx = B.x[i], by = B.y[i], bz = B.z[i];
+      const double tx = f.T.x[i], ty = f.T.y[i], tz = f.T.z[i];
+      const double nx = f.N.x[i], ny = f.N.y[i], nz = f.N.z[i];
+      const double bx = f.B.x[i], by = f.B.y[i], bz = f.B.z[i];
       const double r0x = by * nz - bz * ny, r0y = bz * nx - bx * nz, r0z = bx * ny - by * nx;
       const double r1x = ny * tz - nz * ty, r1y = nz * tx - nx * tz, r1z = nx * ty - ny * tx;
       const double r2x = ty * bz - tz * by, r2y = tz * bx - tx * bz, r2z = tx * by - ty * bx;
@@ -315,7 +329,7 @@ struct TangentNormalShader : BakeShaderBase {
       const double wz = sd * (r2x * vx + r2y * vy + r2z * vz);
       const double len2 = wx * wx + wy * wy + wz * wz;
       const double inv = 1 / std::sqrt(len2);
-      slow[i] = slow[i] | (!flat & !((len2 > 0) & finiteLane(len2)));
+      f.slow[i] = f.slow[i] | (!flat & !((len2 > 0) & finiteLane(len2)));
       const double ox = flat ? 0.0 : inv * wx;
       const double oy = flat ? 0.0 : inv * wy;
       const double oz = flat ? 1.0 : inv * wz;
@@ -323,8 +337,7 @@ struct TangentNormalShader : BakeShaderBase {
       out[3 * i + 1] = 0.5 * (greenSign * oy) + 0.5;
       out[3 * i + 2] = 0.5 * oz + 0.5;
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 3 * i);
+    shadeSlowLanes(*this, s, f.slow, out);
   }
 };
 
@@ -339,14 +352,13 @@ struct ObjectNormalShader : BakeShaderBase {
   /// normalized as perturbed() normalizes it, encoded.
   void shadeBatch(const SampleBatch& s, double* out) {
     const std::size_t n = static_cast<std::size_t>(s.count);
-    Lanes3 T, N, B, unitN;
-    LaneFlags slow;
-    batchTexelFrames(tri, s, T, N, B, unitN, slow);
+    BatchFrames f;
+    batchTexelFrames(tri, s, f);
     Lanes3 perturbedNormals;
-    const Lanes3& v = layers.empty() ? unitN : perturbedNormals;
+    const Lanes3& v = layers.empty() ? f.unitN : perturbedNormals;
     if (!layers.empty()) {
       Lanes3& w = perturbedNormals;
-      batchPerturbedDirections(*this, s, unitN, w, slow);
+      batchPerturbedDirections(*this, s, f.unitN, w, f.slow);
       for (std::size_t i = 0; i < n; ++i) {  // unitOr's common case (slow covers the rest)
         const double len2 = w.x[i] * w.x[i] + w.y[i] * w.y[i] + w.z[i] * w.z[i];
         const double inv = 1 / std::sqrt(len2);
@@ -360,8 +372,7 @@ struct ObjectNormalShader : BakeShaderBase {
       out[3 * i + 1] = 0.5 * v.y[i] + 0.5;
       out[3 * i + 2] = 0.5 * v.z[i] + 0.5;
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 3 * i);
+    shadeSlowLanes(*this, s, f.slow, out);
   }
 };
 
@@ -420,17 +431,16 @@ struct DerivativeShader : BakeShaderBase {
   /// shade() of every sample of @p s, lane-parallel (batchGradients).
   void shadeBatch(const SampleBatch& s, double* out) {
     const std::size_t n = static_cast<std::size_t>(s.count);
-    Lanes3 T, N, B, unitN, gamma;
-    LaneFlags slow;
-    batchTexelFrames(tri, s, T, N, B, unitN, slow);
-    batchGradients(*this, s, unitN, gamma);
+    BatchFrames f;
+    batchTexelFrames(tri, s, f);
+    Lanes3 gamma;
+    batchGradients(*this, s, f.unitN, gamma);
     const Vec3d du = tri.bakeDPdu, dv = tri.bakeDPdv;
     for (std::size_t i = 0; i < n; ++i) {
       out[2 * i] = gamma.x[i] * du.x + gamma.y[i] * du.y + gamma.z[i] * du.z;
       out[2 * i + 1] = gamma.x[i] * dv.x + gamma.y[i] * dv.y + gamma.z[i] * dv.z;
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 2 * i);
+    shadeSlowLanes(*this, s, f.slow, out);
   }
 };
 
@@ -444,17 +454,16 @@ struct SurfaceGradientShader : BakeShaderBase {
   /// shade() of every sample of @p s, lane-parallel (batchGradients).
   void shadeBatch(const SampleBatch& s, double* out) {
     const std::size_t n = static_cast<std::size_t>(s.count);
-    Lanes3 T, N, B, unitN, gamma;
-    LaneFlags slow;
-    batchTexelFrames(tri, s, T, N, B, unitN, slow);
-    batchGradients(*this, s, unitN, gamma);
+    BatchFrames f;
+    batchTexelFrames(tri, s, f);
+    Lanes3 gamma;
+    batchGradients(*this, s, f.unitN, gamma);
     for (std::size_t i = 0; i < n; ++i) {
       out[3 * i] = gamma.x[i];
       out[3 * i + 1] = gamma.y[i];
       out[3 * i + 2] = gamma.z[i];
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (slow[i]) shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + 3 * i);
+    shadeSlowLanes(*this, s, f.slow, out);
   }
 };
 
