@@ -56,6 +56,18 @@ std::string scenePrefix(const Scene& scene) {
 std::string layerLabel(std::size_t i) { return "layers[" + std::to_string(i) + "]"; }
 std::string outputLabel(std::size_t i) { return "outputs[" + std::to_string(i) + "]"; }
 
+/// How an image output is padded: masks not at all (padding would overwrite the coverage they
+/// show), else push-pull or Extend by `margin` texels.
+struct OutputPadding {
+  bool pushPull = false;
+  int margin = 0;  ///< Extend rings; 0 for push-pull and masks
+};
+OutputPadding outputPadding(const SceneOutput& output) {
+  if (output.map == MapKind::kMask) return {};
+  if (output.padding == PaddingMode::kPushPull) return {true, 0};
+  return {false, std::max(output.margin, 0)};
+}
+
 /// The directory that holds @p file ("." for a bare name).
 fs::path directoryOf(const fs::path& file) {
   const fs::path dir = file.parent_path();
@@ -303,8 +315,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     const bool udim = hasUdimToken(output.file.string());
     // Memory of the pixels (float values and coverage): bakeImageTile's ring of bands, or the
     // whole image for push-pull.
-    const bool pushPull = output.map != MapKind::kMask && output.padding == PaddingMode::kPushPull;
-    const int margin = output.map == MapKind::kMask || pushPull ? 0 : std::max(output.margin, 0);
+    const auto [pushPull, margin] = outputPadding(output);
     const int rowsHeld = pushPull ? output.height : bakeRingRows(output.height, 2 * margin);
     const double bytes = static_cast<double>(rowsHeld) * output.width *
                          (mapChannels(output.map) + 1) * sizeof(float);
@@ -322,14 +333,12 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
              (udim ? "every UDIM tile the UV set touches"
                    : "UDIM tile " + std::to_string(output.tile)),
          reads + memory});
-    if (output.map == MapKind::kMask) {
-      // Padding would overwrite the coverage the mask is made of.
-    } else if (output.padding == PaddingMode::kPushPull) {
+    if (pushPull) {  // (masks are never padded: outputPadding)
       plan.steps.push_back({"pad " + output.file.string() + " by push-pull",
                             "fills every texel outside the UV islands"});
-    } else if (output.margin > 0) {
+    } else if (margin > 0) {
       plan.steps.push_back(
-          {"pad " + output.file.string() + ": extend " + std::to_string(output.margin) + " texels",
+          {"pad " + output.file.string() + ": extend " + std::to_string(margin) + " texels",
            "margin against bleeding at UV seams under filtering and mipmaps"});
     }
     const ImageFormat format = output.resolvedFormat();
@@ -853,9 +862,7 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const
                                                         mapChannels(settings.map), writeOptions);
   if (!writer) return writer.error();
 
-  const bool isMask = output.map == MapKind::kMask;
-  const bool pushPull = !isMask && output.padding == PaddingMode::kPushPull;
-  const int margin = isMask || pushPull ? 0 : std::max(output.margin, 0);
+  const auto [pushPull, margin] = outputPadding(output);
   const bool signedRange = output.storesSignedRange();
   int rowsWritten = 0;
   double padSeconds = 0, convertSeconds = 0;
