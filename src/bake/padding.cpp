@@ -190,39 +190,51 @@ void extendMargin(FloatImage& image, int margin, int threads) {
   extendMarginIn(paddedRows(rows, 0, image.height), margin, threads);
 }
 
+namespace {
+
+/// Rows a strip [rowBegin, rowEnd) of an image's padding depends on: [rowBegin − margin, rowEnd +
+/// margin) clipped to the image (whose edges the window then shares, so the padding there is
+/// the same too); held when the view can read all of them.
+struct StripWindow {
+  int rowBegin = 0, rowEnd = 0;  ///< the strip, clamped to the image
+  int begin = 0, end = 0;        ///< the rows it depends on
+  bool held = false;
+};
+
+template <class T>
+StripWindow stripWindow(const BasicImageRows<T>& rows, int margin, int rowBegin, int rowEnd) {
+  const int H = std::max(rows.height, 0);
+  StripWindow w;
+  w.rowBegin = std::clamp(rowBegin, 0, H);
+  w.rowEnd = std::clamp(rowEnd, w.rowBegin, H);
+  margin = std::max(margin, 0);
+  w.begin = std::max(0, w.rowBegin - margin);
+  w.end = std::min(H, w.rowEnd + margin);
+  w.held = rows.width > 0 && rows.channels > 0 && w.begin >= rows.begin && w.end <= rows.end;
+  return w;
+}
+
+}  // namespace
+
 void extendMarginRowsInPlace(const MutableImageRows& rows, int margin, int rowBegin, int rowEnd,
                              int threads) {
-  const int H = std::max(rows.height, 0);
-  rowBegin = std::clamp(rowBegin, 0, H);
-  rowEnd = std::clamp(rowEnd, rowBegin, H);
-  const int windowBegin = std::max(0, rowBegin - margin);
-  const int windowEnd = std::min(H, rowEnd + margin);
-  if (margin <= 0 || rows.width <= 0 || rows.channels <= 0 || rowBegin == rowEnd ||
-      windowBegin < rows.begin || windowEnd > rows.end) {
-    return;
-  }
-  extendMarginIn(paddedRows(rows, windowBegin, windowEnd), margin, threads);
+  const StripWindow w = stripWindow(rows, margin, rowBegin, rowEnd);
+  if (margin <= 0 || w.rowBegin == w.rowEnd || !w.held) return;
+  extendMarginIn(paddedRows(rows, w.begin, w.end), margin, threads);
 }
 
 int extendMarginRows(const ImageRows& rows, int margin, int rowBegin, int rowEnd,
                      FloatImage& window, int threads) {
-  const int H = std::max(rows.height, 0);
-  rowBegin = std::clamp(rowBegin, 0, H);
-  rowEnd = std::clamp(rowEnd, rowBegin, H);
-  margin = std::max(margin, 0);
-  // The rows the strip's padding depends on, clipped to the image (whose edges the window then
-  // shares, so the padding there is the same too).
-  const int windowBegin = std::max(0, rowBegin - margin);
-  const int windowEnd = std::min(H, rowEnd + margin);
+  const StripWindow w = stripWindow(rows, margin, rowBegin, rowEnd);
+  const int windowBegin = w.begin, windowEnd = w.end;
   window.width = rows.width;
   window.height = windowEnd - windowBegin;
   window.channels = rows.channels;
-  if (rows.width <= 0 || rows.channels <= 0 || window.height == 0 || windowBegin < rows.begin ||
-      windowEnd > rows.end) {
+  if (!w.held || window.height == 0) {
     window.height = 0;
     window.pixels.clear();
     window.coverage.clear();
-    return rowBegin - windowBegin;
+    return w.rowBegin - windowBegin;
   }
   const std::size_t rowValues = rows.rowValues();
   const std::size_t rowTexels = static_cast<std::size_t>(rows.width);
@@ -238,7 +250,7 @@ int extendMarginRows(const ImageRows& rows, int margin, int rowBegin, int rowEnd
     r += run;
   }
   extendMargin(window, margin, threads);
-  return rowBegin - windowBegin;
+  return w.rowBegin - windowBegin;
 }
 
 int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
