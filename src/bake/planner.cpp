@@ -267,6 +267,11 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
   if (plan.loadMesh) {
     plan.steps.push_back({"load mesh " + scene.mesh.string() + ", UVs required",
                           "read by every output to bake: " + joinLabels(toBake)});
+    if (scene.subdivision.requested()) {
+      plan.steps.push_back({"subdivide the mesh " + describeSubdivision(scene.subdivision),
+                            "the scene's \"subdivision\" block (Blender's Subdivision Surface "
+                            "modifier)"});
+    }
   }
   for (const PlannedImage& image : plan.images) {
     plan.steps.push_back(
@@ -469,10 +474,10 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   if (Status valid = validateScene(scene); !valid) {
     return Error::badInput(prefix + valid.error().message);
   }
-  if (scene.subdivision.requested()) {
+  if (scene.subdivision.present && scene.subdivision.limit) {
     return Error::badInput(prefix +
-                           "subdivision: subdivision is not supported yet (remove the "
-                           "'subdivision' block or set \"level\": 0)");
+                           "subdivision: \"level\": \"limit\" is not supported yet (give a "
+                           "number of levels, 1 to " + std::to_string(kMaxSubdivisionLevel) + ")");
   }
   if (Status ok = checkInputFile(scene, "mesh", "file", scene.mesh); !ok) return ok.error();
 
@@ -988,6 +993,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   std::future<Result<Mesh>> meshLoad = std::async(std::launch::async, [&s] {
     LoadOptions meshOptions;
     meshOptions.requireUvs = true;
+    if (s.subdivision.requested()) meshOptions.subdivision = s.subdivision.options();
     return loadMesh(s.mesh, meshOptions);
   });
   const Status textures = loadTextures(plan, loaded, progress, report);

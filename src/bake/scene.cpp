@@ -77,13 +77,6 @@ std::string rangeMessage(std::string_view name, long long value, long long min, 
          std::to_string(min) + ".." + std::to_string(max);
 }
 
-/// A named value of an enumeration in the scene ("bicubic" → Filter::kBicubic).
-template <class E>
-struct Named {
-  const char* name;
-  E value;
-};
-
 constexpr Named<Filter> kFilters[] = {
     {"bilinear", Filter::kBilinear}, {"bicubic", Filter::kBicubic}, {"hermite", Filter::kHermite}};
 constexpr Named<Wrap> kWraps[] = {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClamp}};
@@ -108,15 +101,8 @@ constexpr Named<SceneLayerType> kLayerTypes[] = {{"height", SceneLayerType::kHei
                                                  {"volume", SceneLayerType::kVolume},
                                                  {"planar", SceneLayerType::kPlanar},
                                                  {"triplanar", SceneLayerType::kTriplanar}};
-constexpr Named<SubdivisionUvSmooth> kUvSmooths[] = {
-    {"none", SubdivisionUvSmooth::kNone},
-    {"keep-corners", SubdivisionUvSmooth::kKeepCorners},
-    {"keep-corners-junctions", SubdivisionUvSmooth::kKeepCornersJunctions},
-    {"keep-corners-junctions-concave", SubdivisionUvSmooth::kKeepCornersJunctionsConcave},
-    {"keep-boundaries", SubdivisionUvSmooth::kKeepBoundaries},
-    {"all", SubdivisionUvSmooth::kAll}};
-constexpr Named<SubdivisionBoundary> kBoundaries[] = {
-    {"all", SubdivisionBoundary::kAll}, {"keep-corners", SubdivisionBoundary::kKeepCorners}};
+constexpr const auto& kUvSmooths = kSubdivisionUvSmoothNames;
+constexpr const auto& kBoundaries = kSubdivisionBoundaryNames;
 
 /// The names of an enumeration table, in order.
 template <class E, std::size_t N>
@@ -928,6 +914,13 @@ std::string outputParametersJson(const SceneOutput& output) {
   j["alpha"] = output.alpha;
   if (output.storesSignedRange()) j["range"] = output.range;
   return j.dump();
+}
+
+std::string describeSubdivision(const SceneSubdivision& subdivision) {
+  const std::string level = subdivision.limit ? std::string("the limit surface")
+                                              : "level " + std::to_string(subdivision.level);
+  return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) +
+         ", boundary " + nameIn(kBoundaries, subdivision.boundary) + ")";
 }
 
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {

@@ -54,11 +54,14 @@ struct BakeArguments {
   int bitDepth = 0;
   bool alpha = false;
   std::optional<double> range;
+  SubdivisionOptions subdivision;  ///< level 0: none
 };
 
 constexpr const char* kFooter =
     "Scene file (JSON; relative paths are relative to the scene file):\n"
     "  { \"mesh\": \"m.obj\", \"uv\": 0,\n"
+    "    \"subdivision\": {\"level\": 2, \"uv_smooth\": \"keep-boundaries\", \"boundary\": "
+    "\"all\"},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -115,7 +118,7 @@ const char* const kOneMapOptions[] = {
     "--mesh",    "--output",       "--map",          "--size",      "--margin",       "--padding",
     "--samples", "--uv",           "--green",        "--height",    "--height-scale", "--filter",
     "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
-    "--range"};
+    "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 
@@ -224,6 +227,10 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   Scene scene;
   scene.mesh = args.mesh;
   scene.uvSet = args.uvSet;
+  scene.subdivision.present = args.subdivision.level > 0;
+  scene.subdivision.level = args.subdivision.level;
+  scene.subdivision.uvSmooth = args.subdivision.uvSmooth;
+  scene.subdivision.boundary = args.subdivision.boundary;
   if (!args.heightImage.empty()) {
     if (Status ok = parseName("--filter", args.filter, {"bilinear", "bicubic", "hermite"}); !ok) {
       return ok.error();
@@ -409,6 +416,7 @@ CommandAction defineBakeCommand(CLI::App& app) {
   app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif; '<UDIM>' allowed)")
       ->type_name("FILE")
       ->group(oneMap);
+  addSubdivisionOptions(app, args->subdivision, oneMap);
   app.add_option("--map", args->map,
                  "tangent-normal, object-normal, height, derivative, surface-gradient, tangent, "
                  "bitangent, mask or corners")

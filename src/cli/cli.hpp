@@ -19,6 +19,7 @@
 
 #include "sgbake/core/result.hpp"
 #include "sgbake/io/atomic_file.hpp"
+#include "sgbake/subdiv/subdivide.hpp"
 
 namespace sgbake::cli {
 
@@ -60,6 +61,12 @@ extern const char* const kExitCodeHelp;
 
 /// @brief CLI11 validator for options that take a count or an index: an integer >= 0.
 extern const CLI::Validator kNonNegativeInteger;
+
+/// @brief Adds --subdivide N, --uv-smooth NAME and --boundary-smooth NAME (Blender's
+/// Subdivision Surface modifier, see subdivideMesh), bound to @p options; level 0 (the default)
+/// means no subdivision. Non-empty @p group files them under that heading of --help.
+void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
+                           const std::string& group = {});
 
 /// @brief Measures wall-clock seconds since construction or the last lap().
 class Stopwatch {

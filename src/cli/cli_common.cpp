@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -39,6 +40,45 @@ const CLI::Validator kNonNegativeInteger(
       return "'" + value + "' is not an integer >= 0";
     },
     /*validator_desc=*/"");
+
+namespace {
+
+/// CLI11's name → value map of a Named table.
+template <class E, std::size_t N>
+std::map<std::string, E> nameMap(const Named<E> (&table)[N]) {
+  std::map<std::string, E> names;
+  for (const Named<E>& entry : table) names.emplace(entry.name, entry.value);
+  return names;
+}
+
+}  // namespace
+
+void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
+                           const std::string& group) {
+  options.level = 0;
+  CLI::Option* const level = app.add_option("--subdivide", options.level,
+                 "Subdivide the mesh first, as Blender's Subdivision Surface modifier with this "
+                 "many levels (0 = not at all)")
+      ->type_name("N")
+      ->check(CLI::Range(0, kMaxSubdivisionLevel))
+      ->capture_default_str();
+  CLI::Option* const uvSmooth = app.add_option("--uv-smooth", options.uvSmooth,
+                 "The modifier's UV Smooth: none, keep-corners, keep-corners-junctions, "
+                 "keep-corners-junctions-concave, keep-boundaries, all")
+      ->type_name("NAME")
+      ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionUvSmoothNames), CLI::ignore_case)
+                      .description(""))
+      ->default_str("keep-boundaries");
+  CLI::Option* const boundary = app.add_option("--boundary-smooth", options.boundary,
+                 "The modifier's Boundary Smooth: all, keep-corners")
+      ->type_name("NAME")
+      ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionBoundaryNames), CLI::ignore_case)
+                      .description(""))
+      ->default_str("all");
+  if (!group.empty()) {  // CLI11 hides options of the empty group
+    for (CLI::Option* option : {level, uvSmooth, boundary}) option->group(group);
+  }
+}
 
 ExitCode exitCodeFor(ErrorCode code) {
   return code == ErrorCode::kBadInput ? kExitBadInput : kExitInternal;

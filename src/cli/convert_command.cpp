@@ -33,6 +33,7 @@ struct ConvertArguments {
   int bitDepth = 0;
   int threads = 0;
   bool stats = false;
+  SubdivisionOptions subdivision;  ///< level 0: none
 };
 
 constexpr const char* kFooter =
@@ -120,6 +121,7 @@ Status runConvert(const ConvertArguments& args) {
   Stopwatch step;
   LoadOptions meshOptions;
   meshOptions.requireUvs = true;
+  meshOptions.subdivision = args.subdivision;
   Result<Mesh> mesh = loadMesh(args.mesh, meshOptions);
   if (!mesh) return mesh.error();
   if (!mesh->hasUvSet(static_cast<std::size_t>(args.uvSet))) {
@@ -200,6 +202,7 @@ CommandAction defineConvertCommand(CLI::App& app) {
   app.add_option("--mesh", args->mesh, "Mesh with UVs the map was baked for")
       ->required()
       ->type_name("FILE");
+  addSubdivisionOptions(app, args->subdivision);
   app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif); same size as IN")
       ->required()
       ->type_name("FILE");

@@ -15,7 +15,9 @@
 #include "cli.hpp"
 #include "float_format.hpp"
 #include "sgbake/frames/tangents.hpp"
+#include "sgbake/io/atomic_file.hpp"
 #include "sgbake/mesh/io.hpp"
+#include "sgbake/subdiv/subdivide.hpp"
 
 namespace sgbake::cli {
 namespace {
@@ -27,6 +29,8 @@ struct TangentsArguments {
   int uvSet = 0;
   int threads = 0;
   bool stats = false;
+  SubdivisionOptions subdivision;  ///< level 0: none
+  std::string meshOut;             ///< --mesh-out: the (subdivided) mesh as OBJ, or empty
 };
 
 constexpr const char* kFooter =
@@ -37,10 +41,13 @@ constexpr const char* kFooter =
     "  digits (enough to read the float back exactly); sign is 1 or -1, and the bitangent is\n"
     "  sign * cross(normal, tangent). Normals come from the file, or are smooth angle-weighted\n"
     "  normals when it has none.\n"
+    "  With --subdivide, the rows are the corners of the subdivided mesh (Blender's modifier\n"
+    "  applied): --mesh-out writes that mesh as OBJ, its corners in the rows' order.\n"
     "  With -o, the file is replaced only once everything has succeeded: never left partial.\n"
     "\n"
     "Examples:\n"
     "  sgbake tangents suzanne.obj -o suzanne_tangents.csv\n"
+    "  sgbake tangents suzanne.obj --subdivide 2 --mesh-out suzanne_l2.obj -o l2_tangents.csv\n"
     "  sgbake tangents scan.ply --uv 1 --threads 4 --stats > tangents.csv\n"
     "\n";
 
@@ -139,9 +146,11 @@ Status runTangents(const TangentsArguments& args) {
   Stopwatch step;
   LoadOptions loadOptions;
   loadOptions.requireUvs = true;
+  loadOptions.subdivision = args.subdivision;
   Result<Mesh> mesh = loadMesh(args.mesh, loadOptions);
   if (!mesh) return mesh.error();
   const double loadSeconds = step.lap();
+
 
   const auto uvSet = static_cast<std::size_t>(args.uvSet);
   if (!mesh->hasUvSet(uvSet)) {
@@ -164,6 +173,11 @@ Status runTangents(const TangentsArguments& args) {
   }
   const double tangentSeconds = step.lap();
 
+  if (!args.meshOut.empty()) {
+    if (Status written = writeFileAtomically(args.meshOut, formatObj(*mesh, uvSet)); !written) {
+      return written;
+    }
+  }
   if (Status written = writeCsv(*mesh, *frames, *output); !written) return written;
   const double writeSeconds = step.lap();
 
@@ -177,6 +191,7 @@ Status runTangents(const TangentsArguments& args) {
         {"corners", mesh->numCorners()},
         {"uv_set", uvSet},
         {"threads", threadLimit.effectiveThreads()},
+        {"subdivision_level", args.subdivision.level},
         {"load_s", loadSeconds},
         {"tangents_s", tangentSeconds},
         {"write_s", writeSeconds},
@@ -206,6 +221,10 @@ CommandAction defineTangentsCommand(CLI::App& app) {
       ->type_name("N")
       ->check(kNonNegativeInteger)
       ->capture_default_str();
+  addSubdivisionOptions(app, args->subdivision);
+  app.add_option("--mesh-out", args->meshOut,
+                 "Also write the mesh the tangents are of (subdivided, with its normals) as OBJ")
+      ->type_name("FILE");
   app.add_flag("--stats", args->stats,
                "Print timings and sizes as one line of JSON on standard error");
   return [args] { return runTangents(*args); };

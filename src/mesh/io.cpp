@@ -28,6 +28,7 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 
 #include "sgbake/mesh/io.hpp"
+#include "sgbake/subdiv/subdivide.hpp"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
@@ -284,6 +285,7 @@ Result<Mesh> loadMeshFromMemory(std::string_view bytes, std::string_view extensi
   if (Status s = validate(*mesh); !s) {
     return Error::internal("loaded mesh breaks an invariant: " + s.error().message);
   }
+  if (options.subdivision.level > 0) return subdivideMesh(*mesh, options.subdivision);
   return mesh;
 }
 

@@ -261,13 +261,23 @@ TEST_F(PlannerTest, ExplainListsStepsAndSkippedWork) {
   EXPECT_FALSE(fs::exists(dir_ / "n_out.png"));
 }
 
-TEST_F(PlannerTest, SubdivisionIsNotSupportedYet) {
+TEST_F(PlannerTest, TheLimitSurfaceIsNotSupportedYet) {
   Result<Plan> p = makePlan(scene(R"({"mesh": "plane.obj", "subdivision": {"level": "limit"},
                                       "outputs": [{"map": "mask", "file": "m.png"}]})"));
   ASSERT_FALSE(p);
   EXPECT_EQ(p.error().code, ErrorCode::kBadInput);
-  EXPECT_NE(p.error().message.find("subdivision is not supported yet"), std::string::npos)
+  EXPECT_NE(p.error().message.find("\"limit\" is not supported yet"), std::string::npos)
       << p.error().message;
+}
+
+TEST_F(PlannerTest, ExplainSaysTheMeshIsSubdivided) {
+  Result<Plan> p = makePlan(scene(R"({"mesh": "plane.obj", "subdivision": {"level": 2},
+                                      "outputs": [{"map": "mask", "file": "m.png"}]})"));
+  ASSERT_TRUE(p) << p.error().message;
+  const std::string text = explainPlan(*p);
+  EXPECT_NE(text.find("subdivide the mesh to level 2 (uv_smooth keep-boundaries, boundary all)"),
+            std::string::npos)
+      << text;
 }
 
 TEST_F(PlannerTest, MissingInputsAreNamed) {

@@ -128,9 +128,9 @@ TEST_F(BakeCliTest, BadScenesExitTwoNamingTheProblemAndCreateNothing) {
                  dir_);
   expectBadScene(bakeScene(planeScene(kHeightLayer, "{" + std::string(out) + "}", "nouv.obj")),
                  "nouv.obj", before, dir_);
-  expectBadScene(bakeScene(R"({"mesh": "plane.obj", "subdivision": {"level": 2},
+  expectBadScene(bakeScene(R"({"mesh": "plane.obj", "subdivision": {"level": "limit"},
                               "outputs": [{"map": "mask", "file": "m.png"}]})"),
-                 "subdivision is not supported yet", before, dir_);
+                 "\"limit\" is not supported yet", before, dir_);
   expectBadScene(bakeScene("{\"mesh\": "), "invalid JSON", before, dir_);
   // The scene file itself.
   const ProcessResult missing = run({"bake", (dir_ / "none.json").string()});

@@ -43,6 +43,7 @@
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/projection.hpp"
 #include "sgbake/gradient/volume.hpp"
+#include "sgbake/subdiv/subdivide.hpp"
 
 namespace sgbake {
 
@@ -76,24 +77,9 @@ enum class PaddingMode {
   kPushPull,  ///< "push-pull": pushPullFill, every uncovered texel (the margin is ignored)
 };
 
-/// @brief Subdivision "uv_smooth" (Blender's UV Smooth of the Subdivision Surface modifier).
-enum class SubdivisionUvSmooth {
-  kNone,                         ///< "none"
-  kKeepCorners,                  ///< "keep-corners"
-  kKeepCornersJunctions,         ///< "keep-corners-junctions"
-  kKeepCornersJunctionsConcave,  ///< "keep-corners-junctions-concave"
-  kKeepBoundaries,               ///< "keep-boundaries" (Blender's default)
-  kAll,                          ///< "all"
-};
-
-/// @brief Subdivision "boundary" (Blender's Boundary Smooth).
-enum class SubdivisionBoundary {
-  kAll,          ///< "all" (Blender's default)
-  kKeepCorners,  ///< "keep-corners"
-};
-
-/// @brief The scene's "subdivision" block. Parsed and validated; not implemented yet (the
-/// planner reports a scene that asks for it as unsupported).
+/// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
+/// (subdivideMesh) before anything is baked. "level": "limit" is parsed but not implemented yet
+/// (the planner reports it as unsupported).
 struct SceneSubdivision {
   bool present = false;  ///< the scene has a "subdivision" block
   bool limit = false;    ///< "level": "limit" — the limit surface
@@ -102,6 +88,8 @@ struct SceneSubdivision {
   SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
   /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
   bool requested() const { return present && (limit || level > 0); }
+  /// @brief The options of subdivideMesh this block stands for (a number of levels).
+  SubdivisionOptions options() const { return {level, uvSmooth, boundary}; }
 };
 
 /// @brief A layer's optional "mask": a scalar image on a UV set that scales its Γ (LayerMask).
@@ -251,6 +239,10 @@ std::string outputParametersJson(const SceneOutput& output);
 
 /// @brief The subdivision block as canonical JSON text ("null" when the scene has none).
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision);
+
+/// @brief The block in words, for --explain: "to level 2 (uv_smooth keep-boundaries, boundary
+/// all)".
+std::string describeSubdivision(const SceneSubdivision& subdivision);
 
 /// @brief @p path made absolute and canonical as far as it exists (weakly_canonical); the
 /// lexically normal absolute path when that fails.

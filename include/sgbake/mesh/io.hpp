@@ -2,11 +2,14 @@
 /// @brief Reading meshes: OBJ, PLY and OFF, validated before OpenMesh parses them.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 #include "sgbake/core/result.hpp"
 #include "sgbake/mesh/mesh.hpp"
+#include "sgbake/subdiv/subdivide.hpp"
 
 namespace sgbake {
 
@@ -14,6 +17,9 @@ namespace sgbake {
 struct LoadOptions {
   /// Fail with a clear error when the file has no texture coordinates (for work that needs UVs).
   bool requireUvs = false;
+  /// Subdivide the mesh after reading it, as Blender's Subdivision Surface modifier
+  /// (subdivideMesh); level 0, the default, leaves it as the file has it.
+  SubdivisionOptions subdivision{.level = 0};
 };
 
 /// @brief Reads an OBJ, PLY or OFF file (chosen by extension, case-insensitive).
@@ -58,5 +64,11 @@ Result<Mesh> loadMesh(const std::filesystem::path& path, const LoadOptions& opti
 /// @param[in] name      how messages name the source (usually its path)
 Result<Mesh> loadMeshFromMemory(std::string_view bytes, std::string_view extension,
                                 std::string_view name, const LoadOptions& options = {});
+
+/// @brief The mesh as OBJ text that loadMesh reads back bit for bit: `v` per vertex in vertex
+/// order, `vt` (UV set @p uvSet, when the mesh has it) and `vn` per corner in corner order, `f`
+/// per face with its corners in order. Floats are written in the shortest form that reads back
+/// exactly. One UV set only: OBJ has no place for more.
+std::string formatObj(const Mesh& mesh, std::size_t uvSet = 0);
 
 }  // namespace sgbake

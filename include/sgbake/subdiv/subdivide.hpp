@@ -1,0 +1,77 @@
+/// @file subdivide.hpp
+/// @brief Catmull-Clark subdivision as Blender's Subdivision Surface modifier computes it
+/// (OpenSubdiv underneath), so that a coarse mesh plus a level bakes like Blender's modified mesh.
+#pragma once
+
+#include "sgbake/core/named.hpp"
+#include "sgbake/core/result.hpp"
+#include "sgbake/mesh/mesh.hpp"
+
+namespace sgbake {
+
+/// @brief Blender's "UV Smooth": how UVs are interpolated (OpenSubdiv's face-varying linear
+/// interpolation option, mapped as in shared/CONVENTIONS.md).
+enum class SubdivisionUvSmooth {
+  kNone,                         ///< "none": UVs interpolated linearly (FVAR_LINEAR_ALL)
+  kKeepCorners,                  ///< "keep-corners" (FVAR_LINEAR_CORNERS_ONLY)
+  kKeepCornersJunctions,         ///< "keep-corners-junctions" (FVAR_LINEAR_CORNERS_PLUS1)
+  kKeepCornersJunctionsConcave,  ///< "keep-corners-junctions-concave" (FVAR_LINEAR_CORNERS_PLUS2)
+  kKeepBoundaries,               ///< "keep-boundaries", Blender's default (FVAR_LINEAR_BOUNDARIES)
+  kAll,                          ///< "all": UVs smoothed everywhere (FVAR_LINEAR_NONE)
+};
+
+/// @brief Blender's "Boundary Smooth": how open boundaries are treated.
+enum class SubdivisionBoundary {
+  kAll,          ///< "all", Blender's default (VTX_BOUNDARY_EDGE_ONLY)
+  kKeepCorners,  ///< "keep-corners": boundary corners stay sharp (VTX_BOUNDARY_EDGE_AND_CORNER)
+};
+
+/// @brief How scene files ("uv_smooth") and the CLI (--uv-smooth) spell SubdivisionUvSmooth.
+inline constexpr Named<SubdivisionUvSmooth> kSubdivisionUvSmoothNames[] = {
+    {"none", SubdivisionUvSmooth::kNone},
+    {"keep-corners", SubdivisionUvSmooth::kKeepCorners},
+    {"keep-corners-junctions", SubdivisionUvSmooth::kKeepCornersJunctions},
+    {"keep-corners-junctions-concave", SubdivisionUvSmooth::kKeepCornersJunctionsConcave},
+    {"keep-boundaries", SubdivisionUvSmooth::kKeepBoundaries},
+    {"all", SubdivisionUvSmooth::kAll}};
+
+/// @brief How scene files ("boundary") and the CLI (--boundary-smooth) spell SubdivisionBoundary.
+inline constexpr Named<SubdivisionBoundary> kSubdivisionBoundaryNames[] = {
+    {"all", SubdivisionBoundary::kAll}, {"keep-corners", SubdivisionBoundary::kKeepCorners}};
+
+/// @brief The options of subdivideMesh: those of Blender's modifier that change the result.
+struct SubdivisionOptions {
+  int level = 1;  ///< Blender's "Levels" (1..kMaxSubdivisionLevel); 0 returns the mesh unchanged
+  SubdivisionUvSmooth uvSmooth = SubdivisionUvSmooth::kKeepBoundaries;
+  SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
+};
+
+/// @brief The highest level subdivideMesh accepts (a quad becomes 4⁶ = 4096 quads).
+inline constexpr int kMaxSubdivisionLevel = 6;
+
+/// @brief The mesh Blender's Subdivision Surface modifier makes of @p coarse (Catmull-Clark,
+/// "Use Limit Surface" on, as a new modifier has it), with every UV set subdivided.
+///
+/// What Blender does, and so this:
+///  - Each quad becomes a (2^level)² grid of quads; any other face of n corners becomes n
+///    (2^(level-1))² grids, one per corner, meeting at the face's centre.
+///  - Every vertex of the result lies on the limit surface of the coarse mesh: it is evaluated
+///    with OpenSubdiv's Bfr at its grid point (approximating irregular regions to
+///    refinement level 3, Blender's default "Quality").
+///  - UVs are the face-varying limit of the coarse UVs, evaluated per corner; corners of a
+///    vertex whose UVs lie within 1e-4 of each other share one face-varying value.
+///  - Each new quad starts at the corner nearest its face's first corner in the face's own
+///    parameterization, so that it splits into triangles along the same diagonal as Blender's.
+///  - The result is shaded smooth: its normals are computeSmoothNormals of the new faces (the
+///    coarse mesh's normals are not used; Blender recomputes them the same way).
+///
+/// Vertices are numbered as Blender numbers them: the coarse vertices first (same indices), then
+/// the points inside each coarse edge, then those inside each coarse face. Faces are grouped by
+/// coarse face, in coarse order.
+///
+/// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
+///         is out of range or the mesh cannot be subdivided (a face using one vertex twice, or a
+///         topology OpenSubdiv rejects).
+Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options);
+
+}  // namespace sgbake
