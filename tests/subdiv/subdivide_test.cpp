@@ -1,0 +1,262 @@
+// subdivideMesh: counts, closed-form limit points of regular Catmull-Clark patches, UVs with
+// linear face-varying interpolation, and a watertight, consistently oriented result.
+#include "sgbake/subdiv/subdivide.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "sgbake/core/math.hpp"
+#include "sgbake/mesh/normals.hpp"
+
+namespace sgbake {
+namespace {
+
+/// A closed mesh from faces of vertex indices; UVs are each corner's position x, y.
+Mesh closedMesh(std::vector<Vec3f> positions, const std::vector<std::vector<std::uint32_t>>& faces) {
+  Mesh mesh;
+  mesh.source = "test.obj";
+  mesh.positions = std::move(positions);
+  UvSet uv{"UVMap", {}};
+  for (const auto& face : faces) {
+    for (const std::uint32_t v : face) {
+      mesh.cornerVertex.push_back(v);
+      uv.uvs.push_back({mesh.positions[v].x, mesh.positions[v].y});
+    }
+    mesh.faceStart.push_back(static_cast<std::uint32_t>(mesh.cornerVertex.size()));
+  }
+  mesh.uvSets.push_back(std::move(uv));
+  mesh.cornerNormals.resize(mesh.cornerVertex.size());
+  computeSmoothNormals(mesh);
+  return mesh;
+}
+
+Mesh cube() {
+  return closedMesh({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                     {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
+                    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6},
+                     {3, 0, 4, 7}});
+}
+
+/// A prism over a regular n-gon: two n-gon caps and n quads (n = 3: triangles).
+Mesh prism(std::uint32_t n) {
+  std::vector<Vec3f> positions;
+  for (std::uint32_t z = 0; z < 2; ++z) {
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const double a = 2 * kPi * k / n;
+      positions.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)),
+                           static_cast<float>(z)});
+    }
+  }
+  std::vector<std::vector<std::uint32_t>> faces(2);
+  for (std::uint32_t k = 0; k < n; ++k) {
+    faces[0].push_back(n - 1 - k);  // bottom, facing -z
+    faces[1].push_back(n + k);      // top, facing +z
+    faces.push_back({k, (k + 1) % n, n + (k + 1) % n, n + k});
+  }
+  return closedMesh(std::move(positions), faces);
+}
+
+/// A closed torus of nu × nv quads with every vertex of valence 4 (one regular B-spline patch
+/// per face), its vertices displaced by a bumpy function so no symmetry hides an error.
+Mesh torusGrid(int nu, int nv) {
+  std::vector<Vec3f> positions;
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      const double a = 2 * kPi * i / nu, b = 2 * kPi * j / nv;
+      const double r = 0.35 + 0.05 * std::sin(3 * a + b);
+      positions.push_back({static_cast<float>((1 + r * std::cos(b)) * std::cos(a)),
+                           static_cast<float>((1 + r * std::cos(b)) * std::sin(a)),
+                           static_cast<float>(r * std::sin(b))});
+    }
+  }
+  const auto index = [&](int i, int j) {
+    return static_cast<std::uint32_t>(((j + nv) % nv) * nu + (i + nu) % nu);
+  };
+  std::vector<std::vector<std::uint32_t>> faces;
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      faces.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
+    }
+  }
+  return closedMesh(std::move(positions), faces);
+}
+
+Vec3d at(const Mesh& mesh, std::uint32_t v) { return cast<double>(mesh.positions[v]); }
+
+/// Index of the vertex of @p mesh nearest to @p p, and its distance.
+std::pair<std::uint32_t, double> nearest(const Mesh& mesh, Vec3d p) {
+  std::pair<std::uint32_t, double> best{0, 1e30};
+  for (std::uint32_t v = 0; v < mesh.numVertices(); ++v) {
+    const double d = length(at(mesh, v) - p);
+    if (d < best.second) best = {v, d};
+  }
+  return best;
+}
+
+/// Every directed edge appears once and its reverse once: closed, manifold, consistently
+/// oriented.
+void expectClosedAndOriented(const Mesh& mesh) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const std::uint32_t first = mesh.faceStart[f], n = mesh.faceSize(f);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      ++edges[{mesh.cornerVertex[first + k], mesh.cornerVertex[first + (k + 1) % n]}];
+    }
+  }
+  for (const auto& [edge, count] : edges) {
+    ASSERT_EQ(count, 1) << "edge " << edge.first << "-" << edge.second << " used twice";
+    ASSERT_EQ(edges.count({edge.second, edge.first}), 1u)
+        << "edge " << edge.first << "-" << edge.second << " has no opposite";
+  }
+}
+
+TEST(Subdivide, CountsAreThoseOfBlendersModifier) {
+  // A quad becomes 4^L quads; an n-gon n·4^(L-1). Vertices: V + E·(2^L - 1) + interior.
+  for (int level = 1; level <= 3; ++level) {
+    Result<Mesh> fine = subdivideMesh(cube(), {level});
+    ASSERT_TRUE(fine) << fine.error().message;
+    const std::size_t side = (std::size_t{1} << level);
+    EXPECT_EQ(fine->numFaces(), 6 * side * side);
+    EXPECT_EQ(fine->numVertices(), 8 + 12 * (side - 1) + 6 * (side - 1) * (side - 1));
+    EXPECT_EQ(fine->numCorners(), 4 * fine->numFaces());
+  }
+  for (std::uint32_t n : {3u, 5u, 7u}) {
+    Result<Mesh> fine = subdivideMesh(prism(n), {2});
+    ASSERT_TRUE(fine) << fine.error().message;
+    EXPECT_EQ(fine->numFaces(), 2 * n * 4 + n * 16) << n << "-gon prism";
+    // A closed genus-0 surface has V - E + F = 2 (each edge has two corners per side).
+    const std::size_t edges = fine->numCorners() / 2;
+    EXPECT_EQ(fine->numVertices() + fine->numFaces(), edges + 2) << n << "-gon prism";
+  }
+}
+
+TEST(Subdivide, ResultIsClosedAndConsistentlyOrientedOutward) {
+  for (const Mesh& coarse : {cube(), prism(3), prism(5), prism(8)}) {
+    for (int level = 1; level <= 3; ++level) {
+      Result<Mesh> fine = subdivideMesh(coarse, {level});
+      ASSERT_TRUE(fine) << fine.error().message;
+      expectClosedAndOriented(*fine);
+      // Convex input, so every new face faces away from the centre of the coarse mesh.
+      Vec3d centre{0, 0, 0};
+      for (std::uint32_t v = 0; v < coarse.numVertices(); ++v) centre = centre + at(coarse, v);
+      centre = (1.0 / static_cast<double>(coarse.numVertices())) * centre;
+      const std::vector<Vec3f> normals = computeFaceNormals(fine->view());
+      for (std::size_t f = 0; f < fine->numFaces(); ++f) {
+        Vec3d mid{0, 0, 0};
+        for (std::uint32_t c = fine->faceStart[f]; c < fine->faceStart[f + 1]; ++c) {
+          mid = mid + at(*fine, fine->cornerVertex[c]);
+        }
+        mid = (1.0 / fine->faceSize(f)) * mid;
+        ASSERT_GT(dot(cast<double>(normals[f]), mid - centre), 0.0) << "face " << f;
+      }
+    }
+  }
+}
+
+TEST(Subdivide, RegularPatchesAreTheUniformBicubicBSpline) {
+  // Every vertex of the torus grid has valence 4, so each face is one bicubic B-spline patch of
+  // its 4×4 neighbourhood: the limit of vertex P is (16 P + 4 Σ edge neighbours + Σ diagonal
+  // neighbours) / 36, and the middle of a face has weights (1, 23, 23, 1)/48 in each direction.
+  const int nu = 12, nv = 8;
+  const Mesh coarse = torusGrid(nu, nv);
+  Result<Mesh> fine = subdivideMesh(coarse, {2});
+  ASSERT_TRUE(fine) << fine.error().message;
+  const auto grid = [&](int i, int j) {
+    return at(coarse, static_cast<std::uint32_t>(((j + nv) % nv) * nu + (i + nu) % nu));
+  };
+  double worst = 0;
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      const Vec3d vertexLimit =
+          (16.0 * grid(i, j) +
+           4.0 * (grid(i - 1, j) + grid(i + 1, j) + grid(i, j - 1) + grid(i, j + 1)) +
+           grid(i - 1, j - 1) + grid(i + 1, j - 1) + grid(i - 1, j + 1) + grid(i + 1, j + 1));
+      const Vec3d limit = (1.0 / 36) * vertexLimit;
+      // Coarse vertices keep their indices (as in Blender).
+      const auto v = static_cast<std::uint32_t>(j * nu + i);
+      worst = std::max(worst, length(at(*fine, v) - limit));
+      const double w[4] = {1.0 / 48, 23.0 / 48, 23.0 / 48, 1.0 / 48};
+      Vec3d faceMiddle{0, 0, 0};
+      for (int b = 0; b < 4; ++b) {
+        for (int a = 0; a < 4; ++a) faceMiddle = faceMiddle + w[a] * w[b] * grid(i - 1 + a, j - 1 + b);
+      }
+      worst = std::max(worst, nearest(*fine, faceMiddle).second);
+    }
+  }
+  EXPECT_LT(worst, 2e-6);  // float positions of size ~1.4
+}
+
+TEST(Subdivide, LinearUvsInterpolateEachFaceBilinearly) {
+  // uv_smooth "none": UVs are linear, so a grid of UV squares becomes the grid of half squares,
+  // each new corner at the average of the coarse corners around it.
+  Mesh coarse = cube();
+  for (std::size_t c = 0; c < coarse.numCorners(); ++c) {
+    const std::size_t f = c / 4, k = c % 4;
+    coarse.uvSets[0].uvs[c] = {static_cast<float>(f) + (k == 1 || k == 2 ? 1.0f : 0.0f),
+                               k >= 2 ? 1.0f : 0.0f};
+  }
+  Result<Mesh> fine = subdivideMesh(coarse, {1, SubdivisionUvSmooth::kNone});
+  ASSERT_TRUE(fine) << fine.error().message;
+  std::set<std::pair<float, float>> expected, got;
+  for (int f = 0; f < 6; ++f) {
+    for (int a = 0; a <= 2; ++a) {
+      for (int b = 0; b <= 2; ++b) expected.insert({static_cast<float>(f + 0.5 * a), static_cast<float>(0.5 * b)});
+    }
+  }
+  for (const Vec2f& uv : fine->uvSets[0].uvs) got.insert({uv.x, uv.y});
+  EXPECT_EQ(got, expected);
+  // Each new face lies in one coarse face's UV square and keeps its winding (area > 0).
+  for (std::size_t f = 0; f < fine->numFaces(); ++f) {
+    const Vec2f* t = &fine->uvSets[0].uvs[fine->faceStart[f]];
+    const double area = 0.5 * ((t[1].x - t[0].x) * (t[2].y - t[0].y) -
+                               (t[2].x - t[0].x) * (t[1].y - t[0].y));
+    EXPECT_NEAR(area, 0.125, 1e-6) << "face " << f;
+  }
+}
+
+TEST(Subdivide, KeepsEveryUvSetAndComputesSmoothNormals) {
+  Mesh coarse = prism(5);
+  coarse.uvSets.push_back({"second", coarse.uvSets[0].uvs});
+  for (Vec2f& uv : coarse.uvSets[1].uvs) uv = {uv.y, uv.x};
+  Result<Mesh> fine = subdivideMesh(coarse, {2});
+  ASSERT_TRUE(fine) << fine.error().message;
+  ASSERT_EQ(fine->uvSets.size(), 2u);
+  EXPECT_EQ(fine->uvSets[1].name, "second");
+  for (std::size_t c = 0; c < fine->numCorners(); ++c) {
+    const Vec2f a = fine->uvSets[0].uvs[c], b = fine->uvSets[1].uvs[c];
+    ASSERT_EQ(a.x, b.y);
+    ASSERT_EQ(a.y, b.x);
+  }
+  Mesh renormalized = *fine;
+  computeSmoothNormals(renormalized);
+  EXPECT_EQ(fine->cornerNormals, renormalized.cornerNormals);
+  EXPECT_EQ(fine->normalSource, NormalSource::kComputed);
+}
+
+TEST(Subdivide, LevelZeroIsTheMeshAndBadLevelsAreNamed) {
+  const Mesh coarse = cube();
+  Result<Mesh> same = subdivideMesh(coarse, {0});
+  ASSERT_TRUE(same);
+  EXPECT_EQ(same->positions, coarse.positions);
+  EXPECT_EQ(same->cornerVertex, coarse.cornerVertex);
+  for (int level : {-1, kMaxSubdivisionLevel + 1}) {
+    Result<Mesh> bad = subdivideMesh(coarse, {level});
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::kBadInput);
+    EXPECT_EQ(bad.error().message.rfind("test.obj: subdivision level", 0), 0u)
+        << bad.error().message;
+  }
+  Mesh repeated = cube();
+  repeated.cornerVertex[1] = repeated.cornerVertex[0];
+  Result<Mesh> bad = subdivideMesh(repeated, {1});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, "test.obj: face 0 uses a vertex twice and cannot be subdivided");
+}
+
+}  // namespace
+}  // namespace sgbake
