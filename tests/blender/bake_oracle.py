@@ -2,10 +2,14 @@
 """The BlenderBakeOracle test: sgbake's normal maps against Cycles' bakes of the same scenes.
 
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
-        [--keep DIR] [--cases suzanne,sphere,cube_flat] [--sabotage green|scale|input]
+        [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat]
+        [--sabotage green|scale|input]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
-   once, smooth, 512^2; a UV sphere, smooth, 256^2; a flat-shaded cube, 512^2), gives it a
+   once, smooth, 512^2; the same Suzanne with the Subdivision Surface modifier kept live, so
+   that mesh.obj is the coarse mesh and every sgbake command below gets --subdivide 1 (the
+   JSON scene "subdivision": {"level": 1}); a UV sphere, smooth, 256^2; a flat-shaded cube,
+   512^2), gives it a
    Bump node fed by a procedural height image (32-bit float EXR, Non-Color, bilinear) with
    Distance = S, and bakes with Cycles (1 sample, denoising off, margin 0): NORMAL in OBJECT
    and in TANGENT space (+X +Y +Z) and an EMIT coverage mask. It writes mesh.obj (objio, exact
@@ -25,7 +29,8 @@
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
       (both go through the same per-texel frame: only float rounding and the odd texel whose
-      centre lies on a triangle edge differ); outside the islands the input is kept
+      centre lies on a triangle edge differ; 2.5 deg when sgbake subdivides the mesh itself,
+      see CONVERT_P99_SUBDIVIDED_DEG); outside the islands the input is kept
       (|diff| <= 1e-6 at texels two or more texels away from any island);
   (b) bake vs Blender's tangent bake: median <= 1 deg (Cycles' Bump is a finite difference
       over about half a texel; sgbake differentiates the filtered height exactly); the JSON
@@ -57,6 +62,12 @@ import objio  # noqa: E402
 
 CONVERT_MEDIAN_DEG = 0.05
 CONVERT_P99_DEG = 0.5
+# When sgbake subdivides the mesh itself (a live modifier), the frames differ from Blender's at
+# a few vertices: Blender evaluates each corner's UV in float per face, so corners that share a
+# vertex can differ in the last bit and MikkTSpace (which welds only identical corners) leaves
+# their tangents unaveraged; sgbake's corners there are identical and welded. Measured on
+# Suzanne, level 1: median 0.041 deg, p99 1.96 deg. The 99th percentile is allowed 2.5 deg.
+CONVERT_P99_SUBDIVIDED_DEG = 2.5
 BAKE_MEDIAN_DEG = 1.0
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
@@ -92,6 +103,9 @@ def sgbake_case(cli, entry, sabotage, threads):
     # 0.016 deg on Suzanne, a third of the 0.05 deg budget), and
     # no .sgbake-manifest.json (it would let a re-run in a kept directory skip the bake).
     common = ["--margin", 0, "--samples", 1, "--bit-depth", 32, "--no-manifest"]
+    # A case with a live Subdivision Surface modifier: mesh.obj is coarse, sgbake subdivides.
+    subdivide = ["--subdivide", entry["subdivision"]] if entry.get("subdivision") else []
+    common += subdivide
     if threads:
         common += ["--threads", threads]
     failed, log = [], []
@@ -99,7 +113,8 @@ def sgbake_case(cli, entry, sabotage, threads):
     convert_input = p("blender_tangent.exr" if sabotage == "input" else "blender_object.exr")
     if not run_sgbake(cli, ["convert", "--mesh", p("mesh.obj"), "--from", "object", "--to",
                             "tangent", convert_input, "-o", p("ours_convert.exr"),
-                            "--bit-depth", 32] + (["--threads", threads] if threads else []),
+                            "--bit-depth", 32] + subdivide
+                      + (["--threads", threads] if threads else []),
                       log):
         failed.append(log[-1])
 
@@ -116,6 +131,7 @@ def sgbake_case(cli, entry, sabotage, threads):
 
     scene = {
         "mesh": p("mesh.obj"),
+        "subdivision": {"level": entry.get("subdivision", 0)},
         "layers": [{"type": "height", "image": p("height.exr"), "scale": bake_scale,
                     "filter": entry["filter"], "uv": 0, "weight": 1.0}],
         "outputs": [{"map": "tangent-normal", "file": p("ours_bake_json.exr"), "size": size,
@@ -140,17 +156,19 @@ def fmt(stats):
             f"max {stats['max_deg']:.3f} deg, {stats['texels']} texels")
 
 
-def passes_convert(s):
-    return s["median_deg"] <= CONVERT_MEDIAN_DEG and s["p99_deg"] <= CONVERT_P99_DEG
+def passes_convert(s, p99_deg=CONVERT_P99_DEG):
+    return s["median_deg"] <= CONVERT_MEDIAN_DEG and s["p99_deg"] <= p99_deg
 
 
 def passes_bake(s):
     return s["median_deg"] <= BAKE_MEDIAN_DEG
 
 
-def evaluate(name, r):
-    """Prints the figures of one case; returns a list of failure descriptions."""
+def evaluate(name, r, subdivided=False):
+    """Prints the figures of one case; returns a list of failure descriptions. `subdivided`:
+    sgbake subdivided the mesh (the case's modifier is live), see CONVERT_P99_SUBDIVIDED_DEG."""
     fails = []
+    convert_p99 = CONVERT_P99_SUBDIVIDED_DEG if subdivided else CONVERT_P99_DEG
     print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {r['covered']} covered texels, "
           f"{r['compared']} compared; bump tilt from +Z: {fmt(r['tilt'])}")
 
@@ -165,16 +183,16 @@ def evaluate(name, r):
 
     if not missing("convert", "convert"):
         s = r["convert"]
-        ok = passes_convert(s)
+        ok = passes_convert(s, convert_p99)
         print(f"  (a) convert vs Blender tangent: {fmt(s)} worst at (x, row) {s.get('worst_at')}"
               f" -> {'ok' if ok else 'FAIL'} (median <= {CONVERT_MEDIAN_DEG}, p99 <= "
-              f"{CONVERT_P99_DEG})")
+              f"{convert_p99})")
         if not ok:
             fails.append(f"{name}: convert differs from Blender's tangent bake: {fmt(s)}")
         if s["outside_max_abs"] > SAME_IMAGE_ABS:
             fails.append(f"{name}: convert changed texels outside the islands "
                          f"(max |diff| {s['outside_max_abs']:.3g})")
-        if passes_convert(s["flipped_green"]):
+        if passes_convert(s["flipped_green"], convert_p99):
             fails.append(f"{name}: negative control: convert with green flipped still passes "
                          f"({fmt(s['flipped_green'])})")
     if not missing("bake", "bake"):
@@ -222,7 +240,7 @@ def main():
     parser.add_argument("--cli", required=True, help="path to the sgbake executable")
     parser.add_argument("--blender", default="blender", help="Blender executable")
     parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
-    parser.add_argument("--cases", default="suzanne,sphere,cube_flat")
+    parser.add_argument("--cases", default="suzanne,suzanne_live,sphere,cube_flat")
     parser.add_argument("--threads", type=int, help="pass --threads N to sgbake")
     parser.add_argument("--sabotage", choices=("green", "scale", "input"),
                         help="make sgbake answer wrongly on purpose (the test must fail)")
@@ -259,7 +277,8 @@ def main():
             print(f"blender: {entry['name']}: {entry['faces']} faces, scale {entry['scale']}, "
                   f"bakes {', '.join(f'{k} {v:.2f} s' for k, v in entry['bake_s'].items())}")
         for entry in entries:
-            failures += evaluate(entry["name"], results[entry["name"]])
+            failures += evaluate(entry["name"], results[entry["name"]],
+                                 subdivided=bool(entry.get("subdivision")))
         if args.keep:
             print(f"files kept in {work}")
 

@@ -72,9 +72,15 @@ HEIGHT_SIZE = 512
 CASES = {}
 
 
-def case(name, size, scale):
+# name -> Subdivision Surface levels of a modifier the case keeps live: mesh.obj is then the
+# coarse mesh, Cycles bakes the subdivided one, and sgbake is asked to subdivide (--subdivide).
+SUBDIVISION = {}
+
+
+def case(name, size, scale, subdivision=0):
     def register(fn):
         CASES[name] = (fn, size, scale)
+        SUBDIVISION[name] = subdivision
         return fn
     return register
 
@@ -99,6 +105,20 @@ def build_suzanne():
     ob = bpy.context.object
     apply_subdivision(ob, 1)
     set_smooth(ob, True)
+    return ob
+
+
+@case("suzanne_live", 512, 0.1, subdivision=1)
+def build_suzanne_live():
+    """Suzanne, smooth, with a live Subdivision Surface modifier at level 1 and a new modifier's
+    settings (UV Smooth Keep Boundaries, Boundary Smooth All, Use Limit Surface, Quality 3):
+    mesh.obj is the coarse Suzanne (500 faces, triangles among them), sgbake subdivides it."""
+    bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
+    ob = bpy.context.object
+    set_smooth(ob, True)
+    mod = ob.modifiers.new("Subdivision", "SUBSURF")
+    mod.levels = SUBDIVISION["suzanne_live"]
+    mod.render_levels = SUBDIVISION["suzanne_live"]
     return ob
 
 
@@ -229,7 +249,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
 
     entry = {"name": name, "dir": os.path.abspath(out_dir), "size": size, "scale": scale,
              "filter": "bilinear", "height_size": height_size, "margin": margin,
-             "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {}}
+             "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {},
+             "subdivision": SUBDIVISION[name]}
     for kind in passes:
         img = bake_common.new_float_image(f"blender_{kind}", size, size)
         for _ in range(runs):
