@@ -1,0 +1,182 @@
+"""Generates Subdivision Surface reference cases with Blender (runs inside Blender).
+
+    blender -b --factory-startup --python-exit-code 1 \\
+        --python tests/blender/make_subdivision_cases.py -- OUT_DIR
+
+Builds four coarse meshes with bpy, all smooth shaded, with their own UVs:
+  cube       the default cube (6 quads, closed, UV seams)
+  suzanne    the monkey primitive (triangles and quads, open boundaries at the eyes)
+  cylinder   a 7-sided cylinder with n-gon caps (the caps are 7-gons, not triangulated)
+  grid       an open 4 x 3 grid of size 2, lifted by a wave (4 boundary corners of valence 2)
+and writes each as OUT_DIR/MESH.obj (objio.write_obj: exact floats, one vt and vn per corner,
+n-gons kept). Then, for every case in CASES, it gives the object a Subdivision Surface modifier
+(Catmull-Clark, Use Limit Surface on, Quality 3, the case's Levels, UV Smooth and Boundary
+Smooth), evaluates it, lets Blender compute split normals and MikkTSpace tangents of the
+subdivided mesh (`Mesh.calc_normals_split()`, `Mesh.calc_tangents()`), and writes
+  TAG.npz   positions (V, 3), face_size (F,), corner_vertex (C,), uvs (C, 2),
+            tangents (C, 3), signs (C,) of the subdivided mesh, in Blender's order
+and finally cases.json: {"blender": version, "meshes": {MESH: {vertices, edges, faces,
+valence2}}, "cases": [{tag, mesh, level, uv_smooth, boundary_smooth, vertices, faces,
+corners}]}, where valence2 counts the coarse vertices with exactly two edges (the open
+boundary corners) and uv_smooth / boundary_smooth are Blender's enum names.
+subdivision_oracle.py runs sgbake on MESH.obj with the same settings and compares.
+"""
+
+import json
+import math
+import os
+import sys
+
+import bpy
+
+sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import objio  # noqa: E402  (needs the sys.path entry above)
+
+
+# ---------------------------------------------------------------------------------------------
+# Helpers
+
+
+def reset_scene():
+    """Removes every object and mesh so each mesh starts from an empty scene."""
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob, do_unlink=True)
+    for me in list(bpy.data.meshes):
+        bpy.data.meshes.remove(me)
+
+
+def set_smooth(ob):
+    """Shades every face of the object smooth (the modifier keeps the shading)."""
+    ob.data.polygons.foreach_set("use_smooth", [True] * len(ob.data.polygons))
+    ob.data.update()
+
+
+# ---------------------------------------------------------------------------------------------
+# Coarse meshes: each builder adds one object to the empty scene and returns it.
+
+
+def mesh_cube():
+    bpy.ops.mesh.primitive_cube_add(calc_uvs=True)
+    return bpy.context.object
+
+
+def mesh_suzanne():
+    bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
+    return bpy.context.object
+
+
+def mesh_cylinder():
+    """Seven sides, so that the caps are n-gons (the modifier splits them into 7 quads)."""
+    bpy.ops.mesh.primitive_cylinder_add(vertices=7, end_fill_type="NGON", calc_uvs=True)
+    return bpy.context.object
+
+
+def mesh_grid():
+    """An open grid (4 x 3 quads, size 2), lifted so that it is not planar."""
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=4, y_subdivisions=3, size=2.0,
+                                    calc_uvs=True)
+    ob = bpy.context.object
+    for v in ob.data.vertices:
+        v.co.z = 0.3 * math.sin(3.0 * v.co.x) * math.cos(2.0 * v.co.y)
+    ob.data.update()
+    return ob
+
+
+MESHES = [
+    ("cube", mesh_cube),
+    ("suzanne", mesh_suzanne),
+    ("cylinder", mesh_cylinder),
+    ("grid", mesh_grid),
+]
+
+# (mesh, level, uv_smooth, boundary_smooth), Blender's enum names. Boundary smooth matters only
+# on open boundaries, so only the grid tries both.
+UV_SMOOTHS = ("PRESERVE_BOUNDARIES", "NONE", "SMOOTH_ALL")
+CASES = (
+    [(mesh, 1, uv, "ALL") for mesh, _ in MESHES for uv in UV_SMOOTHS]
+    + [("grid", 1, uv, "PRESERVE_CORNERS") for uv in UV_SMOOTHS]
+    + [(mesh, 2, "PRESERVE_BOUNDARIES", "ALL") for mesh in ("suzanne", "cylinder", "grid")]
+    + [("grid", 2, "PRESERVE_BOUNDARIES", "PRESERVE_CORNERS")]
+)
+
+
+def case_tag(mesh, level, uv_smooth, boundary_smooth):
+    return f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+def write_coarse(name, ob, out_dir):
+    """Writes the coarse mesh as NAME.obj; returns its counts."""
+    import numpy as np
+
+    me = ob.data
+    me.calc_normals_split()
+    arrays = objio.mesh_arrays(me)
+    objio.write_obj(os.path.join(out_dir, name + ".obj"), arrays,
+                    comment=f"sgbake subdivision oracle mesh {name} "
+                            f"(Blender {bpy.app.version_string})")
+    edge_vertices = np.empty(len(me.edges) * 2, np.int32)
+    me.edges.foreach_get("vertices", edge_vertices)
+    valence = np.bincount(edge_vertices, minlength=len(me.vertices))
+    return {"vertices": len(me.vertices), "edges": len(me.edges), "faces": len(me.polygons),
+            "valence2": int((valence == 2).sum())}
+
+
+def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, out_dir):
+    """Evaluates the object with the modifier set to the case; writes TAG.npz."""
+    import numpy as np
+
+    mod.levels = level
+    mod.render_levels = level
+    mod.uv_smooth = uv_smooth
+    mod.boundary_smooth = boundary_smooth
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    depsgraph.update()
+    me = bpy.data.meshes.new_from_object(ob.evaluated_get(depsgraph))
+    me.calc_normals_split()
+    me.calc_tangents(uvmap=me.uv_layers.active.name)
+    arrays = objio.mesh_arrays(me)
+    tangents, signs = objio.mesh_tangents(me)
+    tag = case_tag(mesh, level, uv_smooth, boundary_smooth)
+    np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
+             face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
+             uvs=arrays["uvs"], tangents=tangents, signs=signs)
+    info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
+            "boundary_smooth": boundary_smooth, "vertices": len(me.vertices),
+            "faces": len(me.polygons), "corners": len(me.loops)}
+    bpy.data.meshes.remove(me)
+    return info
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    if not argv or argv[0].startswith("-"):
+        print(__doc__)
+        raise SystemExit("usage: ... -- OUT_DIR")
+    out_dir = argv[0]
+    os.makedirs(out_dir, exist_ok=True)
+    manifest = {"blender": bpy.app.version_string, "meshes": {}, "cases": []}
+    for name, build in MESHES:
+        reset_scene()
+        ob = build()
+        set_smooth(ob)
+        manifest["meshes"][name] = write_coarse(name, ob, out_dir)
+        mod = ob.modifiers.new("Subdivision", "SUBSURF")
+        mod.subdivision_type = "CATMULL_CLARK"
+        mod.use_limit_surface = True
+        mod.quality = 3
+        for mesh, level, uv_smooth, boundary_smooth in CASES:
+            if mesh != name:
+                continue
+            info = write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, out_dir)
+            manifest["cases"].append(info)
+            print("case %-45s vertices %6d faces %6d corners %6d"
+                  % (info["tag"], info["vertices"], info["faces"], info["corners"]))
+    with open(os.path.join(out_dir, "cases.json"), "w", encoding="ascii") as f:
+        json.dump(manifest, f, indent=1)
+
+
+main()
