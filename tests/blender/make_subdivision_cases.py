@@ -15,10 +15,11 @@ Smooth), evaluates it, lets Blender compute split normals and MikkTSpace tangent
 subdivided mesh (`Mesh.calc_normals_split()`, `Mesh.calc_tangents()`), and writes
   TAG.npz   positions (V, 3), face_size (F,), corner_vertex (C,), uvs (C, 2),
             tangents (C, 3), signs (C,) of the subdivided mesh, in Blender's order
-and finally cases.json: {"blender": version, "meshes": {MESH: {vertices, edges, faces,
-valence2}}, "cases": [{tag, mesh, level, uv_smooth, boundary_smooth, vertices, faces,
-corners}]}, where valence2 counts the coarse vertices with exactly two edges (the open
-boundary corners) and uv_smooth / boundary_smooth are Blender's enum names.
+and finally cases.json: {"blender": version, "python": Blender's Python interpreter (it has
+numpy), "meshes": {MESH: {vertices, edges, faces, valence2}}, "cases": [{tag, mesh, level,
+uv_smooth, boundary_smooth, vertices, faces, corners}]}, where valence2 counts the coarse
+vertices with exactly two edges (the open boundary corners) and uv_smooth / boundary_smooth are
+Blender's enum names.
 subdivision_oracle.py runs sgbake on MESH.obj with the same settings and compares.
 """
 
@@ -158,7 +159,10 @@ def main():
         raise SystemExit("usage: ... -- OUT_DIR")
     out_dir = argv[0]
     os.makedirs(out_dir, exist_ok=True)
-    manifest = {"blender": bpy.app.version_string, "meshes": {}, "cases": []}
+    # "python": Blender's own interpreter, which has numpy; the driver compares with it when
+    # the python3 running the driver has no numpy (e.g. a pyenv one under CTest).
+    manifest = {"blender": bpy.app.version_string, "python": sys.executable, "meshes": {},
+                "cases": []}
     for name, build in MESHES:
         reset_scene()
         ob = build()

@@ -1,0 +1,480 @@
+#!/usr/bin/env python3
+"""The BlenderSubdivisionOracle test: sgbake's --subdivide against Blender's Subdivision Surface.
+
+    python3 tests/blender/subdivision_oracle.py --cli build/src/sgbake
+        [--blender blender] [--keep DIR]
+
+1. Runs make_subdivision_cases.py inside Blender (headless, factory settings, once for all
+   cases): it writes four coarse meshes (cube; Suzanne, triangles and quads; a 7-sided cylinder
+   with n-gon caps; a wavy open grid) as OBJ and, for each case (mesh, level, UV Smooth,
+   Boundary Smooth), the mesh Blender's modifier makes (Catmull-Clark, Use Limit Surface on)
+   with its MikkTSpace tangents (`Mesh.calc_tangents()`) as NPZ.
+2. For each case runs
+     sgbake tangents MESH.obj --subdivide L --uv-smooth U --boundary-smooth B
+                    --mesh-out TAG.sgbake.obj -o TAG.sgbake.csv
+   and compares sgbake's subdivided mesh and tangents with Blender's (numpy, no Blender; when
+   the python3 running this has no numpy, e.g. a pyenv one under CTest, it hands the comparison
+   to Blender's own Python interpreter, which has numpy, as `--compare-only DIR`):
+     counts     the same numbers of vertices and faces;
+     vertices   each sgbake vertex's nearest Blender vertex is a different one (bijective);
+     positions  every vertex within 1e-5 x the bounding-box diagonal D of Blender's, except, with
+                Boundary Smooth ALL, at most as many vertices as the coarse mesh has open
+                boundary corners (vertices with exactly two edges), which must be within
+                2e-3 x D: there Blender's adaptive patches (isolation level = Quality 3) only
+                approximate the limit point sgbake computes exactly (2.2e-3 on the 2-unit grid,
+                elsewhere ~4e-7, float rounding);
+     faces      every Blender face is an sgbake face with the same vertex cycle, its first
+                corner the same or the opposite one (the same diagonal: Blender splits a quad
+                0-1-2 / 0-2-3), and no face is left over;
+     uvs        per matched corner, max |du|, |dv| <= 1e-6 (float rounding; measured <= 2.5e-7); with UV Smooth SMOOTH_ALL
+                (--uv-smooth all) Blender's face-varying patches are approximate too (1.3e-3
+                measured): there max <= 5e-3 and median <= 1e-6;
+     tangents   asserted only for UV Smooth NONE on the cube and Suzanne: max angle <= 0.05
+                deg (0.0000 and 0.0013 deg measured, Blender 3.4), identical bitangent
+                signs. Elsewhere Blender's float evaluation leaves last-bit differences
+                between corners that share a vertex, MikkTSpace welds only bit-identical
+                corners, and so Blender's tangents are not averaged at some corners where
+                sgbake's are (measured: medians up to 1.4 deg on the cube and 0.44 deg on the
+                level-2 cylinder, <= 0.16 deg elsewhere; p99 up to 9.6 deg; single corners of
+                Suzanne up to 75 deg): the median, p99 and max are printed for every case,
+                not asserted.
+3. Negative controls, which must FAIL, or the checks could not tell right from wrong:
+     boundary   sgbake --boundary-smooth keep-corners against Blender's grid made with ALL
+                (level 1): the position check must fail;
+     level      sgbake --subdivide 1 against Blender's level-2 grid: the count check must fail.
+
+Prints one line of figures per case (D, the largest position error of the ordinary vertices
+and of the excused boundary corners, unmatched faces and diagonal mismatches, UV max and
+median, tangent median / p99 / max in degrees and sign mismatches). --keep DIR writes every file
+there and keeps it.
+
+Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed
+(CTest: SKIP_RETURN_CODE 77). Takes ~4 s: Blender starts once for all cases.
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
+sys.path.insert(0, HERE)
+import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
+
+SKIP = bc.SKIP
+BLENDER_TIMEOUT = 240
+SGBAKE_TIMEOUT = 120
+
+POSITION_REL = 1e-5          # x bounding-box diagonal, every vertex ...
+CORNER_POSITION_REL = 2e-3   # ... but the open boundary corners with Boundary Smooth ALL
+UV_MAX = 1e-6
+UV_MAX_SMOOTH_ALL = 5e-3
+UV_MEDIAN_SMOOTH_ALL = 1e-6
+TANGENT_MAX_DEG = 0.05
+TANGENT_MESHES = ("cube", "suzanne")  # tangents asserted for these with UV Smooth NONE
+
+# Blender's enum names -> sgbake's option values.
+UV_SMOOTH = {
+    "NONE": "none",
+    "PRESERVE_CORNERS": "keep-corners",
+    "PRESERVE_CORNERS_AND_JUNCTIONS": "keep-corners-junctions",
+    "PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE": "keep-corners-junctions-concave",
+    "PRESERVE_BOUNDARIES": "keep-boundaries",
+    "SMOOTH_ALL": "all",
+}
+BOUNDARY_SMOOTH = {"ALL": "all", "PRESERVE_CORNERS": "keep-corners"}
+
+# Negative controls: (name, Blender's case, sgbake option overrides, the check that must fail).
+CONTROLS = [
+    ("boundary", "grid_L1_PRESERVE_BOUNDARIES_ALL", {"--boundary-smooth": "keep-corners"},
+     "positions"),
+    ("level", "grid_L2_PRESERVE_BOUNDARIES_ALL", {"--subdivide": "1"}, "counts"),
+]
+
+
+# ---------------------------------------------------------------------------------------------
+# Running Blender and sgbake
+
+
+def make_cases(blender, out_dir):
+    """Runs the case generator in Blender; returns True on success (prints Blender's output
+    on failure)."""
+    try:
+        proc = objio.run_blender(blender, os.path.join(HERE, "make_subdivision_cases.py"),
+                                 [out_dir], capture_output=True, text=True,
+                                 timeout=BLENDER_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        print(f"error: Blender did not finish make_subdivision_cases.py in {BLENDER_TIMEOUT} s")
+        return False
+    if proc.returncode != 0:
+        print(f"error: `{' '.join(proc.args)}` exited with {proc.returncode}\n"
+              f"{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+        return False
+    return True
+
+
+def run_sgbake(cli, work, case, overrides, out_name):
+    """Runs `sgbake tangents` on the case's coarse mesh with the case's settings (and the
+    overrides); returns (OBJ path, CSV path) or an error message."""
+    options = {
+        "--subdivide": str(case["level"]),
+        "--uv-smooth": UV_SMOOTH[case["uv_smooth"]],
+        "--boundary-smooth": BOUNDARY_SMOOTH[case["boundary_smooth"]],
+    }
+    options.update(overrides)
+    obj = os.path.join(work, out_name + ".sgbake.obj")
+    csv = os.path.join(work, out_name + ".sgbake.csv")
+    cmd = [cli, "tangents", os.path.join(work, case["mesh"] + ".obj")]
+    for key, value in options.items():
+        cmd += [key, value]
+    cmd += ["--mesh-out", obj, "-o", csv]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=SGBAKE_TIMEOUT,
+                              check=False)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        return f"`{' '.join(cmd)}`: {exc}"
+    if proc.returncode != 0:
+        return (f"`{' '.join(cmd)}` exited with {proc.returncode}: "
+                f"{proc.stderr.strip()[-2000:]}")
+    return obj, csv
+
+
+# ---------------------------------------------------------------------------------------------
+# Reading sgbake's output
+
+
+def read_obj(path):
+    """Reads the OBJ sgbake's --mesh-out writes (v; vt per corner; vn per corner; f v/vt/vn).
+
+    Returns (positions (V, 3) float64, uvs (T, 2) float64, face_size (F,) int64,
+    corner_vertex (C,) int64, corner_uv (C,) int64), indices 0-based."""
+    import numpy as np
+    positions, uvs, face_size, corner_vertex, corner_uv = [], [], [], [], []
+    with open(path, "r", encoding="ascii", errors="replace") as f:
+        for line_no, line in enumerate(f, start=1):
+            words = line.split()
+            if not words or words[0].startswith("#"):
+                continue
+            try:
+                if words[0] == "v":
+                    positions.append([float(x) for x in words[1:4]])
+                elif words[0] == "vt":
+                    uvs.append([float(x) for x in words[1:3]])
+                elif words[0] == "f":
+                    face_size.append(len(words) - 1)
+                    for token in words[1:]:
+                        fields = token.split("/")
+                        corner_vertex.append(int(fields[0]) - 1)
+                        corner_uv.append(int(fields[1]) - 1)
+            except (ValueError, IndexError):
+                raise ValueError(f"{path}:{line_no}: cannot parse {line.strip()!r}") from None
+    positions = np.array(positions, dtype=np.float64).reshape(-1, 3)
+    uvs = np.array(uvs, dtype=np.float64).reshape(-1, 2)
+    corner_vertex = np.array(corner_vertex, dtype=np.int64)
+    corner_uv = np.array(corner_uv, dtype=np.int64)
+    if (corner_vertex.size and (corner_vertex.min() < 0 or corner_vertex.max() >= len(positions)
+                                or corner_uv.min() < 0 or corner_uv.max() >= len(uvs))):
+        raise ValueError(f"{path}: a face refers to a missing v or vt")
+    return positions, uvs, np.array(face_size, dtype=np.int64), corner_vertex, corner_uv
+
+
+def read_tangents(path, face_size):
+    """Reads sgbake's tangent CSV; returns (tangents (C, 3) float64, signs (C,) float64) after
+    checking that its rows are the corners of the faces in order."""
+    import numpy as np
+    rows = objio.read_tangent_csv(path)
+    face, corner = objio.corner_ids(face_size)
+    if len(rows) != len(face):
+        raise ValueError(f"{path}: {len(rows)} rows for {len(face)} corners")
+    ids = np.array([(r[0], r[1]) for r in rows], dtype=np.int64).reshape(-1, 2)
+    if not (np.array_equal(ids[:, 0], face) and np.array_equal(ids[:, 1], corner)):
+        raise ValueError(f"{path}: rows are not the mesh's corners in face order")
+    return (np.array([r[2] for r in rows], dtype=np.float64).reshape(-1, 3),
+            np.array([r[3] for r in rows], dtype=np.float64))
+
+
+# ---------------------------------------------------------------------------------------------
+# Comparison
+
+
+def nearest(points, reference):
+    """Index of the nearest reference point of every point and the distance to it."""
+    import numpy as np
+    ref_sq = (reference * reference).sum(1)
+    index = np.empty(len(points), dtype=np.int64)
+    for start in range(0, len(points), 512):
+        chunk = points[start:start + 512]
+        # |p - r|^2 up to the constant |p|^2; the exact distance is taken below.
+        d2 = ref_sq[None, :] - 2.0 * chunk @ reference.T
+        index[start:start + 512] = d2.argmin(1)
+    return index, np.linalg.norm(points - reference[index], axis=1)
+
+
+def angles_deg(a, b):
+    """Angles between the rows of a and b in degrees, accurate for tiny angles (atan2)."""
+    import numpy as np
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), (a * b).sum(1)))
+
+
+def compare(case, valence2, ref, obj, csv):
+    """Compares sgbake's subdivided mesh and tangents with Blender's. Returns (figures,
+    failures), failures a list of (check, message); figures are None when the counts differ
+    (nothing else can be compared)."""
+    import numpy as np
+    P, T, face_size, corner_vertex, corner_uv = read_obj(obj)
+    tangents, signs = read_tangents(csv, face_size)
+    BP = ref["positions"].astype(np.float64)
+    b_size, b_vertex = ref["face_size"], ref["corner_vertex"]
+    BU, BT, BS = (ref["uvs"].astype(np.float64), ref["tangents"].astype(np.float64),
+                  ref["signs"])
+    failures = []
+    if len(P) != len(BP) or len(face_size) != len(b_size):
+        failures.append(("counts", f"sgbake made {len(P)} vertices and {len(face_size)} faces, "
+                                   f"Blender {len(BP)} and {len(b_size)}"))
+        return None, failures
+    fig = {"vertices": len(BP), "faces": len(b_size)}
+
+    # Vertices: nearest Blender vertex, bijective; positions relative to the bbox diagonal.
+    index, dist = nearest(P, BP)
+    matched = len(np.unique(index))
+    if matched != len(P):
+        failures.append(("vertices", f"{len(P) - matched} sgbake vertices share their nearest "
+                                     "Blender vertex with another one"))
+    diag = float(np.linalg.norm(BP.max(0) - BP.min(0)))
+    allowance = valence2 if case["boundary_smooth"] == "ALL" else 0
+    over = np.flatnonzero(dist > POSITION_REL * diag)
+    ordinary = np.delete(dist, over) if len(over) <= allowance else dist
+    fig.update(diag=diag, pos_max=float(ordinary.max()) if ordinary.size else 0.0,
+               excused=len(over) if len(over) <= allowance else 0,
+               excused_max=float(dist[over].max()) if 0 < len(over) <= allowance else None)
+    if len(over) > allowance:
+        failures.append(("positions", f"{len(over)} vertices are farther than "
+                                      f"{POSITION_REL:g} x D = {POSITION_REL * diag:.3g} from "
+                                      f"Blender's ({allowance} allowed), max {dist.max():.3g}"))
+    elif over.size and dist[over].max() > CORNER_POSITION_REL * diag:
+        failures.append(("positions", f"a boundary corner is {dist[over].max():.3g} from "
+                                      f"Blender's (> {CORNER_POSITION_REL:g} x D)"))
+
+    # Faces: same vertex cycle, first corner the same or opposite; corners paired up.
+    b_start = np.concatenate(([0], np.cumsum(b_size)))
+    by_vertices = {}
+    for f in range(len(b_size)):
+        cycle = b_vertex[b_start[f]:b_start[f + 1]]
+        by_vertices.setdefault(tuple(sorted(cycle.tolist())), []).append(f)
+    start = np.concatenate(([0], np.cumsum(face_size)))
+    mapped = index[corner_vertex]
+    used = np.zeros(len(b_size), dtype=bool)
+    ours_corners, blender_corners = [], []
+    unmatched = diagonal = 0
+    for f in range(len(face_size)):
+        n = int(face_size[f])
+        cycle = mapped[start[f]:start[f + 1]].tolist()
+        hit = None
+        for bf in by_vertices.get(tuple(sorted(cycle)), ()):
+            b_cycle = b_vertex[b_start[bf]:b_start[bf + 1]].tolist()
+            if used[bf] or len(b_cycle) != n:
+                continue
+            for shift in range(n):  # our corner j is Blender's corner (j + shift) % n
+                if all(b_cycle[(j + shift) % n] == cycle[j] for j in range(n)):
+                    hit = (bf, shift)
+                    break
+            if hit:
+                break
+        if hit is None:
+            unmatched += 1
+            continue
+        bf, shift = hit
+        used[bf] = True
+        if n == 4 and shift % 2:
+            diagonal += 1
+        ours_corners += range(start[f], start[f + 1])
+        blender_corners += [b_start[bf] + (j + shift) % n for j in range(n)]
+    unmatched = max(unmatched, int((~used).sum()))
+    fig.update(unmatched=unmatched, diagonal=diagonal)
+    if unmatched:
+        failures.append(("faces", f"{unmatched} Blender faces have no sgbake face with the "
+                                  "same vertex cycle"))
+    if diagonal:
+        failures.append(("faces", f"{diagonal} quads start at a neighbouring corner of "
+                                  "Blender's (the other triangulation diagonal)"))
+    if not ours_corners:
+        return fig, failures + [("faces", "no face matches")]
+
+    # UVs and tangents of the matched corners.
+    ours_corners = np.array(ours_corners)
+    blender_corners = np.array(blender_corners)
+    uv_error = np.abs(T[corner_uv[ours_corners]] - BU[blender_corners]).max(1)
+    angle = angles_deg(tangents[ours_corners], BT[blender_corners])
+    sign_diff = int((np.sign(signs[ours_corners]) != np.sign(BS[blender_corners])).sum())
+    fig.update(uv_max=float(uv_error.max()), uv_median=float(np.median(uv_error)),
+               t_median=float(np.median(angle)), t_p99=float(np.percentile(angle, 99)),
+               t_max=float(angle.max()), sign_diff=sign_diff)
+    if case["uv_smooth"] == "SMOOTH_ALL":
+        if fig["uv_max"] > UV_MAX_SMOOTH_ALL or fig["uv_median"] > UV_MEDIAN_SMOOTH_ALL:
+            failures.append(("uvs", f"UVs differ: max {fig['uv_max']:.3g} (<= "
+                                    f"{UV_MAX_SMOOTH_ALL:g}), median {fig['uv_median']:.3g} "
+                                    f"(<= {UV_MEDIAN_SMOOTH_ALL:g})"))
+    elif fig["uv_max"] > UV_MAX:
+        failures.append(("uvs", f"UVs differ by up to {fig['uv_max']:.3g} (> {UV_MAX:g})"))
+    fig["t_checked"] = case["mesh"] in TANGENT_MESHES and case["uv_smooth"] == "NONE"
+    if fig["t_checked"]:
+        if fig["t_max"] > TANGENT_MAX_DEG:
+            failures.append(("tangents", f"tangents differ by up to {fig['t_max']:.4f} deg "
+                                         f"(> {TANGENT_MAX_DEG} deg)"))
+        if sign_diff:
+            failures.append(("tangents", f"{sign_diff} bitangent signs differ"))
+    return fig, failures
+
+
+HEADER = ("%-45s %6s %6s %6s %9s %-12s %7s %9s %9s %7s %7s %7s %4s  %s"
+          % ("case (Blender enums)", "verts", "faces", "D", "pos max", "corners(max)",
+             "unm/dg", "uv max", "uv med", "t med", "t p99", "t max", "sgn", "result"))
+
+
+def table_row(label, fig, failures):
+    if fig is None:
+        return "%-45s %s  FAIL (%s)" % (label, "counts differ", "; ".join(m for _, m in failures))
+    excused = ("%d(%.2g)" % (fig["excused"], fig["excused_max"]) if fig["excused"] else "-")
+    tangent = ("%7.4f %7.4f %7.4f %4d" % (fig["t_median"], fig["t_p99"], fig["t_max"],
+                                          fig["sign_diff"]) if "t_max" in fig else "-")
+    mark = "*" if fig.get("t_checked") else " "
+    return ("%-45s %6d %6d %6.3f %9.2e %-12s %3d/%-3d %9.2e %9.2e %s%s %s"
+            % (label, fig["vertices"], fig["faces"], fig["diag"], fig["pos_max"], excused,
+               fig["unmatched"], fig["diagonal"], fig.get("uv_max", float("nan")),
+               fig.get("uv_median", float("nan")), tangent, mark,
+               "ok" if not failures else "FAIL"))
+
+
+def compare_all(cli, work):
+    """Runs sgbake on every case in WORK (made by make_subdivision_cases.py) and on the negative
+    controls, prints the figures and the verdict; returns the exit status (0 or 1)."""
+    import numpy as np
+    with open(os.path.join(work, "cases.json"), encoding="ascii") as f:
+        manifest = json.load(f)
+    cases = {c["tag"]: c for c in manifest["cases"]}
+    print(f"Blender {manifest['blender']}, {len(cases)} cases; coarse meshes: "
+          + ", ".join(f"{name} {m['vertices']} v / {m['faces']} f / {m['valence2']} corners"
+                      for name, m in manifest["meshes"].items()))
+    print("D = bounding-box diagonal; pos max = largest |sgbake - Blender| of the ordinary "
+          "vertices;\ncorners = excused open boundary corners (their largest error); unm/dg = "
+          "unmatched faces / diagonal\nmismatches; uv = max |du|, |dv| per corner; t = tangent "
+          "angle in degrees; sgn = sign mismatches;\n* = tangents asserted")
+    print(HEADER)
+    failures = []
+    for tag, case in cases.items():
+        result = run_sgbake(cli, work, case, {}, tag)
+        if isinstance(result, str):
+            failures.append(f"{tag}: {result}")
+            print("%-45s sgbake failed" % tag)
+            continue
+        try:
+            fig, fails = compare(case, manifest["meshes"][case["mesh"]]["valence2"],
+                                 np.load(os.path.join(work, tag + ".npz")), *result)
+        except (OSError, ValueError) as exc:
+            failures.append(f"{tag}: {exc}")
+            print("%-45s cannot compare: %s" % (tag, exc))
+            continue
+        print(table_row(tag, fig, fails))
+        failures += [f"{tag}: {check}: {message}" for check, message in fails]
+
+    for name, tag, overrides, must_fail in CONTROLS:
+        options = " ".join(f"{k} {v}" for k, v in overrides.items())
+        case = cases[tag]
+        result = run_sgbake(cli, work, case, overrides, "control_" + name)
+        if isinstance(result, str):
+            failures.append(f"control {name}: {result}")
+            continue
+        try:
+            _, fails = compare(case, manifest["meshes"][case["mesh"]]["valence2"],
+                               np.load(os.path.join(work, tag + ".npz")), *result)
+        except (OSError, ValueError) as exc:
+            failures.append(f"control {name}: {exc}")
+            continue
+        failed = [message for check, message in fails if check == must_fail]
+        if failed:
+            print(f"control {name} (sgbake {options} vs Blender's {tag}): control failed as "
+                  f"expected: {must_fail}: {failed[0]}")
+        else:
+            print(f"control {name} (sgbake {options} vs Blender's {tag}): PASSED the "
+                  f"{must_fail} check")
+            failures.append(f"negative control {name}: sgbake with {options} passes the "
+                            f"{must_fail} check against {tag}, so the check cannot tell right "
+                            "from wrong")
+
+    if failures:
+        print(f"FAIL: {len(failures)} problem(s):")
+        for line in failures:
+            print("  " + line)
+        return 1
+    print(f"PASS: {len(cases)} cases agree with Blender, {len(CONTROLS)} negative controls fail")
+    return 0
+
+
+def has_numpy():
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
+    parser.add_argument("--blender", default="blender",
+                        help="Blender executable (default: `blender` on PATH)")
+    parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
+    # Internal: compare the cases already in DIR (how the driver hands the comparison to
+    # Blender's Python when its own has no numpy).
+    parser.add_argument("--compare-only", metavar="DIR", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+
+    if args.compare_only:
+        if not has_numpy():
+            print(f"error: {sys.executable} has no numpy")
+            return 2
+        return compare_all(args.cli, args.compare_only)
+
+    blender = bc.find_blender(args.blender)
+    if blender is None:
+        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
+        return SKIP
+    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
+        print(f"error: {args.cli} is not an executable file (build sgbake_cli first)")
+        return 2
+    cli = os.path.abspath(args.cli)
+
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="sgbake-subdiv-oracle-") as tmp:
+        work = os.path.abspath(args.keep or tmp)
+        os.makedirs(work, exist_ok=True)
+        if not make_cases(blender, work):
+            return 1
+        blender_s = time.perf_counter() - started
+        if has_numpy():
+            status = compare_all(cli, work)
+        else:
+            with open(os.path.join(work, "cases.json"), encoding="ascii") as f:
+                python = json.load(f)["python"]
+            print(f"note: {sys.executable} has no numpy; comparing with Blender's Python "
+                  f"{python}")
+            sys.stdout.flush()
+            try:
+                status = subprocess.run([python, os.path.abspath(__file__), "--cli", cli,
+                                         "--compare-only", work], check=False).returncode
+            except OSError as exc:
+                print(f"error: cannot run {python}: {exc}")
+                status = 1
+        if args.keep:
+            print(f"files kept in {work}")
+    print(f"time: {time.perf_counter() - started:.1f} s (Blender {blender_s:.1f} s)")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
