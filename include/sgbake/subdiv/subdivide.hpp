@@ -65,9 +65,9 @@ inline constexpr int kMaxSubdivisionLevel = 6;
 ///  - The result is shaded smooth: its normals are computeSmoothNormals of the new faces (the
 ///    coarse mesh's normals are not used; Blender recomputes them the same way).
 ///
-/// Vertices are numbered as Blender numbers them: the coarse vertices first (same indices), then
-/// the points inside each coarse edge, then those inside each coarse face. Faces are grouped by
-/// coarse face, in coarse order.
+/// The coarse vertices keep their indices (as in Blender); the points inside each coarse edge
+/// follow (in OpenSubdiv's edge order), then those inside each coarse face. Faces are grouped by
+/// coarse face, in coarse order, each face's grids in corner order, cells row by row.
 ///
 /// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
 ///         is out of range or the mesh cannot be subdivided (a face using one vertex twice, or a
