@@ -11,14 +11,18 @@
    503,808 corners), computes split normals, then times calc_normals_split() and
    calc_tangents() separately: one warm-up, then the best of --runs (time.perf_counter).
    It also records process CPU time over wall time during calc_tangents, i.e. how many cores
-   Blender kept busy. It writes the mesh as OBJ with tests/blender/objio.py (the same writer as
+   Blender kept busy. Before that it writes the coarse Suzanne (SUZANNE_coarse.obj) and times
+   the modifier itself, best of --runs: the object's data tagged, the depsgraph re-evaluated
+   and the result copied out with to_mesh(). It writes the mesh as OBJ with tests/blender/objio.py (the same writer as
    the oracle test) and prints its results as a JSON line tagged BLENDER_RESULT.
 2. Driver half (plain python3): runs `sgbake tangents MESH.obj -o OUT.csv --stats` --runs
-   times and takes the best `tangents_s` from the JSON line on stderr.
+   times and takes the best `tangents_s` from the JSON line on stderr; then `sgbake tangents
+   SUZANNE_coarse.obj --subdivide LEVEL --stats` and takes the best `subdivide_s`.
 
 Prints one JSON line: blender_calc_tangents_s, blender_calc_normals_split_s,
 blender_cpu_over_wall, blender_threads, sgbake_tangents_s, sgbake_load_s, ratio (sgbake /
-Blender), corners, faces, threads (sgbake's). With --check the exit status is 1 when ratio > 0.5.
+Blender), corners, faces, threads (sgbake's), blender_subdivide_s, sgbake_subdivide_s and
+subdivide_ratio (sgbake / Blender; reported, not checked). With --check the exit status is 1 when ratio > 0.5.
 Exit 2 on usage errors or a failed run, 77 when Blender is not installed.
 """
 
@@ -67,9 +71,24 @@ def blender_main(argv):
     ob = bpy.context.object
     me = ob.data
     me.polygons.foreach_set("use_smooth", [True] * len(me.polygons))
+    me.calc_normals_split()
+    objio.write_obj(coarse_path(obj_path), objio.mesh_arrays(me),
+                    comment=f"Suzanne (Blender {bpy.app.version_string})")
     mod = ob.modifiers.new("Subdivision", "SUBSURF")
     mod.levels = levels
     mod.render_levels = levels
+
+    # The modifier itself: tag the mesh, re-evaluate the depsgraph, copy the result out.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+
+    def subdivide():
+        ob.update_tag(refresh={"DATA"})
+        depsgraph.update()
+        evaluated = ob.evaluated_get(depsgraph)
+        evaluated.to_mesh()
+        evaluated.to_mesh_clear()
+
+    subdivide_s, _ = best_of(runs, subdivide)
     bpy.ops.object.modifier_apply(modifier=mod.name)
     me = ob.data
     uvmap = me.uv_layers.active.name
@@ -88,6 +107,7 @@ def blender_main(argv):
         "corners": len(me.loops),
         "blender_calc_normals_split_s": normals_s,
         "blender_calc_tangents_s": tangents_s,
+        "blender_subdivide_s": subdivide_s,
         "blender_cpu_over_wall": cpu_over_wall,
         # Blender's task scheduler (TBB) uses this many threads unless started with -t N;
         # scene.render.threads reports the same automatic count.
@@ -114,9 +134,14 @@ def run_blender_half(args, obj_path):
     return None
 
 
-def run_sgbake(args, obj_path, out_path):
-    """Runs `sgbake tangents --stats` --runs times; returns (best tangents_s, its load_s)."""
-    cmd = [args.cli, "tangents", obj_path, "-o", out_path, "--stats"]
+def coarse_path(obj_path):
+    """Where the Blender half writes Suzanne before subdivision."""
+    return os.path.splitext(obj_path)[0] + "_coarse.obj"
+
+
+def run_sgbake(args, obj_path, out_path, extra=(), key="tangents_s"):
+    """Runs `sgbake tangents OBJ --stats EXTRA` --runs times; returns (best `key`, its load_s)."""
+    cmd = [args.cli, "tangents", obj_path, "-o", out_path, "--stats"] + list(extra)
     if args.threads is not None:
         cmd += ["--threads", str(args.threads)]
     best = None
@@ -131,12 +156,12 @@ def run_sgbake(args, obj_path, out_path):
             if line.startswith("{"):
                 stats = json.loads(line)
                 break
-        if stats is None or "tangents_s" not in stats:
-            print(f"error: no JSON line with tangents_s on stderr of `{' '.join(cmd)}`:\n"
+        if stats is None or key not in stats:
+            print(f"error: no JSON line with {key} on stderr of `{' '.join(cmd)}`:\n"
                   f"{proc.stderr[-2000:]}", file=sys.stderr)
             return None
-        if best is None or stats["tangents_s"] < best[0]:
-            best = (stats["tangents_s"], stats.get("load_s"))
+        if best is None or stats[key] < best[0]:
+            best = (stats[key], stats.get("load_s"))
     return best
 
 
@@ -177,12 +202,18 @@ def main():
         sgbake = run_sgbake(args, obj_path, os.path.join(work, "tangents.csv"))
         if sgbake is None:
             return 2
+        subdivided = run_sgbake(args, coarse_path(obj_path), os.path.join(work, "coarse.csv"),
+                                ["--subdivide", str(args.subdivisions)], key="subdivide_s")
+        if subdivided is None:
+            return 2
 
     result = dict(blender)
     result["sgbake_tangents_s"] = sgbake[0]
     result["sgbake_load_s"] = sgbake[1]
     result["threads"] = args.threads if args.threads else os.cpu_count()
     result["ratio"] = sgbake[0] / blender["blender_calc_tangents_s"]
+    result["sgbake_subdivide_s"] = subdivided[0]
+    result["subdivide_ratio"] = subdivided[0] / blender["blender_subdivide_s"]
     print(json.dumps(result))
     if args.check and result["ratio"] > TARGET_RATIO:
         print(f"FAIL: sgbake takes {result['ratio']:.2f} x Blender's calc_tangents time "

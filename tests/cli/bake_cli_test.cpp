@@ -353,6 +353,87 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
   EXPECT_NE(padding.err.find("did you mean 'extend'?"), std::string::npos) << padding.err;
 }
 
+/// A cube of size 2 with one UV square per face (a row of six squares over u in [0, 1]).
+constexpr const char* kCubeObj =
+    "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+    "vt 0 0.2\nvt 0.16 0.2\nvt 0.16 0.8\nvt 0 0.8\n"
+    "vt 0.17 0.2\nvt 0.33 0.2\nvt 0.33 0.8\nvt 0.17 0.8\n"
+    "vt 0.34 0.2\nvt 0.5 0.2\nvt 0.5 0.8\nvt 0.34 0.8\n"
+    "vt 0.51 0.2\nvt 0.66 0.2\nvt 0.66 0.8\nvt 0.51 0.8\n"
+    "vt 0.67 0.2\nvt 0.83 0.2\nvt 0.83 0.8\nvt 0.67 0.8\n"
+    "vt 0.84 0.2\nvt 1 0.2\nvt 1 0.8\nvt 0.84 0.8\n"
+    "f 1/1 4/2 3/3 2/4\nf 5/5 6/6 7/7 8/8\nf 1/9 2/10 6/11 5/12\n"
+    "f 2/13 3/14 7/15 6/16\nf 3/17 4/18 8/19 7/20\nf 4/21 1/22 5/23 8/24\n";
+
+/// The pixels of an image file as floats (the files themselves differ in their time stamp).
+std::vector<float> readPixels(const fs::path& path) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
+  if (!in) return {};
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data())) return {};
+  return pixels;
+}
+
+TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
+  writeFile(dir_ / "cube.obj", kCubeObj);
+  const std::string mesh = (dir_ / "cube.obj").string();
+  const auto scene = [&](int level, const std::string& file) {
+    return R"({"mesh": "cube.obj", "subdivision": {"level": )" + std::to_string(level) +
+           R"(}, "outputs": [{"map": "object-normal", "file": ")" + file +
+           R"(", "size": 64, "margin": 0, "bit_depth": 32}]})";
+  };
+  ASSERT_EQ(bakeScene(scene(2, "l2.exr")).exitCode, 0);
+  ASSERT_EQ(bakeScene(scene(0, "l0.exr")).exitCode, 0);
+  // The shorthand with --subdivide gives the same file, whatever the number of threads.
+  for (const char* threads : {"1", "2"}) {
+    const fs::path out = dir_ / (std::string("flags") + threads + ".exr");
+    const ProcessResult r = run({"bake", "--mesh", mesh, "--map", "object-normal", "--size", "64",
+                                 "--margin", "0", "--bit-depth", "32", "--subdivide", "2",
+                                 "--threads", threads, "--no-manifest", "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::vector<float> pixels = readPixels(out);
+    EXPECT_FALSE(pixels.empty());
+    EXPECT_TRUE(pixels == readPixels(dir_ / "l2.exr")) << "--threads " << threads;
+  }
+  // Subdividing rounds the cube: its object-space normals are no longer the six face normals.
+  EXPECT_FALSE(readPixels(dir_ / "l2.exr") == readPixels(dir_ / "l0.exr"));
+  // A different level is a different bake (the manifest hashes the subdivision block).
+  const ProcessResult same = bakeScene(scene(2, "l2.exr"));
+  EXPECT_NE(same.out.find("up to date: " + (dir_ / "l2.exr").string()), std::string::npos)
+      << same.out;
+  const ProcessResult changed = bakeScene(scene(1, "l2.exr"));
+  EXPECT_NE(changed.out.find("wrote " + (dir_ / "l2.exr").string()), std::string::npos)
+      << changed.out;
+  const ProcessResult explained = bakeScene(scene(3, "l3.exr"), {"--explain"});
+  EXPECT_NE(explained.out.find("subdivide the mesh to level 3"), std::string::npos)
+      << explained.out;
+
+  // `tangents --subdivide --mesh-out`: one CSV row per corner of the mesh it writes.
+  const ProcessResult tangents = run({"tangents", mesh, "--subdivide", "1", "--uv-smooth", "none",
+                                      "--mesh-out", (dir_ / "fine.obj").string()});
+  ASSERT_EQ(tangents.exitCode, 0) << tangents.err;
+  const std::string obj = readFile(dir_ / "fine.obj");
+  EXPECT_EQ(std::count(obj.begin(), obj.end(), 'f'), 24);  // 24 quads; no other 'f' in it
+  EXPECT_EQ(std::count(tangents.out.begin(), tangents.out.end(), '\n'), 1 + 24 * 4);
+
+  const std::set<std::string> before = listDirectory(dir_);
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"bake", "--mesh", mesh, "--subdivide", "7", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "1", "--uv-smooth", "smooth", "-o",
+            (dir_ / "o.png").string()},
+           {"tangents", mesh, "--subdivide", "-1", "-o", (dir_ / "t.csv").string()},
+           {"convert", "--mesh", mesh, "--subdivide", "1", "--boundary-smooth", "none", "--from",
+            "object", "--to", "tangent", (dir_ / "l0.exr").string(), "-o",
+            (dir_ / "c.exr").string()},
+       }) {
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args[2] << ": " << r.err;
+    expectOneErrorLine(r);
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
 TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   // An object-space map of the flat plane: every texel (0, 0, 1) → tangent space (0, 0, 1).
   writeTestImage(dir_ / "os.png", 8, {0.5f, 0.5f, 1.0f}, false);
