@@ -64,10 +64,17 @@ struct ConvertShader {
 }  // namespace
 }  // namespace bake_detail
 
-Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tangents,
-                                    const FloatImage& input, NormalSpace from, NormalSpace to,
-                                    const ConvertSettings& settings) {
-  const std::string where = mesh.source.empty() ? std::string("convert") : mesh.source;
+namespace {
+
+/// How messages name a conversion: the mesh's file, or "convert".
+std::string convertWhere(const Mesh& mesh) {
+  return mesh.source.empty() ? std::string("convert") : mesh.source;
+}
+
+/// The checks convertNormalMap and convertNormalMapRows share (see convertNormalMap).
+Status validateConvert(const Mesh& mesh, const CornerTangents& tangents, const FloatImage& input,
+                       const ConvertSettings& settings) {
+  const std::string where = convertWhere(mesh);
   if (input.width < 1 || input.height < 1 || input.width > kMaxBakeSide ||
       input.height > kMaxBakeSide) {
     return Error::badInput(where + ": the normal map is empty or too large (" +
@@ -100,6 +107,37 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
   }
   if (settings.threads < 0) return Error::badInput(where + ": threads must be 0 (all cores) or more");
 
+  return Ok{};
+}
+
+/// The shader of a conversion from @p from to @p to.
+bake_detail::ConvertShader convertShader(const Mesh& mesh, const CornerTangents& tangents,
+                                         const FloatImage& input, NormalSpace from, NormalSpace to,
+                                         const ConvertSettings& settings) {
+  bake_detail::ConvertShader shader;
+  shader.mesh = &mesh;
+  shader.tangents = &tangents;
+  shader.input = &input;
+  shader.from = from;
+  shader.to = to;
+  shader.green = settings.green;
+  shader.uvSet = settings.uvSet;
+  return shader;
+}
+
+Error convertOutOfMemory(const Mesh& mesh, const FloatImage& input) {
+  return Error::internal(convertWhere(mesh) + ": out of memory converting a " +
+                         std::to_string(input.width) + "x" + std::to_string(input.height) +
+                         " normal map");
+}
+
+}  // namespace
+
+Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tangents,
+                                    const FloatImage& input, NormalSpace from, NormalSpace to,
+                                    const ConvertSettings& settings) {
+  if (Status valid = validateConvert(mesh, tangents, input, settings); !valid) return valid.error();
+  const std::size_t texels = static_cast<std::size_t>(input.width) * input.height;
   try {
     const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
     FloatImage output;
@@ -115,24 +153,50 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
     const bake_detail::RasterJob job =
         bake_detail::rasterJobFor(mesh, triangles, settings, input.width, input.height);
 
-    bake_detail::ConvertShader shader;
-    shader.mesh = &mesh;
-    shader.tangents = &tangents;
-    shader.input = &input;
-    shader.from = from;
-    shader.to = to;
-    shader.green = settings.green;
-    shader.uvSet = settings.uvSet;
-
     bake_detail::RasterOutput rasterOutput;
     rasterOutput.keepUncovered = true;
     rasterOutput.blank = true;  // the coverage was just zero-filled
-    bake_detail::rasterize(job, shader, rasterOutput, bake_detail::RasterTarget::of(output));
+    bake_detail::rasterize(job, convertShader(mesh, tangents, input, from, to, settings),
+                           rasterOutput, bake_detail::RasterTarget::of(output));
     return output;
   } catch (const std::bad_alloc&) {
-    return Error::internal(where + ": out of memory converting a " + std::to_string(input.width) +
-                           "x" + std::to_string(input.height) + " normal map");
+    return convertOutOfMemory(mesh, input);
   }
+}
+
+Status convertNormalMapRows(const Mesh& mesh, const CornerTangents& tangents,
+                            const FloatImage& input, NormalSpace from, NormalSpace to,
+                            const ConvertSettings& settings, const BakedRowsSink& sink) {
+  if (Status valid = validateConvert(mesh, tangents, input, settings); !valid) return valid;
+  if (!sink) return Error::badInput(convertWhere(mesh) + ": no sink for the converted rows");
+  Status result = Ok{};
+  try {
+    const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+    const int W = input.width, H = input.height, C = input.channels;
+    const int ringRows = bakeRingRows(H, 0);
+    const std::size_t ringTexels = static_cast<std::size_t>(ringRows) * static_cast<std::size_t>(W);
+    std::vector<float> pixels(ringTexels * static_cast<std::size_t>(C));
+    std::vector<float> coverage(ringTexels);
+    const bake_detail::RasterTarget target{pixels.data(), coverage.data(), C, ringRows};
+
+    bake_detail::RasterJob job = bake_detail::rasterJobFor(mesh, triangles, settings, W, H);
+    int previousEnd = 0;
+    job.onRowsFinal = [&](int rowsFinal) {
+      const MutableImageRows rows{W, H, C, previousEnd, rowsFinal, ringRows,
+                                  pixels.data(), coverage.data()};
+      previousEnd = rowsFinal;
+      result = sink(rows);
+      return result.ok();
+    };
+    bake_detail::RasterOutput rasterOutput;
+    rasterOutput.keepUncovered = true;
+    rasterOutput.initialPixels = input.pixels.data();  // each band's rows start from the input
+    bake_detail::rasterize(job, convertShader(mesh, tangents, input, from, to, settings),
+                           rasterOutput, target);
+  } catch (const std::bad_alloc&) {
+    return convertOutOfMemory(mesh, input);
+  }
+  return result;
 }
 
 }  // namespace sgbake

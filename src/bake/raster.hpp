@@ -211,6 +211,11 @@ struct RasterOutput {
   /// Leave the pixels of uncovered texels as they are (convertNormalMap) instead of writing the
   /// background (their coverage is still set to 0).
   bool keepUncovered = false;
+  /// With keepUncovered: the whole image's starting values (height rows of width·channels
+  /// values, file rows top first, the target's channels), copied into each row of the target
+  /// before the row is rasterized; the uncovered texels keep them (convertNormalMapRows, whose
+  /// ring of rows holds another band before). Null: the target's rows already hold them.
+  const float* initialPixels = nullptr;
   /// The image was just allocated: its coverage is all +0, and so are its pixels unless
   /// keepUncovered, so rasterize() writes neither again (one pass over hundreds of MB less) and
   /// the background only when it is not zero.
@@ -266,6 +271,13 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
     // Start from "nothing covered": background (unless kept) and coverage 0.
     const bool writeCoverage = !output.blank;
     const bool writeBackground = !output.keepUncovered && !(output.blank && backgroundIsZero);
+    if (output.keepUncovered && output.initialPixels != nullptr) {
+      const std::size_t rowValues = static_cast<std::size_t>(W) * stride;
+      for (int y = yBegin; y < yEnd; ++y) {
+        const float* from = output.initialPixels + static_cast<std::size_t>(H - 1 - y) * rowValues;
+        std::copy(from, from + rowValues, pixelRows[static_cast<std::size_t>(y - yBegin)]);
+      }
+    }
     for (int y = yBegin; y < yEnd && (writeCoverage || writeBackground); ++y) {
       for (int x = 0; x < W; ++x) {
         if (writeCoverage) coverageAt(x, y) = 0;

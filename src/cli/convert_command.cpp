@@ -72,25 +72,6 @@ FloatImage toFloatImage(const Image& image, bool& hasAlpha) {
   return out;
 }
 
-/// Keeps the first three channels; channel 3 (alpha) moves to the coverage.
-FloatImage toRgb(const FloatImage& image, bool hasAlpha) {
-  if (image.channels <= 3) return image;
-  FloatImage out;
-  out.width = image.width;
-  out.height = image.height;
-  out.channels = 3;
-  const std::size_t texels =
-      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-  out.pixels.resize(texels * 3);
-  out.coverage.resize(texels);
-  for (std::size_t t = 0; t < texels; ++t) {
-    const float* in = &image.pixels[t * static_cast<std::size_t>(image.channels)];
-    for (std::size_t c = 0; c < 3; ++c) out.pixels[t * 3 + c] = in[c];
-    out.coverage[t] = hasAlpha ? in[3] : 1.0f;
-  }
-  return out;
-}
-
 Status runConvert(const ConvertArguments& args) {
   Stopwatch total;
   const ThreadLimit threadLimit(args.threads);
@@ -137,6 +118,7 @@ Status runConvert(const ConvertArguments& args) {
   }
   bool hasAlpha = false;
   const FloatImage input = toFloatImage(*image, hasAlpha);
+  { const Image decoded = std::move(*image); }  // freed now: the conversion reads `input`
   const double loadSeconds = step.lap();
 
   TangentOptions tangentOptions;
@@ -153,21 +135,50 @@ Status runConvert(const ConvertArguments& args) {
   settings.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
   settings.samples = args.samples;
   settings.threads = args.threads;
-  Result<FloatImage> converted = convertNormalMap(*mesh, *tangents, input, *from, *to, settings);
-  if (!converted) {
-    return Error{converted.error().code, args.input + ": " + converted.error().message};
-  }
-  const double convertSeconds = step.lap();
 
+  // Converted band by band; each band's rows go to the writer's thread, which compresses and
+  // writes them while the next band is converted. The output image never exists whole.
   ImageWriteOptions writeOptions;
   writeOptions.format = *format;
   writeOptions.bitDepth = bitDepth;
   writeOptions.alpha = hasAlpha;
   writeOptions.threads = args.threads;
-  if (Status ok = writeImage(toRgb(*converted, hasAlpha), args.output, writeOptions); !ok) {
-    return ok;
+  Result<ImageFileWriter> writer =
+      ImageFileWriter::open(args.output, input.width, input.height, 3, writeOptions);
+  if (!writer) return writer.error();
+  std::vector<float> strip, alpha;  // RGB and alpha of rows with more than three channels
+  bool writeFailed = false;
+  const Status converted = convertNormalMapRows(
+      *mesh, *tangents, input, *from, *to, settings, [&](const MutableImageRows& rows) -> Status {
+        Status ok = Ok{};
+        for (int row = rows.begin; row < rows.end && ok;) {
+          const int run = std::min(rows.contiguousRows(row), rows.end - row);
+          const std::size_t texels = static_cast<std::size_t>(run) * rows.width;
+          if (rows.channels == 3) {
+            ok = writer->writeRows(row, run, {rows.pixelRow(row), 3 * texels}, {});
+          } else {  // channel 3 is alpha (kept, as coverage); further channels are dropped
+            strip.resize(3 * texels);
+            alpha.resize(texels);
+            const float* in = rows.pixelRow(row);
+            for (std::size_t t = 0; t < texels; ++t, in += rows.channels) {
+              std::copy(in, in + 3, strip.begin() + static_cast<std::ptrdiff_t>(3 * t));
+              alpha[t] = in[3];
+            }
+            ok = writer->writeRows(row, run, strip, alpha);
+          }
+          row += run;
+        }
+        writeFailed = !ok;
+        return ok;
+      });
+  if (!converted) {
+    if (writeFailed) return converted.error();  // the writer's errors name the file already
+    return Error{converted.error().code, args.input + ": " + converted.error().message};
   }
-  const double writeSeconds = step.lap();
+  const double convertSeconds = step.lap() - writer->waitSeconds();
+  const double queueWaits = writer->waitSeconds();
+  if (Status ok = writer->commit(); !ok) return ok;
+  const double commitSeconds = step.lap();
 
   if (args.stats) {
     const nlohmann::json stats = {
@@ -183,7 +194,8 @@ Status runConvert(const ConvertArguments& args) {
         {"load_s", loadSeconds},
         {"tangents_s", tangentSeconds},
         {"convert_s", convertSeconds},
-        {"write_s", writeSeconds},
+        {"write_s", writer->fileSeconds()},
+        {"write_wait_s", queueWaits + commitSeconds},
         {"total_s", total.seconds()},
     };
     printStats(stats);

@@ -2,6 +2,7 @@
 // the same layers (and back), texels outside the islands keep the input, threads do not matter.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "bake_test_util.hpp"
@@ -148,6 +149,69 @@ TEST(Convert, ThreadsGiveIdenticalBits) {
       convertNormalMap(b.mesh, b.tangents, b.objectSpace, NormalSpace::kObject, NormalSpace::kTangent, cs);
   ASSERT_TRUE(one.ok() && two.ok());
   EXPECT_EQ(std::memcmp(one->pixels.data(), two->pixels.data(), one->pixels.size() * sizeof(float)), 0);
+}
+
+TEST(Convert, RowsAreTheWholeConversionBandByBand) {
+  // A tall image (three bands and a part), four channels, covered in part: the rows the sink
+  // sees, assembled, are the whole conversion bit for bit, uncovered texels and alpha included.
+  const Mesh mesh = test::gridMesh(test::sphere, 24, 16, [](double s, double t) {
+    return Vec2d{0.1 + 0.8 * s, 0.05 + 0.9 * t};
+  });
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  FloatImage input;
+  input.width = 48;
+  input.height = 3 * kBakeBandRows + 37;
+  input.channels = 4;
+  const std::size_t texels = static_cast<std::size_t>(input.width) * input.height;
+  for (std::size_t i = 0; i < 4 * texels; ++i) {
+    input.pixels.push_back(0.5f + 0.45f * static_cast<float>(std::sin(0.37 * static_cast<double>(i))));
+  }
+  input.coverage.assign(texels, 0.0f);
+  for (const int samples : {1, 2}) {
+    for (const NormalSpace to : {NormalSpace::kTangent, NormalSpace::kObject}) {
+      ConvertSettings cs;
+      cs.samples = samples;
+      const NormalSpace from = to == NormalSpace::kTangent ? NormalSpace::kObject : NormalSpace::kTangent;
+      const Result<FloatImage> whole = convertNormalMap(mesh, *tangents, input, from, to, cs);
+      ASSERT_TRUE(whole.ok()) << whole.error().message;
+      FloatImage rows;
+      rows.pixels.assign(whole->pixels.size(), -1.0f);
+      rows.coverage.assign(texels, -1.0f);
+      int calls = 0, next = 0;
+      const Status done = convertNormalMapRows(
+          mesh, *tangents, input, from, to, cs, [&](const MutableImageRows& band) -> Status {
+            ++calls;
+            EXPECT_EQ(band.begin, next);  // no rows kept above a band
+            next = band.end;
+            for (int row = band.begin; row < band.end; ++row) {
+              const std::size_t at = static_cast<std::size_t>(row) * input.width;
+              std::copy(band.pixelRow(row), band.pixelRow(row) + 4 * input.width,
+                        rows.pixels.begin() + static_cast<std::ptrdiff_t>(4 * at));
+              std::copy(band.coverageRow(row), band.coverageRow(row) + input.width,
+                        rows.coverage.begin() + static_cast<std::ptrdiff_t>(at));
+            }
+            return Ok{};
+          });
+      ASSERT_TRUE(done.ok()) << done.error().message;
+      EXPECT_EQ(calls, 4);
+      EXPECT_EQ(next, input.height);
+      EXPECT_EQ(std::memcmp(rows.pixels.data(), whole->pixels.data(),
+                            whole->pixels.size() * sizeof(float)), 0) << "samples " << samples;
+      EXPECT_EQ(std::memcmp(rows.coverage.data(), whole->coverage.data(), texels * sizeof(float)), 0);
+    }
+  }
+  // An error from the sink stops the conversion and comes back.
+  int calls = 0;
+  const Status stopped = convertNormalMapRows(
+      mesh, *tangents, input, NormalSpace::kObject, NormalSpace::kTangent, {},
+      [&](const MutableImageRows&) -> Status {
+        ++calls;
+        return Error::internal("disk full");
+      });
+  ASSERT_FALSE(stopped.ok());
+  EXPECT_EQ(stopped.error().message, "disk full");
+  EXPECT_EQ(calls, 1);
 }
 
 TEST(Convert, BadInputIsAnErrorValue) {

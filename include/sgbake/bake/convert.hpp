@@ -59,4 +59,15 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
                                     const FloatImage& input, NormalSpace from, NormalSpace to,
                                     const ConvertSettings& settings = {});
 
+/// @brief convertNormalMap band by band, without holding the output image: the rows are
+/// converted in bands of kBakeBandRows rows from the top of the image down into a ring of
+/// bakeRingRows(height, 0) reused rows, each starting from the input's rows, and @p sink is called
+/// after each band with that band's rows (as bakeMapRows calls it with keepRows 0: while the
+/// next band is converted, one call at a time, in order). Every value is bit for bit the one
+/// convertNormalMap gives; an error from @p sink stops the conversion and is returned.
+/// @return the errors of convertNormalMap, or kBadInput when @p sink is empty
+Status convertNormalMapRows(const Mesh& mesh, const CornerTangents& tangents,
+                            const FloatImage& input, NormalSpace from, NormalSpace to,
+                            const ConvertSettings& settings, const BakedRowsSink& sink);
+
 }  // namespace sgbake
