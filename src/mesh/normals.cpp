@@ -12,7 +12,12 @@
 /// - a vertex whose weighted sum is zero gets its normalized position, (0, 0, 1) at the origin.
 #include "sgbake/mesh/normals.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <string>
 
 #include "mesh/validate.hpp"
@@ -85,27 +90,49 @@ std::vector<Vec3f> computeFaceNormals(const MeshView& mesh) {
 
 void computeSmoothNormals(Mesh& mesh) {
   const MeshView view = mesh.view();
-  std::vector<Vec3d> sum(mesh.numVertices());
-  for (std::size_t f = 0; f < view.numFaces(); ++f) {
-    const Vec3d normal = normalizeOr(faceNormalDirection(view, f), kZeroAreaNormal);
-    const std::uint32_t b = view.faceStart[f];
-    const std::uint32_t n = view.faceSize(f);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const Vec3d prev = cornerPosition(view, b + (i + n - 1) % n);
-      const Vec3d curr = cornerPosition(view, b + i);
-      const Vec3d next = cornerPosition(view, b + (i + 1) % n);
-      sum[view.cornerVertex[b + i]] += cornerAngle(prev - curr, next - curr) * normal;
+  const std::size_t numCorners = mesh.numCorners(), numVertices = mesh.numVertices();
+  // Each corner's weighted face normal, face by face in parallel.
+  std::vector<Vec3d> weighted(numCorners);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, view.numFaces(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& faces) {
+    for (std::size_t f = faces.begin(); f != faces.end(); ++f) {
+      const Vec3d normal = normalizeOr(faceNormalDirection(view, f), kZeroAreaNormal);
+      const std::uint32_t b = view.faceStart[f];
+      const std::uint32_t n = view.faceSize(f);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const Vec3d prev = cornerPosition(view, b + (i + n - 1) % n);
+        const Vec3d curr = cornerPosition(view, b + i);
+        const Vec3d next = cornerPosition(view, b + (i + 1) % n);
+        weighted[b + i] = cornerAngle(prev - curr, next - curr) * normal;
+      }
     }
+  });
+  // Each vertex's corners in corner order (a counting sort), so that its sum adds them in the
+  // same order whatever the threads: the normals do not depend on the number of threads.
+  std::vector<std::uint32_t> start(numVertices + 1, 0), corners(numCorners);
+  for (const std::uint32_t v : mesh.cornerVertex) ++start[v + 1];
+  for (std::size_t v = 0; v < numVertices; ++v) start[v + 1] += start[v];
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::uint32_t c = 0; c < numCorners; ++c) corners[fill[mesh.cornerVertex[c]]++] = c;
   }
-  std::vector<Vec3f> vertexNormals(sum.size());
-  for (std::size_t v = 0; v < sum.size(); ++v) {
-    const Vec3d fallback = normalizeOr(cast<double>(mesh.positions[v]), kOriginVertexNormal);
-    vertexNormals[v] = cast<float>(normalizeOr(sum[v], fallback));
-  }
-  mesh.cornerNormals.resize(mesh.numCorners());
-  for (std::size_t c = 0; c < mesh.numCorners(); ++c) {
-    mesh.cornerNormals[c] = vertexNormals[mesh.cornerVertex[c]];
-  }
+  std::vector<Vec3f> vertexNormals(numVertices);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, numVertices, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& vertices) {
+    for (std::size_t v = vertices.begin(); v != vertices.end(); ++v) {
+      Vec3d sum{0, 0, 0};
+      for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) sum += weighted[corners[k]];
+      const Vec3d fallback = normalizeOr(cast<double>(mesh.positions[v]), kOriginVertexNormal);
+      vertexNormals[v] = cast<float>(normalizeOr(sum, fallback));
+    }
+  });
+  mesh.cornerNormals.resize(numCorners);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, numCorners, 16384),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t c = range.begin(); c != range.end(); ++c) {
+      mesh.cornerNormals[c] = vertexNormals[mesh.cornerVertex[c]];
+    }
+  });
   mesh.normalSource = NormalSource::kComputed;
 }
 
