@@ -3,6 +3,7 @@
 // normalized positions, Blender's degenerate cases; and the Mesh invariant check.
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <string>
@@ -213,6 +214,16 @@ TEST(MeshNormals, SmoothNormalsAreSharedByAllCornersOfAVertex) {
     if (seen == nullptr) seen = &mesh.cornerNormals[c];
     EXPECT_EQ(*seen, mesh.cornerNormals[c]) << "corner " << c;
   }
+}
+
+TEST(MeshNormals, SmoothNormalsDoNotDependOnTheNumberOfThreads) {
+  // Large enough to be split among threads; each vertex adds its corners in corner order.
+  Mesh parallel = uvSphere(400, 200);
+  Mesh serial = parallel;
+  computeSmoothNormals(parallel);
+  tbb::task_arena one(1);
+  one.execute([&] { computeSmoothNormals(serial); });
+  EXPECT_TRUE(parallel.cornerNormals == serial.cornerNormals);
 }
 
 TEST(MeshNormals, ValidateReportsEachBrokenInvariantOnOneLine) {
