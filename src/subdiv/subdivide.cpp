@@ -13,7 +13,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -207,6 +209,18 @@ void gridCoord(const osd::Bfr::Parameterization& param, const FaceGrid& grid, in
   }
 }
 
+/// subdivideGrids could not evaluate a face's limit surface.
+struct EvaluationFailed {};
+
+/// The most corners a subdivided mesh may have: corner indices are 32-bit.
+constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_t>::max();
+
+/// The subdivided mesh (see subdivideMesh) of @p coarse, whose topology @p refiner and UV sets
+/// @p channels hold. Throws std::bad_alloc, or EvaluationFailed when Bfr rejects a face.
+Mesh subdivideGrids(const Mesh& coarse, const Refiner& refinerRef,
+                    const std::vector<FVarChannel>& channels, const std::vector<int>& faceSizes,
+                    int level);
+
 }  // namespace
 
 Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options) {
@@ -251,8 +265,36 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
       descriptor, RefinerFactory::Options(osd::Sdc::SCHEME_CATMARK, sdcOptions(options))));
   if (!refiner) return Error::badInput(name + ": OpenSubdiv cannot subdivide this topology");
 
-  // Every new vertex, and which face evaluates it: the first face (in order) that has it.
+  // Corners are numbered with 32 bits: refuse a result that does not fit before allocating it.
   const int level = options.level;
+  std::uint64_t newFaces = 0;
+  for (std::size_t f = 0; f < nf; ++f) {
+    const FaceGrid grid = faceGrid(faceSizes[f], level);
+    newFaces += static_cast<std::uint64_t>(grid.grids() * grid.cellsPerGrid());
+  }
+  if (4 * newFaces > kMaxSubdividedCorners) {
+    return Error::badInput(name + ": subdivision level " + std::to_string(level) + " would make " +
+                           std::to_string(newFaces) + " faces, more than a mesh holds (" +
+                           std::to_string(kMaxSubdividedCorners / 4) + ")");
+  }
+  try {
+    return subdivideGrids(coarse, *refiner, channels, faceSizes, level);
+  } catch (const EvaluationFailed&) {
+    return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
+  } catch (const std::bad_alloc&) {
+    return Error::internal(name + ": out of memory subdividing to level " +
+                           std::to_string(level) + " (" + std::to_string(newFaces) + " faces)");
+  }
+}
+
+namespace {
+
+Mesh subdivideGrids(const Mesh& coarse, const Refiner& refinerRef,
+                    const std::vector<FVarChannel>& channels, const std::vector<int>& faceSizes,
+                    int level) {
+  const Refiner* const refiner = &refinerRef;
+  const std::size_t nf = coarse.numFaces();
+  // Every new vertex, and which face evaluates it: the first face (in order) that has it.
   const VertexNumbering numbering(coarse, *refiner, level);
   std::vector<std::size_t> gridStart(nf + 1, 0);
   for (std::size_t f = 0; f < nf; ++f) {
@@ -396,11 +438,13 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
       }
     }
   });
-  if (failed) return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
+  if (failed) throw EvaluationFailed{};
 
   fine.cornerNormals.resize(fine.cornerVertex.size());
   computeSmoothNormals(fine);
   return fine;
 }
+
+}  // namespace
 
 }  // namespace sgbake

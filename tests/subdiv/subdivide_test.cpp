@@ -16,8 +16,8 @@
 namespace sgbake {
 namespace {
 
-/// A closed mesh from faces of vertex indices; UVs are each corner's position x, y.
-Mesh closedMesh(std::vector<Vec3f> positions, const std::vector<std::vector<std::uint32_t>>& faces) {
+/// A mesh from faces of vertex indices; UVs are each corner's position x, y.
+Mesh meshOf(std::vector<Vec3f> positions, const std::vector<std::vector<std::uint32_t>>& faces) {
   Mesh mesh;
   mesh.source = "test.obj";
   mesh.positions = std::move(positions);
@@ -36,7 +36,7 @@ Mesh closedMesh(std::vector<Vec3f> positions, const std::vector<std::vector<std:
 }
 
 Mesh cube() {
-  return closedMesh({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+  return meshOf({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                      {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
                     {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6},
                      {3, 0, 4, 7}});
@@ -58,7 +58,7 @@ Mesh prism(std::uint32_t n) {
     faces[1].push_back(n + k);      // top, facing +z
     faces.push_back({k, (k + 1) % n, n + (k + 1) % n, n + k});
   }
-  return closedMesh(std::move(positions), faces);
+  return meshOf(std::move(positions), faces);
 }
 
 /// A closed torus of nu × nv quads with every vertex of valence 4 (one regular B-spline patch
@@ -83,7 +83,7 @@ Mesh torusGrid(int nu, int nv) {
       faces.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
     }
   }
-  return closedMesh(std::move(positions), faces);
+  return meshOf(std::move(positions), faces);
 }
 
 Vec3d at(const Mesh& mesh, std::uint32_t v) { return cast<double>(mesh.positions[v]); }
@@ -256,6 +256,27 @@ TEST(Subdivide, LevelZeroIsTheMeshAndBadLevelsAreNamed) {
   Result<Mesh> bad = subdivideMesh(repeated, {1});
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().message, "test.obj: face 0 uses a vertex twice and cannot be subdivided");
+}
+
+TEST(Subdivide, AResultTooLargeForAMeshIsAnErrorNotAnOverflow) {
+  // 520² quads at level 6: 1.1e9 faces, 4.4e9 corners, more than 32-bit corner indices reach.
+  std::vector<Vec3f> positions;
+  const int n = 520;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) positions.push_back({static_cast<float>(i), static_cast<float>(j), 0});
+  }
+  std::vector<std::vector<std::uint32_t>> faces;
+  const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+  }
+  const Mesh plane = meshOf(std::move(positions), faces);
+  Result<Mesh> huge = subdivideMesh(plane, {6});
+  ASSERT_FALSE(huge);
+  EXPECT_EQ(huge.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(huge.error().message,
+            "test.obj: subdivision level 6 would make 1107558400 faces, more than a mesh holds "
+            "(1073741823)");
 }
 
 }  // namespace
