@@ -5,8 +5,6 @@
 
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
-#include <opensubdiv/far/topologyDescriptor.h>
-#include <opensubdiv/far/topologyRefinerFactory.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -20,83 +18,12 @@
 #include <vector>
 
 #include "sgbake/mesh/normals.hpp"
+#include "subdiv/control_mesh.hpp"
 
 namespace sgbake {
 namespace {
 
-namespace osd = OpenSubdiv;
-using Refiner = osd::Far::TopologyRefiner;
-using SurfaceFactory = osd::Bfr::RefinerSurfaceFactory<>;
-
-/// Blender's "Quality" of a new modifier: the adaptive refinement level its patches isolate
-/// irregular features to; Bfr approximates the same regions to the same level.
-constexpr int kApproxLevel = 3;
-/// Blender's STD_UV_CONNECT_LIMIT: corners of a vertex whose UVs differ by less than this in
-/// both u and v share one face-varying value.
-constexpr float kUvConnectLimit = 1e-4f;
-
-osd::Sdc::Options sdcOptions(const SubdivisionOptions& options) {
-  using Sdc = osd::Sdc::Options;
-  Sdc sdc;
-  sdc.SetCreasingMethod(Sdc::CREASE_UNIFORM);
-  sdc.SetTriangleSubdivision(Sdc::TRI_SUB_CATMARK);
-  sdc.SetVtxBoundaryInterpolation(options.boundary == SubdivisionBoundary::kKeepCorners
-                                      ? Sdc::VTX_BOUNDARY_EDGE_AND_CORNER
-                                      : Sdc::VTX_BOUNDARY_EDGE_ONLY);
-  Sdc::FVarLinearInterpolation fvar = Sdc::FVAR_LINEAR_BOUNDARIES;
-  switch (options.uvSmooth) {
-    case SubdivisionUvSmooth::kNone: fvar = Sdc::FVAR_LINEAR_ALL; break;
-    case SubdivisionUvSmooth::kKeepCorners: fvar = Sdc::FVAR_LINEAR_CORNERS_ONLY; break;
-    case SubdivisionUvSmooth::kKeepCornersJunctions: fvar = Sdc::FVAR_LINEAR_CORNERS_PLUS1; break;
-    case SubdivisionUvSmooth::kKeepCornersJunctionsConcave:
-      fvar = Sdc::FVAR_LINEAR_CORNERS_PLUS2;
-      break;
-    case SubdivisionUvSmooth::kKeepBoundaries: fvar = Sdc::FVAR_LINEAR_BOUNDARIES; break;
-    case SubdivisionUvSmooth::kAll: fvar = Sdc::FVAR_LINEAR_NONE; break;
-  }
-  sdc.SetFVarLinearInterpolation(fvar);
-  return sdc;
-}
-
-/// One UV set as an OpenSubdiv face-varying channel: an index per corner into distinct values.
-struct FVarChannel {
-  std::vector<int> cornerValue;  ///< #C
-  std::vector<double> values;    ///< 2 per value
-};
-
-/// Groups each vertex's corners by UV (within kUvConnectLimit of the group's first corner, in
-/// both coordinates), as Blender's mesh converter does.
-FVarChannel weldUvs(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
-  const std::size_t nv = mesh.numVertices(), nc = mesh.numCorners();
-  // Corners of each vertex, in corner order (counting sort).
-  std::vector<std::uint32_t> start(nv + 1, 0), corners(nc);
-  for (const std::uint32_t v : mesh.cornerVertex) ++start[v + 1];
-  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  for (std::uint32_t c = 0; c < nc; ++c) corners[fill[mesh.cornerVertex[c]]++] = c;
-
-  FVarChannel channel;
-  channel.cornerValue.assign(nc, -1);
-  for (std::size_t v = 0; v < nv; ++v) {
-    for (std::uint32_t a = start[v]; a < start[v + 1]; ++a) {
-      const std::uint32_t first = corners[a];
-      if (channel.cornerValue[first] >= 0) continue;
-      const int value = static_cast<int>(channel.values.size() / 2);
-      channel.values.push_back(uvs[first].x);
-      channel.values.push_back(uvs[first].y);
-      channel.cornerValue[first] = value;
-      for (std::uint32_t b = a + 1; b < start[v + 1]; ++b) {
-        const std::uint32_t other = corners[b];
-        if (channel.cornerValue[other] < 0 &&
-            std::fabs(uvs[other].x - uvs[first].x) < kUvConnectLimit &&
-            std::fabs(uvs[other].y - uvs[first].y) < kUvConnectLimit) {
-          channel.cornerValue[other] = value;
-        }
-      }
-    }
-  }
-  return channel;
-}
+using namespace subdiv_detail;
 
 /// The grid of new vertices on one coarse face. A quad has one grid of R×R points (R = 2^level
 /// + 1) on its own [0,1]² parameterization, point (i, j) at (i, j)/(R-1), corner k of the face at
@@ -215,56 +142,34 @@ struct EvaluationFailed {};
 /// The most corners a subdivided mesh may have: corner indices are 32-bit.
 constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_t>::max();
 
-/// The subdivided mesh (see subdivideMesh) of @p coarse, whose topology @p refiner and UV sets
-/// @p channels hold. Throws std::bad_alloc, or EvaluationFailed when Bfr rejects a face.
-Mesh subdivideGrids(const Mesh& coarse, const Refiner& refinerRef,
-                    const std::vector<FVarChannel>& channels, const std::vector<int>& faceSizes,
-                    int level);
+/// The subdivided mesh (see subdivideMesh) of @p coarse as OpenSubdiv sees it (@p control),
+/// and where its corners lie on the limit surface when @p parameters is not null. Throws
+/// std::bad_alloc, or EvaluationFailed when Bfr rejects a face.
+Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
+                    SurfaceParameters* parameters);
 
 }  // namespace
 
-Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options) {
+Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options,
+                           SurfaceParameters* parameters) {
   const std::string& name = coarse.source;
   if (options.level < 0 || options.level > kMaxSubdivisionLevel) {
     return Error::badInput(name + ": subdivision level " + std::to_string(options.level) +
                            " is out of range (0.." + std::to_string(kMaxSubdivisionLevel) + ")");
   }
-  if (options.level == 0) return coarse;
-  const std::size_t nf = coarse.numFaces();
-  for (std::size_t f = 0; f < nf; ++f) {
-    const auto first = coarse.cornerVertex.begin() + coarse.faceStart[f];
-    const auto last = coarse.cornerVertex.begin() + coarse.faceStart[f + 1];
-    std::vector<std::uint32_t> sorted(first, last);
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
-      return Error::badInput(name + ": face " + std::to_string(f) +
-                             " uses a vertex twice and cannot be subdivided");
+  if (options.level == 0) {
+    if (parameters != nullptr) {  // each corner at its own corner of its face
+      *parameters = {};
+      for (std::size_t f = 0; f < coarse.numFaces(); ++f) {
+        parameters->faceOrigin.push_back(static_cast<std::uint32_t>(f));
+      }
     }
+    return coarse;
   }
-
-  // Topology, with one face-varying channel per UV set.
-  std::vector<int> faceSizes(nf), faceVertices(coarse.cornerVertex.begin(),
-                                              coarse.cornerVertex.end());
-  for (std::size_t f = 0; f < nf; ++f) faceSizes[f] = static_cast<int>(coarse.faceSize(f));
-  std::vector<FVarChannel> channels;
-  for (const UvSet& set : coarse.uvSets) channels.push_back(weldUvs(coarse, set.uvs));
-  std::vector<osd::Far::TopologyDescriptor::FVarChannel> fvarDescriptors(channels.size());
-  for (std::size_t s = 0; s < channels.size(); ++s) {
-    fvarDescriptors[s].numValues = static_cast<int>(channels[s].values.size() / 2);
-    fvarDescriptors[s].valueIndices = channels[s].cornerValue.data();
-  }
-  osd::Far::TopologyDescriptor descriptor;
-  descriptor.numVertices = static_cast<int>(coarse.numVertices());
-  descriptor.numFaces = static_cast<int>(nf);
-  descriptor.numVertsPerFace = faceSizes.data();
-  descriptor.vertIndicesPerFace = faceVertices.data();
-  descriptor.numFVarChannels = static_cast<int>(fvarDescriptors.size());
-  descriptor.fvarChannels = fvarDescriptors.empty() ? nullptr : fvarDescriptors.data();
-  using RefinerFactory = osd::Far::TopologyRefinerFactory<osd::Far::TopologyDescriptor>;
-  const std::unique_ptr<Refiner> refiner(RefinerFactory::Create(
-      descriptor, RefinerFactory::Options(osd::Sdc::SCHEME_CATMARK, sdcOptions(options))));
-  if (!refiner) return Error::badInput(name + ": OpenSubdiv cannot subdivide this topology");
-
+  Result<ControlMesh> control = buildControlMesh(coarse, options);
+  if (!control) return control.error();
+  const std::size_t nf = coarse.numFaces();
+  const std::vector<int>& faceSizes = control->faceSizes;
   // Corners are numbered with 32 bits: refuse a result that does not fit before allocating it.
   const int level = options.level;
   std::uint64_t newFaces = 0;
@@ -278,7 +183,7 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
                            std::to_string(kMaxSubdividedCorners / 4) + ")");
   }
   try {
-    return subdivideGrids(coarse, *refiner, channels, faceSizes, level);
+    return subdivideGrids(coarse, *control, level, parameters);
   } catch (const EvaluationFailed&) {
     return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
   } catch (const std::bad_alloc&) {
@@ -289,10 +194,11 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
 
 namespace {
 
-Mesh subdivideGrids(const Mesh& coarse, const Refiner& refinerRef,
-                    const std::vector<FVarChannel>& channels, const std::vector<int>& faceSizes,
-                    int level) {
-  const Refiner* const refiner = &refinerRef;
+Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
+                    SurfaceParameters* parameters) {
+  const Refiner* const refiner = control.refiner.get();
+  const std::vector<FVarChannel>& channels = control.channels;
+  const std::vector<int>& faceSizes = control.faceSizes;
   const std::size_t nf = coarse.numFaces();
   // Every new vertex, and which face evaluates it: the first face (in order) that has it.
   const VertexNumbering numbering(coarse, *refiner, level);
@@ -341,14 +247,13 @@ Mesh subdivideGrids(const Mesh& coarse, const Refiner& refinerRef,
 
   // Limit positions and UVs, face by face in parallel (each thread its own Bfr factory: its
   // cache is not thread-safe).
-  std::vector<double> meshPoints(3 * coarse.numVertices());
-  for (std::size_t v = 0; v < coarse.numVertices(); ++v) {
-    meshPoints[3 * v] = coarse.positions[v].x;
-    meshPoints[3 * v + 1] = coarse.positions[v].y;
-    meshPoints[3 * v + 2] = coarse.positions[v].z;
+  const std::vector<double>& meshPoints = control.points;
+  const SurfaceFactory::Options factoryOptions = surfaceFactoryOptions();
+  if (parameters != nullptr) {
+    parameters->faceOrigin.resize(fineFaces);
+    parameters->cornerSubFace.resize(4 * fineFaces);
+    parameters->cornerCoord.resize(4 * fineFaces);
   }
-  SurfaceFactory::Options factoryOptions;
-  factoryOptions.SetApproxLevelSmooth(kApproxLevel).SetApproxLevelSharp(kApproxLevel);
   struct Worker {
     SurfaceFactory factory;
     osd::Bfr::Surface<double> surface;
@@ -377,6 +282,16 @@ Mesh subdivideGrids(const Mesh& coarse, const Refiner& refinerRef,
           out[1] = pointVertex[pointIndex(g, i + 1, j)];
           out[2] = pointVertex[pointIndex(g, i + 1, j + 1)];
           out[3] = pointVertex[pointIndex(g, i, j + 1)];
+          if (parameters != nullptr) {
+            parameters->faceOrigin[cell] = static_cast<std::uint32_t>(f);
+            const float step = 1.0f / static_cast<float>(grid.side - 1);  // a power of 2: exact
+            const int di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
+            for (std::size_t k = 0; k < 4; ++k) {
+              parameters->cornerSubFace[4 * cell + k] = static_cast<std::uint32_t>(g);
+              parameters->cornerCoord[4 * cell + k] =
+                  Vec2f{static_cast<float>(i + di[k]) * step, static_cast<float>(j + dj[k]) * step};
+            }
+          }
         }
       }
     }

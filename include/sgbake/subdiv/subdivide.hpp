@@ -3,6 +3,9 @@
 /// (OpenSubdiv underneath), so that a coarse mesh plus a level bakes like Blender's modified mesh.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "sgbake/core/named.hpp"
 #include "sgbake/core/result.hpp"
 #include "sgbake/mesh/mesh.hpp"
@@ -49,6 +52,17 @@ struct SubdivisionOptions {
 /// @brief The highest level subdivideMesh accepts (a quad becomes 4⁶ = 4096 quads).
 inline constexpr int kMaxSubdivisionLevel = 6;
 
+/// @brief Where the corners of a subdivided mesh lie on the coarse mesh's limit surface, in the
+/// coarse faces' own parameterization: what LimitSurface needs to evaluate the exact surface
+/// under any point of a subdivided face. (Subdivided meshes are all quads: face f owns corners
+/// 4f … 4f+3.)
+struct SurfaceParameters {
+  std::vector<std::uint32_t> faceOrigin;     ///< per new face: the coarse face it covers part of
+  std::vector<std::uint32_t> cornerSubFace;  ///< per new corner: the sub-face (n-gons: the corner
+                                             ///< of the coarse face it lies at; quads: 0)
+  std::vector<Vec2f> cornerCoord;            ///< per new corner: (s, t) ∈ [0,1]² on that sub-face
+};
+
 /// @brief The mesh Blender's Subdivision Surface modifier makes of @p coarse (Catmull-Clark,
 /// "Use Limit Surface" on, as a new modifier has it), with every UV set subdivided.
 ///
@@ -72,6 +86,9 @@ inline constexpr int kMaxSubdivisionLevel = 6;
 /// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
 ///         is out of range or the mesh cannot be subdivided (a face using one vertex twice, or a
 ///         topology OpenSubdiv rejects).
-Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options);
+/// @param[out] parameters when not null, where each new corner lies (SurfaceParameters); at
+///             level 0, only faceOrigin (the identity)
+Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options,
+                           SurfaceParameters* parameters = nullptr);
 
 }  // namespace sgbake
