@@ -1,6 +1,7 @@
 // subdivideMesh: counts, closed-form limit points of regular Catmull-Clark patches, UVs with
 // linear face-varying interpolation, and a watertight, consistently oriented result.
 #include "sgbake/subdiv/subdivide.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 #include <gtest/gtest.h>
 
@@ -277,6 +278,122 @@ TEST(Subdivide, AResultTooLargeForAMeshIsAnErrorNotAnOverflow) {
   EXPECT_EQ(huge.error().message,
             "test.obj: subdivision level 6 would make 1107558400 faces, more than a mesh holds "
             "(1073741823)");
+}
+
+/// The torus grid of torusGrid with UVs (i/nu, j/nv) per corner: a seam where the grid wraps.
+Mesh torusGridWithUvs(int nu, int nv) {
+  Mesh mesh = torusGrid(nu, nv);
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const double i = static_cast<double>(f % static_cast<std::size_t>(nu));
+    const double j = static_cast<double>(f / static_cast<std::size_t>(nu));
+    const double di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
+    for (std::size_t k = 0; k < 4; ++k) {
+      mesh.uvSets[0].uvs[4 * f + k] = {static_cast<float>((i + di[k]) / nu),
+                                       static_cast<float>((j + dj[k]) / nv)};
+    }
+  }
+  return mesh;
+}
+
+/// The uniform cubic B-spline basis at t and its derivative.
+void bspline(double t, double w[4], double d[4]) {
+  const double u = 1 - t;
+  w[0] = u * u * u / 6;
+  w[1] = (3 * t * t * t - 6 * t * t + 4) / 6;
+  w[2] = (-3 * t * t * t + 3 * t * t + 3 * t + 1) / 6;
+  w[3] = t * t * t / 6;
+  d[0] = -u * u / 2;
+  d[1] = (9 * t * t - 12 * t) / 6;
+  d[2] = (-9 * t * t + 6 * t + 3) / 6;
+  d[3] = t * t / 2;
+}
+
+TEST(LimitSurface, RegularFacesAreTheBicubicBSplineWithItsDerivatives) {
+  const int nu = 10, nv = 7;
+  const Mesh coarse = torusGrid(nu, nv);
+  Result<LimitSurface> limit = LimitSurface::create(coarse, {1});
+  ASSERT_TRUE(limit) << limit.error().message;
+  EXPECT_EQ(limit->numFaces(), static_cast<std::size_t>(nu * nv));
+  LimitSurface::Evaluator evaluator(*limit);
+  const auto grid = [&](int i, int j) {
+    return at(coarse, static_cast<std::uint32_t>(((j + nv) % nv) * nu + (i + nu) % nu));
+  };
+  double worst = 0;
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      for (const Vec2d st : {Vec2d{0.25, 0.6}, Vec2d{0, 1}, Vec2d{0.9, 0.05}}) {
+        double ws[4], ds[4], wt[4], dt[4];
+        bspline(st.x, ws, ds);
+        bspline(st.y, wt, dt);
+        Vec3d P{0, 0, 0}, Ps{0, 0, 0}, Pt{0, 0, 0};
+        for (int b = 0; b < 4; ++b) {
+          for (int a = 0; a < 4; ++a) {
+            const Vec3d c = grid(i - 1 + a, j - 1 + b);
+            P = P + (ws[a] * wt[b]) * c;
+            Ps = Ps + (ds[a] * wt[b]) * c;
+            Pt = Pt + (ws[a] * dt[b]) * c;
+          }
+        }
+        LimitPoint p;
+        ASSERT_TRUE(evaluator.evaluate(static_cast<std::uint32_t>(j * nu + i), 0, st, p));
+        worst = std::max({worst, length(p.position - P), length(p.dPds - Ps), length(p.dPdt - Pt)});
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+  LimitPoint unused;
+  EXPECT_FALSE(evaluator.evaluate(static_cast<std::uint32_t>(nu * nv), 0, {0.5, 0.5}, unused));
+  EXPECT_FALSE(evaluator.evaluate(0, 1, {0.5, 0.5}, unused));  // a quad has one sub-face
+}
+
+TEST(LimitSurface, LocateFindsWhereTheUvsTakeAValue) {
+  const int nu = 8, nv = 6;
+  const Mesh coarse = torusGridWithUvs(nu, nv);
+  for (const SubdivisionUvSmooth uvSmooth : {SubdivisionUvSmooth::kNone, SubdivisionUvSmooth::kAll}) {
+    Result<LimitSurface> limit = LimitSurface::create(coarse, {1, uvSmooth});
+    ASSERT_TRUE(limit) << limit.error().message;
+    LimitSurface::Evaluator evaluator(*limit);
+    for (int f = 0; f < nu * nv; ++f) {
+      const double i = f % nu, j = f / nu;
+      const Vec2d target{(i + 0.3) / nu, (j + 0.8) / nv};
+      LimitPoint p;
+      ASSERT_TRUE(evaluator.locate(static_cast<std::uint32_t>(f), 0, {0.5, 0.5}, 0, target, p));
+      EXPECT_LT(std::sqrt(lengthSquared(p.uv[0] - target)), 1e-12) << "face " << f;
+      if (uvSmooth == SubdivisionUvSmooth::kNone) {
+        // Linear UVs: the point is where the face's bilinear UVs reach the target.
+        LimitPoint expected;
+        ASSERT_TRUE(evaluator.evaluate(static_cast<std::uint32_t>(f), 0, {0.3, 0.8}, expected));
+        EXPECT_LT(length(p.position - expected.position), 1e-7) << "face " << f;  // float UVs
+      }
+    }
+  }
+}
+
+TEST(LimitSurface, SubdividedVerticesAndUvsAreTheSurfaceAtTheirParameters) {
+  for (const Mesh& coarse : {cube(), prism(3), prism(5), torusGridWithUvs(6, 5)}) {
+    for (const SubdivisionUvSmooth uvSmooth :
+         {SubdivisionUvSmooth::kKeepBoundaries, SubdivisionUvSmooth::kAll}) {
+      SurfaceParameters parameters;
+      Result<Mesh> fine = subdivideMesh(coarse, {2, uvSmooth}, &parameters);
+      ASSERT_TRUE(fine) << fine.error().message;
+      ASSERT_EQ(parameters.faceOrigin.size(), fine->numFaces());
+      ASSERT_EQ(parameters.cornerCoord.size(), fine->numCorners());
+      Result<LimitSurface> limit = LimitSurface::create(coarse, {2, uvSmooth});
+      ASSERT_TRUE(limit) << limit.error().message;
+      LimitSurface::Evaluator evaluator(*limit);
+      double worstPosition = 0, worstUv = 0;
+      for (std::size_t c = 0; c < fine->numCorners(); ++c) {
+        LimitPoint p;
+        ASSERT_TRUE(evaluator.evaluate(parameters.faceOrigin[c / 4], parameters.cornerSubFace[c],
+                                       cast<double>(parameters.cornerCoord[c]), p));
+        worstPosition = std::max(worstPosition,
+                                 length(p.position - at(*fine, fine->cornerVertex[c])));
+        worstUv = std::max(worstUv, std::sqrt(lengthSquared(p.uv[0] - cast<double>(fine->uvSets[0].uvs[c]))));
+      }
+      EXPECT_LT(worstPosition, 1e-6);  // float positions of size ~1
+      EXPECT_LT(worstUv, 1e-6);
+    }
+  }
 }
 
 }  // namespace
