@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "bake/height.hpp"
+#include "bake/limit_shader.hpp"
 #include "bake/raster.hpp"
 #include "bake/shaders.hpp"
 #include "bake/texel_frame.hpp"
@@ -212,6 +213,19 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
     return Error::badInput(where + ": the " + std::string(mapKindName(s.map)) +
                            " map needs tangent frames (none given)");
   }
+  if (input.limit != nullptr) {
+    const SurfaceParameters* p = input.limitParameters;
+    bool quads = true;  // face f owns corners 4f … 4f+3
+    for (std::size_t f = 0; f < mesh.faceStart.size(); ++f) quads = quads && mesh.faceStart[f] == 4 * f;
+    if (p == nullptr || !quads || p->faceOrigin.size() != mesh.numFaces() ||
+        p->cornerSubFace.size() != mesh.numCorners() ||
+        p->cornerCoord.size() != mesh.numCorners() ||
+        std::any_of(p->faceOrigin.begin(), p->faceOrigin.end(),
+                    [&](std::uint32_t f) { return f >= input.limit->numFaces(); })) {
+      return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
+                                     "(subdivideMesh with its SurfaceParameters)");
+    }
+  }
   return validateLayers(input.layers, static_cast<int>(mesh.uvSets.size()));
 }
 
@@ -231,17 +245,26 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   static constexpr float kZero[3] = {0, 0, 0};
   RasterOutput output{kZero, false};
   output.blank = blank;
+  // On a limit surface every sample is shaded from the surface under it (LimitShader).
+  const auto run = [&](auto shader) {
+    if (input.limit != nullptr) {
+      rasterize(job, LimitShader<decltype(shader)>(shader, input.limit, input.limitParameters),
+                output, target);
+    } else {
+      rasterize(job, shader, output, target);
+    }
+  };
   switch (settings.map) {
     case MapKind::kTangentNormal:
       output.background = kFlat;
-      rasterize(job, TangentNormalShader{base}, output, target);
+      run(TangentNormalShader{base});
       break;
-    case MapKind::kObjectNormal: rasterize(job, ObjectNormalShader{base}, output, target); break;
-    case MapKind::kHeight: rasterize(job, HeightShader{base}, output, target); break;
-    case MapKind::kDerivative: rasterize(job, DerivativeShader{base}, output, target); break;
-    case MapKind::kSurfaceGradient: rasterize(job, SurfaceGradientShader{base}, output, target); break;
-    case MapKind::kTangent: rasterize(job, TangentShader{base}, output, target); break;
-    case MapKind::kBitangent: rasterize(job, BitangentShader{base}, output, target); break;
+    case MapKind::kObjectNormal: run(ObjectNormalShader{base}); break;
+    case MapKind::kHeight: run(HeightShader{base}); break;
+    case MapKind::kDerivative: run(DerivativeShader{base}); break;
+    case MapKind::kSurfaceGradient: run(SurfaceGradientShader{base}); break;
+    case MapKind::kTangent: run(TangentShader{base}); break;
+    case MapKind::kBitangent: run(BitangentShader{base}); break;
     case MapKind::kMask:
       output.valueIsCoverage = true;
       rasterize(job, MaskShader{}, output, target);

@@ -43,6 +43,10 @@ struct BakeShaderBase {
 
   void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+    triangleChanged();
+  }
+  /// Updates what is derived from `tri` (after beginTriangle, or after LimitShader rewrote it).
+  void triangleChanged() {
     beginSurfacePoint(tri, point);
     for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s)
       preparedUv[s] = gradient_detail::prepareUvFrame(point.uv[s]);

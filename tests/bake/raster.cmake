@@ -6,7 +6,8 @@ sgbake_add_gtest(bake_raster_tests
   maps_test.cpp
   convert_test.cpp
   padding_test.cpp
-  shading_test.cpp)
+  shading_test.cpp
+  limit_bake_test.cpp)
 # rowSpan and the shaders, private to the library, are tested directly (rowSpan against the exact
 # inside test, shadeBatch against shade()).
 target_include_directories(bake_raster_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)

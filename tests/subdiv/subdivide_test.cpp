@@ -13,28 +13,16 @@
 
 #include "sgbake/core/math.hpp"
 #include "sgbake/mesh/normals.hpp"
+#include "support/bspline_torus.hpp"
 
 namespace sgbake {
 namespace {
 
-/// A mesh from faces of vertex indices; UVs are each corner's position x, y.
-Mesh meshOf(std::vector<Vec3f> positions, const std::vector<std::vector<std::uint32_t>>& faces) {
-  Mesh mesh;
-  mesh.source = "test.obj";
-  mesh.positions = std::move(positions);
-  UvSet uv{"UVMap", {}};
-  for (const auto& face : faces) {
-    for (const std::uint32_t v : face) {
-      mesh.cornerVertex.push_back(v);
-      uv.uvs.push_back({mesh.positions[v].x, mesh.positions[v].y});
-    }
-    mesh.faceStart.push_back(static_cast<std::uint32_t>(mesh.cornerVertex.size()));
-  }
-  mesh.uvSets.push_back(std::move(uv));
-  mesh.cornerNormals.resize(mesh.cornerVertex.size());
-  computeSmoothNormals(mesh);
-  return mesh;
-}
+using test::meshOf;
+using test::torusGrid;
+using test::torusGridWithUvs;
+using test::torusGridLimit;
+
 
 Mesh cube() {
   return meshOf({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
@@ -62,30 +50,6 @@ Mesh prism(std::uint32_t n) {
   return meshOf(std::move(positions), faces);
 }
 
-/// A closed torus of nu × nv quads with every vertex of valence 4 (one regular B-spline patch
-/// per face), its vertices displaced by a bumpy function so no symmetry hides an error.
-Mesh torusGrid(int nu, int nv) {
-  std::vector<Vec3f> positions;
-  for (int j = 0; j < nv; ++j) {
-    for (int i = 0; i < nu; ++i) {
-      const double a = 2 * kPi * i / nu, b = 2 * kPi * j / nv;
-      const double r = 0.35 + 0.05 * std::sin(3 * a + b);
-      positions.push_back({static_cast<float>((1 + r * std::cos(b)) * std::cos(a)),
-                           static_cast<float>((1 + r * std::cos(b)) * std::sin(a)),
-                           static_cast<float>(r * std::sin(b))});
-    }
-  }
-  const auto index = [&](int i, int j) {
-    return static_cast<std::uint32_t>(((j + nv) % nv) * nu + (i + nu) % nu);
-  };
-  std::vector<std::vector<std::uint32_t>> faces;
-  for (int j = 0; j < nv; ++j) {
-    for (int i = 0; i < nu; ++i) {
-      faces.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
-    }
-  }
-  return meshOf(std::move(positions), faces);
-}
 
 Vec3d at(const Mesh& mesh, std::uint32_t v) { return cast<double>(mesh.positions[v]); }
 
@@ -280,33 +244,7 @@ TEST(Subdivide, AResultTooLargeForAMeshIsAnErrorNotAnOverflow) {
             "(1073741823)");
 }
 
-/// The torus grid of torusGrid with UVs (i/nu, j/nv) per corner: a seam where the grid wraps.
-Mesh torusGridWithUvs(int nu, int nv) {
-  Mesh mesh = torusGrid(nu, nv);
-  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
-    const double i = static_cast<double>(f % static_cast<std::size_t>(nu));
-    const double j = static_cast<double>(f / static_cast<std::size_t>(nu));
-    const double di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
-    for (std::size_t k = 0; k < 4; ++k) {
-      mesh.uvSets[0].uvs[4 * f + k] = {static_cast<float>((i + di[k]) / nu),
-                                       static_cast<float>((j + dj[k]) / nv)};
-    }
-  }
-  return mesh;
-}
 
-/// The uniform cubic B-spline basis at t and its derivative.
-void bspline(double t, double w[4], double d[4]) {
-  const double u = 1 - t;
-  w[0] = u * u * u / 6;
-  w[1] = (3 * t * t * t - 6 * t * t + 4) / 6;
-  w[2] = (-3 * t * t * t + 3 * t * t + 3 * t + 1) / 6;
-  w[3] = t * t * t / 6;
-  d[0] = -u * u / 2;
-  d[1] = (9 * t * t - 12 * t) / 6;
-  d[2] = (-9 * t * t + 6 * t + 3) / 6;
-  d[3] = t * t / 2;
-}
 
 TEST(LimitSurface, RegularFacesAreTheBicubicBSplineWithItsDerivatives) {
   const int nu = 10, nv = 7;
@@ -315,25 +253,12 @@ TEST(LimitSurface, RegularFacesAreTheBicubicBSplineWithItsDerivatives) {
   ASSERT_TRUE(limit) << limit.error().message;
   EXPECT_EQ(limit->numFaces(), static_cast<std::size_t>(nu * nv));
   LimitSurface::Evaluator evaluator(*limit);
-  const auto grid = [&](int i, int j) {
-    return at(coarse, static_cast<std::uint32_t>(((j + nv) % nv) * nu + (i + nu) % nu));
-  };
   double worst = 0;
   for (int j = 0; j < nv; ++j) {
     for (int i = 0; i < nu; ++i) {
       for (const Vec2d st : {Vec2d{0.25, 0.6}, Vec2d{0, 1}, Vec2d{0.9, 0.05}}) {
-        double ws[4], ds[4], wt[4], dt[4];
-        bspline(st.x, ws, ds);
-        bspline(st.y, wt, dt);
-        Vec3d P{0, 0, 0}, Ps{0, 0, 0}, Pt{0, 0, 0};
-        for (int b = 0; b < 4; ++b) {
-          for (int a = 0; a < 4; ++a) {
-            const Vec3d c = grid(i - 1 + a, j - 1 + b);
-            P = P + (ws[a] * wt[b]) * c;
-            Ps = Ps + (ds[a] * wt[b]) * c;
-            Pt = Pt + (ws[a] * dt[b]) * c;
-          }
-        }
+        Vec3d P, Ps, Pt;
+        torusGridLimit(coarse, nu, nv, i, j, st.x, st.y, P, Ps, Pt);
         LimitPoint p;
         ASSERT_TRUE(evaluator.evaluate(static_cast<std::uint32_t>(j * nu + i), 0, st, p));
         worst = std::max({worst, length(p.position - P), length(p.dPds - Ps), length(p.dPdt - Pt)});

@@ -65,6 +65,7 @@
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/surface_gradient.hpp"
 #include "sgbake/mesh/mesh.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 namespace sgbake {
 
@@ -171,6 +172,13 @@ struct BakeInput {
   /// frame for tangent-space layers.
   const CornerTangents* tangents = nullptr;
   std::span<const Layer> layers;  ///< composited in order; textures must outlive the bake
+  /// With a limit surface, `mesh` is its tessellation (subdivideMesh of the same coarse mesh and
+  /// options, with `limitParameters`): the raster walks the tessellation, and every sample is
+  /// shaded from the exact limit surface at the point whose UV is the sample's (position,
+  /// normal, UVs and their derivatives; tangent frame: ∂P/∂u of UV set 0 made orthogonal to
+  /// the normal). Masks are the tessellation's coverage. Null: shade the mesh as it is.
+  const LimitSurface* limit = nullptr;
+  const SurfaceParameters* limitParameters = nullptr;
 };
 
 /// @brief Bakes one map. Texels no triangle covers get the map's background (tangent-space
