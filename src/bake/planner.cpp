@@ -33,6 +33,7 @@
 #include "sgbake/io/image_io.hpp"
 #include "sgbake/mesh/io.hpp"
 #include "sgbake/sgbake.h"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 namespace sgbake {
 namespace {
@@ -267,7 +268,13 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
   if (plan.loadMesh) {
     plan.steps.push_back({"load mesh " + scene.mesh.string() + ", UVs required",
                           "read by every output to bake: " + joinLabels(toBake)});
-    if (scene.subdivision.requested()) {
+    if (scene.subdivision.requested() && scene.subdivision.limit) {
+      plan.steps.push_back(
+          {"subdivide the mesh " + describeSubdivision(scene.subdivision) +
+               ": every sample is shaded on the exact surface, found through a level-" +
+               std::to_string(kLimitTessellationLevel) + " tessellation",
+           "the scene's \"subdivision\": {\"level\": \"limit\"}"});
+    } else if (scene.subdivision.requested()) {
       plan.steps.push_back({"subdivide the mesh " + describeSubdivision(scene.subdivision),
                             "the scene's \"subdivision\" block (Blender's Subdivision Surface "
                             "modifier)"});
@@ -474,11 +481,6 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   if (Status valid = validateScene(scene); !valid) {
     return Error::badInput(prefix + valid.error().message);
   }
-  if (scene.subdivision.present && scene.subdivision.limit) {
-    return Error::badInput(prefix +
-                           "subdivision: \"level\": \"limit\" is not supported yet (give a "
-                           "number of levels, 1 to " + std::to_string(kMaxSubdivisionLevel) + ")");
-  }
   if (Status ok = checkInputFile(scene, "mesh", "file", scene.mesh); !ok) return ok.error();
 
   Plan plan;
@@ -621,7 +623,9 @@ namespace {
 
 /// Everything loaded for a run; layers point into the textures and volumes held here.
 struct Loaded {
-  Mesh mesh;
+  Mesh mesh;  ///< as read, subdivided, or the tessellation of the limit surface
+  std::optional<LimitSurface> limit;  ///< "level": "limit": the surface the samples are shaded on
+  SurfaceParameters limitParameters;  ///< where mesh's corners lie on it
   std::vector<std::unique_ptr<ImageScalarTexture>> scalar;  ///< per plan texture (or null)
   std::vector<std::unique_ptr<ImageVectorTexture>> vector;  ///< per plan texture (or null)
   std::vector<std::unique_ptr<HeightVolume>> volumes;
@@ -990,16 +994,31 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   progress.start("loading " + s.mesh.string());
   // The mesh is parsed on a thread of its own while the images are decoded here: the two are
   // independent, and each is mostly serial. A bad mesh is still reported before a bad image.
-  std::future<Result<Mesh>> meshLoad = std::async(std::launch::async, [&s] {
+  std::future<Status> meshLoad = std::async(std::launch::async, [&s, &loaded]() -> Status {
     LoadOptions meshOptions;
     meshOptions.requireUvs = true;
-    if (s.subdivision.requested()) meshOptions.subdivision = s.subdivision.options();
-    return loadMesh(s.mesh, meshOptions);
+    if (s.subdivision.requested() && !s.subdivision.limit) {
+      meshOptions.subdivision = s.subdivision.options();
+    }
+    Result<Mesh> mesh = loadMesh(s.mesh, meshOptions);
+    if (!mesh) return mesh.error();
+    if (!(s.subdivision.present && s.subdivision.limit)) {
+      loaded.mesh = std::move(*mesh);
+      return Ok{};
+    }
+    // The limit surface, and the tessellation the raster walks to find it.
+    SubdivisionOptions limitOptions = s.subdivision.options();
+    limitOptions.level = kLimitTessellationLevel;
+    Result<LimitSurface> limit = LimitSurface::create(*mesh, limitOptions);
+    if (!limit) return limit.error();
+    Result<Mesh> tessellation = subdivideMesh(*mesh, limitOptions, &loaded.limitParameters);
+    if (!tessellation) return tessellation.error();
+    loaded.limit = std::move(*limit);
+    loaded.mesh = std::move(*tessellation);
+    return Ok{};
   });
   const Status textures = loadTextures(plan, loaded, progress, report);
-  Result<Mesh> mesh = meshLoad.get();
-  if (!mesh) return mesh.error();
-  loaded.mesh = std::move(*mesh);
+  if (Status mesh = meshLoad.get(); !mesh) return mesh.error();
   progress.finishOne();
   if (Status ok = checkUvSets(plan, loaded.mesh); !ok) return ok.error();
   if (!textures) return textures.error();
@@ -1092,6 +1111,10 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         input.mesh = &loaded.mesh;
         input.tangents = loaded.tangents ? &*loaded.tangents : nullptr;
         input.layers = layers;
+        if (loaded.limit) {
+          input.limit = &*loaded.limit;
+          input.limitParameters = &loaded.limitParameters;
+        }
         BakeSettings settings;
         settings.map = output.map;
         settings.width = output.width;

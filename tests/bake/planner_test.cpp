@@ -261,15 +261,6 @@ TEST_F(PlannerTest, ExplainListsStepsAndSkippedWork) {
   EXPECT_FALSE(fs::exists(dir_ / "n_out.png"));
 }
 
-TEST_F(PlannerTest, TheLimitSurfaceIsNotSupportedYet) {
-  Result<Plan> p = makePlan(scene(R"({"mesh": "plane.obj", "subdivision": {"level": "limit"},
-                                      "outputs": [{"map": "mask", "file": "m.png"}]})"));
-  ASSERT_FALSE(p);
-  EXPECT_EQ(p.error().code, ErrorCode::kBadInput);
-  EXPECT_NE(p.error().message.find("\"limit\" is not supported yet"), std::string::npos)
-      << p.error().message;
-}
-
 TEST_F(PlannerTest, ExplainSaysTheMeshIsSubdivided) {
   Result<Plan> p = makePlan(scene(R"({"mesh": "plane.obj", "subdivision": {"level": 2},
                                       "outputs": [{"map": "mask", "file": "m.png"}]})"));
@@ -278,6 +269,14 @@ TEST_F(PlannerTest, ExplainSaysTheMeshIsSubdivided) {
   EXPECT_NE(text.find("subdivide the mesh to level 2 (uv_smooth keep-boundaries, boundary all)"),
             std::string::npos)
       << text;
+  Result<Plan> limit = makePlan(scene(R"({"mesh": "plane.obj", "subdivision": {"level": "limit"},
+                                          "outputs": [{"map": "mask", "file": "m.png"}]})"));
+  ASSERT_TRUE(limit) << limit.error().message;
+  const std::string limitText = explainPlan(*limit);
+  EXPECT_NE(limitText.find("subdivide the mesh to the limit surface (uv_smooth keep-boundaries, "
+                           "boundary all): every sample is shaded on the exact surface"),
+            std::string::npos)
+      << limitText;
 }
 
 TEST_F(PlannerTest, MissingInputsAreNamed) {

@@ -12,6 +12,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -128,9 +129,9 @@ TEST_F(BakeCliTest, BadScenesExitTwoNamingTheProblemAndCreateNothing) {
                  dir_);
   expectBadScene(bakeScene(planeScene(kHeightLayer, "{" + std::string(out) + "}", "nouv.obj")),
                  "nouv.obj", before, dir_);
-  expectBadScene(bakeScene(R"({"mesh": "plane.obj", "subdivision": {"level": "limit"},
+  expectBadScene(bakeScene(R"({"mesh": "plane.obj", "subdivision": {"level": "limt"},
                               "outputs": [{"map": "mask", "file": "m.png"}]})"),
-                 "\"limit\" is not supported yet", before, dir_);
+                 "subdivision", before, dir_);
   expectBadScene(bakeScene("{\"mesh\": "), "invalid JSON", before, dir_);
   // The scene file itself.
   const ProcessResult missing = run({"bake", (dir_ / "none.json").string()});
@@ -398,6 +399,19 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   }
   // Subdividing rounds the cube: its object-space normals are no longer the six face normals.
   EXPECT_FALSE(readPixels(dir_ / "l2.exr") == readPixels(dir_ / "l0.exr"));
+  // "limit": the exact surface under every texel; close to level 2, not the same.
+  const auto limitScene = [&](const std::string& file) {
+    return R"({"mesh": "cube.obj", "subdivision": {"level": "limit"}, "outputs": [{"map": )"
+           R"("object-normal", "file": ")" + file + R"(", "size": 64, "margin": 0, "bit_depth": 32}]})";
+  };
+  ASSERT_EQ(bakeScene(limitScene("limit.exr")).exitCode, 0);
+  const std::vector<float> limit = readPixels(dir_ / "limit.exr"), l2 = readPixels(dir_ / "l2.exr");
+  ASSERT_EQ(limit.size(), l2.size());
+  double meanDifference = 0;
+  for (std::size_t i = 0; i < limit.size(); ++i) meanDifference += std::abs(limit[i] - l2[i]);
+  meanDifference /= static_cast<double>(limit.size());
+  EXPECT_GT(meanDifference, 0.0);
+  EXPECT_LT(meanDifference, 0.01);
   // A different level is a different bake (the manifest hashes the subdivision block).
   const ProcessResult same = bakeScene(scene(2, "l2.exr"));
   EXPECT_NE(same.out.find("up to date: " + (dir_ / "l2.exr").string()), std::string::npos)

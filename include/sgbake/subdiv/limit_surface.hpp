@@ -14,6 +14,11 @@
 
 namespace sgbake {
 
+/// @brief The level of the tessellation a limit-surface bake rasterizes (to find which texels a
+/// face covers, and where to start looking for each sample's point): Newton's method then
+/// starts within a few thousandths of a face of its answer.
+inline constexpr int kLimitTessellationLevel = 3;
+
 /// @brief The limit surface and its UV sets at one point, with first derivatives along the
 /// normalized coordinates (s, t) ∈ [0,1]² of the (sub-)face (see SurfaceParameters).
 struct LimitPoint {
