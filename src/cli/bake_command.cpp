@@ -55,13 +55,14 @@ struct BakeArguments {
   bool alpha = false;
   std::optional<double> range;
   SubdivisionOptions subdivision;  ///< level 0: none
+  bool limitSurface = false;       ///< --subdivide limit
 };
 
 constexpr const char* kFooter =
     "Scene file (JSON; relative paths are relative to the scene file):\n"
     "  { \"mesh\": \"m.obj\", \"uv\": 0,\n"
-    "    \"subdivision\": {\"level\": 2, \"uv_smooth\": \"keep-boundaries\", \"boundary\": "
-    "\"all\"},\n"
+    "    \"subdivision\": {\"level\": 2 (or \"limit\"), \"uv_smooth\": \"keep-boundaries\", "
+    "\"boundary\": \"all\"},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -227,7 +228,8 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   Scene scene;
   scene.mesh = args.mesh;
   scene.uvSet = args.uvSet;
-  scene.subdivision.present = args.subdivision.level > 0;
+  scene.subdivision.present = args.subdivision.level > 0 || args.limitSurface;
+  scene.subdivision.limit = args.limitSurface;
   scene.subdivision.level = args.subdivision.level;
   scene.subdivision.uvSmooth = args.subdivision.uvSmooth;
   scene.subdivision.boundary = args.subdivision.boundary;
@@ -416,7 +418,7 @@ CommandAction defineBakeCommand(CLI::App& app) {
   app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif; '<UDIM>' allowed)")
       ->type_name("FILE")
       ->group(oneMap);
-  addSubdivisionOptions(app, args->subdivision, oneMap);
+  addSubdivisionOptions(app, args->subdivision, oneMap, &args->limitSurface);
   app.add_option("--map", args->map,
                  "tangent-normal, object-normal, height, derivative, surface-gradient, tangent, "
                  "bitangent, mask or corners")

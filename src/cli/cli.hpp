@@ -64,9 +64,10 @@ extern const CLI::Validator kNonNegativeInteger;
 
 /// @brief Adds --subdivide N, --uv-smooth NAME and --boundary-smooth NAME (Blender's
 /// Subdivision Surface modifier, see subdivideMesh), bound to @p options; level 0 (the default)
-/// means no subdivision. Non-empty @p group files them under that heading of --help.
+/// means no subdivision. Non-empty @p group files them under that heading of --help. With
+/// @p limit, --subdivide also takes "limit", which sets *limit (and level 0).
 void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
-                           const std::string& group = {});
+                           const std::string& group = {}, bool* limit = nullptr);
 
 /// @brief Measures wall-clock seconds since construction or the last lap().
 class Stopwatch {

@@ -53,15 +53,45 @@ std::map<std::string, E> nameMap(const Named<E> (&table)[N]) {
 
 }  // namespace
 
-void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
-                           const std::string& group) {
+void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std::string& group,
+                           bool* limit) {
   options.level = 0;
-  CLI::Option* const level = app.add_option("--subdivide", options.level,
-                 "Subdivide the mesh first, as Blender's Subdivision Surface modifier with this "
-                 "many levels (0 = not at all)")
-      ->type_name("N")
-      ->check(CLI::Range(0, kMaxSubdivisionLevel))
-      ->capture_default_str();
+  CLI::Option* level = nullptr;
+  if (limit == nullptr) {
+    level = app.add_option("--subdivide", options.level,
+                           "Subdivide the mesh first, as Blender's Subdivision Surface modifier "
+                           "with this many levels (0 = not at all)")
+                ->type_name("N")
+                ->check(CLI::Range(0, kMaxSubdivisionLevel))
+                ->capture_default_str();
+  } else {
+    *limit = false;
+    level = app.add_option_function<std::string>(
+                   "--subdivide",
+                   [&options, limit](const std::string& value) {
+                     *limit = value == "limit";
+                     options.level = *limit ? 0 : std::stoi(value);
+                   },
+                   "Subdivide the mesh first, as Blender's Subdivision Surface modifier with "
+                   "this many levels (0 = not at all), or bake from its exact limit surface "
+                   "('limit')")
+                ->type_name("N|limit")
+                ->check(CLI::Validator(
+                    [](std::string& value) -> std::string {
+                      if (value == "limit") return {};
+                      try {
+                        std::size_t used = 0;
+                        const int n = std::stoi(value, &used);
+                        if (used == value.size() && n >= 0 && n <= kMaxSubdivisionLevel) return {};
+                      } catch (const std::exception&) {
+                        // Not a number: reported below.
+                      }
+                      return "'" + value + "' is neither a level 0 to " +
+                             std::to_string(kMaxSubdivisionLevel) + " nor 'limit'";
+                    },
+                    ""))
+                ->default_str("0");
+  }
   CLI::Option* const uvSmooth = app.add_option("--uv-smooth", options.uvSmooth,
                  "The modifier's UV Smooth: none, keep-corners, keep-corners-junctions, "
                  "keep-corners-junctions-concave, keep-boundaries, all")

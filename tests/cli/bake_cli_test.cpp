@@ -412,6 +412,11 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   meanDifference /= static_cast<double>(limit.size());
   EXPECT_GT(meanDifference, 0.0);
   EXPECT_LT(meanDifference, 0.01);
+  const ProcessResult flag = run({"bake", "--mesh", mesh, "--map", "object-normal", "--size", "64",
+                                  "--margin", "0", "--bit-depth", "32", "--subdivide", "limit",
+                                  "--no-manifest", "-o", (dir_ / "limit_flag.exr").string()});
+  ASSERT_EQ(flag.exitCode, 0) << flag.err;
+  EXPECT_TRUE(readPixels(dir_ / "limit_flag.exr") == limit);
   // A different level is a different bake (the manifest hashes the subdivision block).
   const ProcessResult same = bakeScene(scene(2, "l2.exr"));
   EXPECT_NE(same.out.find("up to date: " + (dir_ / "l2.exr").string()), std::string::npos)
@@ -434,6 +439,8 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   const std::set<std::string> before = listDirectory(dir_);
   for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
            {"bake", "--mesh", mesh, "--subdivide", "7", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "limt", "-o", (dir_ / "o.png").string()},
+           {"tangents", mesh, "--subdivide", "limit", "-o", (dir_ / "t.csv").string()},
            {"bake", "--mesh", mesh, "--subdivide", "1", "--uv-smooth", "smooth", "-o",
             (dir_ / "o.png").string()},
            {"tangents", mesh, "--subdivide", "-1", "-o", (dir_ / "t.csv").string()},
