@@ -78,8 +78,8 @@ enum class PaddingMode {
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
-/// (subdivideMesh) before anything is baked. "level": "limit" is parsed but not implemented yet
-/// (the planner reports it as unsupported).
+/// (subdivideMesh) before anything is baked, or with "level": "limit" the exact limit surface
+/// under every sample (LimitSurface, BakeInput::limit).
 struct SceneSubdivision {
   bool present = false;  ///< the scene has a "subdivision" block
   bool limit = false;    ///< "level": "limit" — the limit surface
