@@ -2,6 +2,7 @@
 /// @brief `sgbake`: the command-line tool. Parses the command line, dispatches to a subcommand
 /// from the table below, and turns errors into one line on stderr and an exit code.
 #include <malloc.h>
+
 #include <cctype>
 #include <cstdio>
 #include <exception>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include "cli.hpp"
 #include "sgbake/sgbake.h"
@@ -133,14 +135,11 @@ int run(int argc, char** argv) {
 }  // namespace
 }  // namespace sgbake::cli
 
-int main(int argc, char** argv) {
-  // Keep freed memory for reuse instead of returning it to the kernel: a run allocates and frees
-  // hundreds of MB phase after phase (mesh parsing, tangents, images), and every fresh page
-  // costs a page fault and a zeroing in the kernel.
-  ::mallopt(M_MMAP_THRESHOLD, 1 << 30);
-  ::mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  // Nothing may escape as a crash with a multi-line message: anything thrown is an internal
-  // error (the library reports bad input as values, never by throwing).
+namespace {
+
+/// sgbake::cli::run, where nothing may escape as a crash with a multi-line message: anything
+/// thrown is an internal error (the library reports bad input as values, never by throwing).
+int runCatchingEverything(int argc, char** argv) {
   try {
     return sgbake::cli::run(argc, argv);
   } catch (const std::bad_alloc&) {
@@ -151,4 +150,21 @@ int main(int argc, char** argv) {
     sgbake::cli::printError("internal error: unknown exception");
   }
   return sgbake::cli::kExitInternal;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Keep freed memory for reuse instead of returning it to the kernel: a run allocates and frees
+  // hundreds of MB phase after phase (mesh parsing, tangents, images), and every fresh page
+  // costs a page fault and a zeroing in the kernel.
+  ::mallopt(M_MMAP_THRESHOLD, 1 << 30);
+  ::mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  // TBB's worker threads are joined before the process exits (below), so that it ends with one
+  // thread: exit handlers (and leak checkers, which stop every thread to scan their stacks) never
+  // run while workers are still being torn down.
+  tbb::task_scheduler_handle scheduler{tbb::attach{}};
+  const int code = runCatchingEverything(argc, argv);
+  tbb::finalize(scheduler, std::nothrow);  // false (nothing joined) is harmless
+  return code;
 }
