@@ -88,6 +88,18 @@ std::vector<Vec3f> computeFaceNormals(const MeshView& mesh) {
   return normals;
 }
 
+VertexCorners cornersByVertex(std::span<const std::uint32_t> cornerVertex,
+                              std::size_t numVertices) {
+  VertexCorners result;
+  result.start.assign(numVertices + 1, 0);
+  result.corners.resize(cornerVertex.size());
+  for (const std::uint32_t v : cornerVertex) ++result.start[v + 1];
+  for (std::size_t v = 0; v < numVertices; ++v) result.start[v + 1] += result.start[v];
+  std::vector<std::uint32_t> fill(result.start.begin(), result.start.end() - 1);
+  for (std::uint32_t c = 0; c < cornerVertex.size(); ++c) result.corners[fill[cornerVertex[c]]++] = c;
+  return result;
+}
+
 void computeSmoothNormals(Mesh& mesh) {
   const MeshView view = mesh.view();
   const std::size_t numCorners = mesh.numCorners(), numVertices = mesh.numVertices();
@@ -109,19 +121,13 @@ void computeSmoothNormals(Mesh& mesh) {
   });
   // Each vertex's corners in corner order (a counting sort), so that its sum adds them in the
   // same order whatever the threads: the normals do not depend on the number of threads.
-  std::vector<std::uint32_t> start(numVertices + 1, 0), corners(numCorners);
-  for (const std::uint32_t v : mesh.cornerVertex) ++start[v + 1];
-  for (std::size_t v = 0; v < numVertices; ++v) start[v + 1] += start[v];
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::uint32_t c = 0; c < numCorners; ++c) corners[fill[mesh.cornerVertex[c]]++] = c;
-  }
+  const VertexCorners byVertex = cornersByVertex(mesh.cornerVertex, numVertices);
   std::vector<Vec3f> vertexNormals(numVertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, numVertices, 4096),
                     [&](const tbb::blocked_range<std::size_t>& vertices) {
     for (std::size_t v = vertices.begin(); v != vertices.end(); ++v) {
       Vec3d sum{0, 0, 0};
-      for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) sum += weighted[corners[k]];
+      for (const std::uint32_t c : byVertex.of(v)) sum += weighted[c];
       const Vec3d fallback = normalizeOr(cast<double>(mesh.positions[v]), kOriginVertexNormal);
       vertexNormals[v] = cast<float>(normalizeOr(sum, fallback));
     }

@@ -45,25 +45,19 @@ osd::Sdc::Options sdcOptions(const SubdivisionOptions& options) {
 /// Groups each vertex's corners by UV (within kUvConnectLimit of the group's first corner, in
 /// both coordinates), as Blender's mesh converter does.
 FVarChannel weldUvs(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
-  const std::size_t nv = mesh.numVertices(), nc = mesh.numCorners();
-  // Corners of each vertex, in corner order (counting sort).
-  std::vector<std::uint32_t> start(nv + 1, 0), corners(nc);
-  for (const std::uint32_t v : mesh.cornerVertex) ++start[v + 1];
-  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  for (std::uint32_t c = 0; c < nc; ++c) corners[fill[mesh.cornerVertex[c]]++] = c;
-
+  const VertexCorners byVertex = cornersByVertex(mesh.cornerVertex, mesh.numVertices());
   FVarChannel channel;
-  channel.cornerValue.assign(nc, -1);
-  for (std::size_t v = 0; v < nv; ++v) {
-    for (std::uint32_t a = start[v]; a < start[v + 1]; ++a) {
+  channel.cornerValue.assign(mesh.numCorners(), -1);
+  for (std::size_t v = 0; v < mesh.numVertices(); ++v) {
+    const std::span<const std::uint32_t> corners = byVertex.of(v);
+    for (std::size_t a = 0; a < corners.size(); ++a) {
       const std::uint32_t first = corners[a];
       if (channel.cornerValue[first] >= 0) continue;
       const int value = static_cast<int>(channel.values.size() / 2);
       channel.values.push_back(uvs[first].x);
       channel.values.push_back(uvs[first].y);
       channel.cornerValue[first] = value;
-      for (std::uint32_t b = a + 1; b < start[v + 1]; ++b) {
+      for (std::size_t b = a + 1; b < corners.size(); ++b) {
         const std::uint32_t other = corners[b];
         if (channel.cornerValue[other] < 0 &&
             std::fabs(uvs[other].x - uvs[first].x) < kUvConnectLimit &&

@@ -70,4 +70,19 @@ struct Mesh {
   }
 };
 
+/// @brief Each vertex's corners, in corner order: corners[start[v] … start[v+1]) are those of
+/// vertex v (a counting sort of MeshView::cornerVertex).
+struct VertexCorners {
+  std::vector<std::uint32_t> start;    ///< #V+1
+  std::vector<std::uint32_t> corners;  ///< #C
+
+  /// @brief The corners of vertex @p v, ascending.
+  std::span<const std::uint32_t> of(std::size_t v) const {
+    return {corners.data() + start[v], corners.data() + start[v + 1]};
+  }
+};
+
+/// @brief The corners of every vertex of @p mesh (whose corner vertices are < @p numVertices).
+VertexCorners cornersByVertex(std::span<const std::uint32_t> cornerVertex, std::size_t numVertices);
+
 }  // namespace sgbake
