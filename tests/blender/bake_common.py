@@ -181,6 +181,12 @@ def reset_scene():
             coll.remove(item)
 
 
+def set_smooth(ob, smooth):
+    """Shades every face of the object smooth (vertex normals) or flat (face normals)."""
+    ob.data.polygons.foreach_set("use_smooth", [smooth] * len(ob.data.polygons))
+    ob.data.update()
+
+
 def new_float_image(name, width, height, array=None, colour=(0.0, 0.0, 0.0, 1.0)):
     """A 32-bit float, Non-Color (is_data) RGBA image. `array` (H, W, 1..4), rows top first,
     fills it (missing channels: RGB repeat the first, alpha 1); otherwise the flat `colour`."""

@@ -85,11 +85,6 @@ def case(name, size, scale, subdivision=0):
     return register
 
 
-def set_smooth(ob, smooth):
-    ob.data.polygons.foreach_set("use_smooth", [smooth] * len(ob.data.polygons))
-    ob.data.update()
-
-
 def apply_subdivision(ob, levels):
     mod = ob.modifiers.new("Subdivision", "SUBSURF")
     mod.levels = levels
@@ -104,7 +99,7 @@ def build_suzanne():
     bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
     ob = bpy.context.object
     apply_subdivision(ob, 1)
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -115,7 +110,7 @@ def build_suzanne_live():
     mesh.obj is the coarse Suzanne (500 faces, triangles among them), sgbake subdivides it."""
     bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     mod = ob.modifiers.new("Subdivision", "SUBSURF")
     mod.levels = SUBDIVISION["suzanne_live"]
     mod.render_levels = SUBDIVISION["suzanne_live"]
@@ -129,7 +124,7 @@ def build_suzanne2():
     bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
     ob = bpy.context.object
     apply_subdivision(ob, 2)
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -139,7 +134,7 @@ def build_sphere():
     seam, tangents that degenerate towards the poles."""
     bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=1.0, calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -149,7 +144,7 @@ def build_cube_flat():
     uses the face normal, and neighbouring faces in one UV island have different normals."""
     bpy.ops.mesh.primitive_cube_add(size=2.0, calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, False)
+    bake_common.set_smooth(ob, False)
     return ob
 
 

@@ -32,25 +32,8 @@ import bpy
 
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import objio  # noqa: E402  (needs the sys.path entry above)
-
-
-# ---------------------------------------------------------------------------------------------
-# Helpers
-
-
-def reset_scene():
-    """Removes every object and mesh so each mesh starts from an empty scene."""
-    for ob in list(bpy.data.objects):
-        bpy.data.objects.remove(ob, do_unlink=True)
-    for me in list(bpy.data.meshes):
-        bpy.data.meshes.remove(me)
-
-
-def set_smooth(ob):
-    """Shades every face of the object smooth (the modifier keeps the shading)."""
-    ob.data.polygons.foreach_set("use_smooth", [True] * len(ob.data.polygons))
-    ob.data.update()
+import bake_common  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
 
 
 # ---------------------------------------------------------------------------------------------
@@ -164,9 +147,9 @@ def main():
     manifest = {"blender": bpy.app.version_string, "python": sys.executable, "meshes": {},
                 "cases": []}
     for name, build in MESHES:
-        reset_scene()
+        bake_common.reset_scene()
         ob = build()
-        set_smooth(ob)
+        bake_common.set_smooth(ob, True)
         manifest["meshes"][name] = write_coarse(name, ob, out_dir)
         mod = ob.modifiers.new("Subdivision", "SUBSURF")
         mod.subdivision_type = "CATMULL_CLARK"

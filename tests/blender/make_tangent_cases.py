@@ -27,25 +27,12 @@ import bpy
 
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import objio  # noqa: E402  (needs the sys.path entry above)
+import bake_common  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
 
 
 # ---------------------------------------------------------------------------------------------
 # Helpers
-
-
-def reset_scene():
-    """Removes every object and mesh so each case starts from an empty scene."""
-    for ob in list(bpy.data.objects):
-        bpy.data.objects.remove(ob, do_unlink=True)
-    for me in list(bpy.data.meshes):
-        bpy.data.meshes.remove(me)
-
-
-def set_smooth(ob, smooth):
-    """Shades every face of the object smooth (vertex normals) or flat (face normals)."""
-    ob.data.polygons.foreach_set("use_smooth", [smooth] * len(ob.data.polygons))
-    ob.data.update()
 
 
 def triangulate_ngons(me):
@@ -89,7 +76,7 @@ def case_suzanne_flat():
 def case_suzanne_smooth():
     bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -107,7 +94,7 @@ def case_uv_sphere():
     """UV sphere: quads plus triangle fans at the poles, one UV seam."""
     bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -115,7 +102,7 @@ def case_torus():
     """Torus: all quads, UVs stretched unevenly (quads split on the shorter UV diagonal)."""
     bpy.ops.mesh.primitive_torus_add(major_segments=48, minor_segments=12, generate_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -124,7 +111,7 @@ def case_torus_dense():
     MikkTSpace on several threads, whatever it counts (faces or triangles)."""
     bpy.ops.mesh.primitive_torus_add(major_segments=128, minor_segments=80, generate_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -132,7 +119,7 @@ def case_cube_flat():
     """The default cube: six flat quads, every vertex split by normal and by UV."""
     bpy.ops.mesh.primitive_cube_add(calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, False)
+    bake_common.set_smooth(ob, False)
     return ob
 
 
@@ -141,7 +128,7 @@ def case_cylinder_autosmooth():
     normals differ at the cap rims, so the same position carries several normals."""
     bpy.ops.mesh.primitive_cylinder_add(vertices=24, end_fill_type="NGON", calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     ob.data.use_auto_smooth = True
     ob.data.auto_smooth_angle = math.radians(30.0)
     return ob
@@ -155,7 +142,7 @@ def case_grid_mirrored_uv():
                                     calc_uvs=True)
     ob = bpy.context.object
     displace_grid(ob)
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     me = ob.data
     uv = me.uv_layers.active.data
     for poly in me.polygons:
@@ -195,7 +182,7 @@ def case_collapsed_vertices():
     bm.to_mesh(ob.data)
     bm.free()
     ob.data.update()
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     return ob
 
 
@@ -205,7 +192,7 @@ def case_collapsed_uvs():
     zero-area half)."""
     bpy.ops.mesh.primitive_uv_sphere_add(segments=24, ring_count=12, calc_uvs=True)
     ob = bpy.context.object
-    set_smooth(ob, True)
+    bake_common.set_smooth(ob, True)
     me = ob.data
     uv = me.uv_layers.active.data
     for poly in me.polygons:
@@ -282,7 +269,7 @@ def main():
     for name, build in CASES:
         if only and name not in only:
             continue
-        reset_scene()
+        bake_common.reset_scene()
         info = write_case(name, build(), out_dir)
         manifest.append(info)
         print("case %-20s faces %6d corners %6d (tris %d, quads %d, sign -1: %d, "
