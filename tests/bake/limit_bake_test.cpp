@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "sgbake/bake/bake.hpp"
@@ -50,16 +52,33 @@ BakeSettings objectNormals() {
   return settings;
 }
 
-TEST(LimitBake, ObjectNormalsAreTheLimitSurfaceNormals) {
-  const Mesh coarse = test::torusGridWithUvs(kNu, kNv);
-  const SubdivisionOptions options{2, SubdivisionUvSmooth::kNone};
-  Result<LimitSurface> limit = LimitSurface::create(coarse, options);
-  ASSERT_TRUE(limit) << limit.error().message;
+/// The limit surface of the torus grid and the tessellation a limit bake walks (as the planner
+/// makes them for "level": "limit").
+struct LimitScene {
+  Mesh coarse = test::torusGridWithUvs(kNu, kNv);
+  std::optional<LimitSurface> limit;
   SurfaceParameters parameters;
-  Result<Mesh> tessellation = subdivideMesh(coarse, options, &parameters);
-  ASSERT_TRUE(tessellation) << tessellation.error().message;
-  BakeInput input{&*tessellation, nullptr, {}, &*limit, &parameters};
-  Result<FloatImage> baked = bakeMap(input, objectNormals());
+  Mesh tessellation;
+
+  explicit LimitScene(const SubdivisionOptions& options) {
+    Result<LimitSurface> surface = LimitSurface::create(coarse, options);
+    EXPECT_TRUE(surface) << surface.error().message;
+    if (surface) limit = std::move(*surface);
+    Result<Mesh> mesh = subdivideMesh(coarse, options, &parameters);
+    EXPECT_TRUE(mesh) << mesh.error().message;
+    if (mesh) tessellation = std::move(*mesh);
+  }
+  bool ok() const { return limit.has_value() && tessellation.numFaces() > 0; }
+  BakeInput input(const CornerTangents* tangents = nullptr) const {
+    return {&tessellation, tangents, {}, &*limit, &parameters};
+  }
+};
+
+TEST(LimitBake, ObjectNormalsAreTheLimitSurfaceNormals) {
+  const LimitScene scene({2, SubdivisionUvSmooth::kNone});
+  ASSERT_TRUE(scene.ok());
+  const Mesh& coarse = scene.coarse;
+  Result<FloatImage> baked = bakeMap(scene.input(), objectNormals());
   ASSERT_TRUE(baked) << baked.error().message;
   int covered = 0;
   const double limitError = worstNormalError(*baked, coarse, covered);
@@ -83,19 +102,14 @@ TEST(LimitBake, ObjectNormalsAreTheLimitSurfaceNormals) {
 }
 
 TEST(LimitBake, TangentSpaceBakeIsFlatWithoutLayersAndThreadsGiveTheSameBits) {
-  const Mesh coarse = test::torusGridWithUvs(kNu, kNv);
-  const SubdivisionOptions options{3, SubdivisionUvSmooth::kKeepBoundaries};
-  Result<LimitSurface> limit = LimitSurface::create(coarse, options);
-  ASSERT_TRUE(limit) << limit.error().message;
-  SurfaceParameters parameters;
-  Result<Mesh> tessellation = subdivideMesh(coarse, options, &parameters);
-  ASSERT_TRUE(tessellation) << tessellation.error().message;
-  Result<CornerTangents> tangents = computeTangents(tessellation->view(0));
+  const LimitScene scene({3, SubdivisionUvSmooth::kKeepBoundaries});
+  ASSERT_TRUE(scene.ok());
+  Result<CornerTangents> tangents = computeTangents(scene.tessellation.view(0));
   ASSERT_TRUE(tangents);
   BakeSettings settings = objectNormals();
   settings.map = MapKind::kTangentNormal;
   settings.threads = 1;
-  const BakeInput input{&*tessellation, &*tangents, {}, &*limit, &parameters};
+  const BakeInput input = scene.input(&*tangents);
   Result<FloatImage> one = bakeMap(input, settings);
   settings.threads = 2;
   Result<FloatImage> two = bakeMap(input, settings);
@@ -110,7 +124,8 @@ TEST(LimitBake, TangentSpaceBakeIsFlatWithoutLayersAndThreadsGiveTheSameBits) {
   }
   // A mesh that is not the tessellation is refused.
   const Mesh other = test::torusGridWithUvs(kNu, kNv);
-  Result<FloatImage> refused = bakeMap({&other, nullptr, {}, &*limit, &parameters}, objectNormals());
+  Result<FloatImage> refused =
+      bakeMap({&other, nullptr, {}, &*scene.limit, &scene.parameters}, objectNormals());
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.error().message.find("not a tessellation of the limit surface"),
             std::string::npos);
