@@ -366,35 +366,36 @@ def compare_all(cli, work):
           "angle in degrees; sgn = sign mismatches;\n* = tangents asserted")
     print(HEADER)
     failures = []
-    for tag, case in cases.items():
-        result = run_sgbake(cli, work, case, {}, tag)
+    def run_and_compare(tag, overrides, out_tag):
+        """sgbake on Blender's case `tag` with `overrides`; (figures, failed checks), or the
+        reason it could not be compared as a string."""
+        case = cases[tag]
+        result = run_sgbake(cli, work, case, overrides, out_tag)
         if isinstance(result, str):
-            failures.append(f"{tag}: {result}")
-            print("%-45s sgbake failed" % tag)
-            continue
+            return f"sgbake failed: {result}"
         try:
-            fig, fails = compare(case, manifest["meshes"][case["mesh"]]["valence2"],
-                                 np.load(os.path.join(work, tag + ".npz")), *result)
+            return compare(case, manifest["meshes"][case["mesh"]]["valence2"],
+                           np.load(os.path.join(work, tag + ".npz")), *result)
         except (OSError, ValueError) as exc:
-            failures.append(f"{tag}: {exc}")
-            print("%-45s cannot compare: %s" % (tag, exc))
+            return f"cannot compare: {exc}"
+
+    for tag in cases:
+        outcome = run_and_compare(tag, {}, tag)
+        if isinstance(outcome, str):
+            failures.append(f"{tag}: {outcome}")
+            print("%-45s %s" % (tag, outcome))
             continue
+        fig, fails = outcome
         print(table_row(tag, fig, fails))
         failures += [f"{tag}: {check}: {message}" for check, message in fails]
 
     for name, tag, overrides, must_fail in CONTROLS:
         options = " ".join(f"{k} {v}" for k, v in overrides.items())
-        case = cases[tag]
-        result = run_sgbake(cli, work, case, overrides, "control_" + name)
-        if isinstance(result, str):
-            failures.append(f"control {name}: {result}")
+        outcome = run_and_compare(tag, overrides, "control_" + name)
+        if isinstance(outcome, str):
+            failures.append(f"control {name}: {outcome}")
             continue
-        try:
-            _, fails = compare(case, manifest["meshes"][case["mesh"]]["valence2"],
-                               np.load(os.path.join(work, tag + ".npz")), *result)
-        except (OSError, ValueError) as exc:
-            failures.append(f"control {name}: {exc}")
-            continue
+        _, fails = outcome
         failed = [message for check, message in fails if check == must_fail]
         if failed:
             print(f"control {name} (sgbake {options} vs Blender's {tag}): control failed as "
