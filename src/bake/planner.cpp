@@ -268,7 +268,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
   if (plan.loadMesh) {
     plan.steps.push_back({"load mesh " + scene.mesh.string() + ", UVs required",
                           "read by every output to bake: " + joinLabels(toBake)});
-    if (scene.subdivision.requested() && scene.subdivision.limit) {
+    if (scene.subdivision.limitSurface()) {
       plan.steps.push_back(
           {"subdivide the mesh " + describeSubdivision(scene.subdivision) +
                ": every sample is shaded on the exact surface, found through a level-" +
@@ -997,12 +997,12 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   std::future<Status> meshLoad = std::async(std::launch::async, [&s, &loaded]() -> Status {
     LoadOptions meshOptions;
     meshOptions.requireUvs = true;
-    if (s.subdivision.requested() && !s.subdivision.limit) {
+    if (s.subdivision.requested() && !s.subdivision.limitSurface()) {
       meshOptions.subdivision = s.subdivision.options();
     }
     Result<Mesh> mesh = loadMesh(s.mesh, meshOptions);
     if (!mesh) return mesh.error();
-    if (!(s.subdivision.present && s.subdivision.limit)) {
+    if (!s.subdivision.limitSurface()) {
       loaded.mesh = std::move(*mesh);
       return Ok{};
     }

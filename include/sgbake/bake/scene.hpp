@@ -88,6 +88,8 @@ struct SceneSubdivision {
   SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
   /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
   bool requested() const { return present && (limit || level > 0); }
+  /// @brief Whether the samples are shaded on the exact limit surface ("level": "limit").
+  bool limitSurface() const { return present && limit; }
   /// @brief The options of subdivideMesh this block stands for (a number of levels).
   SubdivisionOptions options() const { return {level, uvSmooth, boundary}; }
 };
