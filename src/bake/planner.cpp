@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bake/prepare.hpp"
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/frames/tangents.hpp"
@@ -44,30 +45,10 @@ namespace fs = std::filesystem;
 /// Version of the manifest's layout ("sgbake_manifest": 1).
 constexpr int kManifestVersion = 1;
 
-/// Seconds since @p start.
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// "scene.json: " for scenes read from a file, "" for scenes built in code.
-std::string scenePrefix(const Scene& scene) {
-  return scene.source.empty() ? std::string() : scene.source.string() + ": ";
-}
-
-std::string layerLabel(std::size_t i) { return "layers[" + std::to_string(i) + "]"; }
-std::string outputLabel(std::size_t i) { return "outputs[" + std::to_string(i) + "]"; }
-
-/// How an image output is padded: masks not at all (padding would overwrite the coverage they
-/// show), else push-pull or Extend by `margin` texels.
-struct OutputPadding {
-  bool pushPull = false;
-  int margin = 0;  ///< Extend rings; 0 for push-pull and masks
-};
-OutputPadding outputPadding(const SceneOutput& output) {
-  if (output.map == MapKind::kMask) return {};
-  if (output.padding == PaddingMode::kPushPull) return {true, 0};
-  return {false, std::max(output.margin, 0)};
-}
+using plan_detail::layerLabel;
+using plan_detail::outputLabel;
+using plan_detail::scenePrefix;
+using plan_detail::secondsSince;
 
 /// The directory that holds @p file ("." for a bare name).
 fs::path directoryOf(const fs::path& file) {
@@ -327,7 +308,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     const bool udim = hasUdimToken(output.file.string());
     // Memory of the pixels (float values and coverage): bakeImageTile's ring of bands, or the
     // whole image for push-pull.
-    const auto [pushPull, margin] = outputPadding(output);
+    const auto [pushPull, margin] = plan_detail::outputPadding(output);
     const int rowsHeld = pushPull ? output.height : bakeRingRows(output.height, 2 * margin);
     const double bytes = static_cast<double>(rowsHeld) * output.width *
                          (mapChannels(output.map) + 1) * sizeof(float);
@@ -621,233 +602,8 @@ std::string explainPlan(const Plan& plan) {
 
 namespace {
 
-/// Everything loaded for a run; layers point into the textures and volumes held here.
-struct Loaded {
-  Mesh mesh;  ///< as read, subdivided, or the tessellation of the limit surface
-  std::optional<LimitSurface> limit;  ///< "level": "limit": the surface the samples are shaded on
-  SurfaceParameters limitParameters;  ///< where mesh's corners lie on it
-  std::vector<std::unique_ptr<ImageScalarTexture>> scalar;  ///< per plan texture (or null)
-  std::vector<std::unique_ptr<ImageVectorTexture>> vector;  ///< per plan texture (or null)
-  std::vector<std::unique_ptr<HeightVolume>> volumes;
-  std::vector<Layer> layers;  ///< per plan layer
-  std::optional<CornerTangents> tangents;
-};
-
-/// Calls the progress callback, if any.
-class ProgressReporter {
- public:
-  ProgressReporter(const ExecuteOptions& options, std::size_t total)
-      : callback_(options.progress), total_(total) {}
-  void start(std::string_view what) {
-    if (callback_) callback_({done_, total_, what});
-  }
-  void finishOne() { ++done_; }
-  void addWork(std::size_t units) { total_ += units; }
-  void finishAll() {
-    if (callback_) callback_({total_, total_, "done"});
-  }
-
- private:
-  const std::function<void(const BakeProgress&)>& callback_;
-  std::size_t total_;
-  std::size_t done_ = 0;
-};
-
-/// The length of the mesh's bounding-box diagonal (the scale of volume gradient steps).
-double boundingBoxDiagonal(const Mesh& mesh) {
-  if (mesh.positions.empty()) return 1;
-  Vec3d lo{mesh.positions[0].x, mesh.positions[0].y, mesh.positions[0].z};
-  Vec3d hi = lo;
-  for (const Vec3f& p : mesh.positions) {
-    lo = {std::min<double>(lo.x, p.x), std::min<double>(lo.y, p.y), std::min<double>(lo.z, p.z)};
-    hi = {std::max<double>(hi.x, p.x), std::max<double>(hi.y, p.y), std::max<double>(hi.z, p.z)};
-  }
-  const Vec3d d = hi - lo;
-  return std::sqrt(dot(d, d));
-}
-
-/// The UV set check: every UV set an output bakes on or a layer reads must exist.
-Status checkUvSets(const Plan& plan, const Mesh& mesh) {
-  const Scene& s = plan.scene;
-  const auto missing = [&](const std::string& user, int uvSet) {
-    return Error::badInput(s.mesh.string() + ": has " + std::to_string(mesh.uvSets.size()) +
-                           " UV set(s) but " + user + " uses UV set " + std::to_string(uvSet) +
-                           " (UV sets are numbered from 0)");
-  };
-  for (const PlannedOutput& output : plan.outputs) {
-    const SceneOutput& out = s.outputs[output.sceneOutput];
-    if (!output.upToDate && out.kind == OutputKind::kMap &&
-        !mesh.hasUvSet(static_cast<std::size_t>(out.uvSet))) {
-      return missing(outputLabel(output.sceneOutput), out.uvSet);
-    }
-  }
-  for (const PlannedLayer& planned : plan.layers) {
-    const SceneLayer& layer = s.layers[planned.sceneLayer];
-    const bool uvLayer =
-        layer.type == SceneLayerType::kHeight || layer.type == SceneLayerType::kNormal;
-    if (uvLayer && !mesh.hasUvSet(static_cast<std::size_t>(layer.uvSet))) {
-      return missing(layerLabel(planned.sceneLayer), layer.uvSet);
-    }
-    if (layer.mask && !mesh.hasUvSet(static_cast<std::size_t>(layer.mask->uvSet))) {
-      return missing(layerLabel(planned.sceneLayer) + ".mask", layer.mask->uvSet);
-    }
-  }
-  return Ok{};
-}
-
-/// Loads the images of the plan and makes its textures.
-Status loadTextures(const Plan& plan, Loaded& loaded, ProgressReporter& progress,
-                    ExecuteReport& report) {
-  loaded.scalar.resize(plan.textures.size());
-  loaded.vector.resize(plan.textures.size());
-  for (std::size_t i = 0; i < plan.images.size(); ++i) {
-    const PlannedImage& planned = plan.images[i];
-    progress.start("loading " + planned.path.string());
-    LoadImageOptions imageOptions;
-    imageOptions.channels = planned.channels;
-    Result<Image> image = loadImage(planned.path, imageOptions);
-    if (!image) return image.error();
-    ++report.imagesLoaded;
-    for (std::size_t t = 0; t < plan.textures.size(); ++t) {
-      const PlannedTexture& texture = plan.textures[t];
-      if (texture.image != i) continue;
-      if (texture.vector) {
-        VectorTextureOptions textureOptions;
-        textureOptions.filter = texture.filter;
-        textureOptions.wrap = texture.wrap;
-        Result<ImageVectorTexture> made = ImageVectorTexture::create(*image, textureOptions);
-        if (!made)
-          return Error{made.error().code, planned.path.string() + ": " + made.error().message};
-        loaded.vector[t] = std::make_unique<ImageVectorTexture>(std::move(*made));
-      } else {
-        ScalarTextureOptions textureOptions;
-        textureOptions.filter = texture.filter;
-        textureOptions.wrap = texture.wrap;
-        Result<ImageScalarTexture> made = ImageScalarTexture::create(*image, textureOptions);
-        if (!made)
-          return Error{made.error().code, planned.path.string() + ": " + made.error().message};
-        loaded.scalar[t] = std::make_unique<ImageScalarTexture>(std::move(*made));
-      }
-      ++report.texturesCreated;
-    }
-    progress.finishOne();  // the Image itself is released here: textures keep their own copy
-  }
-  return Ok{};
-}
-
-/// Builds the volume of a volume layer.
-Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
-  if (layer.function == VolumeFunction::kSine) {
-    DirectionalSineParams params;
-    params.amplitude = layer.amplitude;
-    params.frequency = layer.frequency;
-    params.direction = layer.direction;
-    params.phase = layer.phase;
-    Result<DirectionalSine> sine = DirectionalSine::create(params);
-    if (!sine) return sine.error();
-    return std::unique_ptr<HeightVolume>(std::make_unique<DirectionalSine>(std::move(*sine)));
-  }
-  GradientNoiseParams params;
-  params.amplitude = layer.amplitude;
-  params.frequency = layer.frequency;
-  params.seed = layer.seed;
-  params.octaves = layer.octaves;
-  Result<GradientNoise> noise = GradientNoise::create(params);
-  if (!noise) return noise.error();
-  return std::unique_ptr<HeightVolume>(std::make_unique<GradientNoise>(std::move(*noise)));
-}
-
-/// The library Layer of a planned layer (textures and volumes must be loaded).
-Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& loaded,
-                        double objectSize) {
-  const SceneLayer& layer = plan.scene.layers[planned.sceneLayer];
-  const ScalarTexture* scalar = planned.texture ? loaded.scalar[*planned.texture].get() : nullptr;
-  const VectorTexture* vector = planned.texture ? loaded.vector[*planned.texture].get() : nullptr;
-  Layer result;
-  result.weight = layer.weight;
-  if (layer.mask && planned.mask) {
-    result.mask.texture = loaded.scalar[*planned.mask].get();
-    result.mask.uvSet = layer.mask->uvSet;
-    result.mask.tiling = layer.mask->tiling;
-    result.mask.offset = layer.mask->offset;
-  }
-  ProjectedNormalOptions projected;
-  projected.green = layer.green;
-  switch (layer.type) {
-    case SceneLayerType::kHeight: {
-      UvHeightSource source;
-      source.texture = scalar;
-      source.uvSet = layer.uvSet;
-      source.scale = layer.scale;
-      source.tiling = layer.tiling;
-      source.offset = layer.offset;
-      result.source = source;
-      break;
-    }
-    case SceneLayerType::kNormal:
-      if (layer.space == NormalSpace::kTangent) {
-        TangentNormalSource source;
-        source.texture = vector;
-        source.uvSet = layer.uvSet;
-        source.options.green = layer.green;
-        source.options.strength = layer.scale;
-        source.options.tiling = layer.tiling;
-        source.options.offset = layer.offset;
-        result.source = source;
-      } else {
-        ObjectNormalSource source;
-        source.texture = vector;
-        source.uvSet = layer.uvSet;
-        source.tiling = layer.tiling;
-        source.offset = layer.offset;
-        source.strength = layer.scale;
-        result.source = source;
-      }
-      break;
-    case SceneLayerType::kVolume: {
-      Result<std::unique_ptr<HeightVolume>> volume = makeVolume(layer);
-      if (!volume) {
-        return Error::badInput(scenePrefix(plan.scene) + layerLabel(planned.sceneLayer) + ": " +
-                               volume.error().message);
-      }
-      loaded.volumes.push_back(std::move(*volume));
-      VolumeSource source;
-      source.volume = loaded.volumes.back().get();
-      source.scheme = layer.gradient;
-      source.step = layer.step ? *layer.step : defaultStep(objectSize);
-      result.source = source;
-      break;
-    }
-    case SceneLayerType::kPlanar: {
-      PlanarSource source;
-      source.kind = layer.kind;
-      source.height = scalar;
-      source.normals = vector;
-      source.mapping.axis = layer.axis;
-      source.mapping.tiling = layer.tiling;
-      source.mapping.offset = layer.offset;
-      source.scale = layer.scale;
-      source.normal = projected;
-      result.source = source;
-      break;
-    }
-    case SceneLayerType::kTriplanar: {
-      TriplanarSource source;
-      source.kind = layer.kind;
-      source.height = scalar;
-      source.normals = vector;
-      source.options.tiling = layer.tiling;
-      source.options.offset = layer.offset;
-      source.options.scale = layer.scale;
-      source.options.sharpness = layer.sharpness;
-      source.options.minWeight = layer.minWeight;
-      source.options.normal = projected;
-      result.source = source;
-      break;
-    }
-  }
-  return result;
-}
+using plan_detail::Loaded;
+using plan_detail::ProgressReporter;
 
 /// Bakes one image tile into @p file and adds its timings to @p report. The image is baked band
 /// by band into a small ring of rows (bakeMapRows), and each band's final rows are padded and
@@ -871,7 +627,7 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const
                                                         mapChannels(settings.map), writeOptions);
   if (!writer) return writer.error();
 
-  const auto [pushPull, margin] = outputPadding(output);
+  const auto [pushPull, margin] = plan_detail::outputPadding(output);
   const bool signedRange = output.storesSignedRange();
   int rowsWritten = 0;
   double padSeconds = 0, convertSeconds = 0;
@@ -997,43 +753,24 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   std::future<Status> meshLoad = std::async(std::launch::async, [&s, &loaded]() -> Status {
     LoadOptions meshOptions;
     meshOptions.requireUvs = true;
-    if (s.subdivision.requested() && !s.subdivision.limitSurface()) {
-      meshOptions.subdivision = s.subdivision.options();
-    }
     Result<Mesh> mesh = loadMesh(s.mesh, meshOptions);
     if (!mesh) return mesh.error();
-    if (!s.subdivision.limitSurface()) {
-      loaded.mesh = std::move(*mesh);
-      return Ok{};
-    }
-    // The limit surface, and the tessellation the raster walks to find it.
-    SubdivisionOptions limitOptions = s.subdivision.options();
-    limitOptions.level = kLimitTessellationLevel;
-    Result<LimitSurface> limit = LimitSurface::create(*mesh, limitOptions);
-    if (!limit) return limit.error();
-    Result<Mesh> tessellation = subdivideMesh(*mesh, limitOptions, &loaded.limitParameters);
-    if (!tessellation) return tessellation.error();
-    loaded.limit = std::move(*limit);
-    loaded.mesh = std::move(*tessellation);
-    return Ok{};
+    return plan_detail::setSurface(s.subdivision, std::move(*mesh), loaded);
   });
-  const Status textures = loadTextures(plan, loaded, progress, report);
+  const plan_detail::ImageSource imageFiles = [](const PlannedImage& image) {
+    LoadImageOptions imageOptions;
+    imageOptions.channels = image.channels;
+    return loadImage(image.path, imageOptions);
+  };
+  const Status textures = plan_detail::loadTextures(plan, imageFiles, loaded, progress, report);
   if (Status mesh = meshLoad.get(); !mesh) return mesh.error();
   progress.finishOne();
-  if (Status ok = checkUvSets(plan, loaded.mesh); !ok) return ok.error();
   if (!textures) return textures.error();
-  const double objectSize = boundingBoxDiagonal(loaded.mesh);
-  for (const PlannedLayer& planned : plan.layers) {
-    Result<Layer> layer = makeLayer(plan, planned, loaded, objectSize);
-    if (!layer) return layer.error();
-    loaded.layers.push_back(std::move(*layer));
+  // Layers, and tangent frames if the plan needs them (timed apart from the loading).
+  if (Status ok = plan_detail::prepareLayers(plan, options.threads, loaded, progress, report); !ok) {
+    return ok.error();
   }
-  const int numUvSets =
-      static_cast<int>(std::min<std::size_t>(loaded.mesh.uvSets.size(), kMaxUvSets));
-  if (Status valid = validateLayers(loaded.layers, numUvSets); !valid) {
-    return Error{valid.error().code, scenePrefix(s) + valid.error().message};
-  }
-  report.loadSeconds = secondsSince(start);
+  report.loadSeconds = secondsSince(start) - report.tangentsSeconds;
 
   // Every output directory must exist (created here) and be writable before the long work.
   for (const PlannedOutput& planned : plan.outputs) {
@@ -1043,21 +780,6 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     if (Status ok = ensureDirectory(file); !ok) return ok.error();
     Result<AtomicFile> probe = AtomicFile::create(file);  // removed again when it goes out of scope
     if (!probe) return probe.error();
-  }
-
-  if (plan.computeTangents) {
-    start = Clock::now();
-    progress.start("computing tangent frames");
-    TangentOptions tangentOptions;
-    tangentOptions.threads = options.threads;
-    Result<CornerTangents> tangents = computeTangents(loaded.mesh.view(0), tangentOptions);
-    if (!tangents) {
-      return Error{tangents.error().code, s.mesh.string() + ": " + tangents.error().message};
-    }
-    loaded.tangents = std::move(*tangents);
-    report.tangentsComputed = true;
-    progress.finishOne();
-    report.tangentsSeconds = secondsSince(start);
   }
 
   // 2. The tiles of every output to bake (known now that the mesh is loaded).
@@ -1082,8 +804,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     const PlannedOutput& planned = plan.outputs[o];
     if (planned.upToDate) continue;
     const SceneOutput& output = s.outputs[planned.sceneOutput];
-    std::vector<Layer> layers;
-    for (const std::size_t l : planned.layers) layers.push_back(loaded.layers[l]);
+    const std::vector<Layer> layers = plan_detail::outputLayers(planned, loaded);
     OutputReport& outputReport = report.outputs[o];
     json files = json::object();
 
@@ -1107,23 +828,8 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         if (Status ok = writeFileAtomically(file, table); !ok) return ok.error();
         report.writeSeconds += secondsSince(start);
       } else {
-        BakeInput input;
-        input.mesh = &loaded.mesh;
-        input.tangents = loaded.tangents ? &*loaded.tangents : nullptr;
-        input.layers = layers;
-        if (loaded.limit) {
-          input.limit = &*loaded.limit;
-          input.limitParameters = &loaded.limitParameters;
-        }
-        BakeSettings settings;
-        settings.map = output.map;
-        settings.width = output.width;
-        settings.height = output.height;
-        settings.samples = output.samples;
-        settings.uvSet = output.uvSet;
-        settings.udimTile = tile;
-        settings.green = output.green;
-        settings.threads = options.threads;
+        const BakeInput input = plan_detail::bakeInputFor(loaded, layers);
+        const BakeSettings settings = plan_detail::bakeSettingsFor(output, tile, options.threads);
         if (Status ok = bakeImageTile(input, settings, output, file, report); !ok) {
           return ok.error();
         }

@@ -1,0 +1,305 @@
+/// @file prepare.cpp
+/// @brief The input-independent steps of running a plan (see prepare.hpp).
+#include "bake/prepare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "sgbake/gradient/filters.hpp"
+
+namespace sgbake::plan_detail {
+
+OutputPadding outputPadding(const SceneOutput& output) {
+  if (output.map == MapKind::kMask) return {};
+  if (output.padding == PaddingMode::kPushPull) return {true, 0};
+  return {false, std::max(output.margin, 0)};
+}
+
+Status setSurface(const SceneSubdivision& subdivision, Mesh coarse, Loaded& loaded) {
+  if (!subdivision.requested()) {
+    loaded.mesh = std::move(coarse);
+    return Ok{};
+  }
+  if (!subdivision.limitSurface()) {
+    Result<Mesh> subdivided = subdivideMesh(coarse, subdivision.options());
+    if (!subdivided) return subdivided.error();
+    loaded.mesh = std::move(*subdivided);
+    return Ok{};
+  }
+  // The limit surface, and the tessellation the raster walks to find it.
+  SubdivisionOptions limitOptions = subdivision.options();
+  limitOptions.level = kLimitTessellationLevel;
+  Result<LimitSurface> limit = LimitSurface::create(coarse, limitOptions);
+  if (!limit) return limit.error();
+  Result<Mesh> tessellation = subdivideMesh(coarse, limitOptions, &loaded.limitParameters);
+  if (!tessellation) return tessellation.error();
+  loaded.limit = std::move(*limit);
+  loaded.mesh = std::move(*tessellation);
+  return Ok{};
+}
+
+namespace {
+
+/// The length of the mesh's bounding-box diagonal (the scale of volume gradient steps).
+double boundingBoxDiagonal(const Mesh& mesh) {
+  if (mesh.positions.empty()) return 1;
+  Vec3d lo{mesh.positions[0].x, mesh.positions[0].y, mesh.positions[0].z};
+  Vec3d hi = lo;
+  for (const Vec3f& p : mesh.positions) {
+    lo = {std::min<double>(lo.x, p.x), std::min<double>(lo.y, p.y), std::min<double>(lo.z, p.z)};
+    hi = {std::max<double>(hi.x, p.x), std::max<double>(hi.y, p.y), std::max<double>(hi.z, p.z)};
+  }
+  const Vec3d d = hi - lo;
+  return std::sqrt(dot(d, d));
+}
+
+/// The UV set check: every UV set an output bakes on or a layer reads must exist.
+Status checkUvSets(const Plan& plan, const Mesh& mesh) {
+  const Scene& s = plan.scene;
+  const auto missing = [&](const std::string& user, int uvSet) {
+    return Error::badInput(s.mesh.string() + ": has " + std::to_string(mesh.uvSets.size()) +
+                           " UV set(s) but " + user + " uses UV set " + std::to_string(uvSet) +
+                           " (UV sets are numbered from 0)");
+  };
+  for (const PlannedOutput& output : plan.outputs) {
+    const SceneOutput& out = s.outputs[output.sceneOutput];
+    if (!output.upToDate && out.kind == OutputKind::kMap &&
+        !mesh.hasUvSet(static_cast<std::size_t>(out.uvSet))) {
+      return missing(outputLabel(output.sceneOutput), out.uvSet);
+    }
+  }
+  for (const PlannedLayer& planned : plan.layers) {
+    const SceneLayer& layer = s.layers[planned.sceneLayer];
+    const bool uvLayer =
+        layer.type == SceneLayerType::kHeight || layer.type == SceneLayerType::kNormal;
+    if (uvLayer && !mesh.hasUvSet(static_cast<std::size_t>(layer.uvSet))) {
+      return missing(layerLabel(planned.sceneLayer), layer.uvSet);
+    }
+    if (layer.mask && !mesh.hasUvSet(static_cast<std::size_t>(layer.mask->uvSet))) {
+      return missing(layerLabel(planned.sceneLayer) + ".mask", layer.mask->uvSet);
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
+                    ProgressReporter& progress, ExecuteReport& report) {
+  loaded.scalar.resize(plan.textures.size());
+  loaded.vector.resize(plan.textures.size());
+  for (std::size_t i = 0; i < plan.images.size(); ++i) {
+    const PlannedImage& planned = plan.images[i];
+    progress.start("loading " + planned.path.string());
+    Result<Image> image = source(planned);
+    if (!image) return image.error();
+    ++report.imagesLoaded;
+    for (std::size_t t = 0; t < plan.textures.size(); ++t) {
+      const PlannedTexture& texture = plan.textures[t];
+      if (texture.image != i) continue;
+      if (texture.vector) {
+        VectorTextureOptions textureOptions;
+        textureOptions.filter = texture.filter;
+        textureOptions.wrap = texture.wrap;
+        Result<ImageVectorTexture> made = ImageVectorTexture::create(*image, textureOptions);
+        if (!made)
+          return Error{made.error().code, planned.path.string() + ": " + made.error().message};
+        loaded.vector[t] = std::make_unique<ImageVectorTexture>(std::move(*made));
+      } else {
+        ScalarTextureOptions textureOptions;
+        textureOptions.filter = texture.filter;
+        textureOptions.wrap = texture.wrap;
+        Result<ImageScalarTexture> made = ImageScalarTexture::create(*image, textureOptions);
+        if (!made)
+          return Error{made.error().code, planned.path.string() + ": " + made.error().message};
+        loaded.scalar[t] = std::make_unique<ImageScalarTexture>(std::move(*made));
+      }
+      ++report.texturesCreated;
+    }
+    progress.finishOne();  // the Image itself is released here: textures keep their own copy
+  }
+  return Ok{};
+}
+
+namespace {
+
+/// Builds the volume of a volume layer.
+Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
+  if (layer.function == VolumeFunction::kSine) {
+    DirectionalSineParams params;
+    params.amplitude = layer.amplitude;
+    params.frequency = layer.frequency;
+    params.direction = layer.direction;
+    params.phase = layer.phase;
+    Result<DirectionalSine> sine = DirectionalSine::create(params);
+    if (!sine) return sine.error();
+    return std::unique_ptr<HeightVolume>(std::make_unique<DirectionalSine>(std::move(*sine)));
+  }
+  GradientNoiseParams params;
+  params.amplitude = layer.amplitude;
+  params.frequency = layer.frequency;
+  params.seed = layer.seed;
+  params.octaves = layer.octaves;
+  Result<GradientNoise> noise = GradientNoise::create(params);
+  if (!noise) return noise.error();
+  return std::unique_ptr<HeightVolume>(std::make_unique<GradientNoise>(std::move(*noise)));
+}
+
+/// The library Layer of a planned layer (textures and volumes must be loaded).
+Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& loaded,
+                        double objectSize) {
+  const SceneLayer& layer = plan.scene.layers[planned.sceneLayer];
+  const ScalarTexture* scalar = planned.texture ? loaded.scalar[*planned.texture].get() : nullptr;
+  const VectorTexture* vector = planned.texture ? loaded.vector[*planned.texture].get() : nullptr;
+  Layer result;
+  result.weight = layer.weight;
+  if (layer.mask && planned.mask) {
+    result.mask.texture = loaded.scalar[*planned.mask].get();
+    result.mask.uvSet = layer.mask->uvSet;
+    result.mask.tiling = layer.mask->tiling;
+    result.mask.offset = layer.mask->offset;
+  }
+  ProjectedNormalOptions projected;
+  projected.green = layer.green;
+  switch (layer.type) {
+    case SceneLayerType::kHeight: {
+      UvHeightSource source;
+      source.texture = scalar;
+      source.uvSet = layer.uvSet;
+      source.scale = layer.scale;
+      source.tiling = layer.tiling;
+      source.offset = layer.offset;
+      result.source = source;
+      break;
+    }
+    case SceneLayerType::kNormal:
+      if (layer.space == NormalSpace::kTangent) {
+        TangentNormalSource source;
+        source.texture = vector;
+        source.uvSet = layer.uvSet;
+        source.options.green = layer.green;
+        source.options.strength = layer.scale;
+        source.options.tiling = layer.tiling;
+        source.options.offset = layer.offset;
+        result.source = source;
+      } else {
+        ObjectNormalSource source;
+        source.texture = vector;
+        source.uvSet = layer.uvSet;
+        source.tiling = layer.tiling;
+        source.offset = layer.offset;
+        source.strength = layer.scale;
+        result.source = source;
+      }
+      break;
+    case SceneLayerType::kVolume: {
+      Result<std::unique_ptr<HeightVolume>> volume = makeVolume(layer);
+      if (!volume) {
+        return Error::badInput(scenePrefix(plan.scene) + layerLabel(planned.sceneLayer) + ": " +
+                               volume.error().message);
+      }
+      loaded.volumes.push_back(std::move(*volume));
+      VolumeSource source;
+      source.volume = loaded.volumes.back().get();
+      source.scheme = layer.gradient;
+      source.step = layer.step ? *layer.step : defaultStep(objectSize);
+      result.source = source;
+      break;
+    }
+    case SceneLayerType::kPlanar: {
+      PlanarSource source;
+      source.kind = layer.kind;
+      source.height = scalar;
+      source.normals = vector;
+      source.mapping.axis = layer.axis;
+      source.mapping.tiling = layer.tiling;
+      source.mapping.offset = layer.offset;
+      source.scale = layer.scale;
+      source.normal = projected;
+      result.source = source;
+      break;
+    }
+    case SceneLayerType::kTriplanar: {
+      TriplanarSource source;
+      source.kind = layer.kind;
+      source.height = scalar;
+      source.normals = vector;
+      source.options.tiling = layer.tiling;
+      source.options.offset = layer.offset;
+      source.options.scale = layer.scale;
+      source.options.sharpness = layer.sharpness;
+      source.options.minWeight = layer.minWeight;
+      source.options.normal = projected;
+      result.source = source;
+      break;
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+Status prepareLayers(const Plan& plan, int threads, Loaded& loaded, ProgressReporter& progress,
+                     ExecuteReport& report) {
+  const Scene& s = plan.scene;
+  if (Status ok = checkUvSets(plan, loaded.mesh); !ok) return ok.error();
+  const double objectSize = boundingBoxDiagonal(loaded.mesh);
+  for (const PlannedLayer& planned : plan.layers) {
+    Result<Layer> layer = makeLayer(plan, planned, loaded, objectSize);
+    if (!layer) return layer.error();
+    loaded.layers.push_back(std::move(*layer));
+  }
+  const int numUvSets =
+      static_cast<int>(std::min<std::size_t>(loaded.mesh.uvSets.size(), kMaxUvSets));
+  if (Status valid = validateLayers(loaded.layers, numUvSets); !valid) {
+    return Error{valid.error().code, scenePrefix(s) + valid.error().message};
+  }
+  if (!plan.computeTangents) return Ok{};
+  const auto start = std::chrono::steady_clock::now();
+  progress.start("computing tangent frames");
+  TangentOptions tangentOptions;
+  tangentOptions.threads = threads;
+  Result<CornerTangents> tangents = computeTangents(loaded.mesh.view(0), tangentOptions);
+  if (!tangents) {
+    return Error{tangents.error().code, s.mesh.string() + ": " + tangents.error().message};
+  }
+  loaded.tangents = std::move(*tangents);
+  report.tangentsComputed = true;
+  progress.finishOne();
+  report.tangentsSeconds = secondsSince(start);
+  return Ok{};
+}
+
+std::vector<Layer> outputLayers(const PlannedOutput& planned, const Loaded& loaded) {
+  std::vector<Layer> layers;
+  for (const std::size_t l : planned.layers) layers.push_back(loaded.layers[l]);
+  return layers;
+}
+
+BakeInput bakeInputFor(const Loaded& loaded, std::span<const Layer> layers) {
+  BakeInput input;
+  input.mesh = &loaded.mesh;
+  input.tangents = loaded.tangents ? &*loaded.tangents : nullptr;
+  input.layers = layers;
+  if (loaded.limit) {
+    input.limit = &*loaded.limit;
+    input.limitParameters = &loaded.limitParameters;
+  }
+  return input;
+}
+
+BakeSettings bakeSettingsFor(const SceneOutput& output, int tile, int threads) {
+  BakeSettings settings;
+  settings.map = output.map;
+  settings.width = output.width;
+  settings.height = output.height;
+  settings.samples = output.samples;
+  settings.uvSet = output.uvSet;
+  settings.udimTile = tile;
+  settings.green = output.green;
+  settings.threads = threads;
+  return settings;
+}
+
+}  // namespace sgbake::plan_detail

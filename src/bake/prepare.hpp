@@ -1,0 +1,109 @@
+/// @file prepare.hpp
+/// @brief Private: the steps of running a plan that do not depend on where its inputs come from
+/// (files for executePlan, arrays for bakeOutputInMemory): the surface to bake on, textures,
+/// layers, tangent frames, and the BakeInput / BakeSettings of an output.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/bake/planner.hpp"
+#include "sgbake/bake/scene.hpp"
+#include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/image.hpp"
+#include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/texture.hpp"
+#include "sgbake/gradient/volume.hpp"
+#include "sgbake/mesh/mesh.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
+#include "sgbake/subdiv/subdivide.hpp"
+
+namespace sgbake::plan_detail {
+
+/// Seconds since @p start.
+inline double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// "scene.json: " for scenes read from a file, "" for scenes built in code.
+inline std::string scenePrefix(const Scene& scene) {
+  return scene.source.empty() ? std::string() : scene.source.string() + ": ";
+}
+
+inline std::string layerLabel(std::size_t i) { return "layers[" + std::to_string(i) + "]"; }
+inline std::string outputLabel(std::size_t i) { return "outputs[" + std::to_string(i) + "]"; }
+
+/// How an image output is padded: masks not at all (padding would overwrite the coverage they
+/// show), else push-pull or Extend by `margin` texels.
+struct OutputPadding {
+  bool pushPull = false;
+  int margin = 0;  ///< Extend rings; 0 for push-pull and masks
+};
+OutputPadding outputPadding(const SceneOutput& output);
+
+/// Everything loaded for a run; layers point into the textures and volumes held here.
+struct Loaded {
+  Mesh mesh;  ///< as read, subdivided, or the tessellation of the limit surface
+  std::optional<LimitSurface> limit;  ///< "level": "limit": the surface the samples are shaded on
+  SurfaceParameters limitParameters;  ///< where mesh's corners lie on it
+  std::vector<std::unique_ptr<ImageScalarTexture>> scalar;  ///< per plan texture (or null)
+  std::vector<std::unique_ptr<ImageVectorTexture>> vector;  ///< per plan texture (or null)
+  std::vector<std::unique_ptr<HeightVolume>> volumes;
+  std::vector<Layer> layers;  ///< per plan layer
+  std::optional<CornerTangents> tangents;
+};
+
+/// Calls the progress callback, if any.
+class ProgressReporter {
+ public:
+  ProgressReporter(const ExecuteOptions& options, std::size_t total)
+      : callback_(options.progress), total_(total) {}
+  void start(std::string_view what) {
+    if (callback_) callback_({done_, total_, what});
+  }
+  void finishOne() { ++done_; }
+  void addWork(std::size_t units) { total_ += units; }
+  void finishAll() {
+    if (callback_) callback_({total_, total_, "done"});
+  }
+
+ private:
+  const std::function<void(const BakeProgress&)>& callback_;
+  std::size_t total_;
+  std::size_t done_ = 0;
+};
+
+/// @brief Sets loaded.mesh (and the limit surface) from the mesh as read, @p coarse: subdivided
+/// as the scene asks, or, for "level": "limit", the limit surface and its level-3 tessellation.
+Status setSurface(const SceneSubdivision& subdivision, Mesh coarse, Loaded& loaded);
+
+/// Where the images of a plan come from: the image of a PlannedImage, with its channels.
+using ImageSource = std::function<Result<Image>(const PlannedImage&)>;
+
+/// @brief Gets every image of the plan from @p source and makes the plan's textures of it.
+Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
+                    ProgressReporter& progress, ExecuteReport& report);
+
+/// @brief With the surface and textures loaded: checks the UV sets the outputs and layers use,
+/// makes the layers (and their volumes) and, if the plan needs them, the tangent frames.
+Status prepareLayers(const Plan& plan, int threads, Loaded& loaded, ProgressReporter& progress,
+                     ExecuteReport& report);
+
+/// The library Layers an output reads (PlannedOutput::layers), in scene order.
+std::vector<Layer> outputLayers(const PlannedOutput& planned, const Loaded& loaded);
+
+/// @brief What bakeMap reads for an output of layers @p layers (which must outlive it).
+BakeInput bakeInputFor(const Loaded& loaded, std::span<const Layer> layers);
+
+/// @brief The BakeSettings of an image output's UDIM tile @p tile.
+BakeSettings bakeSettingsFor(const SceneOutput& output, int tile, int threads);
+
+}  // namespace sgbake::plan_detail
