@@ -7,6 +7,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <utility>
 #include <string_view>
 #include <system_error>
 
@@ -133,17 +134,30 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
     }
   }
 
-  if (options.channels != ImageChannels::kLuminance || readChannels == 1) return read;
+  // The file's channels were read as the selection needs them; only luminance is left to do.
+  return selectImageChannels(std::move(read), options.channels);
+}
 
-  Image luminance(width, height, 1);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const double luma =
-          kLumaR * read.at(x, y, 0) + kLumaG * read.at(x, y, 1) + kLumaB * read.at(x, y, 2);
-      luminance.at(x, y) = static_cast<float>(luma);
+Image selectImageChannels(Image image, ImageChannels selection) {
+  const int have = image.channels();
+  const int keep = selection == ImageChannels::kAll     ? have
+                   : selection == ImageChannels::kRgb && have >= 3 ? 3
+                                                                   : 1;
+  if (keep == have) return image;
+  const bool luminance = selection == ImageChannels::kLuminance && have >= 3;
+  Image selected(image.width(), image.height(), keep);
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      if (luminance) {
+        const double luma = kLumaR * image.at(x, y, 0) + kLumaG * image.at(x, y, 1) +
+                            kLumaB * image.at(x, y, 2);
+        selected.at(x, y) = static_cast<float>(luma);
+      } else {
+        for (int c = 0; c < keep; ++c) selected.at(x, y, c) = image.at(x, y, c);
+      }
     }
   }
-  return luminance;
+  return selected;
 }
 
 }  // namespace sgbake

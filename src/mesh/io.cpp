@@ -105,15 +105,6 @@ Error disagreement(std::string_view name, const std::string& what) {
   return Error::internal(std::string(name) + ": OpenMesh and sgbake's validator disagree: " + what);
 }
 
-/// A file normal as a corner normal: kept bit-exact when already unit within
-/// kUnitLengthTolerance, normalized (in double) otherwise. The validator guarantees it is
-/// finite and not zero.
-Vec3f unitFileNormal(Vec3f n) {
-  const double len = length(cast<double>(n));
-  if (std::abs(len - 1.0) <= detail::kUnitLengthTolerance) return n;
-  return cast<float>(normalizeOr(cast<double>(n), Vec3d{0, 0, 1}));
-}
-
 /// Lets OpenMesh read the validated bytes and builds the Mesh, verifying every value OpenMesh
 /// produced against the validator's parse.
 Result<Mesh> readWithOpenMesh(const ValidatedFile& file, std::string_view name) {
@@ -235,7 +226,7 @@ Result<Mesh> readWithOpenMesh(const ValidatedFile& file, std::string_view name) 
     mesh.cornerNormals.resize(mesh.cornerVertex.size());
     for (std::size_t c = 0; c < mesh.cornerNormals.size(); ++c) {
       mesh.cornerNormals[c] =
-          unitFileNormal(parsed.normals[static_cast<std::size_t>(parsed.cornerNormal[c])]);
+          unitNormal(parsed.normals[static_cast<std::size_t>(parsed.cornerNormal[c])]);
     }
     mesh.normalSource = NormalSource::kFile;
   } else if (perVertexNormals) {
@@ -246,7 +237,7 @@ Result<Mesh> readWithOpenMesh(const ValidatedFile& file, std::string_view name) 
       if (!detail::sameBits(normal, parsed.normals[v])) {
         return disagreement(name, "normal of vertex " + std::to_string(v));
       }
-      vertexNormals[v] = unitFileNormal(normal);
+      vertexNormals[v] = unitNormal(normal);
     }
     mesh.cornerNormals.resize(mesh.cornerVertex.size());
     for (std::size_t c = 0; c < mesh.cornerNormals.size(); ++c) {

@@ -201,4 +201,10 @@ Status validate(const Mesh& mesh) {
   return Ok{};
 }
 
+Vec3f unitNormal(Vec3f n) {
+  const double len = length(cast<double>(n));
+  if (std::abs(len - 1.0) <= detail::kUnitLengthTolerance) return n;
+  return cast<float>(normalizeOr(cast<double>(n), Vec3d{0, 0, 1}));
+}
+
 }  // namespace sgbake

@@ -115,4 +115,10 @@ struct LoadImageOptions {
 /// @return the image, W×H×C with C as selected by @p options
 Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOptions& options = {});
 
+/// @brief The channels @p selection keeps of an image already in memory, as loadImage keeps
+/// them of a file: kAll all of them, kFirst channel 0, kLuminance the Rec. 709 luminance of
+/// channels 0–2 (channel 0 when there are fewer than three), kRgb channels 0–2.
+/// @note Precondition for kRgb: at least three channels (callers check and report it).
+Image selectImageChannels(Image image, ImageChannels selection);
+
 }  // namespace sgbake

@@ -27,6 +27,12 @@ std::vector<Vec3f> computeFaceNormals(const MeshView& mesh);
 /// finite; normals are not read).
 void computeSmoothNormals(Mesh& mesh);
 
+/// @brief A given normal (read from a file, or handed to the C ABI) as a corner normal: kept
+/// bit-exact when its length is 1 within eight float ulps (about 9.5e-7; a normal normalized in
+/// float stays as it is), normalized in double otherwise.
+/// @note Precondition: @p n is finite and not zero.
+Vec3f unitNormal(Vec3f n);
+
 /// @brief Checks the Mesh invariants (see Mesh); names @p mesh.source in the message.
 ///
 /// Unit length means within eight float ulps of 1 (about 9.5e-7). Returns ErrorCode::kBadInput
