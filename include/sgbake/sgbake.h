@@ -86,6 +86,82 @@ SGBAKE_C_API int sgbake_compute_tangents(const float* positions, size_t num_vert
                                          float* out_signs, char* error_buf,
                                          size_t error_buf_size);
 
+/// @brief A mesh as flat arrays, for sgbake_bake_map (conventions at the top of this file).
+///
+/// Blender: positions from `vertices.foreach_get("co")`, face_start from
+/// `polygons.foreach_get("loop_start")` with #C appended, corner_vertex from
+/// `loops.foreach_get("vertex_index")`, corner_normals from `loops.foreach_get("normal")` after
+/// `calc_normals_split()`, one corner_uvs array per `uv_layers[i].data.foreach_get("uv")`.
+typedef struct sgbake_mesh {
+  const float* positions;         ///< #V × 3 vertex positions, object space
+  size_t num_vertices;            ///< #V
+  const uint32_t* face_start;     ///< #F + 1 offsets, as in sgbake_compute_tangents
+  size_t num_faces;               ///< #F
+  const uint32_t* corner_vertex;  ///< #C vertex indices, each < #V
+  /// #C × 3 unit corner normals (split normals: the face normal on flat faces), or NULL for
+  /// angle-weighted smooth vertex normals computed by sgbake (every face smooth).
+  const float* corner_normals;
+  /// num_uv_sets pointers, each to #C × 2 floats (u, v); UV set 0 is the one MikkTSpace frames
+  /// are computed on, as Blender does for its first UV map. A scene's "uv": N reads set N.
+  const float* const* corner_uvs;
+  size_t num_uv_sets;  ///< at least 1, at most 8
+  size_t num_corners;  ///< #C (must fit in 32 bits)
+} sgbake_mesh;
+
+/// @brief An image in memory, laid out as Blender's `Image.pixels`: width × height × channels
+/// floats, rows **bottom first**, channels interleaved. Values are used as given (no colour-space
+/// conversion: like a file image, they are data, "Non-Color").
+typedef struct sgbake_image {
+  /// The name a scene's "image" keys use to refer to it (Blender: `Image.name`); unique among
+  /// the images of a call.
+  const char* name;
+  const float* pixels;  ///< width × height × channels floats, every one finite
+  int32_t width;        ///< ≥ 1
+  int32_t height;       ///< ≥ 1
+  int32_t channels;     ///< 1 to 4 (Blender: 4). Heights read the Rec. 709 luminance of RGB.
+} sgbake_image;
+
+/// @brief Bakes one map of a mesh given as arrays, into a caller-provided RGBA float buffer laid
+/// out as Blender's `Image.pixels` (rows bottom first), so a Blender image takes it with
+/// `pixels.foreach_set`.
+///
+/// @param[in] scene_json  A scene in the format of `sgbake bake SCENE.json` (docs/baker.md),
+///                        without "mesh" (the mesh is @p mesh) and with exactly one output,
+///                        which has no "file", "format" or "bit_depth" ("tile" picks the UDIM
+///                        tile, 1001 by default) — e.g.
+///                        `{"layers": [{"type": "height", "image": "Bumps", "scale": 0.1}],
+///                          "outputs": [{"map": "tangent-normal", "size": 1024, "margin": 16}]}`.
+///                        "image" keys name entries of @p images instead of files. The planner
+///                        runs as for a scene file: only what the output needs is computed.
+///                        "subdivision" subdivides @p mesh first, as Blender's modifier would.
+/// @param[in]  mesh        the mesh (see sgbake_mesh).
+/// @param[in]  images      the images the scene's layers name; may be NULL when num_images is 0.
+/// @param[in]  num_images  number of entries in images.
+/// @param[in]  threads     maximum number of threads; 0 = all cores. The result is
+///                         bit-identical for every value.
+/// @param[out] out_rgba    width × height × 4 floats (the output's "size", or "width" and
+///                         "height"), rows bottom first. RGB hold the map's values as a float
+///                         file would store them: normal, tangent and bitangent maps encoded as
+///                         n/2 + 0.5; height, mask and signed maps (derivative, surface-gradient)
+///                         raw. One-channel maps fill R, G and B alike; two-channel maps leave B
+///                         at 0. A is the coverage when the output has "alpha": true, else 1.
+///                         Texels outside the UV islands hold the map's background, padded by
+///                         the output's "margin" and "padding" as in a file.
+/// @param[in]  out_floats  number of floats out_rgba holds: must be width × height × 4.
+/// @param[out] error_buf   receives a NUL-terminated one-line message when the call fails; may
+///                         be NULL. Untouched on success.
+/// @param[in]  error_buf_size size of error_buf in bytes; may be 0.
+///
+/// @return SGBAKE_OK, SGBAKE_ERROR_BAD_INPUT (bad scene text — the message names the key as
+///         for a scene file —, a bad mesh array as in sgbake_compute_tangents, an image a layer
+///         names that is not among @p images, a UV set the mesh lacks, a wrong out_floats) or
+///         SGBAKE_ERROR_INTERNAL. Everything is validated before anything is baked; on failure
+///         out_rgba may have been partly written and must not be used.
+SGBAKE_C_API int sgbake_bake_map(const char* scene_json, const sgbake_mesh* mesh,
+                                 const sgbake_image* images, size_t num_images, int threads,
+                                 float* out_rgba, size_t out_floats, char* error_buf,
+                                 size_t error_buf_size);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -190,7 +190,7 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used) {
   const auto addTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
                               const std::string& user) {
     const ImageChannels channels = vector ? ImageChannels::kRgb : ImageChannels::kLuminance;
-    const fs::path canonical = canonicalPath(path);
+    const fs::path canonical = plan.scene.inMemory ? path : canonicalPath(path);
     const auto imageKey = std::make_pair(canonical.string(), static_cast<int>(channels));
     auto [image, newImage] = imageIndex.emplace(imageKey, plan.images.size());
     if (newImage) plan.images.push_back({path, canonical, channels, {}});
@@ -462,10 +462,14 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   if (Status valid = validateScene(scene); !valid) {
     return Error::badInput(prefix + valid.error().message);
   }
-  if (Status ok = checkInputFile(scene, "mesh", "file", scene.mesh); !ok) return ok.error();
+  // In memory there are no files to check, hash or record.
+  if (!scene.inMemory) {
+    if (Status ok = checkInputFile(scene, "mesh", "file", scene.mesh); !ok) return ok.error();
+  }
 
   Plan plan;
   plan.options = options;
+  plan.options.useManifest = options.useManifest && !scene.inMemory;
   plan.scene = std::move(scene);
   const Scene& s = plan.scene;
 
@@ -485,7 +489,8 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   ManifestCache manifests;
   const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
                              "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
-                             ",\"mesh\":" + json(canonicalPath(s.mesh).string()).dump();
+                             ",\"mesh\":" +
+                             json(s.inMemory ? s.mesh.string() : canonicalPath(s.mesh).string()).dump();
   for (std::size_t o = 0; o < s.outputs.size(); ++o) {
     const SceneOutput& output = s.outputs[o];
     PlannedOutput planned;
@@ -510,7 +515,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     planned.parameters = common + ",\"output\":" + outputParametersJson(output) + ",\"layers\":[" +
                          layersJson + "]}";
     planned.parameters = json::parse(planned.parameters).dump();  // canonical key order
-    if (options.useManifest) {
+    if (plan.options.useManifest) {
       for (std::size_t i = 0; i < inputs.size(); ++i) {
         Result<std::string> hash =
             hashOf(inputs[i], users[i],
@@ -564,6 +569,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   }
   // Every image to load must exist (checked here so no output is touched on bad input).
   for (const PlannedImage& image : plan.images) {
+    if (s.inMemory) break;
     if (Status ok = checkInputFile(s, image.users.front(), "image", image.path); !ok) {
       return ok.error();
     }

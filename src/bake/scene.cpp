@@ -308,12 +308,22 @@ std::filesystem::path resolvePath(const std::filesystem::path& base, const std::
   return (base / path).lexically_normal();
 }
 
+/// How a scene's input paths are read: resolved against a directory, or, for a scene of an
+/// in-memory bake, kept as the names of images given in memory.
+struct InputPaths {
+  std::filesystem::path base;
+  bool names = false;
+  std::filesystem::path operator()(const std::string& text) const {
+    return names ? std::filesystem::path(text) : resolvePath(base, text);
+  }
+};
+
 /// A path key: a non-empty string, resolved against @p base.
 std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key,
-                                const std::filesystem::path& base) {
+                                const InputPaths& paths) {
   const std::string text = reader.string(key);
   if (text.empty()) fail(reader.where(), quote(key) + " is empty");
-  return resolvePath(base, text);
+  return paths(text);
 }
 
 // ---- Keys of each kind of object ---------------------------------------------------------------
@@ -398,19 +408,19 @@ SceneSubdivision parseSubdivision(const json& value) {
   return subdivision;
 }
 
-SceneMask parseMask(const json& value, const std::string& where, const std::filesystem::path& base,
+SceneMask parseMask(const json& value, const std::string& where, const InputPaths& paths,
                     int defaultUv) {
   SceneMask mask;
   mask.uvSet = defaultUv;
   if (value.is_string()) {
     if (value.get<std::string>().empty()) fail(where, "'mask' is empty");
-    mask.image = resolvePath(base, value.get<std::string>());
+    mask.image = paths(value.get<std::string>());
     return mask;
   }
   const ObjectReader reader(value, where, "a mask");
   reader.checkKeys(kMaskKeys);
   reader.require("image");
-  mask.image = pathValue(reader, "image", base);
+  mask.image = pathValue(reader, "image", paths);
   if (reader.has("uv")) mask.uvSet = reader.smallInteger("uv", 0, kMaxUvSets - 1);
   if (reader.has("tiling")) mask.tiling = reader.vec2("tiling");
   if (reader.has("offset")) mask.offset = reader.vec2("offset");
@@ -418,8 +428,8 @@ SceneMask parseMask(const json& value, const std::string& where, const std::file
   return mask;
 }
 
-SceneLayer parseLayer(const json& value, const std::string& where,
-                      const std::filesystem::path& base, int defaultUv) {
+SceneLayer parseLayer(const json& value, const std::string& where, const InputPaths& paths,
+                      int defaultUv) {
   SceneLayer layer;
   {
     const ObjectReader probe(value, where, "a layer");
@@ -436,7 +446,7 @@ SceneLayer parseLayer(const json& value, const std::string& where,
 
   if (layer.hasImage()) {
     reader.require("image");
-    layer.image = pathValue(reader, "image", base);
+    layer.image = pathValue(reader, "image", paths);
     reader.optionalName("filter", kFilters, layer.filter);
     reader.optionalName("wrap", kWraps, layer.wrap);
     if (reader.has("tiling")) layer.tiling = reader.vec2("tiling");
@@ -445,7 +455,7 @@ SceneLayer parseLayer(const json& value, const std::string& where,
   if (reader.has("uv")) layer.uvSet = reader.smallInteger("uv", 0, kMaxUvSets - 1);
   if (reader.has("mask")) {
     // The mask is looked up on the layer's UV set unless it names its own.
-    layer.mask = parseMask(reader.at("mask"), appendPath(where, "mask"), base, layer.uvSet);
+    layer.mask = parseMask(reader.at("mask"), appendPath(where, "mask"), paths, layer.uvSet);
   }
   if (reader.has("scale")) layer.scale = reader.number("scale");
   if (reader.has("strength")) layer.scale = reader.number("strength");
@@ -497,7 +507,7 @@ SceneLayer parseLayer(const json& value, const std::string& where,
 }
 
 SceneOutput parseOutput(const json& value, const std::string& where,
-                        const std::filesystem::path& outputBase, int defaultUv) {
+                        const std::filesystem::path& outputBase, int defaultUv, bool inMemory) {
   SceneOutput output;
   output.uvSet = defaultUv;
   {
@@ -521,8 +531,17 @@ SceneOutput parseOutput(const json& value, const std::string& where,
   } else {
     reader.checkKeys(kMapOutputKeys);
   }
-  reader.require("file");
-  output.file = pathValue(reader, "file", outputBase);
+  if (inMemory) {
+    if (corners) fail(where, "a corners table cannot be baked in memory (it is written as a file)");
+    for (const char* key : {"file", "format", "bit_depth"}) {
+      if (reader.has(key)) {
+        fail(where, "key " + quote(key) + " is not used in memory (the map is returned as pixels)");
+      }
+    }
+  } else {
+    reader.require("file");
+    output.file = pathValue(reader, "file", InputPaths{outputBase});
+  }
   if (corners) return output;
 
   if (reader.has("size") && (reader.has("width") || reader.has("height"))) {
@@ -572,8 +591,15 @@ Scene parseDocument(const json& document, const SceneParseOptions& options) {
       options.outputDir.empty() ? options.baseDir : options.outputDir;
 
   Scene scene;
-  top.require("mesh");
-  scene.mesh = pathValue(top, "mesh", options.baseDir);
+  if (options.inMemory) {
+    if (top.has("mesh")) fail("", "key 'mesh' is not used in memory (the mesh is given as arrays)");
+    scene.inMemory = true;
+    scene.mesh = kInMemoryMeshName;
+  } else {
+    top.require("mesh");
+    scene.mesh = pathValue(top, "mesh", InputPaths{options.baseDir});
+  }
+  const InputPaths inputPaths{options.baseDir, options.inMemory};
   if (top.has("uv")) scene.uvSet = top.smallInteger("uv", 0, kMaxUvSets - 1);
   if (top.has("subdivision")) scene.subdivision = parseSubdivision(top.at("subdivision"));
 
@@ -582,7 +608,7 @@ Scene parseDocument(const json& document, const SceneParseOptions& options) {
     if (!layers.is_array()) fail("", "'layers' must be an array, not " + describeType(layers));
     for (std::size_t i = 0; i < layers.size(); ++i) {
       scene.layers.push_back(
-          parseLayer(layers[i], "layers[" + std::to_string(i) + "]", options.baseDir, scene.uvSet));
+          parseLayer(layers[i], "layers[" + std::to_string(i) + "]", inputPaths, scene.uvSet));
     }
   }
 
@@ -592,7 +618,8 @@ Scene parseDocument(const json& document, const SceneParseOptions& options) {
   if (outputs.empty()) fail("", "'outputs' is empty: nothing to bake");
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     scene.outputs.push_back(
-        parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", outputBase, scene.uvSet));
+        parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", outputBase, scene.uvSet,
+                    options.inMemory));
   }
   return scene;
 }
@@ -676,8 +703,8 @@ std::string checkLayer(const SceneLayer& layer) {
   return {};
 }
 
-std::string checkOutput(const SceneOutput& output) {
-  if (output.file.empty()) return "missing key 'file'";
+std::string checkOutput(const SceneOutput& output, bool inMemory) {
+  if (output.file.empty() && !inMemory) return "missing key 'file'";
   if (output.kind == OutputKind::kCorners) return {};
   if (output.width == output.height && (output.width < 1 || output.width > kMaxBakeSide)) {
     return rangeMessage("size", output.width, 1, kMaxBakeSide);
@@ -703,6 +730,7 @@ std::string checkOutput(const SceneOutput& output) {
   if (output.tile < kFirstUdimTile || output.tile > kLastUdimTile) {
     return rangeMessage("tile", output.tile, kFirstUdimTile, kLastUdimTile);
   }
+  if (inMemory) return {};  // no file: no format, no bit depth
   ImageFormat format = output.format;
   if (format == ImageFormat::kAuto) {
     Result<ImageFormat> fromPath = imageFormatFromPath(output.file);
@@ -961,10 +989,10 @@ Status validateScene(const Scene& scene) {
   }
   if (scene.outputs.empty()) return Error::badInput("'outputs' is empty: nothing to bake");
   for (std::size_t i = 0; i < scene.outputs.size(); ++i) {
-    if (std::string why = checkOutput(scene.outputs[i]); !why.empty()) {
+    if (std::string why = checkOutput(scene.outputs[i], scene.inMemory); !why.empty()) {
       return Error::badInput(where("outputs", i) + why);
     }
-    for (std::size_t j = 0; j < i; ++j) {
+    for (std::size_t j = 0; j < i && !scene.inMemory; ++j) {
       if (scene.outputs[j].file == scene.outputs[i].file) {
         return Error::badInput(where("outputs", i) + "file '" + scene.outputs[i].file.string() +
                                "' is also written by outputs[" + std::to_string(j) + "]");

@@ -3,20 +3,27 @@
 /// types and calls the C++ API. No math lives here; nothing escapes as an exception.
 #include "sgbake/sgbake.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <limits>
 #include <new>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "sgbake/bake/bake.hpp"
+#include "sgbake/bake/planner.hpp"
+#include "sgbake/bake/scene.hpp"
 #include "sgbake/core/result.hpp"
 #include "sgbake/core/vec.hpp"
 #include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/image.hpp"
 #include "sgbake/mesh/mesh.hpp"
+#include "sgbake/mesh/normals.hpp"
 
 namespace sgbake {
 namespace {
@@ -25,9 +32,6 @@ namespace {
 /// precision (~1e-7); decoded custom normals are a little less exact. Anything further off is a
 /// caller mistake (unnormalized or garbage data) that would silently skew every tangent.
 constexpr double kUnitNormalTolerance = 1e-3;
-
-/// Messages name the function, as a file-based error names the file.
-constexpr std::string_view kWhere = "sgbake_compute_tangents: ";
 
 /// Copies @p message into the caller's buffer, truncated and always NUL-terminated.
 void writeError(char* buffer, std::size_t size, std::string_view message) noexcept {
@@ -41,14 +45,10 @@ int statusFor(ErrorCode code) {
   return code == ErrorCode::kBadInput ? SGBAKE_ERROR_BAD_INPUT : SGBAKE_ERROR_INTERNAL;
 }
 
-Error badArgument(const std::string& what) {
-  return Error::badInput(std::string(kWhere) + what);
-}
-
 /// `name[i] = (x, y, z)` for messages about one element of a float array.
-std::string describeElement(const char* name, std::size_t index, const float* values,
+std::string describeElement(const std::string& name, std::size_t index, const float* values,
                             std::size_t width) {
-  std::string text = std::string(name) + "[" + std::to_string(index) + "] = (";
+  std::string text = name + "[" + std::to_string(index) + "] = (";
   for (std::size_t k = 0; k < width; ++k) {
     char number[32];
     std::snprintf(number, sizeof number, "%s%.9g", k == 0 ? "" : ", ",
@@ -68,106 +68,94 @@ std::size_t firstNonFinite(const float* values, std::size_t n, std::size_t width
   return n;
 }
 
-/// The raw arguments of sgbake_compute_tangents, grouped so they can be validated and converted
-/// in one place.
-struct TangentArguments {
-  const float* positions;
-  std::size_t numVertices;
-  const std::uint32_t* faceStart;
-  std::size_t numFaces;
-  const std::uint32_t* cornerVertex;
-  const float* cornerNormals;
-  const float* cornerUvs;
-  std::size_t numCorners;
-  int threads;
-  float* outTangents;
-  float* outSigns;
+/// A mesh as the caller's flat arrays (sgbake_compute_tangents' arguments, or sgbake_mesh).
+struct MeshArrays {
+  const float* positions = nullptr;
+  std::size_t numVertices = 0;
+  const std::uint32_t* faceStart = nullptr;
+  std::size_t numFaces = 0;
+  const std::uint32_t* cornerVertex = nullptr;
+  const float* cornerNormals = nullptr;  ///< NULL only where normalsOptional
+  bool normalsOptional = false;
+  std::vector<const float*> uvSets;  ///< each #C × 2
+  std::vector<std::string> uvNames;  ///< how messages name each UV array
+  std::size_t numCorners = 0;
 };
 
-/// Everything sgbake.h promises to check, before a single value is computed.
-Status validate(const TangentArguments& a) {
-  if (a.threads < 0) {
-    return badArgument("threads = " + std::to_string(a.threads) + " (must be >= 0)");
-  }
+/// Everything sgbake.h promises to check about a mesh, before a single value is computed.
+/// Messages start with @p where (the function's name).
+Status validateMesh(const std::string& where, const MeshArrays& a) {
+  const auto bad = [&where](const std::string& what) { return Error::badInput(where + what); };
   if (a.numCorners > std::numeric_limits<std::uint32_t>::max()) {
-    return badArgument("num_corners = " + std::to_string(a.numCorners) +
-                       " does not fit in 32 bits");
+    return bad("num_corners = " + std::to_string(a.numCorners) + " does not fit in 32 bits");
   }
   // Every face needs 3 corners: this bound also keeps num_faces + 1 from overflowing.
   if (a.numFaces > a.numCorners / 3) {
-    return badArgument("num_faces = " + std::to_string(a.numFaces) + " with num_corners = " +
-                       std::to_string(a.numCorners) + " (each face needs at least 3 corners)");
+    return bad("num_faces = " + std::to_string(a.numFaces) + " with num_corners = " +
+               std::to_string(a.numCorners) + " (each face needs at least 3 corners)");
   }
   if (a.numFaces == 0 && a.numCorners == 0) return Ok{};
 
-  const struct {
-    const void* pointer;
-    bool needed;
-    const char* name;
-  } arrays[] = {
-      {a.positions, a.numVertices > 0, "positions"},
-      {a.faceStart, true, "face_start"},
-      {a.cornerVertex, true, "corner_vertex"},
-      {a.cornerNormals, true, "corner_normals"},
-      {a.cornerUvs, true, "corner_uvs"},
-      {a.outTangents, true, "out_tangents"},
-      {a.outSigns, true, "out_signs"},
-  };
-  for (const auto& array : arrays) {
-    if (array.needed && array.pointer == nullptr) {
-      return badArgument(std::string(array.name) + " is NULL");
-    }
+  if (a.positions == nullptr && a.numVertices > 0) return bad("positions is NULL");
+  if (a.faceStart == nullptr) return bad("face_start is NULL");
+  if (a.cornerVertex == nullptr) return bad("corner_vertex is NULL");
+  if (a.cornerNormals == nullptr && !a.normalsOptional) return bad("corner_normals is NULL");
+  for (std::size_t i = 0; i < a.uvSets.size(); ++i) {
+    if (a.uvSets[i] == nullptr) return bad(a.uvNames[i] + " is NULL");
   }
 
   if (a.faceStart[0] != 0) {
-    return badArgument("face_start[0] = " + std::to_string(a.faceStart[0]) + " (must be 0)");
+    return bad("face_start[0] = " + std::to_string(a.faceStart[0]) + " (must be 0)");
   }
   for (std::size_t f = 0; f < a.numFaces; ++f) {
     const std::uint32_t begin = a.faceStart[f];
     const std::uint32_t end = a.faceStart[f + 1];
     if (end < begin) {
-      return badArgument("face_start is not increasing: face_start[" + std::to_string(f) +
-                         "] = " + std::to_string(begin) + ", face_start[" +
-                         std::to_string(f + 1) + "] = " + std::to_string(end));
+      return bad("face_start is not increasing: face_start[" + std::to_string(f) +
+                 "] = " + std::to_string(begin) + ", face_start[" + std::to_string(f + 1) +
+                 "] = " + std::to_string(end));
     }
     if (end - begin < 3) {
-      return badArgument("face " + std::to_string(f) + " has " + std::to_string(end - begin) +
-                         " corners (faces need at least 3)");
+      return bad("face " + std::to_string(f) + " has " + std::to_string(end - begin) +
+                 " corners (faces need at least 3)");
     }
   }
   if (a.faceStart[a.numFaces] != a.numCorners) {
-    return badArgument("face_start[" + std::to_string(a.numFaces) +
-                       "] = " + std::to_string(a.faceStart[a.numFaces]) +
-                       " (must equal num_corners = " + std::to_string(a.numCorners) + ")");
+    return bad("face_start[" + std::to_string(a.numFaces) +
+               "] = " + std::to_string(a.faceStart[a.numFaces]) +
+               " (must equal num_corners = " + std::to_string(a.numCorners) + ")");
   }
 
   for (std::size_t c = 0; c < a.numCorners; ++c) {
     if (a.cornerVertex[c] >= a.numVertices) {
-      return badArgument("corner_vertex[" + std::to_string(c) +
-                         "] = " + std::to_string(a.cornerVertex[c]) +
-                         " is out of range (num_vertices = " + std::to_string(a.numVertices) +
-                         ")");
+      return bad("corner_vertex[" + std::to_string(c) + "] = " +
+                 std::to_string(a.cornerVertex[c]) + " is out of range (num_vertices = " +
+                 std::to_string(a.numVertices) + ")");
     }
   }
 
   if (const std::size_t v = firstNonFinite(a.positions, a.numVertices, 3); v < a.numVertices) {
-    return badArgument(describeElement("positions", v, a.positions, 3) + " is not finite");
+    return bad(describeElement("positions", v, a.positions, 3) + " is not finite");
   }
-  if (const std::size_t c = firstNonFinite(a.cornerNormals, a.numCorners, 3); c < a.numCorners) {
-    return badArgument(describeElement("corner_normals", c, a.cornerNormals, 3) +
-                       " is not finite");
+  if (a.cornerNormals != nullptr) {
+    if (const std::size_t c = firstNonFinite(a.cornerNormals, a.numCorners, 3);
+        c < a.numCorners) {
+      return bad(describeElement("corner_normals", c, a.cornerNormals, 3) + " is not finite");
+    }
   }
-  if (const std::size_t c = firstNonFinite(a.cornerUvs, a.numCorners, 2); c < a.numCorners) {
-    return badArgument(describeElement("corner_uvs", c, a.cornerUvs, 2) + " is not finite");
+  for (std::size_t i = 0; i < a.uvSets.size(); ++i) {
+    if (const std::size_t c = firstNonFinite(a.uvSets[i], a.numCorners, 2); c < a.numCorners) {
+      return bad(describeElement(a.uvNames[i], c, a.uvSets[i], 2) + " is not finite");
+    }
   }
-  for (std::size_t c = 0; c < a.numCorners; ++c) {
+  for (std::size_t c = 0; c < a.numCorners && a.cornerNormals != nullptr; ++c) {
     const float* n = a.cornerNormals + 3 * c;
     const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
     if (!(std::abs(len - 1.0) <= kUnitNormalTolerance)) {
       char length[32];
       std::snprintf(length, sizeof length, "%.6g", len);
-      return badArgument(describeElement("corner_normals", c, a.cornerNormals, 3) +
-                         " has length " + length + " (normals must be unit length)");
+      return bad(describeElement("corner_normals", c, a.cornerNormals, 3) + " has length " +
+                 length + " (normals must be unit length)");
     }
   }
   return Ok{};
@@ -186,13 +174,20 @@ std::vector<Vec2f> toVec2(const float* values, std::size_t n) {
   return out;
 }
 
-Status computeTangentsFromArrays(const TangentArguments& a) {
-  if (Status valid = validate(a); !valid) return valid;
+Status computeTangentsFromArrays(const MeshArrays& a, int threads, float* outTangents,
+                                 float* outSigns) {
+  const std::string where = "sgbake_compute_tangents: ";
+  if (threads < 0) {
+    return Error::badInput(where + "threads = " + std::to_string(threads) + " (must be >= 0)");
+  }
+  if (Status valid = validateMesh(where, a); !valid) return valid;
   if (a.numCorners == 0) return Ok{};
+  if (outTangents == nullptr) return Error::badInput(where + "out_tangents is NULL");
+  if (outSigns == nullptr) return Error::badInput(where + "out_signs is NULL");
 
   const std::vector<Vec3f> positions = toVec3(a.positions, a.numVertices);
   const std::vector<Vec3f> normals = toVec3(a.cornerNormals, a.numCorners);
-  const std::vector<Vec2f> uvs = toVec2(a.cornerUvs, a.numCorners);
+  const std::vector<Vec2f> uvs = toVec2(a.uvSets[0], a.numCorners);
   MeshView mesh;
   mesh.positions = positions;
   mesh.faceStart = {a.faceStart, a.numFaces + 1};
@@ -201,22 +196,208 @@ Status computeTangentsFromArrays(const TangentArguments& a) {
   mesh.cornerUvs = uvs;
 
   TangentOptions options;
-  options.threads = a.threads;
+  options.threads = threads;
   Result<CornerTangents> frames = computeTangents(mesh, options);
-  if (!frames) return Error{frames.error().code, std::string(kWhere) + frames.error().message};
+  if (!frames) return Error{frames.error().code, where + frames.error().message};
   if (frames->tangent.size() != a.numCorners || frames->sign.size() != a.numCorners) {
-    return Error::internal(std::string(kWhere) + "computeTangents returned " +
+    return Error::internal(where + "computeTangents returned " +
                            std::to_string(frames->tangent.size()) + " tangents for " +
                            std::to_string(a.numCorners) + " corners");
   }
   for (std::size_t c = 0; c < a.numCorners; ++c) {
     const Vec3f t = frames->tangent[c];
-    a.outTangents[3 * c] = t.x;
-    a.outTangents[3 * c + 1] = t.y;
-    a.outTangents[3 * c + 2] = t.z;
-    a.outSigns[c] = frames->sign[c];
+    outTangents[3 * c] = t.x;
+    outTangents[3 * c + 1] = t.y;
+    outTangents[3 * c + 2] = t.z;
+    outSigns[c] = frames->sign[c];
   }
   return Ok{};
+}
+
+// ---- sgbake_bake_map ---------------------------------------------------------------------------
+
+/// The mesh of a validated sgbake_mesh as a Mesh: the caller's normals made unit as a file's
+/// are (the C ABI accepts lengths within kUnitNormalTolerance), or smooth ones computed.
+Mesh toMesh(const MeshArrays& a) {
+  Mesh mesh;
+  mesh.source = kInMemoryMeshName;
+  mesh.positions = toVec3(a.positions, a.numVertices);
+  mesh.faceStart.assign(a.faceStart, a.faceStart + a.numFaces + 1);
+  mesh.cornerVertex.assign(a.cornerVertex, a.cornerVertex + a.numCorners);
+  for (std::size_t i = 0; i < a.uvSets.size(); ++i) {
+    mesh.uvSets.push_back({"UV" + std::to_string(i), toVec2(a.uvSets[i], a.numCorners)});
+  }
+  if (a.cornerNormals == nullptr) {
+    computeSmoothNormals(mesh);
+    return mesh;
+  }
+  mesh.cornerNormals = toVec3(a.cornerNormals, a.numCorners);
+  for (Vec3f& n : mesh.cornerNormals) n = unitNormal(n);
+  return mesh;
+}
+
+/// Checks the images of a call; @p where starts every message.
+Status validateImages(const std::string& where, const sgbake_image* images, std::size_t count) {
+  if (images == nullptr && count > 0) return Error::badInput(where + "images is NULL");
+  std::set<std::string_view> names;
+  for (std::size_t i = 0; i < count; ++i) {
+    const sgbake_image& image = images[i];
+    const std::string label = "images[" + std::to_string(i) + "]";
+    if (image.name == nullptr) return Error::badInput(where + label + ".name is NULL");
+    const std::string named = label + " ('" + image.name + "')";
+    if (!names.insert(image.name).second) {
+      return Error::badInput(where + named + ": another image has the same name");
+    }
+    if (image.width < 1 || image.height < 1 || image.width > kMaxImageSide ||
+        image.height > kMaxImageSide) {
+      return Error::badInput(where + named + ": size " + std::to_string(image.width) + "x" +
+                             std::to_string(image.height) + " is out of range 1..." +
+                             std::to_string(kMaxImageSide));
+    }
+    if (image.channels < 1 || image.channels > 4) {
+      return Error::badInput(where + named + ": channels = " + std::to_string(image.channels) +
+                             " (must be 1 to 4)");
+    }
+    if (image.pixels == nullptr) return Error::badInput(where + named + ": pixels is NULL");
+    const std::size_t values = static_cast<std::size_t>(image.width) *
+                               static_cast<std::size_t>(image.height) *
+                               static_cast<std::size_t>(image.channels);
+    for (std::size_t v = 0; v < values; ++v) {
+      if (!std::isfinite(image.pixels[v])) {
+        const std::size_t texel = v / static_cast<std::size_t>(image.channels);
+        return Error::badInput(where + named + ": pixel " + std::to_string(texel) +
+                               " (column " + std::to_string(texel % image.width) + ", row " +
+                               std::to_string(texel / image.width) +
+                               " from the bottom) is not a finite number");
+      }
+    }
+  }
+  return Ok{};
+}
+
+/// The channels a plan asks of an in-memory image (rows bottom first, as Image stores them).
+Image selectChannels(const sgbake_image& source, ImageChannels channels) {
+  Image image(source.width, source.height, source.channels);
+  std::copy_n(source.pixels, image.pixels().size(), image.pixels().begin());
+  return selectImageChannels(std::move(image), channels);
+}
+
+struct BakeArguments {
+  const char* sceneJson;
+  const sgbake_mesh* mesh;
+  const sgbake_image* images;
+  std::size_t numImages;
+  int threads;
+  float* outRgba;
+  std::size_t outFloats;
+};
+
+Status bakeMapFromArrays(const BakeArguments& a) {
+  const std::string where = "sgbake_bake_map: ";
+  if (a.threads < 0) {
+    return Error::badInput(where + "threads = " + std::to_string(a.threads) + " (must be >= 0)");
+  }
+  if (a.sceneJson == nullptr) return Error::badInput(where + "scene_json is NULL");
+  if (a.mesh == nullptr) return Error::badInput(where + "mesh is NULL");
+  if (a.outRgba == nullptr) return Error::badInput(where + "out_rgba is NULL");
+
+  SceneParseOptions parseOptions;
+  parseOptions.inMemory = true;
+  parseOptions.name = "sgbake_bake_map: scene_json";
+  Result<Scene> scene = parseScene(a.sceneJson, parseOptions);
+  if (!scene) return scene.error();
+  if (scene->outputs.size() != 1) {
+    return Error::badInput(where + "scene_json: has " + std::to_string(scene->outputs.size()) +
+                           " outputs (sgbake_bake_map bakes exactly one)");
+  }
+  const SceneOutput output = scene->outputs[0];
+  const std::size_t texels =
+      static_cast<std::size_t>(output.width) * static_cast<std::size_t>(output.height);
+  if (a.outFloats != 4 * texels) {
+    return Error::badInput(where + "out_floats = " + std::to_string(a.outFloats) + " but the " +
+                           std::to_string(output.width) + "x" + std::to_string(output.height) +
+                           " output needs " + std::to_string(4 * texels) + " (width x height x 4)");
+  }
+
+  const sgbake_mesh& m = *a.mesh;
+  MeshArrays arrays{m.positions, m.num_vertices, m.face_start, m.num_faces, m.corner_vertex,
+                    m.corner_normals, true, {}, {}, m.num_corners};
+  if (m.num_uv_sets < 1 || m.num_uv_sets > static_cast<std::size_t>(kMaxUvSets)) {
+    return Error::badInput(where + "num_uv_sets = " + std::to_string(m.num_uv_sets) +
+                           " (must be 1 to " + std::to_string(kMaxUvSets) + ")");
+  }
+  if (m.corner_uvs == nullptr) return Error::badInput(where + "corner_uvs is NULL");
+  for (std::size_t i = 0; i < m.num_uv_sets; ++i) {
+    arrays.uvSets.push_back(m.corner_uvs[i]);
+    arrays.uvNames.push_back("corner_uvs[" + std::to_string(i) + "]");
+  }
+  if (Status valid = validateMesh(where, arrays); !valid) return valid;
+  if (m.num_faces == 0) return Error::badInput(where + "the mesh has no faces");
+  if (Status valid = validateImages(where, a.images, a.numImages); !valid) return valid;
+
+  Result<Plan> plan = makePlan(std::move(*scene), PlanOptions{.force = true, .useManifest = false});
+  if (!plan) return plan.error();
+  const Mesh mesh = toMesh(arrays);
+  MemoryInputs inputs;
+  inputs.mesh = &mesh;
+  inputs.image = [&](const PlannedImage& planned) -> Result<Image> {
+    const std::string name = planned.path.string();
+    for (std::size_t i = 0; i < a.numImages; ++i) {
+      if (name == a.images[i].name) {
+        if (planned.channels == ImageChannels::kRgb && a.images[i].channels < 3) {
+          return Error::badInput(where + "image '" + name + "' has " +
+                                 std::to_string(a.images[i].channels) +
+                                 " channel(s) but normal maps need 3 (RGB)");
+        }
+        return selectChannels(a.images[i], planned.channels);
+      }
+    }
+    return Error::badInput(where + planned.users.front() + ": no image named '" + name +
+                           "' among the " + std::to_string(a.numImages) + " given");
+  };
+  Result<FloatImage> baked = bakeOutputInMemory(*plan, 0, inputs, a.threads);
+  if (!baked) {
+    const std::string& message = baked.error().message;
+    if (message.starts_with(where)) return baked.error();
+    return Error{baked.error().code, where + message};
+  }
+
+  // Rows top first → Blender's bottom-first RGBA.
+  const FloatImage& image = *baked;
+  const int channels = image.channels;
+  for (int row = 0; row < image.height; ++row) {
+    const int y = image.height - 1 - row;
+    for (int x = 0; x < image.width; ++x) {
+      float* rgba = a.outRgba + 4 * (static_cast<std::size_t>(y) * image.width + x);
+      const std::size_t texel = static_cast<std::size_t>(row) * image.width + x;
+      const float* value = image.pixels.data() + texel * static_cast<std::size_t>(channels);
+      rgba[0] = value[0];
+      rgba[1] = channels == 1 ? value[0] : value[1];
+      rgba[2] = channels == 1 ? value[0] : channels == 2 ? 0.0f : value[2];
+      rgba[3] = output.alpha ? image.coverage[texel] : 1.0f;
+    }
+  }
+  return Ok{};
+}
+
+/// Runs @p body, turning its Status into the C status and message, and any exception into
+/// SGBAKE_ERROR_INTERNAL: nothing escapes into the caller's C or Python.
+template <class Body>
+int guarded(const char* function, char* errorBuf, std::size_t errorBufSize, const Body& body) {
+  const std::string where = std::string(function) + ": ";
+  try {
+    const Status status = body();
+    if (status) return SGBAKE_OK;
+    writeError(errorBuf, errorBufSize, status.error().message);
+    return statusFor(status.error().code);
+  } catch (const std::bad_alloc&) {
+    writeError(errorBuf, errorBufSize, where + "out of memory");
+  } catch (const std::exception& e) {
+    writeError(errorBuf, errorBufSize, where + "internal error: " + e.what());
+  } catch (...) {
+    writeError(errorBuf, errorBufSize, where + "unknown internal error");
+  }
+  return SGBAKE_ERROR_INTERNAL;
 }
 
 }  // namespace
@@ -232,28 +413,21 @@ int sgbake_compute_tangents(const float* positions, size_t num_vertices,
                             const float* corner_uvs, size_t num_corners, int threads,
                             float* out_tangents, float* out_signs, char* error_buf,
                             size_t error_buf_size) {
-  using sgbake::writeError;
-  try {
-    const sgbake::TangentArguments arguments{positions,     num_vertices,   face_start,
-                                             num_faces,     corner_vertex,  corner_normals,
-                                             corner_uvs,    num_corners,    threads,
-                                             out_tangents,  out_signs};
-    const sgbake::Status status = sgbake::computeTangentsFromArrays(arguments);
-    if (status) return SGBAKE_OK;
-    writeError(error_buf, error_buf_size, status.error().message);
-    return sgbake::statusFor(status.error().code);
-  } catch (const std::bad_alloc&) {
-    writeError(error_buf, error_buf_size, "sgbake_compute_tangents: out of memory");
-  } catch (const std::exception& e) {
-    writeError(error_buf, error_buf_size, "sgbake_compute_tangents: internal error: ");
-    if (error_buf != nullptr && error_buf_size > 0) {
-      const std::size_t used = std::strlen(error_buf);
-      writeError(error_buf + used, error_buf_size - used, e.what());
-    }
-  } catch (...) {
-    writeError(error_buf, error_buf_size, "sgbake_compute_tangents: unknown internal error");
-  }
-  return SGBAKE_ERROR_INTERNAL;
+  return sgbake::guarded("sgbake_compute_tangents", error_buf, error_buf_size, [&] {
+    const sgbake::MeshArrays arrays{positions,     num_vertices,   face_start, num_faces,
+                                    corner_vertex, corner_normals, false,      {corner_uvs},
+                                    {"corner_uvs"}, num_corners};
+    return sgbake::computeTangentsFromArrays(arrays, threads, out_tangents, out_signs);
+  });
+}
+
+int sgbake_bake_map(const char* scene_json, const sgbake_mesh* mesh, const sgbake_image* images,
+                    size_t num_images, int threads, float* out_rgba, size_t out_floats,
+                    char* error_buf, size_t error_buf_size) {
+  return sgbake::guarded("sgbake_bake_map", error_buf, error_buf_size, [&] {
+    return sgbake::bakeMapFromArrays(
+        {scene_json, mesh, images, num_images, threads, out_rgba, out_floats});
+  });
 }
 
 }  // extern "C"

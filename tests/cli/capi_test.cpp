@@ -115,6 +115,27 @@ TEST(CApi, DoesNotLoadOpenImageIO) {
   EXPECT_EQ(maps.find("libsgbake_oiio"), std::string::npos);
 }
 
+TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
+  // An in-memory bake (images as arrays, if any) reads and writes no file: the add-on's bakes
+  // must not load the image I/O module either.
+  const FlatMesh m;
+  const float* uvSets[] = {m.cornerUvs.data()};
+  const sgbake_mesh mesh{m.positions.data(), m.numVertices(), m.faceStart.data(), m.numFaces(),
+                         m.cornerVertex.data(), m.cornerNormals.data(), uvSets, 1,
+                         m.numCorners()};
+  std::vector<float> rgba(32 * 32 * 4);
+  char error[256] = "";
+  ASSERT_EQ(sgbake_bake_map(R"({"layers": [{"type": "volume", "function": "noise"}],
+                                "outputs": [{"map": "tangent-normal", "size": 32}]})",
+                            &mesh, nullptr, 0, 0, rgba.data(), rgba.size(), error, sizeof error),
+            SGBAKE_OK)
+      << error;
+  EXPECT_NE(rgba[4 * (8 * 32 + 8)], rgba[4 * (8 * 32 + 9)]);  // the noise bumps the normals
+  const std::string maps = test::readFile("/proc/self/maps");
+  EXPECT_EQ(maps.find("libOpenImageIO"), std::string::npos);
+  EXPECT_EQ(maps.find("libsgbake_oiio"), std::string::npos);
+}
+
 TEST(CApi, ThreadCountDoesNotChangeTheResult) {
   const FlatMesh m;
   const CallResult one = callC(m, 1);

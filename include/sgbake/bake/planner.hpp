@@ -48,9 +48,11 @@
 #include <string_view>
 #include <vector>
 
+#include "sgbake/bake/bake.hpp"
 #include "sgbake/bake/scene.hpp"
 #include "sgbake/core/result.hpp"
 #include "sgbake/gradient/image.hpp"
+#include "sgbake/mesh/mesh.hpp"
 
 namespace sgbake {
 
@@ -190,5 +192,26 @@ struct ExecuteReport {
 /// unreadable image, a mesh without UVs or without a UV set an output or layer names) leaves
 /// every output untouched. Output directories are created when missing.
 Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& options = {});
+
+/// @brief What an in-memory plan bakes from instead of files (bakeOutputInMemory).
+struct MemoryInputs {
+  /// The mesh, before the scene's subdivision. It must have the UV sets the scene uses.
+  const Mesh* mesh = nullptr;
+  /// The image a scene's "image" key names (PlannedImage::path), with the plan's channels
+  /// (PlannedImage::channels: kLuminance or kRgb); kBadInput naming it when there is none.
+  std::function<Result<Image>(const PlannedImage& image)> image;
+};
+
+/// @brief Bakes output @p output of a plan of an in-memory scene (SceneParseOptions::inMemory)
+/// and pads it as executePlan pads a file, without writing anything.
+///
+/// The planner's decisions hold as for files: only the layers the output reads are built, and
+/// tangent frames only when the output or a layer needs them. The result is the one a float
+/// file of the same output holds (executePlan and this give the same values): rows top first,
+/// normal maps encoded, signed maps raw (no "range" remapping).
+/// @param[in] threads maximum threads; 0 = all cores (the result does not depend on it)
+/// @return the image, or kBadInput for a missing image, a UV set the mesh lacks, a bad layer
+Result<FloatImage> bakeOutputInMemory(const Plan& plan, std::size_t output,
+                                      const MemoryInputs& inputs, int threads = 0);
 
 }  // namespace sgbake

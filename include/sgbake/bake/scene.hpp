@@ -185,10 +185,16 @@ struct SceneOutput {
   int resolvedBitDepth() const;
 };
 
+/// What Scene::mesh is for a scene of an in-memory bake (messages name the mesh so).
+inline constexpr const char* kInMemoryMeshName = "mesh";
+
 /// @brief A parsed scene: every path resolved, every value validated.
 struct Scene {
   std::filesystem::path source;  ///< the scene file ("" for scenes built in code)
-  std::filesystem::path mesh;    ///< resolved
+  std::filesystem::path mesh;    ///< resolved; kInMemoryMeshName in memory
+  /// The scene of an in-memory bake (SceneParseOptions::inMemory): the mesh and the images are
+  /// given as arrays, "image" keys are their names, and outputs have no file.
+  bool inMemory = false;
   int uvSet = 0;                 ///< top-level "uv": default UV set of layers and outputs
   SceneSubdivision subdivision;
   std::vector<SceneLayer> layers;
@@ -200,6 +206,10 @@ struct SceneParseOptions {
   std::filesystem::path baseDir;    ///< relative mesh/image paths start here ("" = cwd)
   std::filesystem::path outputDir;  ///< relative output files start here ("" = baseDir)
   std::string name = "scene";       ///< prefix of every message ("scene.json: ...")
+  /// For a bake in memory (bakeOutputInMemory, the C ABI's sgbake_bake_map): no "mesh" key,
+  /// "image" keys are names of images given in memory (kept verbatim), and outputs have no
+  /// "file", "format" or "bit_depth" and are not corners tables.
+  bool inMemory = false;
 };
 
 /// @brief Parses and validates a scene from JSON text.
