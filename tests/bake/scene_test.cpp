@@ -392,5 +392,52 @@ TEST(Scene, ClosestMatch) {
   EXPECT_EQ(closestMatch("x", keys), "");
 }
 
+// ---- Scenes of in-memory bakes (the C ABI) ------------------------------------------------------
+
+/// Parses @p text as the scene of an in-memory bake.
+Result<Scene> parseInMemory(const std::string& text) {
+  SceneParseOptions o = options();
+  o.inMemory = true;
+  o.name = "sgbake_bake_map: scene_json";
+  return parseScene(text, o);
+}
+
+TEST(Scene, InMemoryScenesNameImagesVerbatimAndHaveNoFiles) {
+  Result<Scene> parsed = parseInMemory(
+      R"({"layers": [{"type": "height", "image": "Bumps/../Height.001", "mask": "a//mask"}],
+          "outputs": [{"map": "tangent-normal", "size": 64, "tile": 1002}]})");
+  ASSERT_TRUE(parsed) << parsed.error().message;
+  EXPECT_TRUE(parsed->inMemory);
+  EXPECT_EQ(parsed->mesh, kInMemoryMeshName);
+  // Names are not paths: not resolved against the base directory, not normalized.
+  EXPECT_EQ(parsed->layers[0].image, "Bumps/../Height.001");
+  EXPECT_EQ(parsed->layers[0].mask->image, "a//mask");
+  EXPECT_TRUE(parsed->outputs[0].file.empty());
+  EXPECT_EQ(parsed->outputs[0].tile, 1002);
+  EXPECT_TRUE(validateScene(*parsed));
+}
+
+TEST(Scene, InMemoryScenesRejectFileKeys) {
+  const auto error = [](const std::string& text) {
+    Result<Scene> parsed = parseInMemory(text);
+    return parsed ? std::string("parsed") : parsed.error().message;
+  };
+  EXPECT_EQ(error(R"({"mesh": "m.obj", "outputs": [{"map": "height"}]})"),
+            "sgbake_bake_map: scene_json: key 'mesh' is not used in memory (the mesh is given as "
+            "arrays)");
+  for (const char* key : {"file", "format", "bit_depth"}) {
+    const std::string value = std::string(key) == "bit_depth" ? "16" : "\"exr\"";
+    EXPECT_EQ(error(R"({"outputs": [{"map": "height", ")" + std::string(key) + "\": " + value +
+                    "}]}"),
+              "sgbake_bake_map: scene_json: outputs[0]: key '" + std::string(key) +
+                  "' is not used in memory (the map is returned as pixels)");
+  }
+  EXPECT_EQ(error(R"({"outputs": [{"map": "corners"}]})"),
+            "sgbake_bake_map: scene_json: outputs[0]: a corners table cannot be baked in memory "
+            "(it is written as a file)");
+  // The same scene as a file scene: a missing 'file' is still an error there.
+  EXPECT_FALSE(parseScene(R"({"mesh": "m.obj", "outputs": [{"map": "height"}]})", options()));
+}
+
 }  // namespace
 }  // namespace sgbake
