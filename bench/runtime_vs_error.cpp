@@ -213,6 +213,12 @@ void heightFilters(const Settings& settings) {
       table.row(std::string(filterName(filter)) + ", " + std::to_string(r), seconds, error);
     }
   }
+  std::printf(
+      "\nBilinear slopes are constant across each map texel in their own direction (first "
+      "order: the error halves when R doubles); Catmull-Rom (bicubic) slopes are second order "
+      "and Hermite's (from fourth-order derivative estimates) third order. How accurate a filter is also depends on where in a map texel it "
+      "is sampled: when R equals the bake size, every sample falls on a map texel centre, where "
+      "bilinear slopes are one-sided differences and Catmull-Rom slopes central differences.\n");
 }
 
 void supersampling(const Settings& settings) {
