@@ -104,7 +104,7 @@ typedef struct sgbake_mesh {
   /// num_uv_sets pointers, each to #C × 2 floats (u, v); UV set 0 is the one MikkTSpace frames
   /// are computed on, as Blender does for its first UV map. A scene's "uv": N reads set N.
   const float* const* corner_uvs;
-  size_t num_uv_sets;  ///< at least 1, at most 8
+  size_t num_uv_sets;  ///< at least 1, at most 4 (the UV sets a scene's "uv" keys can name)
   size_t num_corners;  ///< #C (must fit in 32 bits)
 } sgbake_mesh;
 
