@@ -1,0 +1,133 @@
+"""The add-on's settings: a PropertyGroup on the Scene (scene.sgbake) with a list of layers.
+
+Enum identifiers are sgbake's own names ("tangent-normal", "bicubic"), so scene.py sends them
+as they are. Defaults are those of a scene file (docs/baker.md), except where noted.
+"""
+
+import bpy
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       FloatVectorProperty, IntProperty, PointerProperty, StringProperty)
+
+from . import scene
+
+FILTERS = (
+    ("bilinear", "Bilinear", "Bilinear interpolation (Blender's Linear)"),
+    ("bicubic", "Bicubic", "Cubic B-spline interpolation (Blender's Cubic)"),
+    ("hermite", "Hermite", "Hermite interpolation with exact derivatives (height images only)"),
+)
+WRAPS = (
+    ("repeat", "Repeat", "Tile the image (Blender's Repeat)"),
+    ("clamp", "Clamp", "Extend the edge texels (Blender's Extend)"),
+)
+GREENS = (
+    ("opengl", "OpenGL (Y+)", "Green = +bitangent, as Blender, Substance and Unity use"),
+    ("directx", "DirectX (Y-)", "Green = -bitangent, as Unreal and 3ds Max use"),
+)
+SPACES = (
+    ("tangent", "Tangent", "The normal map is in tangent space"),
+    ("object", "Object", "The normal map is in object space"),
+)
+KINDS = (
+    ("height", "Height", "The image holds heights"),
+    ("tangent-normal", "Tangent Normal", "The image holds tangent-space normals"),
+    ("object-normal", "Object Normal", "The image holds object-space normals"),
+)
+AXES = (("x", "X", "Project along X"), ("y", "Y", "Project along Y"),
+        ("z", "Z", "Project along Z"))
+FUNCTIONS = (
+    ("sine", "Sine", "amplitude * sin(2 pi frequency (direction . p) + phase)"),
+    ("noise", "Noise", "Gradient noise of the given frequency and octaves"),
+)
+GRADIENTS = (
+    ("analytic", "Analytic", "Exact derivative of the function"),
+    ("central", "Central", "Central differences (6 evaluations)"),
+    ("tetrahedral", "Tetrahedral", "Tetrahedral differences (4 evaluations)"),
+)
+PADDINGS = (
+    ("extend", "Extend", "Extend the islands' edge texels by Margin texels (Blender's Extend)"),
+    ("push-pull", "Push-Pull", "Fill every uncovered texel from the islands (Margin unused)"),
+)
+
+
+class SgbakeLayer(bpy.types.PropertyGroup):
+    """One layer of the bake; which settings apply depends on its type."""
+    name: StringProperty(name="Name", default="Layer")
+    type: EnumProperty(name="Type", items=scene.LAYER_TYPES, default="height")
+    weight: FloatProperty(name="Weight", default=1.0, soft_min=0.0, soft_max=1.0,
+                          description="Multiplies the layer's bump; 0 disables it")
+    image: PointerProperty(name="Image", type=bpy.types.Image,
+                           description="The layer's image (heights, or encoded normals)")
+    scale: FloatProperty(
+        name="Scale", default=1.0, precision=4, step=1,
+        description="Height layers: object units per unit of image value (the Bump node's "
+                    "Distance x Strength). Normal layers: strength. Projections: both")
+    filter: EnumProperty(name="Filter", items=FILTERS, default="bilinear")
+    wrap: EnumProperty(name="Wrap", items=WRAPS, default="repeat")
+    tiling: FloatVectorProperty(name="Tiling", size=2, default=(1.0, 1.0),
+                                description="Repetitions of the image per UV unit (u, v)")
+    uv_map: StringProperty(name="UV Map",
+                           description="UV map the image is on; empty: the bake's UV map")
+    space: EnumProperty(name="Space", items=SPACES, default="tangent")
+    green: EnumProperty(name="Green", items=GREENS, default="opengl",
+                        description="Green channel convention of the normal map image")
+    kind: EnumProperty(name="Kind", items=KINDS, default="height",
+                       description="What the projected image holds")
+    axis: EnumProperty(name="Axis", items=AXES, default="z")
+    sharpness: FloatProperty(name="Sharpness", default=4.0, min=0.0,
+                             description="Exponent of the triplanar blend weights")
+    function: EnumProperty(name="Function", items=FUNCTIONS, default="sine")
+    amplitude: FloatProperty(name="Amplitude", default=1.0, precision=4,
+                             description="Height amplitude, object units")
+    frequency: FloatProperty(name="Frequency", default=1.0, precision=4,
+                             description="Cycles (sine) or noise features per object unit")
+    direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0),
+                                   description="Direction of the sine wave, object space")
+    phase: FloatProperty(name="Phase", default=0.0, subtype="ANGLE")
+    seed: IntProperty(name="Seed", default=0, min=0)
+    octaves: IntProperty(name="Octaves", default=1, min=1, max=16)
+    gradient: EnumProperty(name="Gradient", items=GRADIENTS, default="analytic",
+                           description="How the volume's gradient is computed")
+
+
+class SgbakeSettings(bpy.types.PropertyGroup):
+    """What to bake (scene.sgbake)."""
+    map: EnumProperty(name="Map", items=scene.MAPS, default="tangent-normal")
+    width: IntProperty(name="Width", default=1024, min=1, max=65536, soft_max=16384,
+                       subtype="PIXEL")
+    height: IntProperty(name="Height", default=1024, min=1, max=65536, soft_max=16384,
+                        subtype="PIXEL")
+    margin: IntProperty(name="Margin", default=16, min=0, soft_max=64, subtype="PIXEL",
+                        description="Texels of padding around the UV islands")
+    padding: EnumProperty(name="Padding", items=PADDINGS, default="extend")
+    samples: IntProperty(name="Samples", default=1, min=1, max=16,
+                         description="N x N samples per texel, averaged")
+    green: EnumProperty(name="Green", items=GREENS, default="opengl",
+                        description="Green channel of the baked tangent-space normal map")
+    uv_map: StringProperty(
+        name="UV Map",
+        description="UV map to bake on; empty: the active UV map (Blender's bake default)")
+    threads: IntProperty(name="Threads", default=0, min=0,
+                         description="Maximum threads; 0 = all cores (same result for any)")
+    use_alpha: BoolProperty(name="Alpha from Coverage", default=False,
+                            description="Alpha = the texel's coverage by the UV islands; "
+                                        "otherwise 1")
+    target_image: PointerProperty(
+        name="Target", type=bpy.types.Image,
+        description="Image to bake into; empty: '<object>_<map>', created as a float image")
+    layers: CollectionProperty(type=SgbakeLayer)
+    active_layer_index: IntProperty(name="Active Layer", default=0, min=0)
+
+
+CLASSES = (SgbakeLayer, SgbakeSettings)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.sgbake = PointerProperty(type=SgbakeSettings)
+
+
+def unregister():
+    del bpy.types.Scene.sgbake
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,100 @@
+"""The add-on's settings as an sgbake scene (the JSON of `sgbake bake SCENE.json`, docs/baker.md).
+
+No bpy here: the functions read the settings and layers through their attributes only (the
+PropertyGroups of properties.py, or anything with the same attributes).
+
+The scene parser refuses keys that do not apply (a "green" on an object-space normal map, a
+"phase" on a noise volume, an "image" on a volume), so every key below is sent only for the
+layer types, spaces and maps it applies to (scene.cpp's layerKeys and kMapOutputKeys).
+"""
+
+MAPS = (
+    ("tangent-normal", "Tangent Normal", "Normal map in tangent space (n/2 + 0.5)"),
+    ("object-normal", "Object Normal", "Normal map in object space (n/2 + 0.5)"),
+    ("height", "Height", "The layers' heights (object units)"),
+    ("derivative", "Derivative", "Height derivatives along u and v (signed, 2 channels)"),
+    ("surface-gradient", "Surface Gradient", "Object-space surface gradient (signed)"),
+    ("tangent", "Tangent", "MikkTSpace tangent (n/2 + 0.5)"),
+    ("bitangent", "Bitangent", "Bitangent, sign x N x T (n/2 + 0.5)"),
+    ("mask", "Mask", "1 where a triangle covers the texel, else 0"),
+)
+# Maps that read no layer: their bakes send none, so an unfinished layer cannot stop them.
+LAYERLESS_MAPS = {"tangent", "bitangent", "mask"}
+
+LAYER_TYPES = (
+    ("height", "Height", "Height image on a UV map"),
+    ("normal", "Normal", "Normal map image on a UV map (tangent or object space)"),
+    ("volume", "Volume", "Procedural height in object space (sine or noise)"),
+    ("planar", "Planar", "Image projected along an object axis"),
+    ("triplanar", "Triplanar", "Image projected on the three axis planes and blended"),
+)
+IMAGE_LAYER_TYPES = {"height", "normal", "planar", "triplanar"}
+UV_LAYER_TYPES = {"height", "normal"}  # layer types with their own "uv"
+
+
+def _number(value):
+    """A Blender float/int property as a JSON number (plain Python float/int)."""
+    return float(value) if isinstance(value, float) else int(value)
+
+
+def reads_tangent_normals(layer):
+    """Whether the layer's image holds tangent-space normals (then "green" applies)."""
+    if layer.type == "normal":
+        return layer.space == "tangent"
+    if layer.type in ("planar", "triplanar"):
+        return layer.kind == "tangent-normal"
+    return False
+
+
+def layer_json(layer, uv_index):
+    """One entry of "layers". uv_index(name) gives the UV set of a UV map name (the layer's own
+    UV map, when it names one, for height and normal layers)."""
+    entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
+    if layer.type in IMAGE_LAYER_TYPES:
+        entry.update(image=layer.image.name, filter=layer.filter, wrap=layer.wrap,
+                     tiling=[_number(layer.tiling[0]), _number(layer.tiling[1])])
+    if layer.type in UV_LAYER_TYPES and layer.uv_map:
+        entry["uv"] = uv_index(layer.uv_map)
+    if layer.type == "height":
+        entry["scale"] = _number(layer.scale)
+    elif layer.type == "normal":
+        entry.update(space=layer.space, strength=_number(layer.scale))
+    elif layer.type == "volume":
+        entry.update(function=layer.function, amplitude=_number(layer.amplitude),
+                     frequency=_number(layer.frequency), gradient=layer.gradient)
+        if layer.function == "sine":
+            entry.update(direction=[_number(c) for c in layer.direction],
+                         phase=_number(layer.phase))
+        else:
+            entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
+    elif layer.type == "planar":
+        entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
+    elif layer.type == "triplanar":
+        entry.update(kind=layer.kind, scale=_number(layer.scale),
+                     sharpness=_number(layer.sharpness))
+    if reads_tangent_normals(layer):
+        entry["green"] = layer.green
+    return entry
+
+
+def output_json(settings):
+    """The single entry of "outputs" (no "file": the pixels come back in memory)."""
+    output = {"map": settings.map, "width": int(settings.width), "height": int(settings.height),
+              "margin": int(settings.margin), "padding": settings.padding,
+              "samples": int(settings.samples), "alpha": bool(settings.use_alpha)}
+    if settings.map == "tangent-normal":
+        output["green"] = settings.green
+    return output
+
+
+def baked_layers(settings):
+    """The layers the settings' map reads: all of them, or none for LAYERLESS_MAPS."""
+    return [] if settings.map in LAYERLESS_MAPS else list(settings.layers)
+
+
+def scene_json(settings, layers, bake_uv_set, uv_index):
+    """The scene for sgbake_bake_map: the bake's UV set as the default of the layers and the
+    output ("uv"), the layers (baked_layers) and one output."""
+    return {"uv": bake_uv_set,
+            "layers": [layer_json(layer, uv_index) for layer in layers],
+            "outputs": [output_json(settings)]}

@@ -1,0 +1,133 @@
+"""The panel in Properties > Render > sgbake: output settings, the layer list and the bake
+button, with the library's version (or why it cannot be loaded) at the top."""
+
+import bpy
+
+from . import library, scene
+
+
+class SGBAKE_UL_layers(bpy.types.UIList):
+    """One row per layer: name, type, image (or volume function) and weight."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        row = layout.row(align=True)
+        row.prop(item, "name", text="", emboss=False,
+                 icon="NODE_MATERIAL" if item.type == "normal" else "MOD_DISPLACE")
+        row.label(text=item.type)
+        if item.type in scene.IMAGE_LAYER_TYPES:
+            row.label(text=item.image.name if item.image else "(no image)",
+                      icon="IMAGE_DATA" if item.image else "ERROR")
+        else:
+            row.label(text=item.function)
+        row.prop(item, "weight", text="", emboss=False)
+
+
+class SGBAKE_PT_bake(bpy.types.Panel):
+    """Output settings and the bake button."""
+    bl_label = "sgbake"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.sgbake
+        loaded, line = library.describe(context)
+        layout.label(text=line, icon="CHECKMARK" if loaded else "ERROR")
+
+        ob = context.active_object
+        layout.prop(settings, "map")
+        col = layout.column(align=True)
+        col.prop(settings, "width", text="Size X")
+        col.prop(settings, "height", text="Y")
+        layout.prop(settings, "padding")
+        row = layout.row()
+        row.active = settings.padding == "extend"
+        row.prop(settings, "margin")
+        layout.prop(settings, "samples")
+        if settings.map == "tangent-normal":
+            layout.prop(settings, "green")
+        if ob is not None and ob.type == "MESH":
+            layout.prop_search(settings, "uv_map", ob.data, "uv_layers")
+        else:
+            layout.prop(settings, "uv_map")
+        layout.prop(settings, "use_alpha")
+        layout.prop(settings, "threads")
+        layout.template_ID(settings, "target_image", new="image.new", open="image.open")
+
+        row = layout.row()
+        row.scale_y = 1.4
+        row.enabled = ob is not None and ob.type == "MESH"
+        row.operator("object.sgbake_bake", icon="RENDER_STILL")
+
+
+class SGBAKE_PT_layers(bpy.types.Panel):
+    """The layer list and the active layer's settings (only those its type uses)."""
+    bl_label = "Layers"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    bl_parent_id = "SGBAKE_PT_bake"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.sgbake
+        if settings.map in scene.LAYERLESS_MAPS:
+            layout.label(text=f"The {settings.map} map reads no layer", icon="INFO")
+        row = layout.row()
+        row.template_list("SGBAKE_UL_layers", "", settings, "layers", settings,
+                          "active_layer_index", rows=3)
+        buttons = row.column(align=True)
+        buttons.operator("sgbake.layer_add", icon="ADD", text="")
+        buttons.operator("sgbake.layer_remove", icon="REMOVE", text="")
+        buttons.separator()
+        buttons.operator("sgbake.layer_move", icon="TRIA_UP", text="").direction = "UP"
+        buttons.operator("sgbake.layer_move", icon="TRIA_DOWN", text="").direction = "DOWN"
+        layout.operator("object.sgbake_layers_from_material", icon="MATERIAL")
+
+        if not 0 <= settings.active_layer_index < len(settings.layers):
+            return
+        layer = settings.layers[settings.active_layer_index]
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        col = layout.column()
+        col.prop(layer, "type")
+        col.prop(layer, "weight")
+        if layer.type in scene.IMAGE_LAYER_TYPES:
+            col.template_ID(layer, "image", open="image.open")
+            if layer.type in ("planar", "triplanar"):
+                col.prop(layer, "kind")
+            if layer.type == "planar":
+                col.prop(layer, "axis")
+            col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
+            col.prop(layer, "filter")
+            col.prop(layer, "wrap")
+            col.prop(layer, "tiling")
+        if layer.type in scene.UV_LAYER_TYPES:
+            ob = context.active_object
+            if ob is not None and ob.type == "MESH":
+                col.prop_search(layer, "uv_map", ob.data, "uv_layers")
+            else:
+                col.prop(layer, "uv_map")
+        if layer.type == "normal":
+            col.prop(layer, "space")
+        if layer.type == "triplanar":
+            col.prop(layer, "sharpness")
+        if scene.reads_tangent_normals(layer):
+            col.prop(layer, "green")
+        if layer.type == "volume":
+            col.prop(layer, "function")
+            col.prop(layer, "amplitude")
+            col.prop(layer, "frequency")
+            if layer.function == "sine":
+                col.prop(layer, "direction")
+                col.prop(layer, "phase")
+            else:
+                col.prop(layer, "seed")
+                col.prop(layer, "octaves")
+            col.prop(layer, "gradient")
+
+
+CLASSES = (SGBAKE_UL_layers, SGBAKE_PT_bake, SGBAKE_PT_layers)
