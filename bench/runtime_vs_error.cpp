@@ -55,7 +55,7 @@ namespace {
 
 struct Settings {
   int runs = 5;
-  int size = 512;  ///< bake size, texels per side
+  int size = 1024;  ///< bake size, texels per side
   int threads = 0;
   bool quick = false;
 };
@@ -216,9 +216,7 @@ void heightFilters(const Settings& settings) {
   std::printf(
       "\nBilinear slopes are constant across each map texel in their own direction (first "
       "order: the error halves when R doubles); Catmull-Rom (bicubic) slopes are second order "
-      "and Hermite's (from fourth-order derivative estimates) third order. How accurate a filter is also depends on where in a map texel it "
-      "is sampled: when R equals the bake size, every sample falls on a map texel centre, where "
-      "bilinear slopes are one-sided differences and Catmull-Rom slopes central differences.\n");
+      "and Hermite's (from fourth-order derivative estimates) third order.\n");
 }
 
 void supersampling(const Settings& settings) {
