@@ -569,7 +569,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   }
   // Every image to load must exist (checked here so no output is touched on bad input).
   for (const PlannedImage& image : plan.images) {
-    if (s.inMemory) break;
+    if (s.inMemory) continue;  // images in memory are looked up when they are loaded
     if (Status ok = checkInputFile(s, image.users.front(), "image", image.path); !ok) {
       return ok.error();
     }

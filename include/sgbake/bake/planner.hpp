@@ -131,9 +131,10 @@ struct Plan {
 };
 
 /// @brief Plans @p scene: checks that the files it reads exist, decides what each output reads,
-/// and (with the manifest) which outputs are up to date.
-/// @return kBadInput for a scene asking for subdivision ("subdivision is not supported yet"),
-/// a missing mesh or image (naming the file and the layer), or a scene validateScene rejects.
+/// and (with the manifest) which outputs are up to date. An in-memory scene (Scene::inMemory)
+/// has no files: nothing is checked on disk and the manifest is never used.
+/// @return kBadInput for a missing mesh or image (naming the file and the layer), or a scene
+/// validateScene rejects.
 Result<Plan> makePlan(Scene scene, const PlanOptions& options = {});
 
 /// @brief The plan as text: a header, one numbered line per step (what: why), and a "skipped:"
