@@ -181,7 +181,9 @@ class CApiBake : public ::testing::Test {
       }
     }
     EXPECT_EQ(differing, 0u);
-    if (alpha) EXPECT_GT(covered, static_cast<std::size_t>(size * size / 10));
+    if (alpha) {
+      EXPECT_GT(covered, static_cast<std::size_t>(size * size / 10));
+    }
   }
 
   fs::path dir_;
