@@ -39,7 +39,8 @@ extern "C" {
 enum sgbake_status {
   SGBAKE_OK = 0,             ///< success; every output array has been written
   SGBAKE_ERROR_INTERNAL = 1, ///< a bug or a resource failure (e.g. out of memory) in sgbake
-  SGBAKE_ERROR_BAD_INPUT = 2 ///< the arguments are inconsistent or the data is invalid
+  SGBAKE_ERROR_BAD_INPUT = 2, ///< the arguments are inconsistent or the data is invalid
+  SGBAKE_CANCELLED = 3        ///< the caller asked the call to stop (sgbake_progress::cancel)
 };
 
 /// @brief The library's version, "MAJOR.MINOR.PATCH" (a static string; never NULL).
@@ -121,6 +122,14 @@ typedef struct sgbake_image {
   int32_t channels;     ///< 1 to 4 (Blender: 4). Heights read the Rec. 709 luminance of RGB.
 } sgbake_image;
 
+/// @brief Progress of a long call, shared with the caller while it runs: the library writes
+/// `fraction`, the caller may set `cancel` from another thread (e.g. a UI's, while a worker
+/// thread is in the call). The library reads and writes both fields atomically (relaxed).
+typedef struct sgbake_progress {
+  float fraction;  ///< written by the library: 0 at the start, rising to 1 when the map is baked
+  int32_t cancel;  ///< set to non-zero by the caller to stop: the call returns SGBAKE_CANCELLED
+} sgbake_progress;
+
 /// @brief Bakes one map of a mesh given as arrays, into a caller-provided RGBA float buffer laid
 /// out as Blender's `Image.pixels` (rows bottom first), so a Blender image takes it with
 /// `pixels.foreach_set`.
@@ -139,6 +148,9 @@ typedef struct sgbake_image {
 /// @param[in]  num_images  number of entries in images.
 /// @param[in]  threads     maximum number of threads; 0 = all cores. The result is
 ///                         bit-identical for every value.
+/// @param[in,out] progress may be NULL. Its `fraction` rises with the rows baked (band by band);
+///                         a non-zero `cancel` stops the bake within two bands of 256 rows, and
+///                         the call returns SGBAKE_CANCELLED (out_rgba is then unusable).
 /// @param[out] out_rgba    width × height × 4 floats (the output's "size", or "width" and
 ///                         "height"), rows bottom first. RGB hold the map's values as a float
 ///                         file would store them: normal, tangent and bitangent maps encoded as
@@ -152,15 +164,15 @@ typedef struct sgbake_image {
 ///                         be NULL. Untouched on success.
 /// @param[in]  error_buf_size size of error_buf in bytes; may be 0.
 ///
-/// @return SGBAKE_OK, SGBAKE_ERROR_BAD_INPUT (bad scene text — the message names the key as
+/// @return SGBAKE_OK, SGBAKE_CANCELLED, SGBAKE_ERROR_BAD_INPUT (bad scene text — the message names the key as
 ///         for a scene file —, a bad mesh array as in sgbake_compute_tangents, an image a layer
 ///         names that is not among @p images, a UV set the mesh lacks, a wrong out_floats) or
 ///         SGBAKE_ERROR_INTERNAL. Everything is validated before anything is baked; on failure
 ///         out_rgba may have been partly written and must not be used.
 SGBAKE_C_API int sgbake_bake_map(const char* scene_json, const sgbake_mesh* mesh,
                                  const sgbake_image* images, size_t num_images, int threads,
-                                 float* out_rgba, size_t out_floats, char* error_buf,
-                                 size_t error_buf_size);
+                                 sgbake_progress* progress, float* out_rgba, size_t out_floats,
+                                 char* error_buf, size_t error_buf_size);
 
 #ifdef __cplusplus
 } /* extern "C" */

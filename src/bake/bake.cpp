@@ -280,15 +280,28 @@ Error outOfMemory(const BakeSettings& settings) {
 }  // namespace
 
 Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings) {
+  return bakeMap(input, settings, {});
+}
+
+Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings,
+                           const BakeProgressCallback& progress) {
   if (Status s = validateSettings(input, settings); !s) return s.error();
   try {
     const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(*input.mesh);
     FloatImage image;
     bake_detail::allocateImage(image, settings.width, settings.height, mapChannels(settings.map),
                                settings.threads);
-    const bake_detail::RasterJob job =
+    bake_detail::RasterJob job =
         bake_detail::rasterJobFor(*input.mesh, triangles, settings, settings.width, settings.height);
+    bool stopped = false;
+    if (progress) {  // bands of the whole image: it holds every row they read
+      job.onRowsFinal = [&](int rowsFinal) {
+        stopped = !progress(rowsFinal, settings.height);
+        return !stopped;
+      };
+    }
     runBake(input, settings, job, bake_detail::RasterTarget::of(image), /*blank=*/true);
+    if (stopped) return Error{ErrorCode::kCancelled, "bake: cancelled"};
     return image;
   } catch (const std::bad_alloc&) {
     return outOfMemory(settings);

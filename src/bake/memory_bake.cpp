@@ -11,7 +11,8 @@
 namespace sgbake {
 
 Result<FloatImage> bakeOutputInMemory(const Plan& plan, std::size_t output,
-                                      const MemoryInputs& inputs, int threads) {
+                                      const MemoryInputs& inputs, int threads,
+                                      const BakeProgressCallback& progress) {
   const Scene& s = plan.scene;
   if (!s.inMemory) return Error::internal("bakeOutputInMemory: the scene is not an in-memory one");
   if (output >= plan.outputs.size()) {
@@ -28,22 +29,22 @@ Result<FloatImage> bakeOutputInMemory(const Plan& plan, std::size_t output,
   if (Status valid = validate(*inputs.mesh); !valid) return valid.error();
 
   ExecuteOptions silent;
-  plan_detail::ProgressReporter progress(silent, 0);
+  plan_detail::ProgressReporter steps(silent, 0);
   ExecuteReport report;
   plan_detail::Loaded loaded;
   if (Status ok = plan_detail::setSurface(s.subdivision, *inputs.mesh, loaded); !ok) {
     return Error{ok.error().code, s.mesh.string() + ": " + ok.error().message};
   }
-  if (Status ok = plan_detail::loadTextures(plan, inputs.image, loaded, progress, report); !ok) {
+  if (Status ok = plan_detail::loadTextures(plan, inputs.image, loaded, steps, report); !ok) {
     return ok.error();
   }
-  if (Status ok = plan_detail::prepareLayers(plan, threads, loaded, progress, report); !ok) {
+  if (Status ok = plan_detail::prepareLayers(plan, threads, loaded, steps, report); !ok) {
     return ok.error();
   }
 
   const std::vector<Layer> layers = plan_detail::outputLayers(planned, loaded);
   Result<FloatImage> image = bakeMap(plan_detail::bakeInputFor(loaded, layers),
-                                     plan_detail::bakeSettingsFor(out, out.tile, threads));
+                                     plan_detail::bakeSettingsFor(out, out.tile, threads), progress);
   if (!image) return image.error();
   const auto [pushPull, margin] = plan_detail::outputPadding(out);
   if (pushPull) {

@@ -4,6 +4,7 @@
 #include "sgbake/sgbake.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -42,7 +43,15 @@ void writeError(char* buffer, std::size_t size, std::string_view message) noexce
 }
 
 int statusFor(ErrorCode code) {
-  return code == ErrorCode::kBadInput ? SGBAKE_ERROR_BAD_INPUT : SGBAKE_ERROR_INTERNAL;
+  switch (code) {
+    case ErrorCode::kBadInput:
+      return SGBAKE_ERROR_BAD_INPUT;
+    case ErrorCode::kCancelled:
+      return SGBAKE_CANCELLED;
+    case ErrorCode::kInternal:
+      break;
+  }
+  return SGBAKE_ERROR_INTERNAL;
 }
 
 /// `name[i] = (x, y, z)` for messages about one element of a float array.
@@ -288,6 +297,7 @@ struct BakeArguments {
   const sgbake_image* images;
   std::size_t numImages;
   int threads;
+  sgbake_progress* progress;
   float* outRgba;
   std::size_t outFloats;
 };
@@ -355,7 +365,16 @@ Status bakeMapFromArrays(const BakeArguments& a) {
     return Error::badInput(where + planned.users.front() + ": no image named '" + name +
                            "' among the " + std::to_string(a.numImages) + " given");
   };
-  Result<FloatImage> baked = bakeOutputInMemory(*plan, 0, inputs, a.threads);
+  BakeProgressCallback onRows;
+  if (a.progress != nullptr) {
+    std::atomic_ref<float>(a.progress->fraction).store(0.0f, std::memory_order_relaxed);
+    onRows = [progress = a.progress](int rowsDone, int rows) {
+      const float fraction = static_cast<float>(rowsDone) / static_cast<float>(rows);
+      std::atomic_ref<float>(progress->fraction).store(fraction, std::memory_order_relaxed);
+      return std::atomic_ref<std::int32_t>(progress->cancel).load(std::memory_order_relaxed) == 0;
+    };
+  }
+  Result<FloatImage> baked = bakeOutputInMemory(*plan, 0, inputs, a.threads, onRows);
   if (!baked) {
     const std::string& message = baked.error().message;
     if (message.starts_with(where)) return baked.error();
@@ -422,11 +441,11 @@ int sgbake_compute_tangents(const float* positions, size_t num_vertices,
 }
 
 int sgbake_bake_map(const char* scene_json, const sgbake_mesh* mesh, const sgbake_image* images,
-                    size_t num_images, int threads, float* out_rgba, size_t out_floats,
-                    char* error_buf, size_t error_buf_size) {
+                    size_t num_images, int threads, sgbake_progress* progress, float* out_rgba,
+                    size_t out_floats, char* error_buf, size_t error_buf_size) {
   return sgbake::guarded("sgbake_bake_map", error_buf, error_buf_size, [&] {
     return sgbake::bakeMapFromArrays(
-        {scene_json, mesh, images, num_images, threads, out_rgba, out_floats});
+        {scene_json, mesh, images, num_images, threads, progress, out_rgba, out_floats});
   });
 }
 

@@ -111,7 +111,7 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
 }
 
 ExitCode exitCodeFor(ErrorCode code) {
-  return code == ErrorCode::kBadInput ? kExitBadInput : kExitInternal;
+  return code == ErrorCode::kBadInput ? kExitBadInput : kExitInternal;  // (never kCancelled)
 }
 
 void printError(std::string_view message) {

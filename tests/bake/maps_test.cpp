@@ -402,6 +402,37 @@ TEST(Maps, BandByBandStopsAtTheSinksError) {
   EXPECT_EQ(calls, 1);
 }
 
+TEST(Maps, ProgressReportsEveryBandAndGivesTheSameBitsAndStopsWhenAsked) {
+  const HandTriangle h = handTriangle();
+  BakeSettings s;
+  s.map = MapKind::kTangentNormal;
+  s.width = 29;
+  s.height = 603;  // three bands
+  s.samples = 2;
+  const Result<FloatImage> plain = bakeMap({&h.mesh, &h.tangents, {}}, s);
+  ASSERT_TRUE(plain.ok());
+  std::vector<int> reported;
+  const Result<FloatImage> tracked =
+      bakeMap({&h.mesh, &h.tangents, {}}, s, [&](int rowsDone, int rows) {
+        EXPECT_EQ(rows, 603);
+        reported.push_back(rowsDone);
+        return true;
+      });
+  ASSERT_TRUE(tracked.ok());
+  EXPECT_EQ(tracked->pixels, plain->pixels);
+  EXPECT_EQ(tracked->coverage, plain->coverage);
+  ASSERT_EQ(reported.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+  EXPECT_EQ(reported.back(), 603);
+
+  int calls = 0;
+  const Result<FloatImage> stopped =
+      bakeMap({&h.mesh, &h.tangents, {}}, s, [&](int, int) { return ++calls < 1; });
+  ASSERT_FALSE(stopped.ok());
+  EXPECT_EQ(stopped.error().code, ErrorCode::kCancelled);
+  EXPECT_EQ(calls, 1);
+}
+
 TEST(Maps, BadInputIsAnErrorValue) {
   const Mesh mesh = scaledPlane(1, 1);
   BakeSettings s;

@@ -149,8 +149,8 @@ class CApiBake : public ::testing::Test {
                            uvSets,                1,                   mesh_.numCorners()};
     rgba.assign(static_cast<std::size_t>(size) * size * 4, -1.0f);
     char error[512] = "";
-    const int status = sgbake_bake_map(scene.c_str(), &mesh, images, 2, 0, rgba.data(),
-                                       rgba.size(), error, sizeof error);
+    const int status = sgbake_bake_map(scene.c_str(), &mesh, images, 2, 0, nullptr,
+                                       rgba.data(), rgba.size(), error, sizeof error);
     message = error;
     return status;
   }
@@ -232,16 +232,18 @@ TEST_F(CApiBake, NamesAMissingImageAndAWrongBufferSize) {
   char error[256] = "";
   EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}],
                                 "layers": [{"type": "height", "image": "Bump"}]})",
-                            &mesh, &image, 1, 0, out.data(), out.size(), error, sizeof error),
+                            &mesh, &image, 1, 0, nullptr, out.data(), out.size(), error,
+                            sizeof error),
             SGBAKE_ERROR_BAD_INPUT);
   EXPECT_NE(std::string(error).find("no image named 'Bump'"), std::string::npos) << error;
   EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}]})", &mesh, &image, 1,
-                            0, out.data(), out.size() - 1, error, sizeof error),
+                            0, nullptr, out.data(), out.size() - 1, error, sizeof error),
             SGBAKE_ERROR_BAD_INPUT);
   EXPECT_NE(std::string(error).find("out_floats = 1023"), std::string::npos) << error;
   // Without normals the triangle is smooth-shaded by sgbake: its object normal is +z.
   ASSERT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "object-normal", "size": 16}]})", &mesh,
-                            &image, 1, 0, out.data(), out.size(), error, sizeof error),
+                            &image, 1, 0, nullptr, out.data(), out.size(), error,
+                            sizeof error),
             SGBAKE_OK)
       << error;
   const float* texel = &out[4 * (2 * 16 + 2)];  // x = 2, y = 2: inside the triangle

@@ -127,13 +127,46 @@ TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
   char error[256] = "";
   ASSERT_EQ(sgbake_bake_map(R"({"layers": [{"type": "volume", "function": "noise"}],
                                 "outputs": [{"map": "tangent-normal", "size": 32}]})",
-                            &mesh, nullptr, 0, 0, rgba.data(), rgba.size(), error, sizeof error),
+                            &mesh, nullptr, 0, 0, nullptr, rgba.data(), rgba.size(), error,
+                            sizeof error),
             SGBAKE_OK)
       << error;
   EXPECT_NE(rgba[4 * (8 * 32 + 8)], rgba[4 * (8 * 32 + 9)]);  // the noise bumps the normals
   const std::string maps = test::readFile("/proc/self/maps");
   EXPECT_EQ(maps.find("libOpenImageIO"), std::string::npos);
   EXPECT_EQ(maps.find("libsgbake_oiio"), std::string::npos);
+}
+
+TEST(CApi, BakeMapReportsProgressAndStopsWhenCancelled) {
+  const FlatMesh m;
+  const float* uvSets[] = {m.cornerUvs.data()};
+  const sgbake_mesh mesh{m.positions.data(), m.numVertices(), m.faceStart.data(), m.numFaces(),
+                         m.cornerVertex.data(), m.cornerNormals.data(), uvSets, 1,
+                         m.numCorners()};
+  const char* scene = R"({"layers": [{"type": "volume", "function": "noise"}],
+                          "outputs": [{"map": "tangent-normal", "size": 1024}]})";
+  std::vector<float> plain(1024 * 1024 * 4), tracked(plain.size());
+  char error[256] = "";
+  ASSERT_EQ(sgbake_bake_map(scene, &mesh, nullptr, 0, 0, nullptr, plain.data(), plain.size(),
+                            error, sizeof error),
+            SGBAKE_OK)
+      << error;
+  sgbake_progress progress{-1.0f, 0};
+  ASSERT_EQ(sgbake_bake_map(scene, &mesh, nullptr, 0, 0, &progress, tracked.data(),
+                            tracked.size(), error, sizeof error),
+            SGBAKE_OK)
+      << error;
+  EXPECT_EQ(progress.fraction, 1.0f);
+  EXPECT_EQ(tracked, plain);
+  // Cancelled before it starts: the first band is baked, then the call stops.
+  progress = {-1.0f, 1};
+  std::strcpy(error, "untouched");
+  EXPECT_EQ(sgbake_bake_map(scene, &mesh, nullptr, 0, 0, &progress, tracked.data(),
+                            tracked.size(), error, sizeof error),
+            SGBAKE_CANCELLED);
+  EXPECT_EQ(std::string(error), "sgbake_bake_map: bake: cancelled");
+  EXPECT_GT(progress.fraction, 0.0f);
+  EXPECT_LT(progress.fraction, 1.0f);
 }
 
 TEST(CApi, ThreadCountDoesNotChangeTheResult) {

@@ -190,6 +190,18 @@ struct BakeInput {
 ///         kInternal when memory runs out.
 Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings);
 
+/// @brief How far a bake is: @p rowsDone of the image's @p rows rows are baked. Return false to
+/// stop the bake (it then fails with ErrorCode::kCancelled).
+using BakeProgressCallback = std::function<bool(int rowsDone, int rows)>;
+
+/// @brief bakeMap that reports its progress after each band of kBakeBandRows rows (from a thread
+/// of the bake, one call at a time, in order; the last call has rowsDone == height) and stops
+/// within two bands when @p progress returns false. The image is the one bakeMap gives, bit for
+/// bit.
+/// @return bakeMap's errors, or kCancelled ("bake: cancelled") when @p progress stopped it
+Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings,
+                           const BakeProgressCallback& progress);
+
 /// Rows per band of bakeMapRows (the last band, or the first of a height that is not a multiple
 /// of 8, may have fewer).
 inline constexpr int kBakeBandRows = 256;

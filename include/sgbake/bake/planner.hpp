@@ -211,8 +211,11 @@ struct MemoryInputs {
 /// file of the same output holds (executePlan and this give the same values): rows top first,
 /// normal maps encoded, signed maps raw (no "range" remapping).
 /// @param[in] threads maximum threads; 0 = all cores (the result does not depend on it)
-/// @return the image, or kBadInput for a missing image, a UV set the mesh lacks, a bad layer
+/// @param[in] progress called as the bake goes (bakeMap's BakeProgressCallback); may stop it
+/// @return the image, or kBadInput for a missing image, a UV set the mesh lacks, a bad layer;
+/// kCancelled when @p progress stopped the bake
 Result<FloatImage> bakeOutputInMemory(const Plan& plan, std::size_t output,
-                                      const MemoryInputs& inputs, int threads = 0);
+                                      const MemoryInputs& inputs, int threads = 0,
+                                      const BakeProgressCallback& progress = {});
 
 }  // namespace sgbake

@@ -12,6 +12,7 @@ namespace sgbake {
 enum class ErrorCode {
   kBadInput,  ///< the caller's data or file is wrong (missing, malformed, unsupported): exit 2
   kInternal,  ///< a bug or resource failure inside sgbake: exit 1
+  kCancelled,  ///< the caller stopped the work (a progress callback returned false)
 };
 
 /// @brief A failure with a one-line, human-readable message that names the file (when there is
