@@ -24,6 +24,7 @@ import numpy as np
 LIBRARY_ENV = "SGBAKE_LIBRARY"
 LIBRARY_FILE = "libsgbake.so"
 ERROR_BUFFER_SIZE = 1024
+CANCELLED = 3  # SGBAKE_CANCELLED
 
 _float_p = ctypes.POINTER(ctypes.c_float)
 _uint32_p = ctypes.POINTER(ctypes.c_uint32)
@@ -39,6 +40,17 @@ class SgbakeError(Exception):
     def __init__(self, message, status=None):
         super().__init__(message)
         self.status = status
+
+
+class SgbakeCancelled(SgbakeError):
+    """The bake was stopped through its Progress (cancel set): not an error of the input."""
+
+
+class Progress(ctypes.Structure):
+    """struct sgbake_progress: the library writes `fraction` (0 to 1) while it bakes; set
+    `cancel` to 1 from another thread to stop the bake (bake_map then raises SgbakeCancelled).
+    ctypes releases the GIL during the call, so a UI thread can poll and cancel meanwhile."""
+    _fields_ = [("fraction", ctypes.c_float), ("cancel", ctypes.c_int32)]
 
 
 class Mesh(ctypes.Structure):
@@ -94,6 +106,7 @@ def _declare(lib):
         ctypes.POINTER(Image),      # images
         ctypes.c_size_t,            # num_images
         ctypes.c_int,               # threads
+        ctypes.POINTER(Progress),   # progress (may be NULL)
         _float_p,                   # out_rgba
         ctypes.c_size_t,            # out_floats
         ctypes.c_char_p,            # error_buf
@@ -180,7 +193,7 @@ def _image_entry(name, image):
 
 
 def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, uv_sets,
-             images=None, threads=0):
+             images=None, threads=0, progress=None):
     """Bakes one map with sgbake_bake_map and returns its pixels.
 
     scene           dict: a scene as for `sgbake bake SCENE.json` without "mesh", with one
@@ -195,9 +208,11 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
     images          dict name -> ndarray H x W x C (or H x W) rows bottom first, or
                     name -> (flat pixels, width, height, channels).
     threads         maximum number of threads, 0 = all cores (same result for every value).
+    progress        a Progress to follow or cancel the bake from another thread, or None.
 
     Returns a float32 array of width * height * 4 values (RGBA, rows bottom first: the layout
-    of Blender's Image.pixels). Raises SgbakeError on any failure.
+    of Blender's Image.pixels). Raises SgbakeError on any failure, SgbakeCancelled when
+    `progress.cancel` stopped the bake.
     """
     width, height = output_size(scene)
     # Every array handed to C is bound to a local name below, so it lives until the call ends.
@@ -237,9 +252,10 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
     error = ctypes.create_string_buffer(ERROR_BUFFER_SIZE)
     scene_text = json.dumps(scene).encode("utf-8")
     status = lib.sgbake_bake_map(scene_text, ctypes.byref(mesh), image_structs, len(entries),
-                                 int(threads), _pointer(out, _float_p), out.size, error,
-                                 ctypes.sizeof(error))
+                                 int(threads),
+                                 ctypes.byref(progress) if progress is not None else None,
+                                 _pointer(out, _float_p), out.size, error, ctypes.sizeof(error))
     if status != 0:
         message = error.value.decode("utf-8", "replace") or f"sgbake_bake_map returned {status}"
-        raise SgbakeError(message, status)
+        raise (SgbakeCancelled if status == CANCELLED else SgbakeError)(message, status)
     return out

@@ -112,13 +112,11 @@ def layer_images(layers):
     return images
 
 
-def target_image(settings, object_name):
-    """The image to bake into: the settings' Target, else '<object>_<map>' (created as a
-    32-bit float Non-Color image when missing), scaled to the bake's size when it differs."""
-    width, height = settings.width, settings.height
-    image = settings.target_image
+def target_image(target, name, width, height):
+    """The image to bake into: `target` (an Image or None), else the image `name` (created as
+    a 32-bit float Non-Color image when missing), scaled to width x height when it differs."""
+    image = target
     if image is None:
-        name = f"{object_name}_{settings.map}"
         image = bpy.data.images.get(name)
         if image is None:
             image = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True,

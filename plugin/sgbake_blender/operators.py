@@ -5,6 +5,7 @@ loaded, a scene libsgbake refuses) is reported with self.report({'ERROR'}, messa
 operator returns {'CANCELLED'}: the user sees one line, never a traceback.
 """
 
+import threading
 import time
 
 import bpy
@@ -19,32 +20,18 @@ INTERPOLATION_FILTERS = {"Linear": "bilinear", "Cubic": "bicubic", "Smart": "bic
 NORMAL_MAP_SPACES = {"TANGENT": "tangent", "OBJECT": "object"}
 
 
-class OBJECT_OT_sgbake_bake(bpy.types.Operator):
-    """Bake the chosen map of the active mesh object with sgbake into an image"""
-    bl_idname = "object.sgbake_bake"
-    bl_label = "Bake with sgbake"
-    bl_options = {"REGISTER"}
+class BakeJob:
+    """One bake, split so that the part without bpy can run on a worker thread: prepare()
+    reads everything from Blender (in the main thread), run() calls libsgbake (any thread;
+    ctypes releases the GIL meanwhile), finish() writes the target image (main thread)."""
 
-    def execute(self, context):
-        try:
-            image, seconds = self.bake(context)
-        except (gather.BakeInputError, capi.SgbakeError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        settings = context.scene.sgbake
-        self.report({"INFO"}, f"sgbake: {settings.map} {settings.width} x {settings.height} "
-                              f"into '{image.name}' in {seconds:.2f} s")
-        return {"FINISHED"}
-
-    @staticmethod
-    def bake(context):
-        """Bakes and writes the target image; returns (image, seconds in sgbake)."""
+    def __init__(self, context):
         settings = context.scene.sgbake
         ob = context.active_object
         if ob is None or ob.type != "MESH":
             raise gather.BakeInputError("sgbake bakes the active object, which must be a mesh")
         layers = scene.baked_layers(settings)
-        images = gather.layer_images(layers)
+        self.images = gather.layer_images(layers)
 
         if ob.mode == "EDIT":
             ob.update_from_editmode()
@@ -58,20 +45,104 @@ class OBJECT_OT_sgbake_bake(bpy.types.Operator):
             if len(mesh.polygons) == 0:
                 raise gather.BakeInputError(f"object '{ob.name}' has no faces")
             mesh.calc_normals_split()
-            arrays = gather.mesh_arrays(mesh, uv_names)
+            self.arrays = gather.mesh_arrays(mesh, uv_names)
         finally:
             ob_eval.to_mesh_clear()
 
-        scene_dict = scene.scene_json(settings, layers, bake_uv, uv_names.index)
-        positions, face_start, corner_vertex, normals, uvs = arrays
-        lib = library.get(context)
+        self.scene = scene.scene_json(settings, layers, bake_uv, uv_names.index)
+        self.lib = library.get(context)
+        self.threads = settings.threads
+        # What finish() needs, fixed now: the settings may change while the bake runs.
+        self.map, self.width, self.height = settings.map, settings.width, settings.height
+        self.target = settings.target_image.name if settings.target_image else None
+        self.default_name = f"{ob.name}_{settings.map}"
+        self.progress = capi.Progress(0.0, 0)
+        self.rgba = None
+        self.error = None
+        self.seconds = 0.0
+
+    def run(self):
+        """Bakes; keeps the pixels in self.rgba or the failure in self.error."""
         start = time.perf_counter()
-        rgba = capi.bake_map(lib, scene_dict, positions, face_start, corner_vertex, normals,
-                             uvs, images, threads=settings.threads)
-        seconds = time.perf_counter() - start
-        image = gather.target_image(settings, ob.name)
-        gather.write_pixels(image, rgba)
-        return image, seconds
+        try:
+            positions, face_start, corner_vertex, normals, uvs = self.arrays
+            self.rgba = capi.bake_map(self.lib, self.scene, positions, face_start, corner_vertex,
+                                      normals, uvs, self.images, threads=self.threads,
+                                      progress=self.progress)
+        except capi.SgbakeError as exc:
+            self.error = exc
+        self.seconds = time.perf_counter() - start
+
+    def finish(self):
+        """Writes the pixels into the target image and returns it (after a successful run)."""
+        target = bpy.data.images.get(self.target) if self.target else None
+        image = gather.target_image(target, self.default_name, self.width, self.height)
+        gather.write_pixels(image, self.rgba)
+        return image
+
+
+class OBJECT_OT_sgbake_bake(bpy.types.Operator):
+    """Bake the chosen map of the active mesh object with sgbake into an image (Esc cancels)"""
+    bl_idname = "object.sgbake_bake"
+    bl_label = "Bake with sgbake"
+    bl_options = {"REGISTER"}
+
+    def execute(self, context):
+        """From scripts: bakes before returning."""
+        try:
+            job = BakeJob(context)
+        except (gather.BakeInputError, capi.SgbakeError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        job.run()
+        return self._finish(job)
+
+    def invoke(self, context, event):
+        """From the UI: bakes on a worker thread and shows its progress; Esc cancels it."""
+        try:
+            self.job = BakeJob(context)
+        except (gather.BakeInputError, capi.SgbakeError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self.thread = threading.Thread(target=self.job.run, name="sgbake bake", daemon=True)
+        self.thread.start()
+        wm = context.window_manager
+        self.timer = wm.event_timer_add(0.1, window=context.window)
+        wm.progress_begin(0.0, 1.0)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self.job.progress.cancel = 1  # the library stops within two bands
+            return {"RUNNING_MODAL"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}  # the rest of Blender stays usable meanwhile
+        context.window_manager.progress_update(self.job.progress.fraction)
+        if context.workspace is not None:
+            context.workspace.status_text_set(
+                f"sgbake: baking {self.job.map} {self.job.width} x {self.job.height}: "
+                f"{100 * self.job.progress.fraction:.0f} % (Esc to cancel)")
+        if self.thread.is_alive():
+            return {"RUNNING_MODAL"}
+        wm = context.window_manager
+        wm.event_timer_remove(self.timer)
+        wm.progress_end()
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+        return self._finish(self.job)
+
+    def _finish(self, job):
+        if isinstance(job.error, capi.SgbakeCancelled):
+            self.report({"WARNING"}, "sgbake: bake cancelled; the image was not changed")
+            return {"CANCELLED"}
+        if job.error is not None:
+            self.report({"ERROR"}, str(job.error))
+            return {"CANCELLED"}
+        image = job.finish()
+        self.report({"INFO"}, f"sgbake: {job.map} {job.width} x {job.height} into "
+                              f"'{image.name}' in {job.seconds:.2f} s")
+        return {"FINISHED"}
 
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):

@@ -14,7 +14,10 @@
    the image then holds are saved as addon_CASE.npy (rows top first). One case bakes into a
    Target image that starts at 64^2 (the add-on must scale it) with margin 8, 2 x 2 samples
    and alpha from coverage. mesh.obj (objio: every float exact) and height.exr (raw float) are
-   the same mesh and image for the CLI. It also checks that bad input becomes an error report,
+   the same mesh and image for the CLI. The UI's way to bake, the bake job on a worker thread
+   (as the modal operator runs it), must report a progress rising to 1, and a cancel set from
+   the main thread must stop it without creating an image. It also checks that bad input
+   becomes an error report,
    not a traceback: a layer without an image, an object without a UV map, no active object,
    a library path that does not exist, and a scene libsgbake refuses (a normal layer with the
    hermite filter: its message must come through).
@@ -193,6 +196,47 @@ def error_reports(settings, prefs, height, work, library_path):
     return checks
 
 
+def worker_thread_checks(settings, ob):
+    """The UI's way to bake (operators.BakeJob.run on a worker thread, as the modal operator
+    runs it): progress rises to 1, and a cancel set from this thread stops the bake without
+    touching any image. Returns check records like expect_error's."""
+    import threading
+    import bpy
+    from sgbake_blender import capi, operators
+    settings.map, settings.width, settings.height = "tangent-normal", 1024, 1024
+    settings.target_image = None
+    checks = []
+
+    job = operators.BakeJob(bpy.context)
+    seen = []
+    worker = threading.Thread(target=job.run)
+    worker.start()
+    while worker.is_alive():
+        seen.append(job.progress.fraction)
+        worker.join(0.005)
+    seen.append(job.progress.fraction)
+    ok = job.error is None and seen[-1] == 1.0 and seen == sorted(seen)
+    checks.append({"name": "progress from a worker thread", "ok": ok,
+                   "expected": "no error, fractions rising to 1",
+                   "message": f"error {job.error}, {len(seen)} polls, fractions "
+                              f"{sorted(set(seen))[:6]}..., last {seen[-1]}"})
+
+    name = f"{ob.name}_tangent-normal"
+    if name in bpy.data.images:
+        bpy.data.images.remove(bpy.data.images[name])
+    job = operators.BakeJob(bpy.context)
+    job.progress.cancel = 1
+    worker = threading.Thread(target=job.run)
+    worker.start()
+    worker.join()
+    ok = isinstance(job.error, capi.SgbakeCancelled) and name not in bpy.data.images
+    checks.append({"name": "cancel from another thread", "ok": ok,
+                   "expected": "SgbakeCancelled and no image",
+                   "message": f"{type(job.error).__name__}: {job.error}"})
+    settings.width = settings.height = SIZE
+    return checks
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -208,7 +252,8 @@ def blender_make(work, library_path, sabotage):
     layers = manifest["layers_from_material"]["layers"]
     manifest["scale"] = layers[0]["scale"] if layers else distance
     manifest["cases"] = bake_cases(settings, ob, work, sabotage)
-    manifest["errors"] = error_reports(settings, prefs, height, work, library_path)
+    manifest["errors"] = (worker_thread_checks(settings, ob)
+                          + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
         json.dump(manifest, f, indent=1)
 
@@ -317,7 +362,7 @@ def evaluate(manifest, results):
                             f"{r['max_abs']:.3g} at (x, row) {r['worst_at']}, add-on / CLI "
                             f"{r['worst_values']}" + (" (must be identical)" if exact else ""))
     for check in manifest["errors"]:
-        print(f"  error report, {check['name']}: {check['message']!r} -> "
+        print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
             failures.append(f"{check['name']}: expected an error report containing "
