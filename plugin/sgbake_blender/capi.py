@@ -82,14 +82,22 @@ class Image(ctypes.Structure):
 def candidate_paths(path=None, path_source="the given path"):
     """The places load_library tries, in order, as (description, path or library name,
     explicit) triples: the given path (described as path_source), $SGBAKE_LIBRARY, libsgbake.so
-    in this file's folder, then the system's search (ctypes.util.find_library, which runs only
-    when the earlier places had nothing)."""
+    in this file's folder, the library of the installation this add-on came from (the
+    installed_library.py that `cmake --install` writes beside it), then the system's search
+    (ctypes.util.find_library, which runs only when the earlier places had nothing)."""
     if path:
         yield path_source, path, True
     if os.environ.get(LIBRARY_ENV):
         yield f"${LIBRARY_ENV}", os.environ[LIBRARY_ENV], True
-    yield ("beside the add-on",
-           os.path.join(os.path.dirname(os.path.abspath(__file__)), LIBRARY_FILE), False)
+    here = os.path.dirname(os.path.realpath(__file__))  # through a symbolic link to the add-on
+    yield "beside the add-on", os.path.join(here, LIBRARY_FILE), False
+    try:
+        from . import installed_library
+    except ImportError:  # the add-on from the source tree: no installation
+        installed_library = None
+    if installed_library is not None:
+        yield ("the add-on's installation",
+               os.path.normpath(os.path.join(here, installed_library.LIBRARY)), False)
     system = ctypes.util.find_library("sgbake")
     if system:
         yield "the system library path", system, False

@@ -48,6 +48,22 @@ message(STATUS "${consumer_output}")
 
 # The installed tool must run from its prefix (it finds libsgbake through its RPATH).
 run_step("run installed sgbake --version" version_output "${PREFIX}/bin/sgbake" --version)
+
+# The Blender add-on is installed with a note of where this installation's library is.
+set(addon "${PREFIX}/share/sgbake/blender/sgbake_blender")
+foreach(file __init__.py capi.py installed_library.py)
+  if(NOT EXISTS "${addon}/${file}")
+    message(FATAL_ERROR "InstallConsumer: the add-on's ${file} is not installed in ${addon}")
+  endif()
+endforeach()
+file(STRINGS "${addon}/installed_library.py" library_line REGEX "^LIBRARY = ")
+string(REGEX REPLACE "^LIBRARY = \"(.*)\"$" "\\1" library_relative "${library_line}")
+get_filename_component(library "${addon}/${library_relative}" ABSOLUTE)
+if(NOT EXISTS "${library}")
+  message(FATAL_ERROR "InstallConsumer: the add-on's installed_library.py names ${library}, "
+                      "which does not exist")
+endif()
+message(STATUS "InstallConsumer: the installed add-on finds ${library}: ok")
 if(NOT version_output STREQUAL "sgbake ${EXPECTED_VERSION}\n")
   message(FATAL_ERROR "InstallConsumer: installed sgbake --version printed '${version_output}'")
 endif()
