@@ -253,7 +253,7 @@ Status validateImages(const std::string& where, const sgbake_image* images, std:
     const sgbake_image& image = images[i];
     const std::string label = "images[" + std::to_string(i) + "]";
     if (image.name == nullptr) return Error::badInput(where + label + ".name is NULL");
-    const std::string named = label + " ('" + image.name + "')";
+    const std::string named = label + " ('" + printableText(image.name) + "')";
     if (!names.insert(image.name).second) {
       return Error::badInput(where + named + ": another image has the same name");
     }
@@ -362,7 +362,7 @@ Status bakeMapFromArrays(const BakeArguments& a) {
         return selectChannels(a.images[i], planned.channels);
       }
     }
-    return Error::badInput(where + planned.users.front() + ": no image named '" + name +
+    return Error::badInput(where + planned.users.front() + ": no image named '" + printableText(name) +
                            "' among the " + std::to_string(a.numImages) + " given");
   };
   BakeProgressCallback onRows;

@@ -30,19 +30,10 @@ constexpr double kLumaR = 0.2126;
 constexpr double kLumaG = 0.7152;
 constexpr double kLumaB = 0.0722;
 
-// Text made safe for a one-line message: control characters become '?'.
-std::string oneLine(std::string_view text) {
-  std::string out(text);
-  for (char& c : out) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  return out;
-}
-
 std::string channelsText(int n) { return std::to_string(n) + (n == 1 ? " channel" : " channels"); }
 
 Error fileError(const std::filesystem::path& path, std::string_view what) {
-  return Error::badInput(oneLine(path.string()) + ": " + std::string(what));
+  return Error::badInput(printableText(path.string()) + ": " + std::string(what));
 }
 
 // How many leading file channels to read for a selection, or -1 when the file has too few.

@@ -88,13 +88,7 @@ Result<ValidatedFile> validateOff(std::string_view bytes, std::string_view name)
 // Helpers shared by the three checkers.
 
 /// @p name made safe for a one-line message: control characters become '?'.
-inline std::string displayName(std::string_view name) {
-  std::string out(name);
-  for (char& c : out) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  return out;
-}
+inline std::string displayName(std::string_view name) { return printableText(name); }
 
 /// A token from the file, quoted for a message: at most 40 characters, non-printable bytes
 /// written as \xNN, so that a message stays one printable line whatever the file contains.

@@ -236,6 +236,13 @@ TEST_F(CApiBake, NamesAMissingImageAndAWrongBufferSize) {
                             sizeof error),
             SGBAKE_ERROR_BAD_INPUT);
   EXPECT_NE(std::string(error).find("no image named 'Bump'"), std::string::npos) << error;
+  // Names come from the caller: a control character in one does not break the message's line.
+  EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}],
+                                "layers": [{"type": "height", "image": "Bu\nmp"}]})",
+                            &mesh, &image, 1, 0, nullptr, out.data(), out.size(), error,
+                            sizeof error),
+            SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_NE(std::string(error).find("no image named 'Bu?mp'"), std::string::npos) << error;
   EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}]})", &mesh, &image, 1,
                             0, nullptr, out.data(), out.size() - 1, error, sizeof error),
             SGBAKE_ERROR_BAD_INPUT);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <utility>
 #include <variant>
 
@@ -54,5 +55,15 @@ class [[nodiscard]] Result {
 /// @brief Result of an operation that produces no value.
 struct Ok {};
 using Status = Result<Ok>;
+
+/// @brief @p text made safe inside a one-line message (a file name, an image name from the
+/// caller): control characters, newlines included, become '?'.
+inline std::string printableText(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
 
 }  // namespace sgbake
