@@ -16,6 +16,7 @@
 
 extern "C" int consumer_c_tangents(float out_tangents[9], float out_signs[3], char* error,
                                    size_t size);
+extern "C" int consumer_c_bake(float out_rgba[64], char* error, size_t size);
 
 namespace {
 
@@ -58,6 +59,14 @@ int main() {
     std::fprintf(stderr, "consumer: %s\n", error);
     return 1;
   }
+
+  float rgba[64] = {};
+  const int baked = consumer_c_bake(rgba, error, sizeof error);
+  check(baked == SGBAKE_OK, "C sgbake_bake_map succeeds");
+  if (baked != SGBAKE_OK) std::fprintf(stderr, "consumer: %s\n", error);
+  // Texel (0, 0) (bottom left, the triangle's right-angle corner) is +z, alpha 1.
+  check(rgba[0] == 0.5f && rgba[1] == 0.5f && rgba[2] == 1.0f && rgba[3] == 1.0f,
+        "C bake of the triangle is the encoded +z normal");
 
   for (int c = 0; c < 3; ++c) {
     const sgbake::Vec3f t = cpp->tangent[c];
