@@ -61,7 +61,6 @@ Exit 2 on usage errors or a failed run, 77 when Blender is not installed.
 """
 
 import argparse
-import importlib.util
 import json
 import os
 import sys
@@ -272,13 +271,5 @@ def main():
     return 1 if misses else 0
 
 
-def running_in_blender():
-    """True inside Blender, whose Python has the bpy module."""
-    return importlib.util.find_spec("bpy") is not None
-
-
 if __name__ == "__main__":
-    if running_in_blender():
-        blender_main(sys.argv[sys.argv.index("--") + 1:])
-    else:
-        sys.exit(main())
+    objio.run_script(blender_main, main)

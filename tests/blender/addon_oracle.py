@@ -435,13 +435,5 @@ def main():
     return 0
 
 
-def running_in_blender():
-    import importlib.util
-    return importlib.util.find_spec("bpy") is not None
-
-
 if __name__ == "__main__":
-    if running_in_blender():
-        blender_main(sys.argv[sys.argv.index("--") + 1:])
-    else:
-        sys.exit(main())
+    objio.run_script(blender_main, main)

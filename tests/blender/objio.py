@@ -48,6 +48,18 @@ def run_blender(blender, script, args, blender_options=(), **kwargs):
     return subprocess.run(cmd, env=env, check=False, **kwargs)
 
 
+def run_script(blender_main, main):
+    """The entry point of a script that is both the driver (plain python3) and, re-run by
+    run_blender, the Blender half: inside Blender (bpy importable) calls blender_main with the
+    arguments after "--", elsewhere exits with main()'s status."""
+    import importlib.util
+    import sys
+    if importlib.util.find_spec("bpy") is not None:
+        blender_main(sys.argv[sys.argv.index("--") + 1:])
+    else:
+        sys.exit(main())
+
+
 def mesh_arrays(me):
     """Returns the per-vertex and per-corner arrays of a Blender mesh as numpy arrays.
 
