@@ -4,11 +4,12 @@ Blender and without Cycles.
 
 The add-on moves arrays and reports errors; every computation is libsgbake's, reached through
 its C ABI (include/sgbake/sgbake.h) with ctypes (capi.py). The baked pixels go into a Blender
-image. Modules:
+image, every tile of a UDIM image. Modules:
   capi.py        ctypes binding (no bpy): finds and loads libsgbake.so, calls sgbake_bake_map
   library.py     loads the library on first use (preferences path, $SGBAKE_LIBRARY, ...)
   scene.py       the settings as an sgbake scene (JSON), keys only where they apply
   gather.py      the evaluated mesh and the layers' images as numpy arrays; pixels back
+                 (UDIM tiles through temporary files, packed)
   properties.py  scene.sgbake: the map, its size and padding, the layers
   operators.py   Bake, Layers from Material, and the layer list's add/remove/move
   ui.py          the panel in Properties > Render

@@ -1,9 +1,13 @@
 """Blender data as the flat arrays libsgbake takes, and the baked pixels back into an image.
 
 Everything is moved with foreach_get / foreach_set into numpy arrays (no Python loop per
-vertex or texel). Problems with the user's data raise BakeInputError with a message meant for
-the operator's error report.
+vertex or texel); the tiles of a UDIM image go in through files (write_tiles). Problems with
+the user's data raise BakeInputError with a message meant for the operator's error report.
 """
+
+import os
+import shutil
+import tempfile
 
 import numpy as np
 
@@ -30,6 +34,8 @@ def uv_sets(mesh, bake_uv_name, layers):
     wanted = [("the bake", bake_uv_name)]
     wanted += [(f"layer '{layer.name}'", layer.uv_map) for layer in layers
                if layer.type in scene.UV_LAYER_TYPES and layer.uv_map]
+    wanted += [(f"the mask of layer '{layer.name}'", layer.mask_uv_map) for layer in layers
+               if layer.mask_image is not None and layer.mask_uv_map]
     for user, name in wanted:
         if name not in mesh.uv_layers:
             raise BakeInputError(f"has no UV map '{name}' (used by {user})")
@@ -84,7 +90,8 @@ def image_pixels(image):
     an Image Texture node gives the shader: byte images in the sRGB colour space are
     converted to linear as Blender does; float images and Non-Color data are used as stored."""
     if image.source == "TILED":
-        raise BakeInputError(f"image '{image.name}' is a UDIM image (not supported as a layer)")
+        raise BakeInputError(f"image '{image.name}' is a UDIM (tiled) image: layers and masks "
+                             "read single images (bake into UDIM images, not from them)")
     width, height = image.size
     channels = image.channels
     if width * height == 0 or len(image.pixels) == 0:
@@ -99,17 +106,46 @@ def image_pixels(image):
 
 
 def layer_images(layers):
-    """{Image.name: image_pixels(image)} of every layer that reads an image. Layers are named
-    layers[i], counted from 0 as in libsgbake's messages about the same list."""
+    """{Image.name: image_pixels(image)} of every image the layers read (their images and
+    masks). Layers are named layers[i], counted from 0 as in libsgbake's messages about the
+    same list."""
     images = {}
     for index, layer in enumerate(layers):
-        if layer.type not in scene.IMAGE_LAYER_TYPES:
-            continue
-        if layer.image is None:
-            raise BakeInputError(f"layers[{index}] '{layer.name}' ({layer.type}) has no image")
-        if layer.image.name not in images:
-            images[layer.image.name] = image_pixels(layer.image)
+        used = [layer.mask_image] if layer.mask_image is not None else []
+        if layer.type in scene.IMAGE_LAYER_TYPES:
+            if layer.image is None:
+                raise BakeInputError(f"layers[{index}] '{layer.name}' ({layer.type}) has no "
+                                     "image")
+            used.insert(0, layer.image)
+        for image in used:
+            if image.name not in images:
+                try:
+                    images[image.name] = image_pixels(image)
+                except BakeInputError as exc:
+                    raise BakeInputError(f"layers[{index}] '{layer.name}': {exc}") from None
     return images
+
+
+def uv_tiles(uv, face_start):
+    """The UDIM tiles (1001 + u + 10 v) the faces of a UV map lie in, each face counted in the
+    tile of its corners' mean UV: a summary for the report, the bake itself covers whatever
+    each tile's square holds."""
+    uv = uv.reshape(-1, 2).astype(np.float64)
+    counts = np.diff(face_start.astype(np.int64))
+    if counts.size == 0:
+        return set()
+    centre = np.add.reduceat(uv, face_start[:-1].astype(np.int64), axis=0) / counts[:, None]
+    tile = np.floor(centre).astype(np.int64)
+    inside = (tile[:, 0] >= 0) & (tile[:, 0] < 10) & (tile[:, 1] >= 0) & (tile[:, 1] < 100)
+    return {int(t) for t in np.unique(1001 + tile[inside, 0] + 10 * tile[inside, 1])}
+
+
+def image_tiles(image):
+    """The UDIM tiles a bake into `image` fills: the tiles of a tiled image, in order, else
+    [1001] (a single image holds the 0-1 UV square)."""
+    if image is not None and image.source == "TILED":
+        return [tile.number for tile in image.tiles]
+    return [1001]
 
 
 def target_image(target, name, width, height):
@@ -135,3 +171,78 @@ def write_pixels(image, rgba):
         rgba = np.ascontiguousarray(rgba.reshape(-1, 4)[:, :channels]).reshape(-1)
     image.pixels.foreach_set(rgba)
     image.update()
+
+
+def _tile_path(template, tile):
+    """A <UDIM> (or <UVTILE>) path template with tile `tile` filled in."""
+    u, v = (tile - 1001) % 10, (tile - 1001) // 10
+    return template.replace("<UDIM>", str(tile)).replace("<UVTILE>", f"u{u + 1}_v{v + 1}")
+
+
+def packed_template(image):
+    """Where a tiled image's baked tiles say they belong once packed: the image's own path
+    with .exr as extension, or //<name>.<UDIM>.exr beside the .blend file for an image without
+    a <UDIM> path (a generated one). Nothing is written there until the user saves."""
+    path = image.filepath_raw
+    if "<UDIM>" not in path and "<UVTILE>" not in path:
+        return f"//{bpy.path.clean_name(image.name)}.<UDIM>.exr"
+    root, ext = os.path.splitext(path)
+    return path if ext.lower() == ".exr" else root + ".exr"
+
+
+def write_tiles(image, tiles, width, height):
+    """Stores baked UDIM tiles ({tile number: width x height x 4 floats, rows bottom first})
+    into the tiled `image`, whose tiles must be exactly those. Returns notes for the report.
+
+    Blender 3.4's Image.pixels reaches only a tiled image's first tile, so each tile is saved
+    as a 32-bit float OpenEXR in a temporary folder, the image is pointed at those files
+    (<UDIM>) and reloaded, every tile is read (tile.size loads it), and the image is packed
+    into the .blend file, which keeps the pixels once the folder is deleted. The image keeps
+    its name; its path becomes packed_template(image), and its colour space Non-Color, which
+    loads the files' values as they are (any other would convert them or their alpha)."""
+    numbers = sorted(tile.number for tile in image.tiles)
+    if numbers != sorted(tiles):
+        raise BakeInputError(f"the tiles of image '{image.name}' changed during the bake "
+                             f"(baked {sorted(tiles)}, now {numbers}); bake again")
+    notes = []
+    if image.colorspace_settings.name != "Non-Color":
+        notes.append(f"colour space {image.colorspace_settings.name} -> Non-Color")
+        image.colorspace_settings.name = "Non-Color"
+    template = packed_template(image)
+    folder = tempfile.mkdtemp(prefix="sgbake-udim-")
+    scratch = None
+    try:
+        scratch = bpy.data.images.new("sgbake tile", width, height, alpha=True,
+                                      float_buffer=True, is_data=True)
+        scratch.colorspace_settings.name = "Non-Color"
+        for tile, rgba in tiles.items():
+            scratch.pixels.foreach_set(rgba)
+            # Set after the pixels: before, the image has no buffer to take the format.
+            scratch.file_format = "OPEN_EXR"
+            scratch.use_half_precision = False
+            scratch.filepath_raw = os.path.join(folder, f"bake.{tile}.exr")
+            scratch.save()
+        if image.packed_file is not None or len(image.packed_files) > 0:
+            image.unpack(method="REMOVE")  # reload would read the old packed tiles
+        original = image.filepath_raw
+        image.filepath_raw = os.path.join(folder, "bake.<UDIM>.exr")
+        image.reload()
+        failed = [tile.number for tile in image.tiles if tuple(tile.size) != (width, height)]
+        if failed:
+            image.filepath_raw = original
+            image.reload()
+            raise BakeInputError(f"image '{image.name}': baked tile(s) {failed} did not load "
+                                 "back into it")
+        image.pack()
+        for packed in image.packed_files:
+            packed.filepath = _tile_path(template, packed.tile_number)
+        image.filepath_raw = template
+    except RuntimeError as exc:  # Blender could not save, load or pack a tile
+        raise BakeInputError(f"cannot put the baked tiles into image '{image.name}': "
+                             f"{str(exc).strip()}") from None
+    finally:
+        if scratch is not None:
+            bpy.data.images.remove(scratch)
+        shutil.rmtree(folder, ignore_errors=True)
+    image.update()
+    return notes

@@ -49,36 +49,77 @@ class BakeJob:
         finally:
             ob_eval.to_mesh_clear()
 
-        self.scene = scene.scene_json(settings, layers, bake_uv, uv_names.index)
         self.lib = library.get(context)
         self.threads = settings.threads
         # What finish() needs, fixed now: the settings may change while the bake runs.
         self.map, self.width, self.height = settings.map, settings.width, settings.height
         self.target = settings.target_image.name if settings.target_image else None
         self.default_name = f"{ob.name}_{settings.map}"
+        # A tiled (UDIM) target gets every one of its tiles, each baked by its own call.
+        image = bpy.data.images.get(self.target or self.default_name)
+        self.tiled = image is not None and image.source == "TILED"
+        self.tiles = gather.image_tiles(image)
+        self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile)
+                       for tile in self.tiles}
+        self.scene = self.scenes[self.tiles[0]]
+        self.uv_tiles = gather.uv_tiles(self.arrays[4][bake_uv], self.arrays[1])
         self.progress = capi.Progress(0.0, 0)
+        self.tile_index = 0
         self.rgba = None
         self.error = None
         self.seconds = 0.0
 
+    def fraction(self):
+        """The bake's progress, 0 to 1, over all its tiles."""
+        done = self.tile_index + min(max(self.progress.fraction, 0.0), 1.0)
+        return min(done / len(self.tiles), 1.0)
+
     def run(self):
-        """Bakes; keeps the pixels in self.rgba or the failure in self.error."""
+        """Bakes every tile; keeps the pixels in self.rgba ({tile: RGBA floats}) or the failure
+        in self.error."""
         start = time.perf_counter()
         try:
             positions, face_start, corner_vertex, normals, uvs = self.arrays
-            self.rgba = capi.bake_map(self.lib, self.scene, positions, face_start, corner_vertex,
-                                      normals, uvs, self.images, threads=self.threads,
-                                      progress=self.progress)
+            rgba = {}
+            for index, tile in enumerate(self.tiles):
+                self.progress.fraction = 0.0
+                self.tile_index = index
+                rgba[tile] = capi.bake_map(self.lib, self.scenes[tile], positions, face_start,
+                                           corner_vertex, normals, uvs, self.images,
+                                           threads=self.threads, progress=self.progress)
+            self.rgba = rgba
         except capi.SgbakeError as exc:
             self.error = exc
         self.seconds = time.perf_counter() - start
 
     def finish(self):
-        """Writes the pixels into the target image and returns it (after a successful run)."""
+        """Writes the pixels into the target image (after a successful run); returns the image
+        and notes for the report. Raises BakeInputError when the target changed meanwhile."""
         target = bpy.data.images.get(self.target) if self.target else None
+        if self.tiled:
+            image = target if self.target else bpy.data.images.get(self.default_name)
+            if image is None or image.source != "TILED":
+                raise gather.BakeInputError(f"image '{self.target or self.default_name}' is no "
+                                            "longer a UDIM image; bake again")
+            return image, gather.write_tiles(image, self.rgba, self.width, self.height)
         image = gather.target_image(target, self.default_name, self.width, self.height)
-        gather.write_pixels(image, self.rgba)
-        return image
+        gather.write_pixels(image, self.rgba[1001])
+        return image, []
+
+    def tile_notes(self, image_name):
+        """(level, text) about UDIM tiles for the report: tiles the UVs reach that the image
+        lacks (a warning: nothing was baked there) and tiles of the image no UV lies in."""
+        missing = sorted(self.uv_tiles - set(self.tiles))
+        empty = sorted(set(self.tiles) - self.uv_tiles) if self.tiled else []
+        notes, level = [], "INFO"
+        if missing:
+            level = "WARNING"
+            where = (f"which image '{image_name}' lacks (add them to bake there)" if self.tiled
+                     else "which a single image cannot hold (bake into a UDIM image)")
+            notes.append(f"UVs also lie in UDIM tile(s) {_tile_list(missing)}, {where}")
+        if empty:
+            notes.append(f"no UV lies in tile(s) {_tile_list(empty)} (background only)")
+        return level, notes
 
 
 class OBJECT_OT_sgbake_bake(bpy.types.Operator):
@@ -118,11 +159,14 @@ class OBJECT_OT_sgbake_bake(bpy.types.Operator):
             return {"RUNNING_MODAL"}
         if event.type != "TIMER":
             return {"PASS_THROUGH"}  # the rest of Blender stays usable meanwhile
-        context.window_manager.progress_update(self.job.progress.fraction)
+        context.window_manager.progress_update(self.job.fraction())
         if context.workspace is not None:
+            tiles = (f", tile {self.job.tiles[self.job.tile_index]} "
+                     f"({self.job.tile_index + 1} of {len(self.job.tiles)})"
+                     if self.job.tiled else "")
             context.workspace.status_text_set(
-                f"sgbake: baking {self.job.map} {self.job.width} x {self.job.height}: "
-                f"{100 * self.job.progress.fraction:.0f} % (Esc to cancel)")
+                f"sgbake: baking {self.job.map} {self.job.width} x {self.job.height}{tiles}: "
+                f"{100 * self.job.fraction():.0f} % (Esc to cancel)")
         if self.thread.is_alive():
             return {"RUNNING_MODAL"}
         wm = context.window_manager
@@ -139,10 +183,22 @@ class OBJECT_OT_sgbake_bake(bpy.types.Operator):
         if job.error is not None:
             self.report({"ERROR"}, str(job.error))
             return {"CANCELLED"}
-        image = job.finish()
-        self.report({"INFO"}, f"sgbake: {job.map} {job.width} x {job.height} into "
-                              f"'{image.name}' in {job.seconds:.2f} s")
+        try:
+            image, notes = job.finish()
+        except gather.BakeInputError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        level, tile_notes = job.tile_notes(image.name)
+        tiles = (f" (UDIM tile(s) {_tile_list(job.tiles)}, packed into the .blend file)"
+                 if job.tiled else "")
+        self.report({level}, "; ".join([f"sgbake: {job.map} {job.width} x {job.height} into "
+                                        f"'{image.name}'{tiles} in {job.seconds:.2f} s"]
+                                       + notes + tile_notes))
         return {"FINISHED"}
+
+
+def _tile_list(tiles):
+    return ", ".join(str(tile) for tile in tiles)
 
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):

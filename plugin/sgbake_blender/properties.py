@@ -65,6 +65,10 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     wrap: EnumProperty(name="Wrap", items=WRAPS, default="repeat")
     tiling: FloatVectorProperty(name="Tiling", size=2, default=(1.0, 1.0),
                                 description="Repetitions of the image per UV unit (u, v)")
+    offset: FloatVectorProperty(
+        name="Offset", size=2, default=(0.0, 0.0),
+        description="Added to the lookup after tiling, in image units: the image is read at "
+                    "tiling x (u, v) + offset (projections: of the plane coordinates)")
     uv_map: StringProperty(name="UV Map",
                            description="UV map the image is on; empty: the bake's UV map")
     space: EnumProperty(name="Space", items=SPACES, default="tangent")
@@ -75,6 +79,9 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     axis: EnumProperty(name="Axis", items=AXES, default="z")
     sharpness: FloatProperty(name="Sharpness", default=4.0, min=0.0,
                              description="Exponent of the triplanar blend weights")
+    min_weight: FloatProperty(name="Minimum Weight", default=0.001, min=0.0, precision=4,
+                              description="Triplanar blend weights below this are dropped "
+                                          "(their plane is not sampled)")
     function: EnumProperty(name="Function", items=FUNCTIONS, default="sine")
     amplitude: FloatProperty(name="Amplitude", default=1.0, precision=4,
                              description="Height amplitude, object units")
@@ -87,6 +94,24 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     octaves: IntProperty(name="Octaves", default=1, min=1, max=16)
     gradient: EnumProperty(name="Gradient", items=GRADIENTS, default="analytic",
                            description="How the volume's gradient is computed")
+    step: FloatProperty(
+        name="Step", default=0.0, min=0.0, precision=6, step=0.01,
+        description="Finite-difference step of the Central and Tetrahedral gradients, object "
+                    "units; 0: libsgbake's default (2^-20 of the mesh's bounding-box diagonal)")
+    mask_image: PointerProperty(
+        name="Mask", type=bpy.types.Image,
+        description="Optional mask image: the layer's bump is scaled by its value (luminance, "
+                    "clamped to 0..1); empty: no mask")
+    mask_uv_map: StringProperty(
+        name="Mask UV Map",
+        description="UV map the mask is on; empty: the layer's UV map (height and normal "
+                    "layers), else the bake's")
+    mask_tiling: FloatVectorProperty(name="Mask Tiling", size=2, default=(1.0, 1.0),
+                                     description="Repetitions of the mask per UV unit (u, v)")
+    mask_offset: FloatVectorProperty(
+        name="Mask Offset", size=2, default=(0.0, 0.0),
+        description="Added to the mask's lookup after tiling: tiling x (u, v) + offset")
+    mask_filter: EnumProperty(name="Mask Filter", items=FILTERS, default="bilinear")
 
 
 class SgbakeSettings(bpy.types.PropertyGroup):

@@ -6,6 +6,10 @@ PropertyGroups of properties.py, or anything with the same attributes).
 The scene parser refuses keys that do not apply (a "green" on an object-space normal map, a
 "phase" on a noise volume, an "image" on a volume), so every key below is sent only for the
 layer types, spaces and maps it applies to (scene.cpp's layerKeys and kMapOutputKeys).
+Every per-layer key of the scene format is covered: the common ones (name, weight, mask with
+its image, uv, tiling, offset and filter), the image ones (image, filter, wrap, tiling,
+offset), uv, scale/strength, space, green, kind, axis, sharpness, min_weight and the volume's
+function, amplitude, frequency, direction, phase, seed, octaves, gradient and step.
 """
 
 MAPS = (
@@ -37,6 +41,21 @@ def _number(value):
     return float(value) if isinstance(value, float) else int(value)
 
 
+def _pair(values):
+    """A 2-vector property as a JSON list of two numbers."""
+    return [_number(values[0]), _number(values[1])]
+
+
+def mask_json(layer, uv_index):
+    """A layer's "mask" (it has a mask_image): the image, its lookup and, when the layer names
+    a mask UV map, that UV set (otherwise the mask is read on the layer's UV set)."""
+    mask = {"image": layer.mask_image.name, "tiling": _pair(layer.mask_tiling),
+            "offset": _pair(layer.mask_offset), "filter": layer.mask_filter}
+    if layer.mask_uv_map:
+        mask["uv"] = uv_index(layer.mask_uv_map)
+    return mask
+
+
 def reads_tangent_normals(layer):
     """Whether the layer's image holds tangent-space normals (then "green" applies)."""
     if layer.type == "normal":
@@ -52,7 +71,9 @@ def layer_json(layer, uv_index):
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
     if layer.type in IMAGE_LAYER_TYPES:
         entry.update(image=layer.image.name, filter=layer.filter, wrap=layer.wrap,
-                     tiling=[_number(layer.tiling[0]), _number(layer.tiling[1])])
+                     tiling=_pair(layer.tiling), offset=_pair(layer.offset))
+    if layer.mask_image is not None:
+        entry["mask"] = mask_json(layer, uv_index)
     if layer.type in UV_LAYER_TYPES and layer.uv_map:
         entry["uv"] = uv_index(layer.uv_map)
     if layer.type == "height":
@@ -62,6 +83,8 @@ def layer_json(layer, uv_index):
     elif layer.type == "volume":
         entry.update(function=layer.function, amplitude=_number(layer.amplitude),
                      frequency=_number(layer.frequency), gradient=layer.gradient)
+        if layer.gradient != "analytic" and layer.step > 0:  # 0: the library's default
+            entry["step"] = _number(layer.step)
         if layer.function == "sine":
             entry.update(direction=[_number(c) for c in layer.direction],
                          phase=_number(layer.phase))
@@ -71,17 +94,19 @@ def layer_json(layer, uv_index):
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
     elif layer.type == "triplanar":
         entry.update(kind=layer.kind, scale=_number(layer.scale),
-                     sharpness=_number(layer.sharpness))
+                     sharpness=_number(layer.sharpness), min_weight=_number(layer.min_weight))
     if reads_tangent_normals(layer):
         entry["green"] = layer.green
     return entry
 
 
-def output_json(settings):
-    """The single entry of "outputs" (no "file": the pixels come back in memory)."""
+def output_json(settings, tile=1001):
+    """The single entry of "outputs" (no "file": the pixels come back in memory) for UDIM
+    tile `tile` (1001: the 0-1 UV square)."""
     output = {"map": settings.map, "width": int(settings.width), "height": int(settings.height),
               "margin": int(settings.margin), "padding": settings.padding,
-              "samples": int(settings.samples), "alpha": bool(settings.use_alpha)}
+              "samples": int(settings.samples), "alpha": bool(settings.use_alpha),
+              "tile": int(tile)}
     if settings.map == "tangent-normal":
         output["green"] = settings.green
     return output
@@ -92,9 +117,9 @@ def baked_layers(settings):
     return [] if settings.map in LAYERLESS_MAPS else list(settings.layers)
 
 
-def scene_json(settings, layers, bake_uv_set, uv_index):
+def scene_json(settings, layers, bake_uv_set, uv_index, tile=1001):
     """The scene for sgbake_bake_map: the bake's UV set as the default of the layers and the
-    output ("uv"), the layers (baked_layers) and one output."""
+    output ("uv"), the layers (baked_layers) and one output, of UDIM tile `tile`."""
     return {"uv": bake_uv_set,
             "layers": [layer_json(layer, uv_index) for layer in layers],
-            "outputs": [output_json(settings)]}
+            "outputs": [output_json(settings, tile)]}

@@ -56,6 +56,10 @@ class SGBAKE_PT_bake(bpy.types.Panel):
         layout.prop(settings, "use_alpha")
         layout.prop(settings, "threads")
         layout.template_ID(settings, "target_image", new="image.new", open="image.open")
+        target = settings.target_image
+        if target is not None and target.source == "TILED":
+            tiles = ", ".join(str(tile.number) for tile in target.tiles)
+            layout.label(text=f"UDIM: bakes tile(s) {tiles}", icon="UV")
 
         row = layout.row()
         row.scale_y = 1.4
@@ -105,6 +109,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "filter")
             col.prop(layer, "wrap")
             col.prop(layer, "tiling")
+            col.prop(layer, "offset")
         if layer.type in scene.UV_LAYER_TYPES:
             ob = context.active_object
             if ob is not None and ob.type == "MESH":
@@ -115,6 +120,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "space")
         if layer.type == "triplanar":
             col.prop(layer, "sharpness")
+            col.prop(layer, "min_weight")
         if scene.reads_tangent_normals(layer):
             col.prop(layer, "green")
         if layer.type == "volume":
@@ -128,6 +134,20 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 col.prop(layer, "seed")
                 col.prop(layer, "octaves")
             col.prop(layer, "gradient")
+            if layer.gradient != "analytic":
+                col.prop(layer, "step")
+
+        col = layout.column(heading="Mask")
+        col.template_ID(layer, "mask_image", open="image.open")
+        if layer.mask_image is not None:
+            ob = context.active_object
+            if ob is not None and ob.type == "MESH":
+                col.prop_search(layer, "mask_uv_map", ob.data, "uv_layers", text="UV Map")
+            else:
+                col.prop(layer, "mask_uv_map", text="UV Map")
+            col.prop(layer, "mask_tiling", text="Tiling")
+            col.prop(layer, "mask_offset", text="Offset")
+            col.prop(layer, "mask_filter", text="Filter")
 
 
 CLASSES = (SGBAKE_UL_layers, SGBAKE_PT_bake, SGBAKE_PT_layers)

@@ -19,13 +19,31 @@
    the main thread must stop it without creating an image. It also checks that bad input
    becomes an error report,
    not a traceback: a layer without an image, an object without a UV map, no active object,
-   a library path that does not exist, and a scene libsgbake refuses (a normal layer with the
-   hermite filter: its message must come through).
+   a library path that does not exist, a scene libsgbake refuses (a normal layer with the
+   hermite filter: its message must come through), a mask on a missing UV map, and a UDIM
+   image as a layer's image or mask.
+   UDIM (udim_case): a copy of Suzanne whose faces with x < 0 have u + 1 (tile 1002; the rest
+   in 1001; mesh_udim.obj) is baked (UDIM_MAP, margin UDIM_MARGIN) into a tiled image with
+   tiles 1001, 1002 and 1011 (no UV there) created at 64^2, twice (height first, so that the
+   second bake replaces packed tiles). The image must keep its name, be tiled with those tiles
+   at 256^2, packed as //udim_target.<UDIM>.exr, Non-Color, with no image or temporary
+   folder left behind; the job must name the tiles the UVs lie in, note 1011, and a single
+   target must warn about 1002. Blender's own Image.save() then writes the tiles as
+   addon_udim.<UDIM>.exr.
+   Layer options (options_case): a height layer with an offset and a mask (own tiling, offset,
+   bicubic filter, named UV map), a noise volume with central differences and a step, a
+   triplanar layer with an offset and a minimum weight: the add-on's scene JSON must carry
+   those values (as Blender holds them), and its tangent-normal bake is addon_options.npy.
+   The CLI scenes are written from the same values (options.json), plus one per key without
+   it (options_no_KEY_LAYER.json), the negative controls.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
                  --bit-depth 32 --no-manifest -o cli_CASE.exr
    with S the layer's scale as Blender holds it (float32 0.1), so both read the same number.
+   The UDIM bake: `sgbake bake --mesh mesh_udim.obj ... -o cli_udim.<UDIM>.exr` (the tiles the
+   UVs touch, 1001 and 1002) and a scene with "tile": 1011 for the empty tile; the layer
+   options: `sgbake bake options*.json`.
 3. Blender half `compare` (Blender reads the EXRs; the python3 CTest finds may lack numpy):
    every texel's RGB (RGBA with alpha) of the add-on's image must equal the CLI's file within
    1e-5, and the mask exactly. Both are libsgbake's floats and the file stores float32
@@ -34,6 +52,11 @@
    some normals by one float ulp (measured: 336 of 7,872 corners between two to_mesh() calls),
    and the maps that read normals then differ by as much (~6e-8) near those corners. Heights,
    derivatives and the mask, which read no normal, come out bit-identical.
+   Each UDIM tile must equal the CLI's file of that tile within UDIM_TOLERANCE (1e-6: the
+   tiles pass through files, and a 16-bit one would be 7.6e-6 off), and the add-on's tile
+   1002 must differ from the CLI's 1001 by more than 1e-5 (negative control). The layer
+   options bake must equal options.json's within 1e-5 and differ from every
+   options_no_*.json by more than that.
 
 --sabotage bakes the add-on's tangent-normal cases with green DirectX: the test must FAIL.
 Prints per case the largest difference, where it is, and the texels compared.
@@ -41,7 +64,7 @@ Prints per case the largest difference, where it is, and the texels compared.
 Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed or
 the library is built with AddressSanitizer (SGBAKE_SANITIZE: ASan's runtime must come first
 in a process, and Blender does not start with it; CTest: SKIP_RETURN_CODE 77).
-Takes ~6 s (Blender starts twice; nine CLI bakes).
+Takes ~9 s (Blender starts twice; seventeen CLI bakes).
 """
 
 import argparse
@@ -63,6 +86,17 @@ ADDON = "sgbake_blender"
 
 # name -> (map, margin, samples, alpha, target image's initial side or None for the default
 # '<object>_<map>' image)
+# The UDIM bake: map, margin, and the target image's tiles (1001 and 1002 hold Suzanne's
+# two halves; no UV lies in 1011, which must hold the map's background).
+UDIM_MAP = "tangent-normal"
+UDIM_MARGIN = 4
+UDIM_TILES = [1001, 1002, 1011]
+# The tiles reach Blender through temporary files: a format that is not 32-bit float must fail
+# (16-bit integers put 0.5 at 0.5000076, under TOLERANCE), so the tiles get a bound above the
+# 1-ulp noise of the normals (~6e-8) and below that.
+UDIM_TOLERANCE = 1e-6
+OPTIONS_MAP = "tangent-normal"
+
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
     "object-normal": ("object-normal", 0, 1, False, None),
@@ -179,6 +213,18 @@ def error_reports(settings, prefs, height, work, library_path):
     checks.append(expect_error("layer without an image", "has no image", bake))
     layer.type, layer.image, layer.filter = "normal", height, "hermite"
     checks.append(expect_error("scene refused by libsgbake", "filter 'hermite' is only", bake))
+    layer.filter = "bilinear"
+    layer.mask_image, layer.mask_uv_map = height, "NoSuchMap"
+    checks.append(expect_error("mask on a UV map the object lacks",
+                               "has no UV map 'NoSuchMap' (used by the mask of layer", bake))
+    layer.mask_uv_map = ""
+    tiled = bpy.data.images.new("tiled_input", 8, 8, float_buffer=True, tiled=True)
+    layer.mask_image = tiled
+    checks.append(expect_error("UDIM image as a mask", "'tiled_input' is a UDIM (tiled) image",
+                               bake))
+    layer.mask_image, layer.image = None, tiled
+    checks.append(expect_error("UDIM image as a layer", "'tiled_input' is a UDIM (tiled) image",
+                               bake))
     settings.layers.remove(len(settings.layers) - 1)
 
     prefs.library_path = os.path.join(work, "missing", "libsgbake.so")
@@ -237,6 +283,226 @@ def worker_thread_checks(settings, ob):
     return checks
 
 
+def shifted_suzanne(ob, work):
+    """A copy of Suzanne whose faces with x < 0 have their UVs moved by +1 in u (UDIM tile
+    1002), the others staying in tile 1001; writes it as mesh_udim.obj. Returns the object."""
+    import bpy
+    import numpy as np
+    me = ob.data.copy()
+    me.name = "suzanne_udim"
+    centres = np.empty(len(me.polygons) * 3, np.float32)
+    me.polygons.foreach_get("center", centres)
+    uv = np.empty(len(me.loops) * 2, np.float32)
+    me.uv_layers.active.data.foreach_get("uv", uv)
+    uv = uv.reshape(-1, 2)
+    for poly, centre in zip(me.polygons, centres.reshape(-1, 3)):
+        if centre[0] < 0:
+            uv[poly.loop_start:poly.loop_start + poly.loop_total, 0] += 1.0
+    me.uv_layers.active.data.foreach_set("uv", uv.ravel())
+    udim = bpy.data.objects.new("SuzanneUdim", me)
+    bpy.context.scene.collection.objects.link(udim)
+    me.calc_normals_split()
+    objio.write_obj(os.path.join(work, "mesh_udim.obj"), objio.mesh_arrays(me),
+                    comment="add-on test Suzanne on UDIM tiles 1001 and 1002")
+    return udim
+
+
+def sgbake_temp_dirs():
+    """The add-on's temporary tile folders currently in the temporary directory."""
+    return {name for name in os.listdir(tempfile.gettempdir())
+            if name.startswith("sgbake-udim-")}
+
+
+def udim_case(settings, ob, work, sabotage):
+    """Bakes UDIM_MAP of the UV-shifted Suzanne into a tiled image (tiles UDIM_TILES, created
+    at 64^2: each must come out SIZE^2) with the add-on, twice (a height bake first, so the
+    second replaces tiles already packed); saves the image's tiles with Blender's own
+    Image.save() as addon_udim.<UDIM>.exr. Returns the manifest entry: checks (the image keeps
+    its name, every tile baked, nothing left behind, the report's tile notes) and the CLI
+    commands of the same bake."""
+    import bpy
+    from sgbake_blender import operators
+    udim = shifted_suzanne(ob, work)
+    bpy.context.view_layer.objects.active = udim
+    image = bpy.data.images.new("udim_target", 64, 64, alpha=True, float_buffer=True,
+                                tiled=True)
+    for tile in UDIM_TILES[1:]:
+        image.tiles.new(tile)
+    images_before = set(bpy.data.images.keys())
+    dirs_before = sgbake_temp_dirs()
+    settings.target_image = image
+    settings.width = settings.height = SIZE
+    settings.margin, settings.samples, settings.use_alpha = UDIM_MARGIN, 1, False
+    settings.green = "directx" if sabotage else "opengl"
+    entry = {"map": UDIM_MAP, "margin": UDIM_MARGIN, "tiles": UDIM_TILES, "checks": []}
+    checks = entry["checks"]
+    job = operators.BakeJob(bpy.context)
+    level, notes = job.tile_notes(image.name)
+    checks.append({"name": "UDIM: tiles baked and UV tiles seen",
+                   "ok": (job.tiles == UDIM_TILES and job.uv_tiles == set(UDIM_TILES[:2])
+                          and any("no UV lies in tile(s) 1011" in n for n in notes)),
+                   "expected": f"tiles {UDIM_TILES}, UVs in {UDIM_TILES[:2]}, a note on 1011",
+                   "message": f"tiles {job.tiles}, UV tiles {sorted(job.uv_tiles)}, {notes}"})
+    settings.target_image = None  # the default '<object>_<map>' image: a single image
+    single = operators.BakeJob(bpy.context)
+    level, notes = single.tile_notes("single")
+    checks.append({"name": "UDIM: a single target reports the UVs it cannot hold",
+                   "ok": (single.tiles == [1001] and level == "WARNING"
+                          and any("tile(s) 1002, which a single image" in n for n in notes)),
+                   "expected": "tiles [1001], a warning naming 1002",
+                   "message": f"tiles {single.tiles}, {level} {notes}"})
+    settings.target_image = image
+    results = []
+    for kind in ("height", UDIM_MAP):
+        settings.map = kind
+        try:
+            results.append(sorted(bpy.ops.object.sgbake_bake()))
+        except RuntimeError as exc:
+            results.append(["ERROR", str(exc).strip()])
+    entry["result"] = results[-1]
+    sizes = [tuple(tile.size) for tile in image.tiles]
+    packed = [(p.tile_number, p.filepath) for p in image.packed_files]
+    checks.append({
+        "name": "UDIM: bakes into the tiled image",
+        "ok": (results == [["FINISHED"]] * 2 and settings.target_image == image
+               and image.name == "udim_target" and image.source == "TILED"
+               and [t.number for t in image.tiles] == UDIM_TILES
+               and sizes == [(SIZE, SIZE)] * len(UDIM_TILES)
+               and sorted(packed) == [(t, f"//udim_target.{t}.exr") for t in UDIM_TILES]
+               and image.filepath_raw == "//udim_target.<UDIM>.exr"
+               and image.colorspace_settings.name == "Non-Color"),
+        "expected": f"FINISHED twice, 'udim_target' tiled, tiles {UDIM_TILES} at {SIZE}^2, "
+                    "packed as //udim_target.<UDIM>.exr, Non-Color",
+        "message": f"{results}, '{image.name}' {image.source}, tiles "
+                   f"{[t.number for t in image.tiles]} sizes {sizes}, packed {packed}, "
+                   f"path {image.filepath_raw}, {image.colorspace_settings.name}"})
+    stray_images = set(bpy.data.images.keys()) - images_before
+    stray_dirs = sgbake_temp_dirs() - dirs_before
+    checks.append({"name": "UDIM: nothing left behind", "ok": not stray_images and not stray_dirs,
+                   "expected": "no new image, no temporary folder",
+                   "message": f"images {sorted(stray_images)}, folders {sorted(stray_dirs)}"})
+    image.filepath_raw = os.path.join(work, "addon_udim.<UDIM>.exr")
+    image.file_format = "OPEN_EXR"
+    image.save()
+    settings.target_image = None
+    bpy.context.view_layer.objects.active = ob
+    # The CLI: '<UDIM>' bakes the tiles the UVs touch (1001, 1002); a scene with "tile" bakes
+    # the empty one.
+    scale = float(settings.layers[0].scale)
+    entry["cli"] = [
+        ["bake", "--mesh", "mesh_udim.obj", "--height", "height.exr", "--height-scale",
+         repr(scale), "--filter", "bilinear", "--map", UDIM_MAP, "--size", str(SIZE),
+         "--margin", str(UDIM_MARGIN), "--green", "opengl", "--bit-depth", "32",
+         "--no-manifest", "-o", "cli_udim.<UDIM>.exr"],
+        ["bake", "udim_1011.json", "--no-manifest"]]
+    with open(os.path.join(work, "udim_1011.json"), "w", encoding="ascii") as out:
+        json.dump({"mesh": "mesh_udim.obj",
+                   "layers": [{"type": "height", "image": "height.exr", "scale": scale,
+                               "filter": "bilinear"}],
+                   "outputs": [{"map": UDIM_MAP, "size": SIZE, "margin": UDIM_MARGIN,
+                                "green": "opengl", "tile": 1011, "file": "cli_udim.1011.exr",
+                                "format": "exr", "bit_depth": 32}]}, out, indent=1)
+    return entry
+
+
+def mask_field(side):
+    """The mask image (side, side) float32 rows top first: a smooth ramp, values in [0, 1]
+    (clamped at both ends, so the mask's clamp is exercised)."""
+    import numpy as np
+    c = (np.arange(side, dtype=np.float64) + 0.5) / side
+    u, v = c[None, :], 1.0 - c[:, None]
+    return np.clip(1.2 * np.sin(2 * np.pi * u) * np.cos(2 * np.pi * v) + 0.5, 0, 1).astype(
+        np.float32)
+
+
+def options_case(settings, height, work):
+    """Task of the per-layer keys the scene format has beyond the basics: a masked, offset
+    height layer (mask with its own tiling, offset, filter and UV map), a noise volume with
+    central differences and a step, an offset triplanar layer with a minimum weight. Checks
+    the add-on's scene JSON for them, bakes OPTIONS_MAP with the add-on (addon_options.npy),
+    and writes the CLI scenes: the same keys (options.json) and, as negative controls, the
+    scene without each key (options_no_KEY.json), whose bakes must differ."""
+    import bpy
+    import numpy as np
+    from sgbake_blender import operators
+    side = 128
+    mask = bc.new_float_image("mask", side, side, mask_field(side))
+    bc.save_exr(mask, os.path.join(work, "mask.exr"))
+    settings.layers.clear()
+    spec = []
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.image, layer.scale = "masked", "height", height, 0.1
+    layer.offset = (0.25, -0.125)
+    layer.mask_image, layer.mask_uv_map = mask, "UVMap"
+    layer.mask_tiling, layer.mask_offset, layer.mask_filter = (1.0, 2.0), (0.1, 0.3), "bicubic"
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.function = "noise", "volume", "noise"
+    layer.amplitude, layer.frequency, layer.octaves = 0.02, 3.0, 2
+    layer.gradient, layer.step = "central", 0.05
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.image, layer.kind = "tri", "triplanar", height, "height"
+    layer.scale, layer.offset, layer.min_weight = 0.05, (0.3, 0.7), 0.2
+    settings.map, settings.target_image = OPTIONS_MAP, None
+    settings.width = settings.height = SIZE
+    settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+    settings.green = "opengl"
+
+    # The values as Blender holds them (float32), read back from the properties.
+    f = float
+    first, vol, tri = settings.layers
+    expected = [
+        {"offset": [f(first.offset[0]), f(first.offset[1])],
+         "mask": {"image": "mask", "uv": 0, "tiling": [f(first.mask_tiling[0]),
+                                                        f(first.mask_tiling[1])],
+                  "offset": [f(first.mask_offset[0]), f(first.mask_offset[1])],
+                  "filter": "bicubic"}},
+        {"gradient": "central", "step": f(vol.step)},
+        {"offset": [f(tri.offset[0]), f(tri.offset[1])], "min_weight": f(tri.min_weight)},
+    ]
+    job = operators.BakeJob(bpy.context)
+    sent = job.scene["layers"]
+    wrong = [(i, key, sent[i].get(key), value) for i, want in enumerate(expected)
+             for key, value in want.items() if sent[i].get(key) != value]
+    checks = [{"name": "layer options in the add-on's scene JSON", "ok": not wrong,
+               "expected": json.dumps(expected),
+               "message": f"sent {json.dumps(sent)}; wrong (layer, key, sent, expected) "
+                          f"{wrong}"}]
+    try:
+        result = sorted(bpy.ops.object.sgbake_bake())
+    except RuntimeError as exc:
+        result = ["ERROR", str(exc).strip()]
+    image = bpy.data.images.get(f"{bpy.context.active_object.name}_{OPTIONS_MAP}")
+    if result == ["FINISHED"]:
+        np.save(os.path.join(work, "addon_options.npy"), bc.image_array(image))
+
+    # The CLI's scenes, from the values above (not from the add-on's JSON).
+    scale = f(first.scale)
+    layers = [
+        {"type": "height", "image": "height.exr", "scale": scale, "filter": "bilinear",
+         "offset": expected[0]["offset"],
+         "mask": dict(expected[0]["mask"], image="mask.exr")},
+        {"type": "volume", "function": "noise", "amplitude": f(vol.amplitude),
+         "frequency": f(vol.frequency), "octaves": 2, "gradient": "central",
+         "step": expected[1]["step"]},
+        {"type": "triplanar", "image": "height.exr", "kind": "height", "scale": f(tri.scale),
+         "offset": expected[2]["offset"], "min_weight": expected[2]["min_weight"]},
+    ]
+    output = {"map": OPTIONS_MAP, "size": SIZE, "margin": 0, "format": "exr", "bit_depth": 32}
+    scenes = {"options": layers}
+    for index, key in ((0, "offset"), (0, "mask"), (1, "step"), (2, "offset"),
+                       (2, "min_weight")):
+        without = [dict(layer) for layer in layers]
+        del without[index][key]
+        scenes[f"options_no_{key}_{index}"] = without
+    for name, scene_layers in scenes.items():
+        with open(os.path.join(work, f"{name}.json"), "w", encoding="ascii") as out:
+            json.dump({"mesh": "mesh.obj", "layers": scene_layers,
+                       "outputs": [dict(output, file=f"cli_{name}.exr")]}, out, indent=1)
+    settings.layers.clear()
+    return {"map": OPTIONS_MAP, "result": result, "scenes": sorted(scenes), "checks": checks,
+            "cli": [["bake", f"{name}.json", "--no-manifest"] for name in sorted(scenes)]}
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -252,6 +518,9 @@ def blender_make(work, library_path, sabotage):
     layers = manifest["layers_from_material"]["layers"]
     manifest["scale"] = layers[0]["scale"] if layers else distance
     manifest["cases"] = bake_cases(settings, ob, work, sabotage)
+    manifest["udim"] = udim_case(settings, ob, work, sabotage)
+    manifest["options"] = options_case(settings, height, work)
+    layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
@@ -292,8 +561,55 @@ def blender_compare(work):
             "texels": int(per_texel.size),
             "covered": covered,
         }
+    results["extra"] = extra_comparisons(work, manifest)
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
+
+
+def difference(ours, theirs, channels):
+    """Largest per-texel difference of two (H, W, 4) arrays over `channels` channels, and
+    where it is."""
+    import numpy as np
+    if ours.shape != theirs.shape:
+        return {"error": f"shapes differ: add-on {ours.shape}, CLI {theirs.shape}"}
+    diff = np.abs(ours[..., :channels].astype(np.float64) - theirs[..., :channels])
+    per_texel = diff.max(axis=-1)
+    worst = np.unravel_index(int(per_texel.argmax()), per_texel.shape)
+    return {"max_abs": float(per_texel.max()), "worst_at": [int(worst[1]), int(worst[0])],
+            "texels": int(per_texel.size)}
+
+
+def extra_comparisons(work, manifest):
+    """The UDIM tiles (each add-on tile against the CLI's file of that tile; negative control:
+    tile 1002 against the CLI's 1001) and the layer options (the add-on against the CLI's
+    scene with the same keys; negative controls: against each scene without one key).
+    Returns records {name, expect ("equal" or "differ"), max_abs, ...}."""
+    import numpy as np
+
+    def load(name):
+        path = os.path.join(work, name)
+        if not os.path.exists(path):
+            return None
+        return np.load(path) if name.endswith(".npy") else bc.load_raw(path)
+
+    pairs = [(f"UDIM tile {t}", f"addon_udim.{t}.exr", f"cli_udim.{t}.exr", "equal",
+              UDIM_TOLERANCE) for t in manifest["udim"]["tiles"]]
+    pairs.append(("UDIM negative control: add-on tile 1002 vs CLI tile 1001",
+                  "addon_udim.1002.exr", "cli_udim.1001.exr", "differ", TOLERANCE))
+    for name in manifest["options"]["scenes"]:
+        pairs.append((f"layer options vs CLI {name}.json", "addon_options.npy",
+                      f"cli_{name}.exr", "equal" if name == "options" else "differ", TOLERANCE))
+    records = []
+    for name, ours_file, theirs_file, expect, tolerance in pairs:
+        record = {"name": name, "expect": expect, "files": [ours_file, theirs_file],
+                  "tolerance": tolerance}
+        ours, theirs = load(ours_file), load(theirs_file)
+        if ours is None or theirs is None:
+            record["error"] = f"missing {ours_file if ours is None else theirs_file}"
+        else:
+            record.update(difference(ours, theirs, 3))
+        records.append(record)
+    return records
 
 
 def blender_main(argv):
@@ -327,6 +643,13 @@ def run_cli(cli, work, manifest):
         proc = bc.run_tool(cmd, timeout=120)
         if proc is None or proc.returncode != 0:
             failed.append(" ".join(map(str, cmd)))
+    for part in ("udim", "options"):
+        for args in manifest[part]["cli"]:
+            cmd = [cli] + [os.path.join(work, a) if a.endswith((".json", ".obj", ".exr"))
+                           else a for a in args]
+            proc = bc.run_tool(cmd, timeout=120)
+            if proc is None or proc.returncode != 0:
+                failed.append(" ".join(map(str, cmd)))
     return failed
 
 
@@ -361,7 +684,26 @@ def evaluate(manifest, results):
             failures.append(f"{case}: the add-on's image differs from the CLI's: max "
                             f"{r['max_abs']:.3g} at (x, row) {r['worst_at']}, add-on / CLI "
                             f"{r['worst_values']}" + (" (must be identical)" if exact else ""))
-    for check in manifest["errors"]:
+    for part in ("udim", "options"):
+        entry = manifest[part]
+        if entry["result"] != ["FINISHED"]:
+            failures.append(f"{part}: the add-on's bake returned {entry['result']}")
+    for r in results["extra"]:
+        if "error" in r:
+            print(f"  {r['name']}: {r['error']}")
+            failures.append(f"{r['name']}: {r['error']}")
+            continue
+        equal, tolerance = r["expect"] == "equal", r["tolerance"]
+        ok = (r["max_abs"] <= tolerance) if equal else (r["max_abs"] > tolerance)
+        print(f"  {r['name']}: max |add-on - CLI| = {r['max_abs']:.3g} over {r['texels']} "
+              f"texels (must {'be within' if equal else 'exceed'} {tolerance:g}) -> "
+              f"{'ok' if ok else 'FAIL'}")
+        if not ok:
+            failures.append(f"{r['name']}: max {r['max_abs']:.3g} at (x, row) "
+                            f"{r['worst_at']}, expected to "
+                            f"{'be within' if equal else 'exceed'} {tolerance:g}")
+    for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
+                  + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
