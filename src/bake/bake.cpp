@@ -213,18 +213,10 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
     return Error::badInput(where + ": the " + std::string(mapKindName(s.map)) +
                            " map needs tangent frames (none given)");
   }
-  if (input.limit != nullptr) {
-    const SurfaceParameters* p = input.limitParameters;
-    bool quads = true;  // face f owns corners 4f … 4f+3
-    for (std::size_t f = 0; f < mesh.faceStart.size(); ++f) quads = quads && mesh.faceStart[f] == 4 * f;
-    if (p == nullptr || !quads || p->faceOrigin.size() != mesh.numFaces() ||
-        p->cornerSubFace.size() != mesh.numCorners() ||
-        p->cornerCoord.size() != mesh.numCorners() ||
-        std::any_of(p->faceOrigin.begin(), p->faceOrigin.end(),
-                    [&](std::uint32_t f) { return f >= input.limit->numFaces(); })) {
-      return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
-                                     "(subdivideMesh with its SurfaceParameters)");
-    }
+  if (input.limit != nullptr && (input.limitParameters == nullptr ||
+                                 !isTessellationOf(mesh, *input.limit, *input.limitParameters))) {
+    return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
+                                   "(subdivideMesh with its SurfaceParameters)");
   }
   return validateLayers(input.layers, static_cast<int>(mesh.uvSets.size()));
 }

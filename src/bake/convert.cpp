@@ -5,6 +5,7 @@
 #include <new>
 #include <string>
 
+#include "bake/limit_shader.hpp"
 #include "bake/raster.hpp"
 #include "bake/texel_frame.hpp"
 
@@ -38,6 +39,8 @@ struct ConvertShader {
   void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
   }
+  /// Nothing is derived from `tri` (LimitShader calls this after rewriting it).
+  void triangleChanged() {}
 
   void shade(const Vec3d& b, int x, int y, double* out) const {
     const int row = input->height - 1 - y;
@@ -106,7 +109,12 @@ Status validateConvert(const Mesh& mesh, const CornerTangents& tangents, const F
                            " is out of range (1 to " + std::to_string(kMaxBakeSamples) + ")");
   }
   if (settings.threads < 0) return Error::badInput(where + ": threads must be 0 (all cores) or more");
-
+  if (settings.limit != nullptr &&
+      (settings.limitParameters == nullptr ||
+       !isTessellationOf(mesh, *settings.limit, *settings.limitParameters))) {
+    return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
+                                   "(tessellateLimitSurface)");
+  }
   return Ok{};
 }
 
@@ -123,6 +131,19 @@ bake_detail::ConvertShader convertShader(const Mesh& mesh, const CornerTangents&
   shader.green = settings.green;
   shader.uvSet = settings.uvSet;
   return shader;
+}
+
+/// Rasterizes a conversion: on the mesh, or on the limit surface it tessellates (LimitShader).
+void rasterizeConversion(const bake_detail::RasterJob& job, const bake_detail::ConvertShader& shader,
+                         const ConvertSettings& settings, const bake_detail::RasterOutput& output,
+                         const bake_detail::RasterTarget& target) {
+  if (settings.limit != nullptr) {
+    bake_detail::rasterize(
+        job, bake_detail::LimitShader(shader, settings.limit, settings.limitParameters), output,
+        target);
+  } else {
+    bake_detail::rasterize(job, shader, output, target);
+  }
 }
 
 Error convertOutOfMemory(const Mesh& mesh, const FloatImage& input) {
@@ -156,8 +177,8 @@ Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tang
     bake_detail::RasterOutput rasterOutput;
     rasterOutput.keepUncovered = true;
     rasterOutput.blank = true;  // the coverage was just zero-filled
-    bake_detail::rasterize(job, convertShader(mesh, tangents, input, from, to, settings),
-                           rasterOutput, bake_detail::RasterTarget::of(output));
+    rasterizeConversion(job, convertShader(mesh, tangents, input, from, to, settings), settings,
+                        rasterOutput, bake_detail::RasterTarget::of(output));
     return output;
   } catch (const std::bad_alloc&) {
     return convertOutOfMemory(mesh, input);
@@ -191,8 +212,8 @@ Status convertNormalMapRows(const Mesh& mesh, const CornerTangents& tangents,
     bake_detail::RasterOutput rasterOutput;
     rasterOutput.keepUncovered = true;
     rasterOutput.initialPixels = input.pixels.data();  // each band's rows start from the input
-    bake_detail::rasterize(job, convertShader(mesh, tangents, input, from, to, settings),
-                           rasterOutput, target);
+    rasterizeConversion(job, convertShader(mesh, tangents, input, from, to, settings), settings,
+                        rasterOutput, target);
   } catch (const std::bad_alloc&) {
     return convertOutOfMemory(mesh, input);
   }

@@ -28,14 +28,11 @@ Status setSurface(const SceneSubdivision& subdivision, Mesh coarse, Loaded& load
     return Ok{};
   }
   // The limit surface, and the tessellation the raster walks to find it.
-  SubdivisionOptions limitOptions = subdivision.options();
-  limitOptions.level = kLimitTessellationLevel;
-  Result<LimitSurface> limit = LimitSurface::create(coarse, limitOptions);
+  Result<LimitTessellation> limit = tessellateLimitSurface(coarse, subdivision.options());
   if (!limit) return limit.error();
-  Result<Mesh> tessellation = subdivideMesh(coarse, limitOptions, &loaded.limitParameters);
-  if (!tessellation) return tessellation.error();
-  loaded.limit = std::move(*limit);
-  loaded.mesh = std::move(*tessellation);
+  loaded.limit = std::move(limit->surface);
+  loaded.mesh = std::move(limit->mesh);
+  loaded.limitParameters = std::move(limit->parameters);
   return Ok{};
 }
 

@@ -3,6 +3,7 @@
 /// normal map between object and tangent space with Blender's per-texel frame.
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include "sgbake/io/atomic_file.hpp"
 #include "sgbake/io/image_io.hpp"
 #include "sgbake/mesh/io.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 namespace sgbake::cli {
 namespace {
@@ -34,6 +36,7 @@ struct ConvertArguments {
   int threads = 0;
   bool stats = false;
   SubdivisionOptions subdivision;  ///< level 0: none
+  bool limitSurface = false;       ///< --subdivide limit: convert on the exact limit surface
 };
 
 constexpr const char* kFooter =
@@ -44,11 +47,15 @@ constexpr const char* kFooter =
     "  Texels outside the UV islands keep their input values. The output has the input's size;\n"
     "  an alpha channel is kept (unassociated), further channels are dropped. The file is\n"
     "  replaced only once complete.\n"
+    "  With --subdivide limit, the frame is the exact limit surface's at each sample, as\n"
+    "  `sgbake bake` uses from \"level\": \"limit\" (T = dP/du made orthogonal to N).\n"
     "\n"
     "Examples:\n"
     "  sgbake convert --mesh suzanne.obj --from object --to tangent n_os.exr -o n_ts.exr\n"
     "  sgbake convert --mesh suzanne.obj --from tangent --to object --green directx \\\n"
     "                 n_ts.png -o n_os.png\n"
+    "  sgbake convert --mesh cage.obj --subdivide limit --from object --to tangent \\\n"
+    "                 n_os.exr -o n_ts.exr\n"
     "\n";
 
 /// The FloatImage (rows top first) of an Image (rows bottom-up), at most three colour channels;
@@ -102,9 +109,17 @@ Status runConvert(const ConvertArguments& args) {
   Stopwatch step;
   LoadOptions meshOptions;
   meshOptions.requireUvs = true;
-  meshOptions.subdivision = args.subdivision;
+  if (!args.limitSurface) meshOptions.subdivision = args.subdivision;
   Result<Mesh> mesh = loadMesh(args.mesh, meshOptions);
   if (!mesh) return mesh.error();
+  // --subdivide limit: the frames are the limit surface's, found through its tessellation.
+  std::optional<LimitTessellation> limit;
+  if (args.limitSurface) {
+    Result<LimitTessellation> tessellated = tessellateLimitSurface(*mesh, args.subdivision);
+    if (!tessellated) return tessellated.error();
+    limit.emplace(std::move(*tessellated));
+    mesh = std::move(limit->mesh);
+  }
   if (!mesh->hasUvSet(static_cast<std::size_t>(args.uvSet))) {
     return Error::badInput(args.mesh + ": has " + std::to_string(mesh->uvSets.size()) +
                            " UV set(s); --uv " + std::to_string(args.uvSet) +
@@ -135,6 +150,10 @@ Status runConvert(const ConvertArguments& args) {
   settings.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
   settings.samples = args.samples;
   settings.threads = args.threads;
+  if (limit) {
+    settings.limit = &limit->surface;
+    settings.limitParameters = &limit->parameters;
+  }
 
   // Converted band by band; each band's rows go to the writer's thread, which compresses and
   // writes them while the next band is converted. The output image never exists whole.
@@ -214,7 +233,7 @@ CommandAction defineConvertCommand(CLI::App& app) {
   app.add_option("--mesh", args->mesh, "Mesh with UVs the map was baked for")
       ->required()
       ->type_name("FILE");
-  addSubdivisionOptions(app, args->subdivision);
+  addSubdivisionOptions(app, args->subdivision, {}, &args->limitSurface);
   app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif); same size as IN")
       ->required()
       ->type_name("FILE");

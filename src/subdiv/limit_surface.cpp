@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "subdiv/control_mesh.hpp"
@@ -98,6 +99,24 @@ struct LimitSurface::Evaluator::State {
     return true;
   }
 
+  /// UV set @p set alone at (s, t) (what each Newton step of locate needs): the values
+  /// evaluate() gives it, bit for bit.
+  bool evaluateUv(std::uint32_t f, std::uint32_t subFace, Vec2d st, std::size_t set, Vec2d& uv,
+                  Vec2d& dUVds, Vec2d& dUVdt) {
+    if (!setUp(f) || set >= uvs.size()) return false;
+    double at[2];
+    Vec2d dds, ddt;
+    if (!coordinates(subFace, st, at, dds, ddt)) return false;
+    const osd::Bfr::Surface<double>::PointDescriptor two(2);
+    double T[2], Tu[2], Tv[2];
+    uvs[set].Evaluate(at, uvPatches[set].data(), two, T, Tu, Tv);
+    const Vec2d tu{Tu[0], Tu[1]}, tv{Tv[0], Tv[1]};
+    uv = {T[0], T[1]};
+    dUVds = dds.x * tu + dds.y * tv;
+    dUVdt = ddt.x * tu + ddt.y * tv;
+    return true;
+  }
+
   bool evaluate(std::uint32_t f, std::uint32_t subFace, Vec2d st, LimitPoint& out) {
     if (!setUp(f)) return false;
     double uv[2];
@@ -137,27 +156,50 @@ bool LimitSurface::Evaluator::evaluate(std::uint32_t face, std::uint32_t subFace
 bool LimitSurface::Evaluator::locate(std::uint32_t face, std::uint32_t subFace, Vec2d start,
                                      int uvSet, Vec2d target, LimitPoint& out) {
   constexpr int kMaxSteps = 8;
-  Vec2d st{std::clamp(start.x, 0.0, 1.0), std::clamp(start.y, 0.0, 1.0)};
-  LimitPoint p;
-  if (!state_->evaluate(face, subFace, st, p)) return false;
-  if (uvSet < 0 || uvSet >= p.numUvSets) return false;
+  if (uvSet < 0 || uvSet >= LimitPoint::kMaxUvSets) return false;
   const std::size_t k = static_cast<std::size_t>(uvSet);
+  // Newton's steps read UV set k only; the whole point is evaluated once, where they end.
+  Vec2d st{std::clamp(start.x, 0.0, 1.0), std::clamp(start.y, 0.0, 1.0)};
+  Vec2d uv, a, b;
+  if (!state_->evaluateUv(face, subFace, st, k, uv, a, b)) return false;
   const double tolerance = 1e-12 * std::max(1.0, std::max(std::abs(target.x), std::abs(target.y)));
   for (int step = 0; step < kMaxSteps; ++step) {
-    const Vec2d r = target - p.uv[k];
+    const Vec2d r = target - uv;
     if (std::max(std::abs(r.x), std::abs(r.y)) <= tolerance) break;
     // Solve [dUV/ds dUV/dt] · Δ = r.
-    const Vec2d a = p.dUVds[k], b = p.dUVdt[k];
     const double det = a.x * b.y - a.y * b.x;
     if (!(std::abs(det) > 0) || !std::isfinite(det)) break;
     const Vec2d delta{(r.x * b.y - r.y * b.x) / det, (a.x * r.y - a.y * r.x) / det};
     const Vec2d next{std::clamp(st.x + delta.x, 0.0, 1.0), std::clamp(st.y + delta.y, 0.0, 1.0)};
     if (next == st) break;  // pinned at the border of the sub-face
     st = next;
-    state_->evaluate(face, subFace, st, p);
+    state_->evaluateUv(face, subFace, st, k, uv, a, b);
   }
-  out = p;
-  return true;
+  return state_->evaluate(face, subFace, st, out);
+}
+
+Result<LimitTessellation> tessellateLimitSurface(const Mesh& coarse,
+                                                 const SubdivisionOptions& options) {
+  SubdivisionOptions tessellation = options;
+  tessellation.level = kLimitTessellationLevel;
+  Result<LimitSurface> surface = LimitSurface::create(coarse, tessellation);
+  if (!surface) return surface.error();
+  SurfaceParameters parameters;
+  Result<Mesh> mesh = subdivideMesh(coarse, tessellation, &parameters);
+  if (!mesh) return mesh.error();
+  return LimitTessellation{std::move(*surface), std::move(*mesh), std::move(parameters)};
+}
+
+bool isTessellationOf(const Mesh& mesh, const LimitSurface& surface,
+                      const SurfaceParameters& parameters) {
+  for (std::size_t f = 0; f < mesh.faceStart.size(); ++f) {
+    if (mesh.faceStart[f] != 4 * f) return false;
+  }
+  return parameters.faceOrigin.size() == mesh.numFaces() &&
+         parameters.cornerSubFace.size() == mesh.numCorners() &&
+         parameters.cornerCoord.size() == mesh.numCorners() &&
+         std::none_of(parameters.faceOrigin.begin(), parameters.faceOrigin.end(),
+                      [&](std::uint32_t f) { return f >= surface.numFaces(); });
 }
 
 }  // namespace sgbake

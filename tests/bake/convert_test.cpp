@@ -6,10 +6,12 @@
 #include <cstring>
 
 #include "bake_test_util.hpp"
+#include "support/bspline_torus.hpp"
 #include "support/parametric_mesh.hpp"
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/bake/convert.hpp"
 #include "sgbake/frames/tangents.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 namespace sgbake {
 namespace {
@@ -79,6 +81,62 @@ TEST(Convert, ObjectToTangentOfAnObjectBakeIsTheTangentBakeAndBack) {
     // The conversion is not the identity: the two bakes differ a lot.
     EXPECT_GT(maxDifference(b.objectSpace, b.tangentSpace, compared), 0.3);
   }
+}
+
+TEST(Convert, OnTheLimitSurfaceAnObjectBakeBecomesTheLimitTangentBake) {
+  // A regular torus grid (its limit is a bicubic B-spline) with a sine height layer, baked from
+  // the limit surface in both spaces: converting with the limit surface's frames (settings.limit)
+  // turns one bake into the other, as on meshes.
+  const Mesh coarse = test::torusGridWithUvs(8, 6);
+  Result<LimitTessellation> limit =
+      tessellateLimitSurface(coarse, {0, SubdivisionUvSmooth::kNone});
+  ASSERT_TRUE(limit) << limit.error().message;
+  Result<CornerTangents> tangents = computeTangents(limit->mesh.view(0));
+  ASSERT_TRUE(tangents);
+  static const test::SineHeight height(0.004, 5);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, 1.0}, 1.0, {}}};
+  const BakeInput input{&limit->mesh, &*tangents, layers, &limit->surface, &limit->parameters};
+  BakeSettings s;
+  s.width = s.height = 96;
+  s.map = MapKind::kObjectNormal;
+  Result<FloatImage> objectSpace = bakeMap(input, s);
+  s.map = MapKind::kTangentNormal;
+  Result<FloatImage> tangentSpace = bakeMap(input, s);
+  ASSERT_TRUE(objectSpace && tangentSpace);
+
+  ConvertSettings cs;
+  cs.limit = &limit->surface;
+  cs.limitParameters = &limit->parameters;
+  const Result<FloatImage> toTangent = convertNormalMap(
+      limit->mesh, *tangents, *objectSpace, NormalSpace::kObject, NormalSpace::kTangent, cs);
+  const Result<FloatImage> toObject = convertNormalMap(
+      limit->mesh, *tangents, *tangentSpace, NormalSpace::kTangent, NormalSpace::kObject, cs);
+  ASSERT_TRUE(toTangent && toObject) << (toTangent ? toObject.error() : toTangent.error()).message;
+  EXPECT_EQ(toTangent->coverage, tangentSpace->coverage);
+  int compared = 0;
+  EXPECT_LT(maxDifference(*toTangent, *tangentSpace, compared), kRoundTripTol);
+  EXPECT_EQ(compared, 96 * 96);  // the UVs tile [0,1]²
+  EXPECT_LT(maxDifference(*toObject, *objectSpace, compared), kRoundTripTol);
+
+  // The tessellation's own MikkTSpace frames are not the limit surface's: without
+  // settings.limit the same conversion misses the limit bake.
+  cs.limit = nullptr;
+  cs.limitParameters = nullptr;
+  const Result<FloatImage> meshFrames = convertNormalMap(
+      limit->mesh, *tangents, *objectSpace, NormalSpace::kObject, NormalSpace::kTangent, cs);
+  ASSERT_TRUE(meshFrames);
+  EXPECT_GT(maxDifference(*meshFrames, *tangentSpace, compared), 100 * kRoundTripTol);
+
+  // A mesh that is not the tessellation is refused.
+  cs.limit = &limit->surface;
+  cs.limitParameters = &limit->parameters;
+  const Result<CornerTangents> coarseTangents = computeTangents(coarse.view(0));
+  ASSERT_TRUE(coarseTangents);
+  const Result<FloatImage> refused = convertNormalMap(
+      coarse, *coarseTangents, *objectSpace, NormalSpace::kObject, NormalSpace::kTangent, cs);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("not a tessellation of the limit surface"),
+            std::string::npos);
 }
 
 TEST(Convert, SupersampledConversionMatchesTheSupersampledBake) {

@@ -10,6 +10,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/surface_gradient.hpp"
 #include "sgbake/mesh/mesh.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 namespace sgbake {
 
@@ -33,6 +34,13 @@ struct ConvertSettings {
   NormalMapGreen green = NormalMapGreen::kOpenGL;
   int samples = 1;  ///< N×N frames per texel, results averaged (encoded), as bakeMap
   int threads = 0;  ///< 0 = all cores; the result does not depend on it
+  /// Optional, as BakeInput::limit: the mesh is the tessellation of this limit surface
+  /// (tessellateLimitSurface), and every sample is converted with the frame of the exact limit
+  /// surface at the point whose UV is the sample's (T = ∂P/∂u of UV set 0 made orthogonal to
+  /// the normal ∂P/∂s × ∂P/∂t; sign from ∂P/∂v), the frame a limit bake uses. Both must outlive
+  /// the conversion.
+  const LimitSurface* limit = nullptr;
+  const SurfaceParameters* limitParameters = nullptr;
 };
 
 /// @brief Converts the normal map @p input from space @p from to space @p to.
@@ -54,7 +62,8 @@ struct ConvertSettings {
 /// @param[in] input    W×H image with ≥ 3 channels, rows top first; it defines the output size
 /// @return W×H image with input.channels channels; kBadInput when the input is empty or has fewer
 ///         than 3 channels, pixel storage does not match its size, the mesh has no UV set
-///         settings.uvSet, the tangents do not match the mesh, or a setting is out of range.
+///         settings.uvSet, the tangents do not match the mesh, a setting is out of range, or
+///         the mesh is not a tessellation of settings.limit.
 Result<FloatImage> convertNormalMap(const Mesh& mesh, const CornerTangents& tangents,
                                     const FloatImage& input, NormalSpace from, NormalSpace to,
                                     const ConvertSettings& settings = {});

@@ -76,4 +76,24 @@ class LimitSurface {
   std::unique_ptr<Data> data_;
 };
 
+/// @brief A limit surface together with the mesh a bake rasterizes to find it: what bakes and
+/// conversions from the limit surface read (BakeInput::limit, ConvertSettings::limit).
+struct LimitTessellation {
+  LimitSurface surface;
+  Mesh mesh;                     ///< subdivideMesh of the coarse mesh at kLimitTessellationLevel
+  SurfaceParameters parameters;  ///< where mesh's corners lie on surface
+};
+
+/// @brief The limit surface of @p coarse under @p options (their level is ignored) and its
+/// tessellation at kLimitTessellationLevel.
+/// @return the errors of LimitSurface::create and subdivideMesh
+Result<LimitTessellation> tessellateLimitSurface(const Mesh& coarse,
+                                                 const SubdivisionOptions& options);
+
+/// @brief Whether @p mesh is a tessellation of @p surface with @p parameters (all quads, face f
+/// owning corners 4f … 4f+3, one parameter per face and corner, every face on a face of the
+/// surface): what a bake or conversion from the limit surface checks before it reads them.
+bool isTessellationOf(const Mesh& mesh, const LimitSurface& surface,
+                      const SurfaceParameters& parameters);
+
 }  // namespace sgbake
