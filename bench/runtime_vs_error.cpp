@@ -316,12 +316,11 @@ void subdivision(const Settings& settings) {
   }
   FloatImage image;
   const double seconds = bestOf(settings.runs, [&] {
-    SubdivisionOptions options{kLimitTessellationLevel, SubdivisionUvSmooth::kNone};
-    Result<LimitSurface> limit = LimitSurface::create(coarse, options);
-    SurfaceParameters parameters;
-    Result<Mesh> tessellation = subdivideMesh(coarse, options, &parameters);
-    if (!limit || !tessellation) std::exit(1);
-    image = bake({&*tessellation, nullptr, {}, &*limit, &parameters}, objectNormals(settings));
+    Result<LimitTessellation> limit =
+        tessellateLimitSurface(coarse, {kLimitTessellationLevel, SubdivisionUvSmooth::kNone});
+    if (!limit) std::exit(1);
+    image = bake({&limit->mesh, nullptr, {}, &limit->surface, &limit->parameters},
+                 objectNormals(settings));
   });
   table.row("limit surface", seconds, compare(image, exact));
 }
