@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <vector>
 
 namespace sgbake::subdiv_detail {
 namespace {
@@ -42,26 +44,59 @@ osd::Sdc::Options sdcOptions(const SubdivisionOptions& options) {
   return sdc;
 }
 
-/// Groups each vertex's corners by UV (within kUvConnectLimit of the group's first corner, in
-/// both coordinates), as Blender's mesh converter does.
+/// The winding of each face in UV space, as Blender's UV vertex map computes it (the
+/// trapezium rule's signed area in float, "positive"): corners of faces of opposite winding
+/// (a mirrored island) never share a face-varying value.
+std::vector<bool> uvWindings(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
+  std::vector<bool> winding(mesh.numFaces());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const std::uint32_t first = mesh.faceStart[f], end = mesh.faceStart[f + 1];
+    float cross = 0;
+    Vec2f previous = uvs[end - 1];
+    for (std::uint32_t c = first; c < end; ++c) {
+      cross += (uvs[c].x - previous.x) * (uvs[c].y + previous.y);
+      previous = uvs[c];
+    }
+    winding[f] = cross > 0;
+  }
+  return winding;
+}
+
+/// Groups each vertex's corners into face-varying values as Blender's mesh converter does (its
+/// UV vertex map, then one write per corner): the corners are taken from the last to the first;
+/// the first one left starts a group, which takes every other corner left whose UV is within
+/// kUvConnectLimit of it in both u and v and whose face has the same UV winding. The value is
+/// the UV of the group's last corner (Blender writes each corner's UV in turn, the last write
+/// stays), which is the corner that started it.
 FVarChannel weldUvs(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
   const VertexCorners byVertex = cornersByVertex(mesh.cornerVertex, mesh.numVertices());
+  const std::vector<bool> winding = uvWindings(mesh, uvs);
+  std::vector<std::uint32_t> cornerFace(mesh.numCorners());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
+      cornerFace[c] = static_cast<std::uint32_t>(f);
+    }
+  }
   FVarChannel channel;
   channel.cornerValue.assign(mesh.numCorners(), -1);
+  std::vector<std::uint32_t> corners;
   for (std::size_t v = 0; v < mesh.numVertices(); ++v) {
-    const std::span<const std::uint32_t> corners = byVertex.of(v);
+    const std::span<const std::uint32_t> of = byVertex.of(v);
+    corners.assign(of.begin(), of.end());
+    std::sort(corners.begin(), corners.end(), std::greater<>());
     for (std::size_t a = 0; a < corners.size(); ++a) {
-      const std::uint32_t first = corners[a];
-      if (channel.cornerValue[first] >= 0) continue;
+      const std::uint32_t head = corners[a];
+      if (channel.cornerValue[head] >= 0) continue;
       const int value = static_cast<int>(channel.values.size() / 2);
-      channel.values.push_back(uvs[first].x);
-      channel.values.push_back(uvs[first].y);
-      channel.cornerValue[first] = value;
+      channel.values.push_back(uvs[head].x);
+      channel.values.push_back(uvs[head].y);
+      channel.cornerValue[head] = value;
       for (std::size_t b = a + 1; b < corners.size(); ++b) {
         const std::uint32_t other = corners[b];
         if (channel.cornerValue[other] < 0 &&
-            std::fabs(uvs[other].x - uvs[first].x) < kUvConnectLimit &&
-            std::fabs(uvs[other].y - uvs[first].y) < kUvConnectLimit) {
+            std::fabs(uvs[head].x - uvs[other].x) < kUvConnectLimit &&
+            std::fabs(uvs[head].y - uvs[other].y) < kUvConnectLimit &&
+            winding[cornerFace[head]] == winding[cornerFace[other]]) {
           channel.cornerValue[other] = value;
         }
       }

@@ -1,10 +1,8 @@
 /// @file subdivide.cpp
-/// @brief subdivideMesh: OpenSubdiv's Far topology plus Bfr limit evaluation on each coarse face's
+/// @brief subdivideMesh: OpenSubdiv's Far topology plus Blender's patch evaluation on each coarse face's
 /// grid of new vertices, numbered and connected as Blender's Subdivision Surface modifier does.
 #include "sgbake/subdiv/subdivide.hpp"
 
-#include <opensubdiv/bfr/refinerSurfaceFactory.h>
-#include <opensubdiv/bfr/surface.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -19,6 +17,7 @@
 
 #include "sgbake/mesh/normals.hpp"
 #include "subdiv/control_mesh.hpp"
+#include "subdiv/patch_evaluator.hpp"
 
 namespace sgbake {
 namespace {
@@ -28,7 +27,7 @@ using namespace subdiv_detail;
 /// The grid of new vertices on one coarse face. A quad has one grid of R×R points (R = 2^level
 /// + 1) on its own [0,1]² parameterization, point (i, j) at (i, j)/(R-1), corner k of the face at
 /// the k-th corner of the square counter-clockwise from (0, 0). Any other face of n corners has
-/// n grids of r×r points (r = 2^(level-1) + 1), one per corner k: Bfr's normalized sub-face k,
+/// n grids of r×r points (r = 2^(level-1) + 1), one per corner k: Ptex sub-face k (Bfr's normalized sub-face k),
 /// whose (0, 0) is corner k, (1, 0) the middle of edge k (corner k → k+1), (0, 1) the middle of
 /// edge k-1 and (1, 1) the face's centre.
 struct FaceGrid {
@@ -123,19 +122,6 @@ class VertexNumbering {
   std::uint32_t count_ = 0;
 };
 
-/// Bfr's coordinate of point (i, j) of grid g on a face with parameterization @p param.
-void gridCoord(const osd::Bfr::Parameterization& param, const FaceGrid& grid, int g, int i,
-               int j, double uv[2]) {
-  const double step = 1.0 / (grid.side - 1);
-  const double normalized[2] = {i * step, j * step};
-  if (grid.corners == 4) {
-    uv[0] = normalized[0];
-    uv[1] = normalized[1];
-  } else {
-    param.ConvertNormalizedSubFaceToCoord(g, normalized, uv);
-  }
-}
-
 /// subdivideGrids could not evaluate a face's limit surface.
 struct EvaluationFailed {};
 
@@ -144,8 +130,8 @@ constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_
 
 /// The subdivided mesh (see subdivideMesh) of @p coarse as OpenSubdiv sees it (@p control),
 /// and where its corners lie on the limit surface when @p parameters is not null. Throws
-/// std::bad_alloc, or EvaluationFailed when Bfr rejects a face.
-Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
+/// std::bad_alloc, or EvaluationFailed when no patch covers a point.
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
                     SurfaceParameters* parameters);
 
 }  // namespace
@@ -194,7 +180,7 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
 
 namespace {
 
-Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
                     SurfaceParameters* parameters) {
   const Refiner* const refiner = control.refiner.get();
   const std::vector<FVarChannel>& channels = control.channels;
@@ -210,17 +196,31 @@ Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
   std::vector<std::uint32_t> pointVertex(gridStart[nf]);
   std::vector<std::uint8_t> pointEvaluates(gridStart[nf], 0);
   {
+    // Faces in order. Within an n-gon, as Blender evaluates the points grids share: first
+    // every grid's row j = 0 (corner k and edge k up to its middle), then every grid's column
+    // i = last (the line from the middle of edge k to the centre, the centre from grid 0),
+    // then the rest grid by grid; so grid k evaluates the middle of edge k and the line to the
+    // centre for every k, including the last.
     std::vector<std::uint8_t> seen(numbering.count(), 0);
     for (std::size_t f = 0; f < nf; ++f) {
       const FaceGrid grid = faceGrid(faceSizes[f], level);
-      std::size_t p = gridStart[f];
+      const auto visit = [&](int g, int i, int j) {
+        const std::size_t p =
+            gridStart[f] + static_cast<std::size_t>(g * grid.pointsPerGrid() + j * grid.side + i);
+        const std::uint32_t v = numbering.vertex(coarse, *refiner, f, g, i, j);
+        pointVertex[p] = v;
+        if (!seen[v]) seen[v] = pointEvaluates[p] = 1;
+      };
       for (int g = 0; g < grid.grids(); ++g) {
-        for (int j = 0; j < grid.side; ++j) {
-          for (int i = 0; i < grid.side; ++i, ++p) {
-            const std::uint32_t v = numbering.vertex(coarse, *refiner, f, g, i, j);
-            pointVertex[p] = v;
-            if (!seen[v]) seen[v] = pointEvaluates[p] = 1;
-          }
+        for (int i = 0; i < grid.side; ++i) visit(g, i, 0);
+      }
+      const int last = grid.side - 1;
+      for (int g = 0; g < grid.grids(); ++g) {
+        for (int j = 1; j <= last; ++j) visit(g, last, j);
+      }
+      for (int g = 0; g < grid.grids(); ++g) {
+        for (int j = 1; j <= last; ++j) {
+          for (int i = 0; i < last; ++i) visit(g, i, j);
         }
       }
     }
@@ -245,33 +245,27 @@ Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
     fine.uvSets[s].uvs.resize(4 * fineFaces);
   }
 
-  // Limit positions and UVs, face by face in parallel (each thread its own Bfr factory: its
-  // cache is not thread-safe).
-  const std::vector<double>& meshPoints = control.points;
-  const SurfaceFactory::Options factoryOptions = surfaceFactoryOptions();
+  // Limit positions and UVs as Blender evaluates them (PatchEvaluator: Osd's patches in
+  // float at each grid point's Ptex coordinates), face by face in parallel.
   if (parameters != nullptr) {
     parameters->faceOrigin.resize(fineFaces);
     parameters->cornerSubFace.resize(4 * fineFaces);
     parameters->cornerCoord.resize(4 * fineFaces);
   }
-  struct Worker {
-    SurfaceFactory factory;
-    osd::Bfr::Surface<double> surface;
-    std::vector<double> patchPoints;
-    std::vector<Vec2f> gridUvs;
-  };
-  tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers;
+  const PatchEvaluator patches(control);
+  tbb::enumerable_thread_specific<std::vector<Vec2f>> gridUvsTls;
   std::atomic<bool> failed{false};
   tbb::parallel_for(std::size_t{0}, nf, [&](std::size_t f) {
-    auto& slot = workers.local();
-    if (!slot) slot.reset(new Worker{SurfaceFactory(*refiner, factoryOptions), {}, {}, {}});
-    Worker& w = *slot;
+    std::vector<Vec2f>& gridUvs = gridUvsTls.local();
     const FaceGrid grid = faceGrid(faceSizes[f], level);
-    const int face = static_cast<int>(f);
     const std::size_t first = gridStart[f];
     const auto pointIndex = [&](int g, int i, int j) {
       return first + static_cast<std::size_t>(g * grid.pointsPerGrid() + j * grid.side + i);
     };
+    // Grid g is Ptex face ptexFace(f) + g; point (i, j) lies at (i, j) / (side − 1), a power of
+    // two: exact in float, as Blender's coordinates are.
+    const float step = 1.0f / static_cast<float>(grid.side - 1);
+    const auto ptex = [&](int g) { return patches.ptexFace(static_cast<int>(f)) + g; };
     // Cells.
     std::size_t cell = cellStart[f];
     for (int g = 0; g < grid.grids(); ++g) {
@@ -284,7 +278,6 @@ Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
           out[3] = pointVertex[pointIndex(g, i, j + 1)];
           if (parameters != nullptr) {
             parameters->faceOrigin[cell] = static_cast<std::uint32_t>(f);
-            const float step = 1.0f / static_cast<float>(grid.side - 1);  // a power of 2: exact
             const int di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
             for (std::size_t k = 0; k < 4; ++k) {
               parameters->cornerSubFace[4 * cell + k] = static_cast<std::uint32_t>(g);
@@ -296,46 +289,34 @@ Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
       }
     }
     // Positions of the points this face evaluates.
-    if (!w.factory.InitVertexSurface(face, &w.surface)) {
-      failed = true;
-      return;
-    }
-    const auto param = w.surface.GetParameterization();
-    const osd::Bfr::Surface<double>::PointDescriptor xyz(3);
-    w.patchPoints.resize(static_cast<std::size_t>(w.surface.GetNumPatchPoints()) * 3);
-    w.surface.PreparePatchPoints(meshPoints.data(), xyz, w.patchPoints.data(), xyz);
     for (int g = 0; g < grid.grids(); ++g) {
       for (int j = 0; j < grid.side; ++j) {
         for (int i = 0; i < grid.side; ++i) {
           const std::size_t p = pointIndex(g, i, j);
           if (!pointEvaluates[p]) continue;
-          double uv[2], P[3];
-          gridCoord(param, grid, g, i, j, uv);
-          w.surface.Evaluate(uv, w.patchPoints.data(), xyz, P);
-          fine.positions[pointVertex[p]] = Vec3f{static_cast<float>(P[0]),
-                                                 static_cast<float>(P[1]),
-                                                 static_cast<float>(P[2])};
+          float P[3];
+          if (!patches.position(ptex(g), static_cast<float>(i) * step,
+                                static_cast<float>(j) * step, P)) {
+            failed = true;
+            return;
+          }
+          fine.positions[pointVertex[p]] = Vec3f{P[0], P[1], P[2]};
         }
       }
     }
     // UVs: each set's face-varying limit at every grid point, then copied to the cells' corners.
-    const osd::Bfr::Surface<double>::PointDescriptor st(2);
     for (std::size_t s = 0; s < channels.size(); ++s) {
-      if (!w.factory.InitFaceVaryingSurface(face, &w.surface, static_cast<int>(s))) {
-        failed = true;
-        return;
-      }
-      w.patchPoints.resize(static_cast<std::size_t>(w.surface.GetNumPatchPoints()) * 2);
-      w.surface.PreparePatchPoints(channels[s].values.data(), st, w.patchPoints.data(), st);
-      w.gridUvs.resize(static_cast<std::size_t>(grid.points()));
+      gridUvs.resize(static_cast<std::size_t>(grid.points()));
       for (int g = 0; g < grid.grids(); ++g) {
         for (int j = 0; j < grid.side; ++j) {
           for (int i = 0; i < grid.side; ++i) {
-            double uv[2], T[2];
-            gridCoord(param, grid, g, i, j, uv);
-            w.surface.Evaluate(uv, w.patchPoints.data(), st, T);
-            w.gridUvs[pointIndex(g, i, j) - first] =
-                Vec2f{static_cast<float>(T[0]), static_cast<float>(T[1])};
+            float T[2];
+            if (!patches.faceVarying(static_cast<int>(s), ptex(g), static_cast<float>(i) * step,
+                                     static_cast<float>(j) * step, T)) {
+              failed = true;
+              return;
+            }
+            gridUvs[pointIndex(g, i, j) - first] = Vec2f{T[0], T[1]};
           }
         }
       }
@@ -344,10 +325,10 @@ Mesh subdivideGrids(const Mesh& coarse, const ControlMesh& control, int level,
       for (int g = 0; g < grid.grids(); ++g) {
         for (int j = 0; j + 1 < grid.side; ++j) {
           for (int i = 0; i + 1 < grid.side; ++i, ++c) {
-            uvs[4 * c] = w.gridUvs[pointIndex(g, i, j) - first];
-            uvs[4 * c + 1] = w.gridUvs[pointIndex(g, i + 1, j) - first];
-            uvs[4 * c + 2] = w.gridUvs[pointIndex(g, i + 1, j + 1) - first];
-            uvs[4 * c + 3] = w.gridUvs[pointIndex(g, i, j + 1) - first];
+            uvs[4 * c] = gridUvs[pointIndex(g, i, j) - first];
+            uvs[4 * c + 1] = gridUvs[pointIndex(g, i + 1, j) - first];
+            uvs[4 * c + 2] = gridUvs[pointIndex(g, i + 1, j + 1) - first];
+            uvs[4 * c + 3] = gridUvs[pointIndex(g, i, j + 1) - first];
           }
         }
       }

@@ -17,35 +17,27 @@
    to Blender's own Python interpreter, which has numpy, as `--compare-only DIR`):
      counts     the same numbers of vertices and faces;
      vertices   each sgbake vertex's nearest Blender vertex is a different one (bijective);
-     positions  every vertex within 1e-5 x the bounding-box diagonal D of Blender's, except, with
-                Boundary Smooth ALL, at most as many vertices as the coarse mesh has open
-                boundary corners (vertices with exactly two edges), which must be within
-                2e-3 x D: there Blender's adaptive patches (isolation level = Quality 3) only
-                approximate the limit point sgbake computes exactly (2.2e-3 on the 2-unit grid,
-                elsewhere ~4e-7, float rounding);
+     positions  every vertex is Blender's float32, bit for bit (sgbake evaluates Blender's
+                way: Far patches refined to Quality 3, Osd's CPU evaluator in float, the
+                same Ptex face and (u, v) for every point; see docs/subdivision.md);
      faces      every Blender face is an sgbake face with the same vertex cycle, its first
                 corner the same or the opposite one (the same diagonal: Blender splits a quad
                 0-1-2 / 0-2-3), and no face is left over;
-     uvs        per matched corner, max |du|, |dv| <= 1e-6 (float rounding; measured <= 2.5e-7); with UV Smooth SMOOTH_ALL
-                (--uv-smooth all) Blender's face-varying patches are approximate too (1.3e-3
-                measured): there max <= 5e-3 and median <= 1e-6;
-     tangents   asserted only for UV Smooth NONE on the cube and Suzanne: max angle <= 0.05
-                deg (0.0000 and 0.0013 deg measured, Blender 3.4), identical bitangent
-                signs. Elsewhere Blender's float evaluation leaves last-bit differences
-                between corners that share a vertex, MikkTSpace welds only bit-identical
-                corners, and so Blender's tangents are not averaged at some corners where
-                sgbake's are (measured: medians up to 1.4 deg on the cube and 0.44 deg on the
-                level-2 cylinder, <= 0.16 deg elsewhere; p99 up to 9.6 deg; single corners of
-                Suzanne up to 75 deg): the median, p99 and max are printed for every case,
-                not asserted.
+     uvs        per matched corner, max |du|, |dv| <= 2.5e-7, and the corners whose UV is not
+                Blender's float are counted (0 in a run measured on Blender 3.4.1): Blender
+                gives a face-varying value shared by corners with nearly equal UVs the UV of
+                whichever corner its threads write last, which changes from run to run (the
+                grid: 28 of 192 corners); sgbake takes the one written last in order;
+     tangents   max angle <= 0.05 deg and identical bitangent signs, every case (measured
+                <= 0.002 deg: MikkTSpace's float rounding).
 3. Negative controls, which must FAIL, or the checks could not tell right from wrong:
      boundary   sgbake --boundary-smooth keep-corners against Blender's grid made with ALL
                 (level 1): the position check must fail;
      level      sgbake --subdivide 1 against Blender's level-2 grid: the count check must fail.
 
-Prints one line of figures per case (D, the largest position error of the ordinary vertices
-and of the excused boundary corners, unmatched faces and diagonal mismatches, UV max and
-median, tangent median / p99 / max in degrees and sign mismatches). --keep DIR writes every file
+Prints one line of figures per case (D, the largest position error and the vertices that
+differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
+median / p99 / max in degrees and sign mismatches). --keep DIR writes every file
 there and keeps it.
 
 Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed
@@ -70,13 +62,13 @@ SKIP = bc.SKIP
 BLENDER_TIMEOUT = 240
 SGBAKE_TIMEOUT = 120
 
-POSITION_REL = 1e-5          # x bounding-box diagonal, every vertex ...
-CORNER_POSITION_REL = 2e-3   # ... but the open boundary corners with Boundary Smooth ALL
-UV_MAX = 1e-6
-UV_MAX_SMOOTH_ALL = 5e-3
-UV_MEDIAN_SMOOTH_ALL = 1e-6
+# Positions must be Blender's floats exactly. UVs may differ by an ulp or two (up to 2: 2.4e-7
+# at most): where corners of a vertex share a face-varying value but not quite the same UV,
+# Blender's value is whichever corner's UV its evaluator was given last, and that changes from
+# run to run (measured: 28 of 192 corners of the grid between two runs); sgbake takes the
+# corner Blender takes when it runs in order. Tangents: MikkTSpace's float rounding only.
+UV_MAX = 2.5e-7
 TANGENT_MAX_DEG = 0.05
-TANGENT_MESHES = ("cube", "suzanne")  # tangents asserted for these with UV Smooth NONE
 
 # Blender's enum names -> sgbake's option values.
 UV_SMOOTH = {
@@ -221,7 +213,7 @@ def angles_deg(a, b):
     return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), (a * b).sum(1)))
 
 
-def compare(case, valence2, ref, obj, csv):
+def compare(case, ref, obj, csv):
     """Compares sgbake's subdivided mesh and tangents with Blender's. Returns (figures,
     failures), failures a list of (check, message); figures are None when the counts differ
     (nothing else can be compared)."""
@@ -246,19 +238,12 @@ def compare(case, valence2, ref, obj, csv):
         failures.append(("vertices", f"{len(P) - matched} sgbake vertices share their nearest "
                                      "Blender vertex with another one"))
     diag = float(np.linalg.norm(BP.max(0) - BP.min(0)))
-    allowance = valence2 if case["boundary_smooth"] == "ALL" else 0
-    over = np.flatnonzero(dist > POSITION_REL * diag)
-    ordinary = np.delete(dist, over) if len(over) <= allowance else dist
-    fig.update(diag=diag, pos_max=float(ordinary.max()) if ordinary.size else 0.0,
-               excused=len(over) if len(over) <= allowance else 0,
-               excused_max=float(dist[over].max()) if 0 < len(over) <= allowance else None)
-    if len(over) > allowance:
-        failures.append(("positions", f"{len(over)} vertices are farther than "
-                                      f"{POSITION_REL:g} x D = {POSITION_REL * diag:.3g} from "
-                                      f"Blender's ({allowance} allowed), max {dist.max():.3g}"))
-    elif over.size and dist[over].max() > CORNER_POSITION_REL * diag:
-        failures.append(("positions", f"a boundary corner is {dist[over].max():.3g} from "
-                                      f"Blender's (> {CORNER_POSITION_REL:g} x D)"))
+    # Bit for bit: sgbake's OBJ holds its floats exactly (9 digits), Blender's NPZ float32.
+    inexact = int((P.astype(np.float32) != BP[index].astype(np.float32)).any(1).sum())
+    fig.update(diag=diag, pos_max=float(dist.max()) if dist.size else 0.0, pos_inexact=inexact)
+    if inexact:
+        failures.append(("positions", f"{inexact} vertices are not Blender's floats (max "
+                                      f"distance {dist.max():.3g}, {dist.max() / diag:.2g} x D)"))
 
     # Faces: same vertex cycle, first corner the same or opposite; corners paired up.
     b_start = np.concatenate(([0], np.cumsum(b_size)))
@@ -308,45 +293,38 @@ def compare(case, valence2, ref, obj, csv):
     # UVs and tangents of the matched corners.
     ours_corners = np.array(ours_corners)
     blender_corners = np.array(blender_corners)
-    uv_error = np.abs(T[corner_uv[ours_corners]] - BU[blender_corners]).max(1)
+    ours_uv = T[corner_uv[ours_corners]].astype(np.float32)
+    blender_uv = BU[blender_corners].astype(np.float32)
+    uv_error = np.abs(ours_uv.astype(np.float64) - blender_uv).max(1)
     angle = angles_deg(tangents[ours_corners], BT[blender_corners])
     sign_diff = int((np.sign(signs[ours_corners]) != np.sign(BS[blender_corners])).sum())
-    fig.update(uv_max=float(uv_error.max()), uv_median=float(np.median(uv_error)),
+    fig.update(uv_max=float(uv_error.max()), uv_inexact=int((ours_uv != blender_uv).any(1).sum()),
                t_median=float(np.median(angle)), t_p99=float(np.percentile(angle, 99)),
                t_max=float(angle.max()), sign_diff=sign_diff)
-    if case["uv_smooth"] == "SMOOTH_ALL":
-        if fig["uv_max"] > UV_MAX_SMOOTH_ALL or fig["uv_median"] > UV_MEDIAN_SMOOTH_ALL:
-            failures.append(("uvs", f"UVs differ: max {fig['uv_max']:.3g} (<= "
-                                    f"{UV_MAX_SMOOTH_ALL:g}), median {fig['uv_median']:.3g} "
-                                    f"(<= {UV_MEDIAN_SMOOTH_ALL:g})"))
-    elif fig["uv_max"] > UV_MAX:
+    if fig["uv_max"] > UV_MAX:
         failures.append(("uvs", f"UVs differ by up to {fig['uv_max']:.3g} (> {UV_MAX:g})"))
-    fig["t_checked"] = case["mesh"] in TANGENT_MESHES and case["uv_smooth"] == "NONE"
-    if fig["t_checked"]:
-        if fig["t_max"] > TANGENT_MAX_DEG:
-            failures.append(("tangents", f"tangents differ by up to {fig['t_max']:.4f} deg "
-                                         f"(> {TANGENT_MAX_DEG} deg)"))
-        if sign_diff:
-            failures.append(("tangents", f"{sign_diff} bitangent signs differ"))
+    if fig["t_max"] > TANGENT_MAX_DEG:
+        failures.append(("tangents", f"tangents differ by up to {fig['t_max']:.4f} deg "
+                                     f"(> {TANGENT_MAX_DEG} deg)"))
+    if sign_diff:
+        failures.append(("tangents", f"{sign_diff} bitangent signs differ"))
     return fig, failures
 
 
-HEADER = ("%-45s %6s %6s %6s %9s %-12s %7s %9s %9s %7s %7s %7s %4s  %s"
-          % ("case (Blender enums)", "verts", "faces", "D", "pos max", "corners(max)",
-             "unm/dg", "uv max", "uv med", "t med", "t p99", "t max", "sgn", "result"))
+HEADER = ("%-45s %6s %6s %6s %9s %6s %7s %9s %6s %7s %7s %7s %4s  %s"
+          % ("case (Blender enums)", "verts", "faces", "D", "pos max", "pos!=", "unm/dg",
+             "uv max", "uv!=", "t med", "t p99", "t max", "sgn", "result"))
 
 
 def table_row(label, fig, failures):
     if fig is None:
         return "%-45s %s  FAIL (%s)" % (label, "counts differ", "; ".join(m for _, m in failures))
-    excused = ("%d(%.2g)" % (fig["excused"], fig["excused_max"]) if fig["excused"] else "-")
     tangent = ("%7.4f %7.4f %7.4f %4d" % (fig["t_median"], fig["t_p99"], fig["t_max"],
                                           fig["sign_diff"]) if "t_max" in fig else "-")
-    mark = "*" if fig.get("t_checked") else " "
-    return ("%-45s %6d %6d %6.3f %9.2e %-12s %3d/%-3d %9.2e %9.2e %s%s %s"
-            % (label, fig["vertices"], fig["faces"], fig["diag"], fig["pos_max"], excused,
-               fig["unmatched"], fig["diagonal"], fig.get("uv_max", float("nan")),
-               fig.get("uv_median", float("nan")), tangent, mark,
+    return ("%-45s %6d %6d %6.3f %9.2e %6d %3d/%-3d %9.2e %6s %s %s"
+            % (label, fig["vertices"], fig["faces"], fig["diag"], fig["pos_max"],
+               fig["pos_inexact"], fig["unmatched"], fig["diagonal"],
+               fig.get("uv_max", float("nan")), fig.get("uv_inexact", "-"), tangent,
                "ok" if not failures else "FAIL"))
 
 
@@ -360,10 +338,10 @@ def compare_all(cli, work):
     print(f"Blender {manifest['blender']}, {len(cases)} cases; coarse meshes: "
           + ", ".join(f"{name} {m['vertices']} v / {m['faces']} f / {m['valence2']} corners"
                       for name, m in manifest["meshes"].items()))
-    print("D = bounding-box diagonal; pos max = largest |sgbake - Blender| of the ordinary "
-          "vertices;\ncorners = excused open boundary corners (their largest error); unm/dg = "
-          "unmatched faces / diagonal\nmismatches; uv = max |du|, |dv| per corner; t = tangent "
-          "angle in degrees; sgn = sign mismatches;\n* = tangents asserted")
+    print("D = bounding-box diagonal; pos max = largest |sgbake - Blender| (as parsed from the "
+          "files), pos!= = vertices\nwhose float32 differs; unm/dg = unmatched faces / diagonal "
+          "mismatches; uv max = max |du|, |dv| per\ncorner, uv!= = corners whose float32 UV "
+          "differs; t = tangent angle in degrees; sgn = sign mismatches")
     print(HEADER)
     failures = []
     def run_and_compare(tag, overrides, out_tag):
@@ -374,8 +352,7 @@ def compare_all(cli, work):
         if isinstance(result, str):
             return f"sgbake failed: {result}"
         try:
-            return compare(case, manifest["meshes"][case["mesh"]]["valence2"],
-                           np.load(os.path.join(work, tag + ".npz")), *result)
+            return compare(case, np.load(os.path.join(work, tag + ".npz")), *result)
         except (OSError, ValueError) as exc:
             return f"cannot compare: {exc}"
 

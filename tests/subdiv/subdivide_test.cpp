@@ -184,18 +184,42 @@ TEST(Subdivide, LinearUvsInterpolateEachFaceBilinearly) {
   }
 }
 
+TEST(Subdivide, CornersWithNearlyEqualUvsShareTheLastCornersUv) {
+  // Two quads side by side; the second gives the shared vertices 1 and 4 UVs 1e-5 away from the
+  // first's (within Blender's 1e-4 connect limit): one face-varying value per vertex, whose
+  // value is the UV of the later corner (Blender writes each corner's UV in turn). With UV
+  // Smooth none, a corner at a coarse vertex gets exactly that value.
+  Mesh mesh = meshOf({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}},
+                     {{0, 1, 4, 3}, {1, 2, 5, 4}});
+  const float shifted = 0.5f + 1e-5f;
+  mesh.uvSets[0].uvs = {{0, 0}, {0.5f, 0}, {0.5f, 1}, {0, 1},
+                        {shifted, 0}, {1, 0}, {1, 1}, {shifted, 1}};
+  Result<Mesh> fine = subdivideMesh(mesh, {1, SubdivisionUvSmooth::kNone});
+  ASSERT_TRUE(fine) << fine.error().message;
+  int atShared = 0;
+  for (std::size_t c = 0; c < fine->numCorners(); ++c) {
+    const std::uint32_t v = fine->cornerVertex[c];
+    if (v != 1 && v != 4) continue;  // coarse vertices keep their index
+    ++atShared;
+    EXPECT_EQ(fine->uvSets[0].uvs[c].x, shifted) << "corner " << c;
+  }
+  EXPECT_EQ(atShared, 4);  // one sub-face of each quad at each shared vertex
+}
+
 TEST(Subdivide, KeepsEveryUvSetAndComputesSmoothNormals) {
   Mesh coarse = prism(5);
   coarse.uvSets.push_back({"second", coarse.uvSets[0].uvs});
-  for (Vec2f& uv : coarse.uvSets[1].uvs) uv = {uv.y, uv.x};
+  // Turned by 180°: the same UV winding (which decides which corners share a value, as in
+  // Blender), and every value negated exactly.
+  for (Vec2f& uv : coarse.uvSets[1].uvs) uv = {-uv.x, -uv.y};
   Result<Mesh> fine = subdivideMesh(coarse, {2});
   ASSERT_TRUE(fine) << fine.error().message;
   ASSERT_EQ(fine->uvSets.size(), 2u);
   EXPECT_EQ(fine->uvSets[1].name, "second");
   for (std::size_t c = 0; c < fine->numCorners(); ++c) {
     const Vec2f a = fine->uvSets[0].uvs[c], b = fine->uvSets[1].uvs[c];
-    ASSERT_EQ(a.x, b.y);
-    ASSERT_EQ(a.y, b.x);
+    ASSERT_EQ(a.x, -b.x);
+    ASSERT_EQ(a.y, -b.y);
   }
   Mesh renormalized = *fine;
   computeSmoothNormals(renormalized);
@@ -315,8 +339,14 @@ TEST(LimitSurface, SubdividedVerticesAndUvsAreTheSurfaceAtTheirParameters) {
                                  length(p.position - at(*fine, fine->cornerVertex[c])));
         worstUv = std::max(worstUv, std::sqrt(lengthSquared(p.uv[0] - cast<double>(fine->uvSets[0].uvs[c]))));
       }
-      EXPECT_LT(worstPosition, 1e-6);  // float positions of size ~1
-      EXPECT_LT(worstUv, 1e-6);
+      // subdivideMesh evaluates Blender's patches: exact where the surface is regular, within
+      // float rounding of the limit where it is isolated to Quality 3. Smoothed UVs ("all")
+      // around an irregular UV vertex are approximated more coarsely by Blender's face-varying
+      // patches (measured: up to 7.8e-3 on these meshes; Blender's own modifier gives the same
+      // floats, BlenderSubdivisionOracle).
+      const double uvTolerance = uvSmooth == SubdivisionUvSmooth::kAll ? 1e-2 : 1e-6;
+      EXPECT_LT(worstPosition, 1e-6) << coarse.numFaces() << " faces";  // positions of size ~1
+      EXPECT_LT(worstUv, uvTolerance) << coarse.numFaces() << " faces";
     }
   }
 }

@@ -69,11 +69,13 @@ struct SurfaceParameters {
 /// What Blender does, and so this:
 ///  - Each quad becomes a (2^level)² grid of quads; any other face of n corners becomes n
 ///    (2^(level-1))² grids, one per corner, meeting at the face's centre.
-///  - Every vertex of the result lies on the limit surface of the coarse mesh: it is evaluated
-///    with OpenSubdiv's Bfr at its grid point (approximating irregular regions to
-///    refinement level 3, Blender's default "Quality").
-///  - UVs are the face-varying limit of the coarse UVs, evaluated per corner; corners of a
-///    vertex whose UVs lie within 1e-4 of each other share one face-varying value.
+///  - Every vertex of the result lies on the limit surface of the coarse mesh, evaluated as
+///    Blender evaluates it, float for float: OpenSubdiv's Far patches isolated to level 3
+///    (Blender's default "Quality"; irregular regions are approximated there), their points
+///    computed and evaluated in float by Osd's CPU evaluator at the vertex's Ptex coordinates.
+///  - UVs are the face-varying patches of the coarse UVs, evaluated per corner the same way;
+///    corners of a vertex whose UVs lie within 1e-4 of each other (and whose faces have the
+///    same UV winding) share one face-varying value, the UV of the last of them.
 ///  - Each new quad starts at the corner nearest its face's first corner in the face's own
 ///    parameterization, so that it splits into triangles along the same diagonal as Blender's.
 ///  - The result is shaded smooth: its normals are computeSmoothNormals of the new faces (the
