@@ -32,7 +32,7 @@ Result<FloatImage> bakeOutputInMemory(const Plan& plan, std::size_t output,
   plan_detail::ProgressReporter steps(silent, 0);
   ExecuteReport report;
   plan_detail::Loaded loaded;
-  if (Status ok = plan_detail::setSurface(s.subdivision, *inputs.mesh, loaded); !ok) {
+  if (Status ok = plan_detail::setSurface(s, *inputs.mesh, loaded); !ok) {
     return Error{ok.error().code, s.mesh.string() + ": " + ok.error().message};
   }
   if (Status ok = plan_detail::loadTextures(plan, inputs.image, loaded, steps, report); !ok) {

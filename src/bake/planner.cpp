@@ -761,7 +761,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     meshOptions.requireUvs = true;
     Result<Mesh> mesh = loadMesh(s.mesh, meshOptions);
     if (!mesh) return mesh.error();
-    return plan_detail::setSurface(s.subdivision, std::move(*mesh), loaded);
+    return plan_detail::setSurface(s, std::move(*mesh), loaded);
   });
   const plan_detail::ImageSource imageFiles = [](const PlannedImage& image) {
     LoadImageOptions imageOptions;

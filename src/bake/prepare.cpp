@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "sgbake/gradient/filters.hpp"
@@ -16,10 +17,18 @@ OutputPadding outputPadding(const SceneOutput& output) {
   return {false, std::max(output.margin, 0)};
 }
 
-Status setSurface(const SceneSubdivision& subdivision, Mesh coarse, Loaded& loaded) {
+Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
+  const SceneSubdivision& subdivision = scene.subdivision;
   if (!subdivision.requested()) {
     loaded.mesh = std::move(coarse);
     return Ok{};
+  }
+  // Creases that do not fit the mesh are the scene's mistake: name its key.
+  if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, subdivision.options())) {
+    return Error::badInput(scenePrefix(scene) + "subdivision." +
+                           (issue->edge ? "edge_creases[" : "vertex_creases[") +
+                           std::to_string(issue->index) + "]: " + issue->what +
+                           (scene.inMemory ? std::string() : " (" + scene.mesh.string() + ")"));
   }
   if (!subdivision.limitSurface()) {
     Result<Mesh> subdivided = subdivideMesh(coarse, subdivision.options());

@@ -83,7 +83,8 @@ class ProgressReporter {
 
 /// @brief Sets loaded.mesh (and the limit surface) from the mesh as read, @p coarse: subdivided
 /// as the scene asks, or, for "level": "limit", the limit surface and its level-3 tessellation.
-Status setSurface(const SceneSubdivision& subdivision, Mesh coarse, Loaded& loaded);
+/// A crease that does not fit the mesh is kBadInput naming the scene and its key.
+Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded);
 
 /// Where the images of a plan come from: the image of a PlannedImage, with its channels.
 using ImageSource = std::function<Result<Image>(const PlannedImage&)>;

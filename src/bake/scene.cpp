@@ -329,7 +329,8 @@ std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key
 // ---- Keys of each kind of object ---------------------------------------------------------------
 
 const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers", "outputs"};
-const std::vector<std::string> kSubdivisionKeys = {"level", "uv_smooth", "boundary"};
+const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
+                                                   "use_creases", "edge_creases", "vertex_creases"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
@@ -387,6 +388,93 @@ const std::vector<std::string> kCornersOutputKeys = {"map", "file"};
 
 // ---- Parsing each part -------------------------------------------------------------------------
 
+/// A vertex index inside a crease entry at @p where.
+std::uint32_t creaseVertex(const json& value, const std::string& where) {
+  if (value.is_number_unsigned() &&
+      value.get<std::uint64_t>() <= std::numeric_limits<std::uint32_t>::max()) {
+    return static_cast<std::uint32_t>(value.get<std::uint64_t>());
+  }
+  if (value.is_number_integer() || (value.is_number_float() && std::isfinite(value.get<double>()) &&
+                                    value.get<double>() == std::floor(value.get<double>()))) {
+    fail(where, "vertex " + value.dump() + " is out of range (vertices are numbered from 0)");
+  }
+  fail(where, "a vertex must be an integer, not " +
+                  (value.is_number() ? describeValue(value) : describeType(value)));
+}
+
+/// The crease value inside a crease entry at @p where: a number in [0, 1].
+float creaseValue(const json& value, const std::string& where) {
+  if (!value.is_number()) {
+    fail(where, "a crease must be a number, not " + describeType(value));
+  }
+  const double c = value.get<double>();
+  if (!(c >= 0.0 && c <= 1.0)) fail(where, "crease " + value.dump() + " is out of range 0..1");
+  return static_cast<float>(c);
+}
+
+/// The entries of a crease list @p key of @p reader: arrays of @p size elements.
+const json& creaseList(const ObjectReader& reader, std::string_view key, std::size_t size,
+                       std::string_view shape) {
+  const json& list = reader.at(key);
+  const std::string where = appendPath(reader.where(), key);
+  if (!list.is_array())
+    fail(reader.where(), quote(key) + " must be an array, not " + describeType(list));
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const json& entry = list[i];
+    if (!entry.is_array() || entry.size() != size) {
+      fail(where + "[" + std::to_string(i) + "]",
+           "expected " + std::string(shape) + ", not " +
+               (entry.is_array() ? "an array of " + std::to_string(entry.size())
+                                 : describeValue(entry)));
+    }
+  }
+  return list;
+}
+
+/// "edge_creases": [[a, b, c], ...], each edge once.
+std::vector<EdgeCrease> parseEdgeCreases(const ObjectReader& reader) {
+  const json& list = creaseList(reader, "edge_creases", 3,
+                                "[a, b, c] (two vertex indices and a crease in [0, 1])");
+  std::vector<EdgeCrease> creases;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> seen;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where =
+        appendPath(reader.where(), "edge_creases") + "[" + std::to_string(i) + "]";
+    EdgeCrease crease{creaseVertex(list[i][0], where), creaseVertex(list[i][1], where),
+                      creaseValue(list[i][2], where)};
+    if (crease.v0 == crease.v1) {
+      fail(where, "an edge joins two different vertices, not " + std::to_string(crease.v0) +
+                      " and itself");
+    }
+    const auto key = std::minmax(crease.v0, crease.v1);
+    if (const auto [it, added] = seen.emplace(key, i); !added) {
+      fail(where, "the edge " + std::to_string(key.first) + "-" + std::to_string(key.second) +
+                      " is already creased by edge_creases[" + std::to_string(it->second) + "]");
+    }
+    creases.push_back(crease);
+  }
+  return creases;
+}
+
+/// "vertex_creases": [[v, c], ...], each vertex once.
+std::vector<VertexCrease> parseVertexCreases(const ObjectReader& reader) {
+  const json& list =
+      creaseList(reader, "vertex_creases", 2, "[v, c] (a vertex index and a crease in [0, 1])");
+  std::vector<VertexCrease> creases;
+  std::map<std::uint32_t, std::size_t> seen;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where =
+        appendPath(reader.where(), "vertex_creases") + "[" + std::to_string(i) + "]";
+    VertexCrease crease{creaseVertex(list[i][0], where), creaseValue(list[i][1], where)};
+    if (const auto [it, added] = seen.emplace(crease.vertex, i); !added) {
+      fail(where, "vertex " + std::to_string(crease.vertex) +
+                      " is already creased by vertex_creases[" + std::to_string(it->second) + "]");
+    }
+    creases.push_back(crease);
+  }
+  return creases;
+}
+
 SceneSubdivision parseSubdivision(const json& value) {
   const ObjectReader reader(value, "subdivision", "the subdivision block");
   reader.checkKeys(kSubdivisionKeys);
@@ -405,6 +493,9 @@ SceneSubdivision parseSubdivision(const json& value) {
   }
   reader.optionalName("uv_smooth", kUvSmooths, subdivision.uvSmooth);
   reader.optionalName("boundary", kBoundaries, subdivision.boundary);
+  if (reader.has("use_creases")) subdivision.useCreases = reader.boolean("use_creases");
+  if (reader.has("edge_creases")) subdivision.edgeCreases = parseEdgeCreases(reader);
+  if (reader.has("vertex_creases")) subdivision.vertexCreases = parseVertexCreases(reader);
   return subdivision;
 }
 
@@ -947,8 +1038,14 @@ std::string outputParametersJson(const SceneOutput& output) {
 std::string describeSubdivision(const SceneSubdivision& subdivision) {
   const std::string level = subdivision.limit ? std::string("the limit surface")
                                               : "level " + std::to_string(subdivision.level);
-  return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) +
-         ", boundary " + nameIn(kBoundaries, subdivision.boundary) + ")";
+  std::string creases;
+  if (!subdivision.edgeCreases.empty() || !subdivision.vertexCreases.empty()) {
+    creases = ", " + std::to_string(subdivision.edgeCreases.size()) + " edge and " +
+              std::to_string(subdivision.vertexCreases.size()) + " vertex crease(s)" +
+              (subdivision.useCreases ? "" : ", not used");
+  }
+  return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
+         nameIn(kBoundaries, subdivision.boundary) + creases + ")";
 }
 
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
@@ -957,6 +1054,17 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
   j["level"] = subdivision.limit ? json("limit") : json(subdivision.level);
   j["uv_smooth"] = nameIn(kUvSmooths, subdivision.uvSmooth);
   j["boundary"] = nameIn(kBoundaries, subdivision.boundary);
+  // Creases only when there are any, so that the text (and the manifest hash) of a scene
+  // without creases stays what it was before creases were read.
+  if (!subdivision.edgeCreases.empty() || !subdivision.vertexCreases.empty()) {
+    j["use_creases"] = subdivision.useCreases;
+    json edges = json::array(), vertices = json::array();
+    for (const EdgeCrease& e : subdivision.edgeCreases) edges.push_back({e.v0, e.v1, e.crease});
+    for (const VertexCrease& v : subdivision.vertexCreases)
+      vertices.push_back({v.vertex, v.crease});
+    j["edge_creases"] = std::move(edges);
+    j["vertex_creases"] = std::move(vertices);
+  }
   return j.dump();
 }
 

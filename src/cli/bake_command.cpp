@@ -62,7 +62,9 @@ constexpr const char* kFooter =
     "Scene file (JSON; relative paths are relative to the scene file):\n"
     "  { \"mesh\": \"m.obj\", \"uv\": 0,\n"
     "    \"subdivision\": {\"level\": 2 (or \"limit\"), \"uv_smooth\": \"keep-boundaries\", "
-    "\"boundary\": \"all\"},\n"
+    "\"boundary\": \"all\",\n"
+    "                    \"use_creases\": true, \"edge_creases\": [[A, B, C], ...], "
+    "\"vertex_creases\": [[V, C], ...]},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -119,7 +121,8 @@ const char* const kOneMapOptions[] = {
     "--mesh",    "--output",       "--map",          "--size",      "--margin",       "--padding",
     "--samples", "--uv",           "--green",        "--height",    "--height-scale", "--filter",
     "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
-    "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth"};
+    "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth",
+    "--edge-crease", "--vertex-crease", "--no-creases"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 
@@ -233,6 +236,9 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   scene.subdivision.level = args.subdivision.level;
   scene.subdivision.uvSmooth = args.subdivision.uvSmooth;
   scene.subdivision.boundary = args.subdivision.boundary;
+  scene.subdivision.useCreases = args.subdivision.useCreases;
+  scene.subdivision.edgeCreases = args.subdivision.edgeCreases;
+  scene.subdivision.vertexCreases = args.subdivision.vertexCreases;
   if (!args.heightImage.empty()) {
     if (Status ok = parseName("--filter", args.filter, {"bilinear", "bicubic", "hermite"}); !ok) {
       return ok.error();

@@ -63,9 +63,11 @@ extern const char* const kExitCodeHelp;
 extern const CLI::Validator kNonNegativeInteger;
 
 /// @brief Adds --subdivide N, --uv-smooth NAME and --boundary-smooth NAME (Blender's
-/// Subdivision Surface modifier, see subdivideMesh), bound to @p options; level 0 (the default)
-/// means no subdivision. Non-empty @p group files them under that heading of --help. With
-/// @p limit, --subdivide also takes "limit", which sets *limit (and level 0).
+/// Subdivision Surface modifier, see subdivideMesh), and --edge-crease A,B,C, --vertex-crease
+/// V,C (each repeatable) and --no-creases (the mesh's creases, the modifier's "Use Creases"),
+/// bound to @p options; level 0 (the default) means no subdivision. Non-empty @p group files
+/// them under that heading of --help. With @p limit, --subdivide also takes "limit", which sets
+/// *limit (and level 0).
 void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
                            const std::string& group = {}, bool* limit = nullptr);
 

@@ -9,10 +9,13 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include <tbb/info.h>
 
@@ -49,6 +52,64 @@ std::map<std::string, E> nameMap(const Named<E> (&table)[N]) {
   std::map<std::string, E> names;
   for (const Named<E>& entry : table) names.emplace(entry.name, entry.value);
   return names;
+}
+
+/// Splits "a,b,c" at its commas.
+std::vector<std::string> splitCommas(const std::string& text) {
+  std::vector<std::string> parts(1);
+  for (const char ch : text) {
+    if (ch == ',') {
+      parts.emplace_back();
+    } else {
+      parts.back() += ch;
+    }
+  }
+  return parts;
+}
+
+/// A vertex index of a crease option, or nullopt.
+std::optional<std::uint32_t> creaseVertex(const std::string& text) {
+  try {
+    std::size_t used = 0;
+    if (text.empty() || text[0] == '-') return std::nullopt;
+    const unsigned long long v = std::stoull(text, &used);
+    if (used != text.size() || v > std::numeric_limits<std::uint32_t>::max()) return std::nullopt;
+    return static_cast<std::uint32_t>(v);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+/// A crease value of a crease option (a number in [0, 1]), or nullopt.
+std::optional<float> creaseValue(const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double c = std::stod(text, &used);
+    if (used != text.size() || !(c >= 0.0 && c <= 1.0)) return std::nullopt;
+    return static_cast<float>(c);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+/// "A,B,C" of --edge-crease.
+std::optional<EdgeCrease> parseEdgeCrease(const std::string& text) {
+  const std::vector<std::string> parts = splitCommas(text);
+  if (parts.size() != 3) return std::nullopt;
+  const auto v0 = creaseVertex(parts[0]), v1 = creaseVertex(parts[1]);
+  const auto c = creaseValue(parts[2]);
+  if (!v0 || !v1 || !c) return std::nullopt;
+  return EdgeCrease{*v0, *v1, *c};
+}
+
+/// "V,C" of --vertex-crease.
+std::optional<VertexCrease> parseVertexCrease(const std::string& text) {
+  const std::vector<std::string> parts = splitCommas(text);
+  if (parts.size() != 2) return std::nullopt;
+  const auto v = creaseVertex(parts[0]);
+  const auto c = creaseValue(parts[1]);
+  if (!v || !c) return std::nullopt;
+  return VertexCrease{*v, *c};
 }
 
 }  // namespace
@@ -105,8 +166,53 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
       ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionBoundaryNames), CLI::ignore_case)
                       .description(""))
       ->default_str("all");
+  options.useCreases = true;
+  options.edgeCreases.clear();
+  options.vertexCreases.clear();
+  CLI::Option* const edgeCrease =
+      app.add_option_function<std::vector<std::string>>(
+             "--edge-crease",
+             [&options](const std::vector<std::string>& values) {
+               for (const std::string& value : values) {
+                 options.edgeCreases.push_back(*parseEdgeCrease(value));
+               }
+             },
+             "Crease of the edge between vertices A and B (0-based, in the file's order), "
+             "C in [0, 1] as Blender's Edge Crease; repeatable")
+          ->type_name("A,B,C")
+          ->expected(1)
+          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+          ->check(CLI::Validator(
+              [](std::string& value) -> std::string {
+                if (parseEdgeCrease(value)) return {};
+                return "'" + value + "' is not A,B,C (two vertex indices >= 0, a crease in [0, 1])";
+              },
+              ""));
+  CLI::Option* const vertexCrease =
+      app.add_option_function<std::vector<std::string>>(
+             "--vertex-crease",
+             [&options](const std::vector<std::string>& values) {
+               for (const std::string& value : values) {
+                 options.vertexCreases.push_back(*parseVertexCrease(value));
+               }
+             },
+             "Crease of vertex V (0-based), C in [0, 1] as Blender's Vertex Crease; repeatable")
+          ->type_name("V,C")
+          ->expected(1)
+          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+          ->check(CLI::Validator(
+              [](std::string& value) -> std::string {
+                if (parseVertexCrease(value)) return {};
+                return "'" + value + "' is not V,C (a vertex index >= 0, a crease in [0, 1])";
+              },
+              ""));
+  CLI::Option* const noCreases = app.add_flag_callback(
+      "--no-creases", [&options] { options.useCreases = false; },
+      "Ignore the creases (the modifier's Use Creases off)");
   if (!group.empty()) {  // CLI11 hides options of the empty group
-    for (CLI::Option* option : {level, uvSmooth, boundary}) option->group(group);
+    for (CLI::Option* option : {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases}) {
+      option->group(group);
+    }
   }
 }
 

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <sstream>
+#include <utility>
 #include <vector>
 
 namespace sgbake::subdiv_detail {
@@ -105,6 +107,63 @@ FVarChannel weldUvs(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
   return channel;
 }
 
+/// An edge as its two vertices, the smaller first.
+using EdgeKey = std::pair<std::uint32_t, std::uint32_t>;
+
+EdgeKey edgeKey(std::uint32_t a, std::uint32_t b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
+
+/// Every edge of @p mesh (consecutive corners of a face), sorted, each once.
+std::vector<EdgeKey> meshEdges(const Mesh& mesh) {
+  std::vector<EdgeKey> edges;
+  edges.reserve(mesh.numCorners());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const std::uint32_t first = mesh.faceStart[f], end = mesh.faceStart[f + 1];
+    for (std::uint32_t c = first; c < end; ++c) {
+      const std::uint32_t next = c + 1 == end ? first : c + 1;
+      edges.push_back(edgeKey(mesh.cornerVertex[c], mesh.cornerVertex[next]));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+/// Why @p crease is not a crease value, or "".
+std::string badCreaseValue(float crease) {
+  if (std::isfinite(crease) && crease >= 0.0f && crease <= 1.0f) return {};
+  std::ostringstream text;
+  text << "crease " << crease << " is outside [0, 1]";
+  return text.str();
+}
+
+/// The creases as the Far topology descriptor takes them: sharpness per edge (vertex pairs)
+/// and per vertex, leaving out the zero ones (as good as absent).
+struct Creases {
+  std::vector<int> edgeVertices;  ///< 2 per creased edge
+  std::vector<float> edgeSharpness;
+  std::vector<int> vertices;
+  std::vector<float> vertexSharpness;
+};
+
+Creases farCreases(const SubdivisionOptions& options) {
+  Creases creases;
+  if (!options.useCreases) return creases;
+  for (const EdgeCrease& edge : options.edgeCreases) {
+    const float sharpness = creaseSharpness(edge.crease);
+    if (!(sharpness > 0.0f)) continue;
+    creases.edgeVertices.push_back(static_cast<int>(edge.v0));
+    creases.edgeVertices.push_back(static_cast<int>(edge.v1));
+    creases.edgeSharpness.push_back(sharpness);
+  }
+  for (const VertexCrease& vertex : options.vertexCreases) {
+    const float sharpness = creaseSharpness(vertex.crease);
+    if (!(sharpness > 0.0f)) continue;
+    creases.vertices.push_back(static_cast<int>(vertex.vertex));
+    creases.vertexSharpness.push_back(sharpness);
+  }
+  return creases;
+}
+
 }  // namespace
 
 SurfaceFactory::Options surfaceFactoryOptions() {
@@ -113,8 +172,80 @@ SurfaceFactory::Options surfaceFactoryOptions() {
   return options;
 }
 
+}  // namespace sgbake::subdiv_detail
+
+namespace sgbake {
+
+std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOptions& options) {
+  using subdiv_detail::EdgeKey;
+  const std::size_t nv = mesh.numVertices();
+  const auto vertexName = [](std::uint32_t v) { return "vertex " + std::to_string(v); };
+  const auto outOfRange = [&](std::uint32_t v) {
+    return vertexName(v) + " is out of range (the mesh has " + std::to_string(nv) +
+           " vertices, numbered from 0)";
+  };
+  if (!options.edgeCreases.empty()) {
+    const std::vector<EdgeKey> edges = subdiv_detail::meshEdges(mesh);
+    std::vector<std::pair<EdgeKey, std::size_t>> seen;  // edge, first index listing it
+    seen.reserve(options.edgeCreases.size());
+    for (std::size_t i = 0; i < options.edgeCreases.size(); ++i) {
+      const EdgeCrease& e = options.edgeCreases[i];
+      for (const std::uint32_t v : {e.v0, e.v1}) {
+        if (v >= nv) return CreaseIssue{true, i, outOfRange(v)};
+      }
+      const EdgeKey key = subdiv_detail::edgeKey(e.v0, e.v1);
+      if (!std::binary_search(edges.begin(), edges.end(), key)) {
+        return CreaseIssue{true, i,
+                           "vertices " + std::to_string(e.v0) + " and " + std::to_string(e.v1) +
+                               " are not the ends of an edge of the mesh"};
+      }
+      if (std::string why = subdiv_detail::badCreaseValue(e.crease); !why.empty()) {
+        return CreaseIssue{true, i, why};
+      }
+      seen.emplace_back(key, i);
+    }
+    std::stable_sort(seen.begin(), seen.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::optional<CreaseIssue> first;
+    for (std::size_t k = 1; k < seen.size(); ++k) {
+      if (seen[k].first != seen[k - 1].first) continue;
+      const std::size_t later = seen[k].second;
+      if (!first || later < first->index) {
+        first = CreaseIssue{true, later,
+                            "the edge " + std::to_string(seen[k].first.first) + "-" +
+                                std::to_string(seen[k].first.second) +
+                                " is also creased by entry " + std::to_string(seen[k - 1].second)};
+      }
+    }
+    if (first) return first;
+  }
+  std::vector<std::int64_t> listedAt(options.vertexCreases.empty() ? 0 : nv, -1);
+  for (std::size_t i = 0; i < options.vertexCreases.size(); ++i) {
+    const VertexCrease& c = options.vertexCreases[i];
+    if (c.vertex >= nv) return CreaseIssue{false, i, outOfRange(c.vertex)};
+    if (std::string why = subdiv_detail::badCreaseValue(c.crease); !why.empty()) {
+      return CreaseIssue{false, i, why};
+    }
+    if (listedAt[c.vertex] >= 0) {
+      return CreaseIssue{
+          false, i,
+          vertexName(c.vertex) + " is also creased by entry " + std::to_string(listedAt[c.vertex])};
+    }
+    listedAt[c.vertex] = static_cast<std::int64_t>(i);
+  }
+  return std::nullopt;
+}
+
+}  // namespace sgbake
+
+namespace sgbake::subdiv_detail {
+
 Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOptions& options) {
   const std::string& name = coarse.source;
+  if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, options)) {
+    return Error::badInput(name + ": " + (issue->edge ? "edge" : "vertex") + " crease " +
+                           std::to_string(issue->index) + ": " + issue->what);
+  }
   const std::size_t nf = coarse.numFaces();
   for (std::size_t f = 0; f < nf; ++f) {
     const auto first = coarse.cornerVertex.begin() + coarse.faceStart[f];
@@ -145,6 +276,16 @@ Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOption
   descriptor.vertIndicesPerFace = faceVertices.data();
   descriptor.numFVarChannels = static_cast<int>(fvarDescriptors.size());
   descriptor.fvarChannels = fvarDescriptors.empty() ? nullptr : fvarDescriptors.data();
+  // Creases: Blender hands OpenSubdiv the sharpness of every edge and vertex; zero is no crease.
+  const Creases creases = farCreases(options);
+  descriptor.numCreases = static_cast<int>(creases.edgeSharpness.size());
+  descriptor.creaseVertexIndexPairs =
+      creases.edgeVertices.empty() ? nullptr : creases.edgeVertices.data();
+  descriptor.creaseWeights = creases.edgeSharpness.empty() ? nullptr : creases.edgeSharpness.data();
+  descriptor.numCorners = static_cast<int>(creases.vertexSharpness.size());
+  descriptor.cornerVertexIndices = creases.vertices.empty() ? nullptr : creases.vertices.data();
+  descriptor.cornerWeights =
+      creases.vertexSharpness.empty() ? nullptr : creases.vertexSharpness.data();
   using RefinerFactory = osd::Far::TopologyRefinerFactory<osd::Far::TopologyDescriptor>;
   ControlMesh control;
   control.refiner.reset(RefinerFactory::Create(

@@ -3,6 +3,7 @@
 /// the key, its place and a suggestion.
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
 
 #include "sgbake/bake/scene.hpp"
@@ -360,6 +361,97 @@ TEST(Scene, SubdivisionIsParsedAndValidated) {
       options());
   ASSERT_TRUE(none);
   EXPECT_FALSE(none->subdivision.requested());
+}
+
+TEST(Scene, CreasesAreParsedAndValidated) {
+  const auto withSubdivision = [](const std::string& block) {
+    return R"({"mesh": "m.obj", "subdivision": )" + block +
+           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+  };
+  Result<Scene> scene = parseScene(withSubdivision(R"({"level": 2, "use_creases": false,
+                          "edge_creases": [[0, 1, 0.5], [3, 2, 1], [4, 5, 0]],
+                          "vertex_creases": [[7, 0.25]]})"),
+                                   options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  const SubdivisionOptions parsed = scene->subdivision.options();
+  EXPECT_FALSE(parsed.useCreases);
+  ASSERT_EQ(parsed.edgeCreases.size(), 3u);
+  EXPECT_EQ(parsed.edgeCreases[1].v0, 3u);
+  EXPECT_EQ(parsed.edgeCreases[1].v1, 2u);
+  EXPECT_EQ(parsed.edgeCreases[1].crease, 1.0f);
+  EXPECT_EQ(parsed.edgeCreases[0].crease, 0.5f);
+  ASSERT_EQ(parsed.vertexCreases.size(), 1u);
+  EXPECT_EQ(parsed.vertexCreases[0].vertex, 7u);
+  EXPECT_EQ(parsed.vertexCreases[0].crease, 0.25f);
+  Result<Scene> defaults = parseScene(withSubdivision(R"({"level": 1})"), options());
+  ASSERT_TRUE(defaults);
+  EXPECT_TRUE(defaults->subdivision.useCreases);
+  EXPECT_TRUE(defaults->subdivision.edgeCreases.empty());
+
+  EXPECT_EQ(parseError(withSubdivision(R"({"use_creases": 1})")),
+            "scene.json: subdivision: 'use_creases' must be true or false, not 1");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": {"0": 1}})")),
+            "scene.json: subdivision: 'edge_creases' must be an array, not an object");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1]]})")),
+            "scene.json: subdivision.edge_creases[0]: expected [a, b, c] (two vertex indices and a "
+            "crease in [0, 1]), not an array of 2");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1, 1], 5]})")),
+            "scene.json: subdivision.edge_creases[1]: expected [a, b, c] (two vertex indices and a "
+            "crease in [0, 1]), not 5");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, -1, 0.5]]})")),
+            "scene.json: subdivision.edge_creases[0]: vertex -1 is out of range (vertices are "
+            "numbered from 0)");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1.5, 0.5]]})")),
+            "scene.json: subdivision.edge_creases[0]: a vertex must be an integer, not 1.5");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [["0", 1, 0.5]]})")),
+            "scene.json: subdivision.edge_creases[0]: a vertex must be an integer, not a string");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1, 1.5]]})")),
+            "scene.json: subdivision.edge_creases[0]: crease 1.5 is out of range 0..1");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1, -0.1]]})")),
+            "scene.json: subdivision.edge_creases[0]: crease -0.1 is out of range 0..1");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1, null]]})")),
+            "scene.json: subdivision.edge_creases[0]: a crease must be a number, not a null");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[2, 2, 0.5]]})")),
+            "scene.json: subdivision.edge_creases[0]: an edge joins two different vertices, not "
+            "2 and itself");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_creases": [[0, 1, 0.5], [2, 3, 1], [1, 0, 1]]})")),
+            "scene.json: subdivision.edge_creases[2]: the edge 0-1 is already creased by "
+            "edge_creases[0]");
+  EXPECT_EQ(parseError(withSubdivision(R"({"vertex_creases": [[0, 0.5, 1]]})")),
+            "scene.json: subdivision.vertex_creases[0]: expected [v, c] (a vertex index and a "
+            "crease in [0, 1]), not an array of 3");
+  EXPECT_EQ(parseError(withSubdivision(R"({"vertex_creases": [[0, 2]]})")),
+            "scene.json: subdivision.vertex_creases[0]: crease 2 is out of range 0..1");
+  EXPECT_EQ(parseError(withSubdivision(R"({"vertex_creases": [[4, 1], [4, 0.5]]})")),
+            "scene.json: subdivision.vertex_creases[1]: vertex 4 is already creased by "
+            "vertex_creases[0]");
+  EXPECT_EQ(parseError(withSubdivision(R"({"edge_crease": []})")),
+            "scene.json: subdivision: unknown key 'edge_crease' (did you mean 'edge_creases'?)");
+}
+
+TEST(Scene, CreasesAreInTheSubdivisionParametersOnlyWhenThereAreAny) {
+  SceneSubdivision subdivision;
+  subdivision.present = true;
+  subdivision.level = 2;
+  const std::string plain = subdivisionParametersJson(subdivision);
+  EXPECT_EQ(plain.find("crease"), std::string::npos) << plain;
+  subdivision.useCreases = false;
+  EXPECT_EQ(subdivisionParametersJson(subdivision), plain) << "no creases: nothing to turn off";
+  subdivision.edgeCreases = {{0, 1, 0.5f}};
+  const std::string off = subdivisionParametersJson(subdivision);
+  subdivision.useCreases = true;
+  const std::string half = subdivisionParametersJson(subdivision);
+  subdivision.edgeCreases[0].crease = 0.75f;
+  const std::string more = subdivisionParametersJson(subdivision);
+  subdivision.edgeCreases.clear();
+  subdivision.vertexCreases = {{1, 0.5f}};
+  const std::string vertex = subdivisionParametersJson(subdivision);
+  const std::set<std::string> distinct{plain, off, half, more, vertex};
+  EXPECT_EQ(distinct.size(), 5u) << "every crease change changes the text (and manifest hash)";
+  EXPECT_NE(half.find("\"edge_creases\":[[0,1,0.5]]"), std::string::npos) << half;
+  EXPECT_NE(describeSubdivision(subdivision).find("0 edge and 1 vertex crease(s)"),
+            std::string::npos)
+      << describeSubdivision(subdivision);
 }
 
 TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {

@@ -3,23 +3,28 @@
     blender -b --factory-startup --python-exit-code 1 \\
         --python tests/blender/make_subdivision_cases.py -- OUT_DIR
 
-Builds four coarse meshes with bpy, all smooth shaded, with their own UVs:
+Builds seven coarse meshes with bpy, all smooth shaded, with their own UVs:
   cube       the default cube (6 quads, closed, UV seams)
   suzanne    the monkey primitive (triangles and quads, open boundaries at the eyes)
   cylinder   a 7-sided cylinder with n-gon caps (the caps are 7-gons, not triangulated)
   grid       an open 4 x 3 grid of size 2, lifted by a wave (4 boundary corners of valence 2)
+  cube_creased, suzanne_creased, cylinder_creased
+             the cube, Suzanne and the cylinder with Edge Creases (0.3 to 1.0) on some edges
+             and Vertex Creases on some vertices
 and writes each as OUT_DIR/MESH.obj (objio.write_obj: exact floats, one vt and vn per corner,
 n-gons kept). Then, for every case in CASES, it gives the object a Subdivision Surface modifier
-(Catmull-Clark, Use Limit Surface on, Quality 3, the case's Levels, UV Smooth and Boundary
-Smooth), evaluates it, lets Blender compute split normals and MikkTSpace tangents of the
+(Catmull-Clark, Use Limit Surface on, Quality 3, the case's Levels, UV Smooth, Boundary
+Smooth and Use Creases), evaluates it, lets Blender compute split normals and MikkTSpace tangents of the
 subdivided mesh (`Mesh.calc_normals_split()`, `Mesh.calc_tangents()`), and writes
   TAG.npz   positions (V, 3), face_size (F,), corner_vertex (C,), uvs (C, 2),
             tangents (C, 3), signs (C,) of the subdivided mesh, in Blender's order
 and finally cases.json: {"blender": version, "python": Blender's Python interpreter (it has
-numpy), "meshes": {MESH: {vertices, edges, faces, valence2}}, "cases": [{tag, mesh, level,
-uv_smooth, boundary_smooth, vertices, faces, corners}]}, where valence2 counts the coarse
-vertices with exactly two edges (the open boundary corners) and uv_smooth / boundary_smooth are
-Blender's enum names.
+numpy), "meshes": {MESH: {vertices, edges, faces, valence2, edge_creases, vertex_creases}},
+"cases": [{tag, mesh, level, uv_smooth, boundary_smooth, use_creases, vertices, faces,
+corners}]}, where valence2 counts the coarse vertices with exactly two edges (the open boundary
+corners), edge_creases lists [v0, v1, crease] of every creased edge and vertex_creases [v,
+crease] of every creased vertex (the creases as Blender stores them, float32, read back from the
+mesh), and uv_smooth / boundary_smooth are Blender's enum names.
 subdivision_oracle.py runs sgbake on MESH.obj with the same settings and compares.
 """
 
@@ -67,26 +72,87 @@ def mesh_grid():
     return ob
 
 
+def set_creases(ob, edge_creases, vertex_creases):
+    """Blender's Edge Crease of the edges given by index, (edge, crease) pairs, and Vertex
+    Crease of the vertices, (vertex, crease) pairs (the vertex crease layer is made with
+    bmesh: Blender 3.4's Python API has no other way to add it)."""
+    import bmesh
+    me = ob.data
+    bm = bmesh.new()
+    bm.from_mesh(me)
+    layer = bm.verts.layers.crease.verify()
+    bm.verts.ensure_lookup_table()
+    for v, crease in vertex_creases:
+        bm.verts[v][layer] = crease
+    bm.to_mesh(me)
+    bm.free()
+    for e, crease in edge_creases:
+        me.edges[e].crease = crease
+    me.update()
+
+
+def mesh_cube_creased():
+    """The cube with creases 0.3, 0.7 and 1.0 on three edges around one face, 0.5 on an edge
+    of the opposite face, and vertex creases 0.6 and 1.0 (one on a creased edge, one not)."""
+    ob = mesh_cube()
+    set_creases(ob, [(0, 0.3), (1, 0.7), (2, 1.0), (8, 0.5)], [(5, 0.6), (2, 1.0)])
+    return ob
+
+
+def mesh_suzanne_creased():
+    """Suzanne with a few creased edges (0.3, 0.7, 1.0, chains and single edges, on triangles
+    and quads) and two creased vertices."""
+    ob = mesh_suzanne()
+    set_creases(ob, [(e, (0.3, 0.7, 1.0)[e % 3]) for e in range(0, 120, 7)]
+                + [(300, 1.0), (301, 1.0), (302, 1.0), (640, 0.45)],
+                [(10, 1.0), (200, 0.4)])
+    return ob
+
+
+def mesh_cylinder_creased():
+    """The 7-sided cylinder with its top cap's rim fully creased (1.0) and the bottom rim at
+    0.5: the n-gon caps next to creases."""
+    ob = mesh_cylinder()
+    me = ob.data
+    top = max(v.co.z for v in me.vertices)
+    rim = [(e.index, 1.0 if me.vertices[e.vertices[0]].co.z == top else 0.5)
+           for e in me.edges
+           if me.vertices[e.vertices[0]].co.z == me.vertices[e.vertices[1]].co.z]
+    set_creases(ob, rim, [])
+    return ob
+
+
 MESHES = [
     ("cube", mesh_cube),
     ("suzanne", mesh_suzanne),
     ("cylinder", mesh_cylinder),
     ("grid", mesh_grid),
+    ("cube_creased", mesh_cube_creased),
+    ("suzanne_creased", mesh_suzanne_creased),
+    ("cylinder_creased", mesh_cylinder_creased),
 ]
 
-# (mesh, level, uv_smooth, boundary_smooth), Blender's enum names. Boundary smooth matters only
-# on open boundaries, so only the grid tries both.
+# (mesh, level, uv_smooth, boundary_smooth, use_creases), Blender's enum names. Boundary smooth
+# matters only on open boundaries, so only the grid tries both; Use Creases only on the creased
+# meshes.
 UV_SMOOTHS = ("PRESERVE_BOUNDARIES", "NONE", "SMOOTH_ALL")
+PLAIN_MESHES = ("cube", "suzanne", "cylinder", "grid")
+CREASED_MESHES = ("cube_creased", "suzanne_creased", "cylinder_creased")
 CASES = (
-    [(mesh, 1, uv, "ALL") for mesh, _ in MESHES for uv in UV_SMOOTHS]
-    + [("grid", 1, uv, "PRESERVE_CORNERS") for uv in UV_SMOOTHS]
-    + [(mesh, 2, "PRESERVE_BOUNDARIES", "ALL") for mesh in ("suzanne", "cylinder", "grid")]
-    + [("grid", 2, "PRESERVE_BOUNDARIES", "PRESERVE_CORNERS")]
+    [(mesh, 1, uv, "ALL", True) for mesh in PLAIN_MESHES for uv in UV_SMOOTHS]
+    + [("grid", 1, uv, "PRESERVE_CORNERS", True) for uv in UV_SMOOTHS]
+    + [(mesh, 2, "PRESERVE_BOUNDARIES", "ALL", True) for mesh in ("suzanne", "cylinder", "grid")]
+    + [("grid", 2, "PRESERVE_BOUNDARIES", "PRESERVE_CORNERS", True)]
+    + [(mesh, level, "PRESERVE_BOUNDARIES", "ALL", True)
+       for mesh in CREASED_MESHES for level in (1, 2)]
+    + [("cube_creased", 1, "NONE", "ALL", True), ("cube_creased", 2, "PRESERVE_BOUNDARIES",
+                                                   "ALL", False)]
 )
 
 
-def case_tag(mesh, level, uv_smooth, boundary_smooth):
-    return f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
+def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True):
+    return (f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
+            + ("" if use_creases else "_nocreases"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -105,11 +171,17 @@ def write_coarse(name, ob, out_dir):
     edge_vertices = np.empty(len(me.edges) * 2, np.int32)
     me.edges.foreach_get("vertices", edge_vertices)
     valence = np.bincount(edge_vertices, minlength=len(me.vertices))
+    # The creases as Blender holds them (float32), by vertex indices.
+    edge_creases = [[int(e.vertices[0]), int(e.vertices[1]), float(e.crease)]
+                    for e in me.edges if e.crease != 0.0]
+    vertex_creases = ([[v, float(d.value)] for v, d in enumerate(me.vertex_creases[0].data)
+                       if d.value != 0.0] if len(me.vertex_creases) else [])
     return {"vertices": len(me.vertices), "edges": len(me.edges), "faces": len(me.polygons),
-            "valence2": int((valence == 2).sum())}
+            "valence2": int((valence == 2).sum()), "edge_creases": edge_creases,
+            "vertex_creases": vertex_creases}
 
 
-def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, out_dir):
+def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, out_dir):
     """Evaluates the object with the modifier set to the case; writes TAG.npz."""
     import numpy as np
 
@@ -117,6 +189,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, out_dir):
     mod.render_levels = level
     mod.uv_smooth = uv_smooth
     mod.boundary_smooth = boundary_smooth
+    mod.use_creases = use_creases
     depsgraph = bpy.context.evaluated_depsgraph_get()
     depsgraph.update()
     me = bpy.data.meshes.new_from_object(ob.evaluated_get(depsgraph))
@@ -124,12 +197,13 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, out_dir):
     me.calc_tangents(uvmap=me.uv_layers.active.name)
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
-    tag = case_tag(mesh, level, uv_smooth, boundary_smooth)
+    tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
              uvs=arrays["uvs"], tangents=tangents, signs=signs)
     info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
-            "boundary_smooth": boundary_smooth, "vertices": len(me.vertices),
+            "boundary_smooth": boundary_smooth, "use_creases": use_creases,
+            "vertices": len(me.vertices),
             "faces": len(me.polygons), "corners": len(me.loops)}
     bpy.data.meshes.remove(me)
     return info
@@ -155,10 +229,11 @@ def main():
         mod.subdivision_type = "CATMULL_CLARK"
         mod.use_limit_surface = True
         mod.quality = 3
-        for mesh, level, uv_smooth, boundary_smooth in CASES:
+        for mesh, level, uv_smooth, boundary_smooth, use_creases in CASES:
             if mesh != name:
                 continue
-            info = write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, out_dir)
+            info = write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases,
+                              out_dir)
             manifest["cases"].append(info)
             print("case %-45s vertices %6d faces %6d corners %6d"
                   % (info["tag"], info["vertices"], info["faces"], info["corners"]))

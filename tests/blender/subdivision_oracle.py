@@ -5,12 +5,16 @@
         [--blender blender] [--keep DIR]
 
 1. Runs make_subdivision_cases.py inside Blender (headless, factory settings, once for all
-   cases): it writes four coarse meshes (cube; Suzanne, triangles and quads; a 7-sided cylinder
-   with n-gon caps; a wavy open grid) as OBJ and, for each case (mesh, level, UV Smooth,
-   Boundary Smooth), the mesh Blender's modifier makes (Catmull-Clark, Use Limit Surface on)
-   with its MikkTSpace tangents (`Mesh.calc_tangents()`) as NPZ.
+   cases): it writes seven coarse meshes (cube; Suzanne, triangles and quads; a 7-sided cylinder
+   with n-gon caps; a wavy open grid; creased copies of the cube, Suzanne and the cylinder,
+   with Edge and Vertex Creases) as OBJ, with their creases in cases.json, and, for each case
+   (mesh, level, UV Smooth, Boundary Smooth, Use Creases), the mesh Blender's modifier makes
+   (Catmull-Clark, Use Limit Surface on) with its MikkTSpace tangents (`Mesh.calc_tangents()`)
+   as NPZ.
 2. For each case runs
      sgbake tangents MESH.obj --subdivide L --uv-smooth U --boundary-smooth B
+                    [--edge-crease A,B,C ... --vertex-crease V,C ... (the mesh's creases)]
+                    [--no-creases (Use Creases off)]
                     --mesh-out TAG.sgbake.obj -o TAG.sgbake.csv
    and compares sgbake's subdivided mesh and tangents with Blender's (numpy, no Blender; when
    the python3 running this has no numpy, e.g. a pyenv one under CTest, it hands the comparison
@@ -33,7 +37,12 @@
 3. Negative controls, which must FAIL, or the checks could not tell right from wrong:
      boundary   sgbake --boundary-smooth keep-corners against Blender's grid made with ALL
                 (level 1): the position check must fail;
-     level      sgbake --subdivide 1 against Blender's level-2 grid: the count check must fail.
+     level      sgbake --subdivide 1 against Blender's level-2 grid: the count check must fail;
+     creases    sgbake --no-creases against Blender's creased cube (level 2) and creased Suzanne
+                (level 1): the position check must fail (0.37 and 0.026 off);
+     sharpness 10c  sgbake given sqrt(c) for every crease c, i.e. sharpness 10 c instead of
+                Blender's 10 c^2, against the creased cube (level 1): the position check must
+                fail (0.20 off).
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -82,10 +91,16 @@ UV_SMOOTH = {
 BOUNDARY_SMOOTH = {"ALL": "all", "PRESERVE_CORNERS": "keep-corners"}
 
 # Negative controls: (name, Blender's case, sgbake option overrides, the check that must fail).
+# An override of None drops the option; "--no-creases": "" adds the flag.
 CONTROLS = [
     ("boundary", "grid_L1_PRESERVE_BOUNDARIES_ALL", {"--boundary-smooth": "keep-corners"},
      "positions"),
     ("level", "grid_L2_PRESERVE_BOUNDARIES_ALL", {"--subdivide": "1"}, "counts"),
+    ("creases", "cube_creased_L2_PRESERVE_BOUNDARIES_ALL", {"--no-creases": ""}, "positions"),
+    ("suzanne creases", "suzanne_creased_L1_PRESERVE_BOUNDARIES_ALL", {"--no-creases": ""},
+     "positions"),
+    ("sharpness 10c", "cube_creased_L1_PRESERVE_BOUNDARIES_ALL", {"sharpness": "10c"},
+     "positions"),
 ]
 
 
@@ -110,20 +125,40 @@ def make_cases(blender, out_dir):
     return True
 
 
-def run_sgbake(cli, work, case, overrides, out_name):
-    """Runs `sgbake tangents` on the case's coarse mesh with the case's settings (and the
-    overrides); returns (OBJ path, CSV path) or an error message."""
+def crease_options(mesh, sharpness="10c^2"):
+    """sgbake's --edge-crease / --vertex-crease options for the creases Blender's mesh has
+    (make_subdivision_cases.py lists them). sharpness "10c" passes sqrt(c) instead of c, so
+    that sgbake's 10 c^2 becomes 10 c: the mapping a negative control must tell apart."""
+    import math
+    value = (lambda c: c) if sharpness == "10c^2" else math.sqrt
+    cmd = []
+    for v0, v1, crease in mesh.get("edge_creases", []):
+        cmd += ["--edge-crease", f"{v0},{v1},{value(crease)!r}"]
+    for v, crease in mesh.get("vertex_creases", []):
+        cmd += ["--vertex-crease", f"{v},{value(crease)!r}"]
+    return cmd
+
+
+def run_sgbake(cli, work, case, mesh, overrides, out_name):
+    """Runs `sgbake tangents` on the case's coarse mesh with the case's settings and the
+    mesh's creases (and the overrides); returns (OBJ path, CSV path) or an error message."""
+    overrides = dict(overrides)
+    sharpness = overrides.pop("sharpness", "10c^2")
     options = {
         "--subdivide": str(case["level"]),
         "--uv-smooth": UV_SMOOTH[case["uv_smooth"]],
         "--boundary-smooth": BOUNDARY_SMOOTH[case["boundary_smooth"]],
     }
+    if not case.get("use_creases", True):
+        options["--no-creases"] = ""
     options.update(overrides)
     obj = os.path.join(work, out_name + ".sgbake.obj")
     csv = os.path.join(work, out_name + ".sgbake.csv")
     cmd = [cli, "tangents", os.path.join(work, case["mesh"] + ".obj")]
+    cmd += crease_options(mesh, sharpness)
     for key, value in options.items():
-        cmd += [key, value]
+        if value is not None:
+            cmd += [key, value] if value != "" else [key]
     cmd += ["--mesh-out", obj, "-o", csv]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=SGBAKE_TIMEOUT,
@@ -348,7 +383,8 @@ def compare_all(cli, work):
         """sgbake on Blender's case `tag` with `overrides`; (figures, failed checks), or the
         reason it could not be compared as a string."""
         case = cases[tag]
-        result = run_sgbake(cli, work, case, overrides, out_tag)
+        mesh = manifest["meshes"][case["mesh"]]
+        result = run_sgbake(cli, work, case, mesh, overrides, out_tag)
         if isinstance(result, str):
             return f"sgbake failed: {result}"
         try:
@@ -368,7 +404,7 @@ def compare_all(cli, work):
 
     for name, tag, overrides, must_fail in CONTROLS:
         options = " ".join(f"{k} {v}" for k, v in overrides.items())
-        outcome = run_and_compare(tag, overrides, "control_" + name)
+        outcome = run_and_compare(tag, overrides, "control_" + name.replace(" ", "_"))
         if isinstance(outcome, str):
             failures.append(f"control {name}: {outcome}")
             continue

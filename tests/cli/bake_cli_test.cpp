@@ -455,6 +455,92 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   EXPECT_EQ(listDirectory(dir_), before);
 }
 
+TEST_F(BakeCliTest, CreasesFromSceneAndFlags) {
+  writeFile(dir_ / "cube.obj", kCubeObj);
+  const std::string mesh = (dir_ / "cube.obj").string();
+  const auto scene = [](const std::string& creases, const std::string& file,
+                        const std::string& level = "2") {
+    return R"({"mesh": "cube.obj", "subdivision": {"level": )" + level + creases +
+           R"(}, "outputs": [{"map": "object-normal", "file": ")" + file +
+           R"(", "size": 32, "margin": 0, "bit_depth": 32}]})";
+  };
+  const std::string creased =
+      R"(, "edge_creases": [[0, 1, 1], [1, 2, 0.5]], "vertex_creases": [[6, 1]])";
+  ASSERT_EQ(bakeScene(scene("", "smooth.exr")).exitCode, 0);
+  const ProcessResult first = bakeScene(scene(creased, "creased.exr"));
+  ASSERT_EQ(first.exitCode, 0) << first.err;
+  EXPECT_FALSE(readPixels(dir_ / "creased.exr") == readPixels(dir_ / "smooth.exr"));
+  // The same creases as flags bake the same file.
+  const ProcessResult flags = run({"bake",
+                                   "--mesh",
+                                   mesh,
+                                   "--map",
+                                   "object-normal",
+                                   "--size",
+                                   "32",
+                                   "--margin",
+                                   "0",
+                                   "--bit-depth",
+                                   "32",
+                                   "--subdivide",
+                                   "2",
+                                   "--edge-crease",
+                                   "0,1,1",
+                                   "--edge-crease",
+                                   "1,2,0.5",
+                                   "--vertex-crease",
+                                   "6,1",
+                                   "--no-manifest",
+                                   "-o",
+                                   (dir_ / "flags.exr").string()});
+  ASSERT_EQ(flags.exitCode, 0) << flags.err;
+  EXPECT_TRUE(readPixels(dir_ / "flags.exr") == readPixels(dir_ / "creased.exr"));
+  // The manifest hashes the creases: the same scene is up to date, a changed crease re-bakes,
+  // and "use_creases": false bakes the smooth cube again.
+  EXPECT_NE(bakeScene(scene(creased, "creased.exr")).out.find("up to date"), std::string::npos);
+  const std::string changed =
+      R"(, "edge_creases": [[0, 1, 1], [1, 2, 0.6]], "vertex_creases": [[6, 1]])";
+  EXPECT_NE(bakeScene(scene(changed, "creased.exr")).out.find("wrote"), std::string::npos);
+  ASSERT_EQ(bakeScene(scene(changed + R"(, "use_creases": false)", "off.exr")).exitCode, 0);
+  EXPECT_TRUE(readPixels(dir_ / "off.exr") == readPixels(dir_ / "smooth.exr"));
+
+  // Creases that do not fit the mesh: exit 2, one line naming the scene and the key, no file.
+  const std::set<std::string> before = listDirectory(dir_);
+  const std::string sceneFile = (dir_ / "scene.json").string();
+  expectBadScene(bakeScene(scene(R"(, "edge_creases": [[0, 1, 1], [0, 2, 0.5]])", "bad.exr")),
+                 sceneFile +
+                     ": subdivision.edge_creases[1]: vertices 0 and 2 are not the ends of "
+                     "an edge of the mesh (" +
+                     mesh + ")",
+                 before, dir_);
+  expectBadScene(bakeScene(scene(R"(, "vertex_creases": [[8, 1]])", "bad.exr")),
+                 sceneFile +
+                     ": subdivision.vertex_creases[0]: vertex 8 is out of range (the mesh "
+                     "has 8 vertices, numbered from 0)",
+                 before, dir_);
+  expectBadScene(bakeScene(scene(R"(, "edge_creases": [[0, 9, 1]])", "bad.exr", "\"limit\"")),
+                 sceneFile + ": subdivision.edge_creases[0]: vertex 9 is out of range", before,
+                 dir_);
+  expectBadScene(bakeScene(scene(R"(, "edge_creases": [[0, 1, 2]])", "bad.exr")),
+                 sceneFile + ": subdivision.edge_creases[0]: crease 2 is out of range 0..1", before,
+                 dir_);
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"tangents", mesh, "--subdivide", "1", "--edge-crease", "0,2,1", "-o",
+            (dir_ / "t.csv").string()},
+           {"tangents", mesh, "--subdivide", "1", "--edge-crease", "0,1", "-o",
+            (dir_ / "t.csv").string()},
+           {"tangents", mesh, "--subdivide", "1", "--vertex-crease", "0,1.5", "-o",
+            (dir_ / "t.csv").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "1", "--vertex-crease", "99,1", "-o",
+            (dir_ / "o.png").string()},
+       }) {
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args[4] << " " << args[5] << ": " << r.err;
+    expectOneErrorLine(r);
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
 TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   // An object-space map of the flat plane: every texel (0, 0, 1) → tangent space (0, 0, 1).
   writeTestImage(dir_ / "os.png", 8, {0.5f, 0.5f, 1.0f}, false);

@@ -5,9 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -268,7 +271,250 @@ TEST(Subdivide, AResultTooLargeForAMeshIsAnErrorNotAnOverflow) {
             "(1073741823)");
 }
 
+// ---- Creases -----------------------------------------------------------------------------------
 
+/// Every edge of @p mesh once, as (smaller, larger) vertex pairs.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> edgesOf(const Mesh& mesh) {
+  std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const std::uint32_t first = mesh.faceStart[f], n = mesh.faceSize(f);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t a = mesh.cornerVertex[first + k];
+      const std::uint32_t b = mesh.cornerVertex[first + (k + 1) % n];
+      edges.insert(std::minmax(a, b));
+    }
+  }
+  return {edges.begin(), edges.end()};
+}
+
+/// @p options with every edge of @p mesh creased by @p crease.
+SubdivisionOptions creasedEdges(const Mesh& mesh, SubdivisionOptions options, float crease) {
+  for (const auto& [a, b] : edgesOf(mesh)) options.edgeCreases.push_back({b, a, crease});
+  return options;
+}
+
+/// How far the subdivided cube's points lie inside the cube [-1, 1]³ at most: 0 on its surface.
+double deepestInsideCube(const Mesh& mesh) {
+  double deepest = 0;
+  for (const Vec3f& p : mesh.positions) {
+    const double outer = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    deepest = std::max(deepest, 1.0 - outer);
+  }
+  return deepest;
+}
+
+TEST(SubdivideCreases, SharpnessIsBlendersTenTimesCreaseSquared) {
+  EXPECT_EQ(creaseSharpness(0.0f), 0.0f);
+  EXPECT_EQ(creaseSharpness(1.0f), 10.0f);  // Sdc's SHARPNESS_INFINITE
+  EXPECT_EQ(creaseSharpness(0.5f), 2.5f);
+  EXPECT_FLOAT_EQ(creaseSharpness(0.3f), 0.9f);
+}
+
+TEST(SubdivideCreases, FullyCreasedCubeStaysTheCube) {
+  // Crease 1 on all twelve edges: every edge infinitely sharp, every corner a corner (three sharp
+  // edges), so each face subdivides as a flat bilinear patch and the result is the cube itself.
+  // Without creases the same points sink up to ~0.4 inside it.
+  for (int level = 1; level <= 3; ++level) {
+    Result<Mesh> sharp = subdivideMesh(cube(), creasedEdges(cube(), {level}, 1.0f));
+    Result<Mesh> smooth = subdivideMesh(cube(), {level});
+    ASSERT_TRUE(sharp) << sharp.error().message;
+    ASSERT_TRUE(smooth) << smooth.error().message;
+    EXPECT_LT(deepestInsideCube(*sharp), 1e-6) << "level " << level;
+    EXPECT_GT(deepestInsideCube(*smooth), 0.2) << "level " << level;
+    expectClosedAndOriented(*sharp);
+  }
+}
+
+TEST(SubdivideCreases, SharperCreasesKeepTheCornerCloserToTheCube) {
+  // Coarse vertex 6 keeps its index; its limit point moves towards the cube's corner (1, 1, 1)
+  // as the crease of every edge grows, until the sharpness reaches 3: Blender's Quality 3
+  // isolates sharp features to refinement level 3 only, so every sharpness from 3 up to (not
+  // including) 10 gives the same point (Blender 3.4 measured the same: 0.108253 from the corner
+  // for creases 0.55 to 0.99). Crease 1 is infinitely sharp: the corner itself.
+  const Vec3d corner{1, 1, 1};
+  const auto cornerDistance = [&](float crease) {
+    Result<Mesh> fine = subdivideMesh(cube(), creasedEdges(cube(), {2}, crease));
+    EXPECT_TRUE(fine) << fine.error().message;
+    return fine ? length(at(*fine, 6) - corner) : 0.0;
+  };
+  double previous = 1e30;
+  for (const float crease : {0.0f, 0.2f, 0.3f, 0.4f, 0.5f, 0.55f}) {
+    const double distance = cornerDistance(crease);
+    EXPECT_LT(distance, previous) << "crease " << crease;
+    previous = distance;
+  }
+  EXPECT_GT(previous, 0.05);
+  for (const float crease : {0.6f, 0.7f, 0.9f, 0.99f}) {
+    EXPECT_NEAR(cornerDistance(crease), previous, 1e-12) << "crease " << crease;
+  }
+  EXPECT_LT(cornerDistance(1.0f), 1e-6);
+}
+
+TEST(SubdivideCreases, ZeroCreasesAndUseCreasesOffAreNoCreasesBitForBit) {
+  for (const Mesh& coarse : {cube(), prism(5)}) {
+    Result<Mesh> plain = subdivideMesh(coarse, {2});
+    ASSERT_TRUE(plain) << plain.error().message;
+    SubdivisionOptions zero = creasedEdges(coarse, {2}, 0.0f);
+    for (std::uint32_t v = 0; v < coarse.numVertices(); ++v) zero.vertexCreases.push_back({v, 0});
+    SubdivisionOptions off = creasedEdges(coarse, {2}, 1.0f);
+    off.vertexCreases.push_back({0, 1.0f});
+    off.useCreases = false;
+    for (const SubdivisionOptions& options : {zero, off}) {
+      Result<Mesh> fine = subdivideMesh(coarse, options);
+      ASSERT_TRUE(fine) << fine.error().message;
+      EXPECT_EQ(fine->positions, plain->positions);
+      EXPECT_EQ(fine->cornerVertex, plain->cornerVertex);
+      EXPECT_EQ(fine->uvSets[0].uvs, plain->uvSets[0].uvs);
+    }
+    off.useCreases = true;
+    Result<Mesh> creased = subdivideMesh(coarse, off);
+    ASSERT_TRUE(creased);
+    EXPECT_NE(creased->positions, plain->positions) << "the creases do matter when used";
+  }
+}
+
+TEST(SubdivideCreases, InfinitelySharpStraightEdgesStayOnTheirLine) {
+  // A 4 × 2 grid of quads, y = j - 1, crossed along y = 0 by a straight polyline at z = 0, the
+  // rows beside it lifted unevenly. Creased 1 (and a level below the sharpness), the crease
+  // curve is the B-spline of collinear points: every point on y = 0 keeps z = 0. Uncreased,
+  // the lifted rows pull it off the line.
+  std::vector<Vec3f> positions;
+  const float lift[3][5] = {
+      {0.4f, 0.9f, 0.2f, 0.7f, 0.5f}, {0, 0, 0, 0, 0}, {1.1f, 0.3f, 0.8f, 1.4f, 0.6f}};
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      positions.push_back({static_cast<float>(i) - 2.0f, static_cast<float>(j - 1), lift[j][i]});
+    }
+  }
+  std::vector<std::vector<std::uint32_t>> faces;
+  const auto vertex = [](int i, int j) { return static_cast<std::uint32_t>(j * 5 + i); };
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 4; ++i) {
+      faces.push_back({vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1)});
+    }
+  }
+  const Mesh grid = meshOf(std::move(positions), faces);
+  for (int level = 1; level <= 3; ++level) {
+    SubdivisionOptions options{level};
+    for (int i = 0; i < 4; ++i) options.edgeCreases.push_back({vertex(i, 1), vertex(i + 1, 1), 1});
+    for (const bool creased : {true, false}) {
+      options.useCreases = creased;
+      Result<Mesh> fine = subdivideMesh(grid, options);
+      ASSERT_TRUE(fine) << fine.error().message;
+      std::size_t onLine = 0;
+      double worst = 0;
+      for (const Vec3f& p : fine->positions) {
+        if (std::abs(p.y) > 1e-6f) continue;
+        ++onLine;
+        worst = std::max(worst, static_cast<double>(std::abs(p.z)));
+      }
+      EXPECT_EQ(onLine, (std::size_t{4} << level) + 1) << "level " << level;
+      if (creased) {
+        EXPECT_LT(worst, 1e-6) << "level " << level;
+      } else {
+        EXPECT_GT(worst, 0.05) << "level " << level;
+      }
+    }
+  }
+}
+
+TEST(SubdivideCreases, VertexCreaseKeepsTheCorner) {
+  // Vertex 6 (1, 1, 1) of the cube creased 1 stays where it is; 0.5 keeps it part of the way;
+  // its neighbours still move.
+  Result<Mesh> smooth = subdivideMesh(cube(), {2});
+  ASSERT_TRUE(smooth);
+  SubdivisionOptions options{2};
+  options.vertexCreases = {{6, 1.0f}};
+  Result<Mesh> sharp = subdivideMesh(cube(), options);
+  options.vertexCreases = {{6, 0.5f}};
+  Result<Mesh> half = subdivideMesh(cube(), options);
+  ASSERT_TRUE(sharp) << sharp.error().message;
+  ASSERT_TRUE(half) << half.error().message;
+  const Vec3d corner{1, 1, 1};
+  EXPECT_LT(length(at(*sharp, 6) - corner), 1e-6);
+  const double smoothDistance = length(at(*smooth, 6) - corner);
+  const double halfDistance = length(at(*half, 6) - corner);
+  EXPECT_GT(halfDistance, 1e-3);
+  EXPECT_LT(halfDistance, smoothDistance);
+  EXPECT_GT(length(at(*sharp, 0) - at(cube(), 0)), 0.2) << "the far corner is still rounded";
+}
+
+TEST(SubdivideCreases, LimitSurfaceHonoursCreases) {
+  // The fully creased cube's limit surface is the cube: every point of every face lies on it,
+  // and subdivideMesh's vertices are that surface at their parameters.
+  const SubdivisionOptions options = creasedEdges(cube(), {2}, 1.0f);
+  Result<LimitSurface> limit = LimitSurface::create(cube(), options);
+  ASSERT_TRUE(limit) << limit.error().message;
+  LimitSurface::Evaluator evaluator(*limit);
+  double worst = 0;
+  for (std::uint32_t f = 0; f < 6; ++f) {
+    for (const Vec2d st : {Vec2d{0.5, 0.5}, Vec2d{0.1, 0.8}, Vec2d{0.97, 0.03}}) {
+      LimitPoint p;
+      ASSERT_TRUE(evaluator.evaluate(f, 0, st, p));
+      const double outer =
+          std::max({std::abs(p.position.x), std::abs(p.position.y), std::abs(p.position.z)});
+      worst = std::max(worst, std::abs(outer - 1.0));
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+  SubdivisionOptions semi = creasedEdges(cube(), {2}, 0.6f);
+  semi.vertexCreases = {{3, 0.8f}};
+  SurfaceParameters parameters;
+  Result<Mesh> fine = subdivideMesh(cube(), semi, &parameters);
+  Result<LimitSurface> semiLimit = LimitSurface::create(cube(), semi);
+  ASSERT_TRUE(fine) << fine.error().message;
+  ASSERT_TRUE(semiLimit) << semiLimit.error().message;
+  LimitSurface::Evaluator semiEvaluator(*semiLimit);
+  double worstVertex = 0;
+  for (std::size_t c = 0; c < fine->numCorners(); ++c) {
+    LimitPoint p;
+    ASSERT_TRUE(semiEvaluator.evaluate(parameters.faceOrigin[c / 4], parameters.cornerSubFace[c],
+                                       cast<double>(parameters.cornerCoord[c]), p));
+    worstVertex = std::max(worstVertex, length(p.position - at(*fine, fine->cornerVertex[c])));
+  }
+  EXPECT_LT(worstVertex, 1e-6);
+}
+
+TEST(SubdivideCreases, CreasesThatDoNotFitTheMeshAreNamed) {
+  const Mesh coarse = cube();  // faces 0 3 2 1, 4 5 6 7, ...: 0-1 is an edge, 0-2 is not
+  const auto issue = [&](const SubdivisionOptions& options) {
+    const std::optional<CreaseIssue> found = findCreaseIssue(coarse, options);
+    return found ? std::string(found->edge ? "edge " : "vertex ") + std::to_string(found->index) +
+                       ": " + found->what
+                 : std::string("none");
+  };
+  SubdivisionOptions options{1};
+  options.edgeCreases = {{0, 1, 0.5f}, {1, 0, 0.2f}};
+  EXPECT_EQ(issue(options), "edge 1: the edge 0-1 is also creased by entry 0");
+  options.edgeCreases = {{0, 1, 0.5f}, {0, 2, 0.2f}};
+  EXPECT_EQ(issue(options), "edge 1: vertices 0 and 2 are not the ends of an edge of the mesh");
+  options.edgeCreases = {{0, 8, 0.5f}};
+  EXPECT_EQ(issue(options),
+            "edge 0: vertex 8 is out of range (the mesh has 8 vertices, numbered from 0)");
+  options.edgeCreases = {{0, 1, 1.5f}};
+  EXPECT_EQ(issue(options), "edge 0: crease 1.5 is outside [0, 1]");
+  options.edgeCreases = {{0, 1, -0.0f}, {5, 6, 1.0f}};
+  options.vertexCreases = {{7, 1.0f}, {9, 0.5f}};
+  EXPECT_EQ(issue(options),
+            "vertex 1: vertex 9 is out of range (the mesh has 8 vertices, numbered from 0)");
+  options.vertexCreases = {{7, 1.0f}, {7, 0.5f}};
+  EXPECT_EQ(issue(options), "vertex 1: vertex 7 is also creased by entry 0");
+  options.vertexCreases = {{7, std::nanf("")}};
+  EXPECT_EQ(issue(options), "vertex 0: crease nan is outside [0, 1]");
+  options.vertexCreases = {{7, 1.0f}};
+  EXPECT_EQ(issue(options), "none");
+  // Checked even with Use Creases off; subdivideMesh and LimitSurface name the mesh.
+  options.useCreases = false;
+  options.edgeCreases = {{0, 2, 0.5f}};
+  Result<Mesh> bad = subdivideMesh(coarse, options);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(bad.error().message,
+            "test.obj: edge crease 0: vertices 0 and 2 are not the ends of an edge of the mesh");
+  Result<LimitSurface> badLimit = LimitSurface::create(coarse, options);
+  ASSERT_FALSE(badLimit);
+  EXPECT_EQ(badLimit.error().message, bad.error().message);
+}
 
 TEST(LimitSurface, RegularFacesAreTheBicubicBSplineWithItsDerivatives) {
   const int nu = 10, nv = 7;

@@ -5,7 +5,9 @@
 /// ## The scene file
 /// ```json
 /// { "mesh": "m.obj", "uv": 0,
-///   "subdivision": {"level": "limit" | 2, "uv_smooth": "keep-boundaries", "boundary": "all"},
+///   "subdivision": {"level": "limit" | 2, "uv_smooth": "keep-boundaries", "boundary": "all",
+///                   "use_creases": true, "edge_creases": [[0, 1, 0.5]],
+///                   "vertex_creases": [[3, 1]]},
 ///   "layers": [
 ///     {"type": "height", "image": "h.exr", "scale": 0.1, "filter": "bicubic", "uv": 0},
 ///     {"type": "normal", "image": "n.png", "space": "tangent", "green": "opengl"},
@@ -86,12 +88,17 @@ struct SceneSubdivision {
   int level = 0;         ///< "level": N — N uniform levels (0 = none)
   SubdivisionUvSmooth uvSmooth = SubdivisionUvSmooth::kKeepBoundaries;
   SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
+  bool useCreases = true;                   ///< "use_creases"
+  std::vector<EdgeCrease> edgeCreases;      ///< "edge_creases": [[a, b, c], ...]
+  std::vector<VertexCrease> vertexCreases;  ///< "vertex_creases": [[v, c], ...]
   /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
   bool requested() const { return present && (limit || level > 0); }
   /// @brief Whether the samples are shaded on the exact limit surface ("level": "limit").
   bool limitSurface() const { return present && limit; }
   /// @brief The options of subdivideMesh this block stands for (a number of levels).
-  SubdivisionOptions options() const { return {level, uvSmooth, boundary}; }
+  SubdivisionOptions options() const {
+    return {level, uvSmooth, boundary, useCreases, edgeCreases, vertexCreases};
+  }
 };
 
 /// @brief A layer's optional "mask": a scalar image on a UV set that scales its Γ (LayerMask).

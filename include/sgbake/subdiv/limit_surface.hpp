@@ -35,7 +35,7 @@ struct LimitPoint {
 class LimitSurface {
  public:
   /// @return kBadInput naming coarse.source as subdivideMesh reports it (a face using a vertex
-  ///         twice, a topology OpenSubdiv rejects)
+  ///         twice, a crease that does not fit the mesh, a topology OpenSubdiv rejects)
   static Result<LimitSurface> create(const Mesh& coarse, const SubdivisionOptions& options);
 
   LimitSurface(LimitSurface&&) noexcept;

@@ -3,7 +3,10 @@
 /// (OpenSubdiv underneath), so that a coarse mesh plus a level bakes like Blender's modified mesh.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "sgbake/core/named.hpp"
@@ -42,12 +45,48 @@ inline constexpr Named<SubdivisionUvSmooth> kSubdivisionUvSmoothNames[] = {
 inline constexpr Named<SubdivisionBoundary> kSubdivisionBoundaryNames[] = {
     {"all", SubdivisionBoundary::kAll}, {"keep-corners", SubdivisionBoundary::kKeepCorners}};
 
-/// @brief The options of subdivideMesh: those of Blender's modifier that change the result.
+/// @brief Blender's crease of one edge ("Edge Crease", `MeshEdge.crease`).
+struct EdgeCrease {
+  std::uint32_t v0 = 0;  ///< one end: a 0-based vertex index, in the mesh's vertex order
+  std::uint32_t v1 = 0;  ///< the other end (either order)
+  float crease = 0;      ///< in [0, 1]; OpenSubdiv sharpness creaseSharpness(crease)
+};
+
+/// @brief Blender's crease of one vertex ("Vertex Crease", `Mesh.vertex_creases`).
+struct VertexCrease {
+  std::uint32_t vertex = 0;  ///< 0-based vertex index, in the mesh's vertex order
+  float crease = 0;          ///< in [0, 1]; OpenSubdiv sharpness creaseSharpness(crease)
+};
+
+/// @brief The options of subdivideMesh: those of Blender's modifier that change the result,
+/// and the creases of the mesh (which Blender keeps on the mesh, not on the modifier).
 struct SubdivisionOptions {
   int level = 1;  ///< Blender's "Levels" (1..kMaxSubdivisionLevel); 0 returns the mesh unchanged
   SubdivisionUvSmooth uvSmooth = SubdivisionUvSmooth::kKeepBoundaries;
   SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
+  bool useCreases = true;  ///< Blender's "Use Creases"; false ignores both lists below
+  std::vector<EdgeCrease> edgeCreases{};      ///< at most one per edge; edges not listed: 0
+  std::vector<VertexCrease> vertexCreases{};  ///< at most one per vertex; others: 0
 };
+
+/// @brief OpenSubdiv's sharpness of a Blender crease @p crease ∈ [0, 1], as Blender 3.4's
+/// converter computes it in float: 10·c², so that c = 1 is infinitely sharp (Sdc's
+/// SHARPNESS_INFINITE = 10) and sharpness s needs c = √(s/10).
+inline float creaseSharpness(float crease) { return crease * crease * 10.0f; }
+
+/// @brief What is wrong with one crease of SubdivisionOptions for a given mesh.
+struct CreaseIssue {
+  bool edge = true;       ///< an entry of edgeCreases (else of vertexCreases)
+  std::size_t index = 0;  ///< its index in that list
+  std::string what;       ///< e.g. "vertices 3 and 7 are not the ends of an edge of the mesh"
+};
+
+/// @brief The first crease of @p options that does not fit @p mesh: a vertex index out of
+/// range, an edge that is not an edge of the mesh (two consecutive corners of a face), a crease
+/// outside [0, 1] (or not finite), an edge or vertex listed twice. Checked even when
+/// useCreases is false.
+/// @return std::nullopt when every crease fits
+std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOptions& options);
 
 /// @brief The highest level subdivideMesh accepts (a quad becomes 4⁶ = 4096 quads).
 inline constexpr int kMaxSubdivisionLevel = 6;
@@ -78,6 +117,8 @@ struct SurfaceParameters {
 ///    same UV winding) share one face-varying value, the UV of the last of them.
 ///  - Each new quad starts at the corner nearest its face's first corner in the face's own
 ///    parameterization, so that it splits into triangles along the same diagonal as Blender's.
+///  - Edge and vertex creases (when useCreases) become OpenSubdiv sharpness creaseSharpness(c)
+///    of the edge or vertex, with uniform creasing, as Blender's converter sets them.
 ///  - The result is shaded smooth: its normals are computeSmoothNormals of the new faces (the
 ///    coarse mesh's normals are not used; Blender recomputes them the same way).
 ///
@@ -86,8 +127,8 @@ struct SurfaceParameters {
 /// coarse face, in coarse order, each face's grids in corner order, cells row by row.
 ///
 /// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
-///         is out of range or the mesh cannot be subdivided (a face using one vertex twice, or a
-///         topology OpenSubdiv rejects).
+///         is out of range, a crease does not fit the mesh (findCreaseIssue) or the mesh cannot
+///         be subdivided (a face using one vertex twice, or a topology OpenSubdiv rejects).
 /// @param[out] parameters when not null, where each new corner lies (SurfaceParameters); at
 ///             level 0, only faceOrigin (the identity)
 Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options,
