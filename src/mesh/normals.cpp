@@ -162,6 +162,10 @@ Status validate(const Mesh& mesh) {
     return fail("faceStart ends at " + std::to_string(mesh.faceStart.back()) + " but there are " +
                 std::to_string(numCorners) + " corners");
   }
+  if (!mesh.faceFlat.empty() && mesh.faceFlat.size() != mesh.numFaces()) {
+    return fail("faceFlat has " + std::to_string(mesh.faceFlat.size()) + " entries for " +
+                std::to_string(mesh.numFaces()) + " faces");
+  }
   for (std::size_t c = 0; c < numCorners; ++c) {
     if (mesh.cornerVertex[c] >= numVertices) {
       return fail("corner " + std::to_string(c) + " refers to vertex " +

@@ -32,7 +32,14 @@ std::string formatObj(const Mesh& mesh, std::size_t uvSet) {
     for (const Vec2f& t : mesh.uvSets[uvSet].uvs) appendFloats(out, "vt", std::array{t.x, t.y});
   }
   for (const Vec3f& n : mesh.cornerNormals) appendFloats(out, "vn", std::array{n.x, n.y, n.z});
+  // Flat faces as Blender's exporter marks them: `s 0` before a run of flat faces, `s 1`
+  // before a run of smooth ones (nothing when the mesh does not say: every face smooth).
+  int smoothing = -1;
   for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    if (!mesh.faceFlat.empty() && smoothing != (mesh.isFlat(f) ? 0 : 1)) {
+      smoothing = mesh.isFlat(f) ? 0 : 1;
+      out += smoothing == 0 ? "s 0\n" : "s 1\n";
+    }
     out += 'f';
     for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
       const std::string vertex = std::to_string(mesh.cornerVertex[c] + 1);

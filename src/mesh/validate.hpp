@@ -60,6 +60,10 @@ struct ParsedMesh {
   std::vector<Vec3f> normals;              ///< per vertex, or the OBJ `vn` pool (finite, non-zero)
   std::vector<std::int32_t> cornerNormal;  ///< kPerCorner: #C indices into normals (all valid)
 
+  /// #F, 1 for a flat-shaded face (OBJ: Blender's reading of `s` statements), or empty when the
+  /// file does not say (no `s` statement at all; PLY, OFF): every face smooth.
+  std::vector<std::uint8_t> faceFlat;
+
   std::size_t numFaces() const { return faceStart.size() - 1; }
 };
 

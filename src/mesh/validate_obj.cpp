@@ -79,7 +79,23 @@ class ObjChecker {
   std::vector<std::size_t> faceLine_;  ///< #F, line of each face (for deferred messages)
   bool anyCornerWithUv_ = false;
   bool everyCornerWithNormal_ = true;
+  bool anySmoothing_ = false;  ///< the file has an `s` statement
+  bool smooth_ = false;        ///< the state `s` statements set: Blender's importer starts flat
 };
+
+/// Whether the argument of an `s` statement makes the faces that follow smooth, as Blender 3.4's
+/// importer reads it: a smoothing group number > 0 does; 0, "off", and anything that is not a
+/// number (even "on") do not.
+bool smoothingGroupIsSmooth(Tokenizer& tokens) {
+  std::string_view token;
+  if (!tokens.next(token) || token.empty()) return false;
+  long long group = 0;
+  for (const char ch : token) {
+    if (ch < '0' || ch > '9') return false;
+    group = std::min<long long>(group * 10 + (ch - '0'), 1LL << 40);
+  }
+  return group > 0;
+}
 
 Result<ValidatedFile> ObjChecker::run() {
   std::string_view text = bytes_;
@@ -131,6 +147,7 @@ Result<ValidatedFile> ObjChecker::run() {
     mesh.cornerUv.clear();  // `vt` lines no face uses: the mesh has no UVs
     mesh.uvs.clear();
   }
+  if (!anySmoothing_) mesh.faceFlat.clear();  // the file does not say: smooth, as before
   if (everyCornerWithNormal_) {
     mesh.normalBinding = Binding::kPerCorner;
   } else {
@@ -146,6 +163,11 @@ Status ObjChecker::statement(std::string_view keyword, Tokenizer& tokens, std::s
   if (keyword == "vt") return texcoord(tokens, line);
   if (keyword == "vn") return normal(tokens, line);
   if (keyword == "f") return face(tokens, line);
+  if (keyword == "s") {
+    anySmoothing_ = true;
+    smooth_ = smoothingGroupIsSmooth(tokens);
+    return Ok{};
+  }
   if (isIgnoredStatement(keyword)) return Ok{};
   return errorAt(name_, line, "unknown OBJ statement " + quoted(keyword));
 }
@@ -310,6 +332,7 @@ Status ObjChecker::face(Tokenizer& tokens, std::size_t line) {
     return errorAt(name_, line, "face uses vertex " + std::to_string(repeated + 1ull) + " twice");
   }
   mesh.faceStart.push_back(static_cast<std::uint32_t>(mesh.cornerVertex.size()));
+  mesh.faceFlat.push_back(smooth_ ? 0 : 1);
   faceLine_.push_back(line);
   return Ok{};
 }

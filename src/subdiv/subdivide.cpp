@@ -336,8 +336,28 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
   });
   if (failed) throw EvaluationFailed{};
 
+  // Normals as Blender 3.4 computes them on the modified mesh (Auto Smooth off): each new face
+  // keeps its coarse face's flat/smooth flag; corners of smooth faces get the vertex normal
+  // (angle-weighted over every face at the vertex, flat ones included), corners of flat faces
+  // their own face's normal.
   fine.cornerNormals.resize(fine.cornerVertex.size());
   computeSmoothNormals(fine);
+  if (std::any_of(coarse.faceFlat.begin(), coarse.faceFlat.end(),
+                  [](std::uint8_t flat) { return flat != 0; })) {
+    fine.faceFlat.resize(fineFaces);
+    for (std::size_t f = 0; f < nf; ++f) {
+      std::fill(fine.faceFlat.begin() + static_cast<std::ptrdiff_t>(cellStart[f]),
+                fine.faceFlat.begin() + static_cast<std::ptrdiff_t>(cellStart[f + 1]),
+                coarse.isFlat(f) ? 1 : 0);
+    }
+    const std::vector<Vec3f> faceNormals = computeFaceNormals(fine.view());
+    for (std::size_t f = 0; f < fineFaces; ++f) {
+      if (!fine.faceFlat[f]) continue;
+      for (std::uint32_t c = fine.faceStart[f]; c < fine.faceStart[f + 1]; ++c) {
+        fine.cornerNormals[c] = faceNormals[f];
+      }
+    }
+  }
   return fine;
 }
 

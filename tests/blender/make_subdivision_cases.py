@@ -3,7 +3,7 @@
     blender -b --factory-startup --python-exit-code 1 \\
         --python tests/blender/make_subdivision_cases.py -- OUT_DIR
 
-Builds seven coarse meshes with bpy, all smooth shaded, with their own UVs:
+Builds nine coarse meshes with bpy, all smooth shaded, with their own UVs:
   cube       the default cube (6 quads, closed, UV seams)
   suzanne    the monkey primitive (triangles and quads, open boundaries at the eyes)
   cylinder   a 7-sided cylinder with n-gon caps (the caps are 7-gons, not triangulated)
@@ -11,13 +11,17 @@ Builds seven coarse meshes with bpy, all smooth shaded, with their own UVs:
   cube_creased, suzanne_creased, cylinder_creased
              the cube, Suzanne and the cylinder with Edge Creases (0.3 to 1.0) on some edges
              and Vertex Creases on some vertices
+  cube_flat, suzanne_flat
+             the cube with two neighbouring faces flat-shaded, Suzanne with every third face
+             flat (their OBJ files mark them with `s 0` / `s 1` as Blender's exporter does)
 and writes each as OUT_DIR/MESH.obj (objio.write_obj: exact floats, one vt and vn per corner,
 n-gons kept). Then, for every case in CASES, it gives the object a Subdivision Surface modifier
 (Catmull-Clark, Use Limit Surface on, Quality 3, the case's Levels, UV Smooth, Boundary
 Smooth and Use Creases), evaluates it, lets Blender compute split normals and MikkTSpace tangents of the
 subdivided mesh (`Mesh.calc_normals_split()`, `Mesh.calc_tangents()`), and writes
-  TAG.npz   positions (V, 3), face_size (F,), corner_vertex (C,), uvs (C, 2),
-            tangents (C, 3), signs (C,) of the subdivided mesh, in Blender's order
+  TAG.npz   positions (V, 3), face_size (F,), corner_vertex (C,), uvs (C, 2), normals (C, 3)
+            (split normals), tangents (C, 3), signs (C,), smooth (F,) of the subdivided mesh,
+            in Blender's order
 and finally cases.json: {"blender": version, "python": Blender's Python interpreter (it has
 numpy), "meshes": {MESH: {vertices, edges, faces, valence2, edge_creases, vertex_creases}},
 "cases": [{tag, mesh, level, uv_smooth, boundary_smooth, use_creases, vertices, faces,
@@ -130,7 +134,15 @@ MESHES = [
     ("cube_creased", mesh_cube_creased),
     ("suzanne_creased", mesh_suzanne_creased),
     ("cylinder_creased", mesh_cylinder_creased),
+    ("cube_flat", mesh_cube),
+    ("suzanne_flat", mesh_suzanne),
 ]
+
+# Meshes with flat-shaded faces (the rest are smooth): name -> the faces to shade flat.
+FLAT_FACES = {
+    "cube_flat": lambda me: [0, 1],                              # two neighbouring faces
+    "suzanne_flat": lambda me: range(0, len(me.polygons), 3),    # every third face
+}
 
 # (mesh, level, uv_smooth, boundary_smooth, use_creases), Blender's enum names. Boundary smooth
 # matters only on open boundaries, so only the grid tries both; Use Creases only on the creased
@@ -138,6 +150,7 @@ MESHES = [
 UV_SMOOTHS = ("PRESERVE_BOUNDARIES", "NONE", "SMOOTH_ALL")
 PLAIN_MESHES = ("cube", "suzanne", "cylinder", "grid")
 CREASED_MESHES = ("cube_creased", "suzanne_creased", "cylinder_creased")
+FLAT_MESHES = tuple(FLAT_FACES)
 CASES = (
     [(mesh, 1, uv, "ALL", True) for mesh in PLAIN_MESHES for uv in UV_SMOOTHS]
     + [("grid", 1, uv, "PRESERVE_CORNERS", True) for uv in UV_SMOOTHS]
@@ -147,6 +160,8 @@ CASES = (
        for mesh in CREASED_MESHES for level in (1, 2)]
     + [("cube_creased", 1, "NONE", "ALL", True), ("cube_creased", 2, "PRESERVE_BOUNDARIES",
                                                    "ALL", False)]
+    + [(mesh, level, "PRESERVE_BOUNDARIES", "ALL", True)
+       for mesh in FLAT_MESHES for level in (1, 2)]
 )
 
 
@@ -165,6 +180,9 @@ def write_coarse(name, ob, out_dir):
     me = ob.data
     me.calc_normals_split()
     arrays = objio.mesh_arrays(me)
+    smooth = np.array([p.use_smooth for p in me.polygons], dtype=bool)
+    if not smooth.all():
+        arrays["smooth"] = smooth  # `s 0` / `s 1` lines, as Blender's exporter writes
     objio.write_obj(os.path.join(out_dir, name + ".obj"), arrays,
                     comment=f"sgbake subdivision oracle mesh {name} "
                             f"(Blender {bpy.app.version_string})")
@@ -200,7 +218,8 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, ou
     tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
-             uvs=arrays["uvs"], tangents=tangents, signs=signs)
+             uvs=arrays["uvs"], normals=arrays["normals"], tangents=tangents, signs=signs,
+             smooth=np.array([p.use_smooth for p in me.polygons], dtype=bool))
     info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
             "boundary_smooth": boundary_smooth, "use_creases": use_creases,
             "vertices": len(me.vertices),
@@ -224,6 +243,9 @@ def main():
         bake_common.reset_scene()
         ob = build()
         bake_common.set_smooth(ob, True)
+        if name in FLAT_FACES:
+            for f in FLAT_FACES[name](ob.data):
+                ob.data.polygons[f].use_smooth = False
         manifest["meshes"][name] = write_coarse(name, ob, out_dir)
         mod = ob.modifiers.new("Subdivision", "SUBSURF")
         mod.subdivision_type = "CATMULL_CLARK"

@@ -13,6 +13,8 @@ OBJ (written by write_obj, not by Blender's exporter, so that we control every b
     vt u v             one per face corner ("loop"), in corner order
     vn x y z           one per face corner, in corner order
     f v/vt/vn ...      one per face, in face order, its corners in corner order
+    s 0 | s 1          before each run of flat / smooth faces, only when the arrays say which
+                       faces are smooth ("smooth")
 Every float is written with '%.9g', which round-trips a float32 exactly, so sgbake reads the
 very bits Blender computed with.
 
@@ -134,8 +136,15 @@ def write_obj(path, arrays, comment=None):
     corner_index = np.arange(1, nc + 1)
     tokens = [f"{v}/{c}/{c}" for v, c in zip((arrays["corner_vertex"] + 1).tolist(),
                                                corner_index.tolist())]
+    # Blender's smooth flags, when given ("smooth" (F,) bool): `s 1` / `s 0` before each run of
+    # smooth / flat faces, as Blender's exporter writes them.
+    smooth = arrays.get("smooth")
+    state = None
     start = 0
-    for size in arrays["face_size"].tolist():
+    for f, size in enumerate(arrays["face_size"].tolist()):
+        if smooth is not None and bool(smooth[f]) != state:
+            state = bool(smooth[f])
+            lines.append("s 1" if state else "s 0")
         lines.append("f " + " ".join(tokens[start:start + size]))
         start += size
     with open(path, "w", encoding="ascii", newline="\n") as f:

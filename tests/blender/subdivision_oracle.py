@@ -5,9 +5,10 @@
         [--blender blender] [--keep DIR]
 
 1. Runs make_subdivision_cases.py inside Blender (headless, factory settings, once for all
-   cases): it writes seven coarse meshes (cube; Suzanne, triangles and quads; a 7-sided cylinder
+   cases): it writes nine coarse meshes (cube; Suzanne, triangles and quads; a 7-sided cylinder
    with n-gon caps; a wavy open grid; creased copies of the cube, Suzanne and the cylinder,
-   with Edge and Vertex Creases) as OBJ, with their creases in cases.json, and, for each case
+   with Edge and Vertex Creases; the cube and Suzanne with some faces flat-shaded, marked with
+   `s 0` / `s 1`) as OBJ, with their creases in cases.json, and, for each case
    (mesh, level, UV Smooth, Boundary Smooth, Use Creases), the mesh Blender's modifier makes
    (Catmull-Clark, Use Limit Surface on) with its MikkTSpace tangents (`Mesh.calc_tangents()`)
    as NPZ.
@@ -27,6 +28,8 @@
      faces      every Blender face is an sgbake face with the same vertex cycle, its first
                 corner the same or the opposite one (the same diagonal: Blender splits a quad
                 0-1-2 / 0-2-3), and no face is left over;
+     normals    per matched corner, the angle between sgbake's `vn` and Blender's split normal
+                <= 0.05 deg (0.0017 deg measured; flat-shaded faces included);
      uvs        per matched corner, max |du|, |dv| <= 2.5e-7, and the corners whose UV is not
                 Blender's float are counted (0 in a run measured on Blender 3.4.1): Blender
                 gives a face-varying value shared by corners with nearly equal UVs the UV of
@@ -40,6 +43,8 @@
      level      sgbake --subdivide 1 against Blender's level-2 grid: the count check must fail;
      creases    sgbake --no-creases against Blender's creased cube (level 2) and creased Suzanne
                 (level 1): the position check must fail (0.37 and 0.026 off);
+     flat faces sgbake on the flat-shaded Suzanne's OBJ without its `s` lines (level 1): the
+                normal check must fail (62 deg off);
      sharpness 10c  sgbake given sqrt(c) for every crease c, i.e. sharpness 10 c instead of
                 Blender's 10 c^2, against the creased cube (level 1): the position check must
                 fail (0.20 off).
@@ -78,6 +83,7 @@ SGBAKE_TIMEOUT = 120
 # corner Blender takes when it runs in order. Tangents: MikkTSpace's float rounding only.
 UV_MAX = 2.5e-7
 TANGENT_MAX_DEG = 0.05
+NORMAL_MAX_DEG = 0.05
 
 # Blender's enum names -> sgbake's option values.
 UV_SMOOTH = {
@@ -101,6 +107,8 @@ CONTROLS = [
      "positions"),
     ("sharpness 10c", "cube_creased_L1_PRESERVE_BOUNDARIES_ALL", {"sharpness": "10c"},
      "positions"),
+    ("flat faces", "suzanne_flat_L1_PRESERVE_BOUNDARIES_ALL", {"smoothing": "strip"},
+     "normals"),
 ]
 
 
@@ -144,6 +152,13 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
     mesh's creases (and the overrides); returns (OBJ path, CSV path) or an error message."""
     overrides = dict(overrides)
     sharpness = overrides.pop("sharpness", "10c^2")
+    mesh_obj = os.path.join(work, case["mesh"] + ".obj")
+    if overrides.pop("smoothing", None) == "strip":  # the OBJ without its `s` lines
+        with open(mesh_obj, encoding="ascii") as f:
+            lines = [line for line in f if not line.startswith("s ")]
+        mesh_obj = os.path.join(work, out_name + ".stripped.obj")
+        with open(mesh_obj, "w", encoding="ascii") as f:
+            f.writelines(lines)
     options = {
         "--subdivide": str(case["level"]),
         "--uv-smooth": UV_SMOOTH[case["uv_smooth"]],
@@ -154,7 +169,7 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
     options.update(overrides)
     obj = os.path.join(work, out_name + ".sgbake.obj")
     csv = os.path.join(work, out_name + ".sgbake.csv")
-    cmd = [cli, "tangents", os.path.join(work, case["mesh"] + ".obj")]
+    cmd = [cli, "tangents", mesh_obj]
     cmd += crease_options(mesh, sharpness)
     for key, value in options.items():
         if value is not None:
@@ -179,9 +194,11 @@ def read_obj(path):
     """Reads the OBJ sgbake's --mesh-out writes (v; vt per corner; vn per corner; f v/vt/vn).
 
     Returns (positions (V, 3) float64, uvs (T, 2) float64, face_size (F,) int64,
-    corner_vertex (C,) int64, corner_uv (C,) int64), indices 0-based."""
+    corner_vertex (C,) int64, corner_uv (C,) int64, corner normals (C, 3) float64), indices
+    0-based."""
     import numpy as np
-    positions, uvs, face_size, corner_vertex, corner_uv = [], [], [], [], []
+    positions, uvs, normals, face_size, corner_vertex, corner_uv, corner_normal = (
+        [], [], [], [], [], [], [])
     with open(path, "r", encoding="ascii", errors="replace") as f:
         for line_no, line in enumerate(f, start=1):
             words = line.split()
@@ -192,12 +209,15 @@ def read_obj(path):
                     positions.append([float(x) for x in words[1:4]])
                 elif words[0] == "vt":
                     uvs.append([float(x) for x in words[1:3]])
+                elif words[0] == "vn":
+                    normals.append([float(x) for x in words[1:4]])
                 elif words[0] == "f":
                     face_size.append(len(words) - 1)
                     for token in words[1:]:
                         fields = token.split("/")
                         corner_vertex.append(int(fields[0]) - 1)
                         corner_uv.append(int(fields[1]) - 1)
+                        corner_normal.append(int(fields[2]) - 1)
             except (ValueError, IndexError):
                 raise ValueError(f"{path}:{line_no}: cannot parse {line.strip()!r}") from None
     positions = np.array(positions, dtype=np.float64).reshape(-1, 3)
@@ -207,7 +227,12 @@ def read_obj(path):
     if (corner_vertex.size and (corner_vertex.min() < 0 or corner_vertex.max() >= len(positions)
                                 or corner_uv.min() < 0 or corner_uv.max() >= len(uvs))):
         raise ValueError(f"{path}: a face refers to a missing v or vt")
-    return positions, uvs, np.array(face_size, dtype=np.int64), corner_vertex, corner_uv
+    normals = np.array(normals, dtype=np.float64).reshape(-1, 3)
+    corner_normal = np.array(corner_normal, dtype=np.int64)
+    if corner_normal.size and (corner_normal.min() < 0 or corner_normal.max() >= len(normals)):
+        raise ValueError(f"{path}: a face refers to a missing vn")
+    return (positions, uvs, np.array(face_size, dtype=np.int64), corner_vertex, corner_uv,
+            normals[corner_normal])
 
 
 def read_tangents(path, face_size):
@@ -253,7 +278,7 @@ def compare(case, ref, obj, csv):
     failures), failures a list of (check, message); figures are None when the counts differ
     (nothing else can be compared)."""
     import numpy as np
-    P, T, face_size, corner_vertex, corner_uv = read_obj(obj)
+    P, T, face_size, corner_vertex, corner_uv, N = read_obj(obj)
     tangents, signs = read_tangents(csv, face_size)
     BP = ref["positions"].astype(np.float64)
     b_size, b_vertex = ref["face_size"], ref["corner_vertex"]
@@ -331,6 +356,11 @@ def compare(case, ref, obj, csv):
     ours_uv = T[corner_uv[ours_corners]].astype(np.float32)
     blender_uv = BU[blender_corners].astype(np.float32)
     uv_error = np.abs(ours_uv.astype(np.float64) - blender_uv).max(1)
+    normal_angle = angles_deg(N[ours_corners], ref["normals"].astype(np.float64)[blender_corners])
+    fig.update(n_max=float(normal_angle.max()) if normal_angle.size else 0.0)
+    if fig["n_max"] > NORMAL_MAX_DEG:
+        failures.append(("normals", f"corner normals differ by up to {fig['n_max']:.4f} deg "
+                                    f"(> {NORMAL_MAX_DEG} deg)"))
     angle = angles_deg(tangents[ours_corners], BT[blender_corners])
     sign_diff = int((np.sign(signs[ours_corners]) != np.sign(BS[blender_corners])).sum())
     fig.update(uv_max=float(uv_error.max()), uv_inexact=int((ours_uv != blender_uv).any(1).sum()),
@@ -346,9 +376,9 @@ def compare(case, ref, obj, csv):
     return fig, failures
 
 
-HEADER = ("%-45s %6s %6s %6s %9s %6s %7s %9s %6s %7s %7s %7s %4s  %s"
+HEADER = ("%-45s %6s %6s %6s %9s %6s %7s %9s %6s %7s %7s %7s %4s %7s  %s"
           % ("case (Blender enums)", "verts", "faces", "D", "pos max", "pos!=", "unm/dg",
-             "uv max", "uv!=", "t med", "t p99", "t max", "sgn", "result"))
+             "uv max", "uv!=", "t med", "t p99", "t max", "sgn", "n max", "result"))
 
 
 def table_row(label, fig, failures):
@@ -356,11 +386,11 @@ def table_row(label, fig, failures):
         return "%-45s %s  FAIL (%s)" % (label, "counts differ", "; ".join(m for _, m in failures))
     tangent = ("%7.4f %7.4f %7.4f %4d" % (fig["t_median"], fig["t_p99"], fig["t_max"],
                                           fig["sign_diff"]) if "t_max" in fig else "-")
-    return ("%-45s %6d %6d %6.3f %9.2e %6d %3d/%-3d %9.2e %6s %s %s"
+    return ("%-45s %6d %6d %6.3f %9.2e %6d %3d/%-3d %9.2e %6s %s %7.4f %s"
             % (label, fig["vertices"], fig["faces"], fig["diag"], fig["pos_max"],
                fig["pos_inexact"], fig["unmatched"], fig["diagonal"],
                fig.get("uv_max", float("nan")), fig.get("uv_inexact", "-"), tangent,
-               "ok" if not failures else "FAIL"))
+               fig.get("n_max", float("nan")), "ok" if not failures else "FAIL"))
 
 
 def compare_all(cli, work):

@@ -68,6 +68,25 @@ void expectSameMesh(const Mesh& a, const Mesh& b) {
   EXPECT_EQ(a.normalSource, b.normalSource);
 }
 
+TEST(MeshObj, SmoothingStatementsMarkFlatFacesAsBlendersImporterDoes) {
+  // Blender 3.4's importer (measured): faces before any `s` are flat; `s N` with N > 0 smooth;
+  // `s 0`, `s off` and even `s on` (not a number) flat. A file without `s` says nothing:
+  // every face smooth (faceFlat empty).
+  const std::string vertices = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  const Mesh marked = loadObjText(vertices +
+                                  "f 1 2 3\ns 1\nf 1 3 4\ns off\nf 1 2 4\ns 0\nf 2 3 4\n"
+                                  "s 2\nf 1 2 3\ns on\nf 1 3 4\n");
+  EXPECT_EQ(marked.faceFlat, (std::vector<std::uint8_t>{1, 0, 1, 1, 0, 1}));
+  EXPECT_TRUE(marked.isFlat(0));
+  EXPECT_FALSE(marked.isFlat(1));
+  const Mesh unmarked = loadObjText(vertices + "f 1 2 3\nf 1 3 4\n");
+  EXPECT_TRUE(unmarked.faceFlat.empty());
+  EXPECT_FALSE(unmarked.isFlat(0));
+  // The writer marks them the same way, so they survive a round trip.
+  EXPECT_EQ(loadObjText(formatObj(marked)).faceFlat, marked.faceFlat);
+  EXPECT_EQ(formatObj(unmarked).find("\ns "), std::string::npos);
+}
+
 TEST(MeshObj, SeamKeepsBothUvsOfASharedVertex) {
   const Mesh mesh = load(goodFile("seam.obj"));
   ASSERT_EQ(mesh.numFaces(), 2u);

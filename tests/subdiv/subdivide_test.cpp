@@ -516,6 +516,39 @@ TEST(SubdivideCreases, CreasesThatDoNotFitTheMeshAreNamed) {
   EXPECT_EQ(badLimit.error().message, bad.error().message);
 }
 
+TEST(Subdivide, FlatFacesKeepTheirFlagAndTheirOwnFaceNormals) {
+  // Coarse face 0 (the bottom) flat: its 4^L sub-faces are flat, their corners carry their own
+  // face normal; every other corner the vertex normal over all faces, flat ones included (what
+  // Blender 3.4 computes with Auto Smooth off, measured on Suzanne).
+  Mesh coarse = cube();
+  coarse.faceFlat = {1, 0, 0, 0, 0, 0};
+  for (int level = 1; level <= 2; ++level) {
+    Result<Mesh> fine = subdivideMesh(coarse, {level});
+    ASSERT_TRUE(fine) << fine.error().message;
+    const std::size_t perFace = std::size_t{1} << (2 * level);
+    ASSERT_EQ(fine->faceFlat.size(), fine->numFaces());
+    Mesh smooth = *fine;
+    smooth.faceFlat.clear();
+    computeSmoothNormals(smooth);
+    const std::vector<Vec3f> faceNormals = computeFaceNormals(fine->view());
+    std::size_t differ = 0;
+    for (std::size_t f = 0; f < fine->numFaces(); ++f) {
+      EXPECT_EQ(fine->isFlat(f), f < perFace) << "face " << f;
+      for (std::uint32_t c = fine->faceStart[f]; c < fine->faceStart[f + 1]; ++c) {
+        const Vec3f expected = f < perFace ? faceNormals[f] : smooth.cornerNormals[c];
+        EXPECT_EQ(fine->cornerNormals[c], expected) << "corner " << c;
+        if (!(fine->cornerNormals[c] == smooth.cornerNormals[c])) ++differ;
+      }
+    }
+    EXPECT_GT(differ, perFace) << "flat corners are not the smooth ones";
+    // The flag changes the normals only, not the surface.
+    Result<Mesh> allSmooth = subdivideMesh(cube(), {level});
+    ASSERT_TRUE(allSmooth);
+    EXPECT_EQ(fine->positions, allSmooth->positions);
+    EXPECT_TRUE(allSmooth->faceFlat.empty());
+  }
+}
+
 TEST(LimitSurface, RegularFacesAreTheBicubicBSplineWithItsDerivatives) {
   const int nu = 10, nv = 7;
   const Mesh coarse = torusGrid(nu, nv);

@@ -55,6 +55,12 @@ struct Mesh {
   std::vector<Vec3f> cornerNormals;    ///< #C
   std::vector<UvSet> uvSets;           ///< zero or more sets of #C UVs
   NormalSource normalSource = NormalSource::kFile;
+  /// #F, 1 for a flat-shaded face (Blender's smooth flag off: OBJ `s 0` / `s off`), or empty:
+  /// every face smooth. Only subdivideMesh reads it; the corner normals already say how a face
+  /// is shaded.
+  std::vector<std::uint8_t> faceFlat;
+  /// @brief Whether face @p f is flat-shaded (faceFlat says so).
+  bool isFlat(std::size_t f) const { return f < faceFlat.size() && faceFlat[f] != 0; }
 
   std::size_t numVertices() const { return positions.size(); }
   std::size_t numFaces() const { return faceStart.size() - 1; }

@@ -119,8 +119,10 @@ struct SurfaceParameters {
 ///    parameterization, so that it splits into triangles along the same diagonal as Blender's.
 ///  - Edge and vertex creases (when useCreases) become OpenSubdiv sharpness creaseSharpness(c)
 ///    of the edge or vertex, with uniform creasing, as Blender's converter sets them.
-///  - The result is shaded smooth: its normals are computeSmoothNormals of the new faces (the
-///    coarse mesh's normals are not used; Blender recomputes them the same way).
+///  - Each new face keeps its coarse face's flat/smooth flag (Mesh::faceFlat). Corners of smooth
+///    faces get computeSmoothNormals of the new faces (angle-weighted over every face at the
+///    vertex, flat ones included), corners of flat faces their face's normal: Blender's normals
+///    of the modified mesh with Auto Smooth off. The coarse mesh's normals are not used.
 ///
 /// The coarse vertices keep their indices (as in Blender); the points inside each coarse edge
 /// follow (in OpenSubdiv's edge order), then those inside each coarse face. Faces are grouped by
