@@ -14,8 +14,10 @@
 namespace sgbake::subdiv_detail {
 namespace {
 
-using osd::Far::StencilTable;
-using osd::Far::StencilTableFactory;
+// The float tables themselves (StencilTableReal<float>): Far's StencilTable and
+// StencilTableFactory are wrappers that downcast every table they hand out to a type it is not.
+using StencilTable = osd::Far::StencilTableReal<float>;
+using StencilTableFactory = osd::Far::StencilTableFactoryReal<float>;
 
 /// Blender's "Quality": the adaptive isolation level of its patches.
 constexpr int kBlenderQuality = 3;
@@ -72,12 +74,12 @@ PatchEvaluator::PatchEvaluator(ControlMesh& control) : ptex_(*control.refiner) {
   patches_.reset(osd::Far::PatchTableFactory::Create(refiner, options));
 
   // Local points (the end caps' control points) after the refined ones.
-  if (const StencilTable* local = patches_->GetLocalPointStencilTable(); local != nullptr) {
+  if (const StencilTable* local = patches_->GetLocalPointStencilTable<float>(); local != nullptr) {
     vertexStencils.reset(
         StencilTableFactory::AppendLocalPointStencilTable(refiner, vertexStencils.get(), local));
   }
   for (int c = 0; c < numChannels; ++c) {
-    const StencilTable* local = patches_->GetLocalPointFaceVaryingStencilTable(c);
+    const StencilTable* local = patches_->GetLocalPointFaceVaryingStencilTable<float>(c);
     if (const StencilTable* all = StencilTableFactory::AppendLocalPointStencilTableFaceVarying(
             refiner, channelStencils[static_cast<std::size_t>(c)].get(), local, c);
         all != nullptr) {
