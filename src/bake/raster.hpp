@@ -249,6 +249,9 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
   // Per-thread scratch for N > 1: per-texel sums (double) and sample counts of one block.
   tbb::enumerable_thread_specific<std::vector<double>> sumsTls;
   tbb::enumerable_thread_specific<std::vector<int>> countsTls;
+  // ... and which of its samples a triangle has claimed (overlapping UVs: see below).
+  tbb::enumerable_thread_specific<std::vector<std::uint8_t>> claimedTls;
+  const std::size_t samplesPerTexel = static_cast<std::size_t>(N) * static_cast<std::size_t>(N);
 
   auto processBlock = [&](int block) {
     const int yBegin = block * kRowsPerBlock;
@@ -289,11 +292,15 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
     }
     std::vector<double>* sums = nullptr;
     std::vector<int>* counts = nullptr;
+    std::uint8_t* claimed = nullptr;
     if (N > 1) {
       sums = &sumsTls.local();
       counts = &countsTls.local();
       sums->assign(blockTexels * kC, 0.0);
       counts->assign(blockTexels, 0);
+      std::vector<std::uint8_t>& claims = claimedTls.local();
+      claims.assign(blockTexels * samplesPerTexel, 0);
+      claimed = claims.data();
     }
 
     Shader shader = prototype;
@@ -322,7 +329,13 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
         batch.count = 0;
       }
     };
-    for (std::uint32_t k = bins.start[block]; k < bins.start[block + 1]; ++k) {
+    // Where UV islands overlap, a sample belongs to the last triangle that covers it, as a
+    // pixel does in Blender's baker. One sample per texel: triangles in order, each overwriting
+    // the texel. Several: triangles in reverse order, each sample kept by the first that claims
+    // it (a texel's sums must not count a sample twice); the same owners.
+    const std::uint32_t first = bins.start[block], end = bins.start[block + 1];
+    for (std::uint32_t n = 0; n < end - first; ++n) {
+      const std::uint32_t k = N == 1 ? first + n : end - 1 - n;
       const std::array<std::uint32_t, 3>& corners = job.triangles[bins.index[k]];
       RasterTriangle tri;
       const std::array<Vec2d, 3> texel{uvToTexel(job.uvs[corners[0]], job.udimTile, W, H),
@@ -346,6 +359,14 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
               if (!tri.edge[1].inside(e1)) continue;
               const double e2 = tri.edge[2](px, py);
               if (!tri.edge[2].inside(e2)) continue;
+              if (claimed != nullptr) {
+                std::uint8_t& owner =
+                    claimed[(static_cast<std::size_t>(y - yBegin) * static_cast<std::size_t>(W) +
+                             static_cast<std::size_t>(x)) * samplesPerTexel +
+                            static_cast<std::size_t>(j * N + i)];
+                if (owner) continue;  // a later triangle has it
+                owner = 1;
+              }
               if (!begun) {
                 shader.beginTriangle(corners);
                 begun = true;

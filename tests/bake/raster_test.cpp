@@ -2,6 +2,7 @@
 // of a watertight UV region claimed exactly once), supersampled coverage, UDIM tiles, threads.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 
@@ -176,6 +177,43 @@ TEST(Raster, MirroredAndDegenerateUvTriangles) {
   const Result<FloatImage> none = bakeMask(flat, 16, 16);
   ASSERT_TRUE(none.ok());
   for (const float c : none->coverage) ASSERT_EQ(c, 0.0f);
+}
+
+TEST(Raster, OverlappingUvsTakeTheLastTriangleAtEverySample) {
+  // Two quads with the same UVs, facing +Z and tilted 45° about X. Blender 3.4's Cycles bake of
+  // this mesh (NORMAL, object space, 16², checked by hand) gives the second quad's normal at
+  // every texel: the last triangle to cover a pixel owns it. sgbake does the same at one
+  // sample per texel and, sample by sample, with supersampling: a texel's samples are counted
+  // once (coverage 1, not 2) and all come from the second quad.
+  const float h = 0.5f;
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                     {0, 0, h}, {1, 0, h}, {1, 1, 1 + h}, {0, 1, 1 + h}};
+  const std::vector<Vec2f> square{{0.25f, 0.25f}, {0.75f, 0.25f}, {0.75f, 0.75f}, {0.25f, 0.75f}};
+  std::vector<Vec2f> uvs = square;
+  uvs.insert(uvs.end(), square.begin(), square.end());
+  const float r = static_cast<float>(std::sqrt(0.5));
+  std::vector<Vec3f> normals(4, Vec3f{0, 0, 1});
+  normals.insert(normals.end(), 4, Vec3f{0, -r, r});
+  const Mesh mesh = test::polygonMesh(positions, {{0, 1, 2, 3}, {4, 5, 6, 7}}, uvs, {0, 0, 1}, normals);
+  for (const int samples : {1, 3}) {
+    BakeSettings settings;
+    settings.map = MapKind::kObjectNormal;
+    settings.width = settings.height = 16;
+    settings.samples = samples;
+    Result<FloatImage> image = bakeMap({&mesh, nullptr, {}}, settings);
+    ASSERT_TRUE(image) << image.error().message;
+    int covered = 0;
+    for (std::size_t t = 0; t < image->coverage.size(); ++t) {
+      const float coverage = image->coverage[t];
+      ASSERT_LE(coverage, 1.0f) << "samples " << samples << " texel " << t;
+      if (coverage == 0) continue;
+      ++covered;
+      EXPECT_NEAR(image->pixels[3 * t], 0.5, 1e-6);
+      EXPECT_NEAR(image->pixels[3 * t + 1], 0.5 - 0.5 * r, 1e-6) << "samples " << samples;
+      EXPECT_NEAR(image->pixels[3 * t + 2], 0.5 + 0.5 * r, 1e-6) << "samples " << samples;
+    }
+    EXPECT_EQ(covered, 8 * 8);
+  }
 }
 
 TEST(Raster, SupersampledCoverageIsTheFractionOfSamples) {

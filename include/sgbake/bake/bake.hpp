@@ -22,7 +22,9 @@
 /// `u = u0 + (x + 0.5)/W`, `v = v0 + (y + 0.5)/H` with `(u0, v0) = ((t−1001) % 10, (t−1001) / 10)`;
 /// it is stored in row `H − 1 − y` of FloatImage (rows top first, as files store them). With
 /// N×N supersampling its samples are at `u0 + (x + (i+0.5)/N)/W`, `v0 + (y + (j+0.5)/N)/H`,
-/// i, j = 0 … N−1 (N = 1: the texel centre). A sample belongs to the triangle containing it.
+/// i, j = 0 … N−1 (N = 1: the texel centre). A sample belongs to the triangle containing it;
+/// where UV islands overlap, to the last such triangle (in loopTriangles order), as a pixel does
+/// in Blender's baker (measured: two quads with the same UVs bake to the second one's normal).
 ///
 /// **Edge rule.** A sample exactly on an edge or vertex is treated as displaced by an
 /// infinitesimal ε·(1, 2) + ε²·(1, 0) texels: the direction in which Blender nudges every sample
