@@ -330,7 +330,8 @@ std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key
 
 const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers", "outputs"};
 const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
-                                                   "use_creases", "edge_creases", "vertex_creases"};
+                                                   "use_creases", "edge_creases", "vertex_creases",
+                                                   "quality"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
@@ -496,6 +497,10 @@ SceneSubdivision parseSubdivision(const json& value) {
   if (reader.has("use_creases")) subdivision.useCreases = reader.boolean("use_creases");
   if (reader.has("edge_creases")) subdivision.edgeCreases = parseEdgeCreases(reader);
   if (reader.has("vertex_creases")) subdivision.vertexCreases = parseVertexCreases(reader);
+  if (reader.has("quality")) {
+    subdivision.quality =
+        reader.smallInteger("quality", kMinSubdivisionQuality, kMaxSubdivisionQuality);
+  }
   return subdivision;
 }
 
@@ -1044,8 +1049,12 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
               std::to_string(subdivision.vertexCreases.size()) + " vertex crease(s)" +
               (subdivision.useCreases ? "" : ", not used");
   }
+  const std::string quality =
+      subdivision.quality == SubdivisionOptions{}.quality
+          ? std::string()
+          : ", quality " + std::to_string(subdivision.quality);
   return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
-         nameIn(kBoundaries, subdivision.boundary) + creases + ")";
+         nameIn(kBoundaries, subdivision.boundary) + creases + quality + ")";
 }
 
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
@@ -1065,6 +1074,8 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
     j["edge_creases"] = std::move(edges);
     j["vertex_creases"] = std::move(vertices);
   }
+  // Likewise the quality, unless it is not the default.
+  if (subdivision.quality != SubdivisionOptions{}.quality) j["quality"] = subdivision.quality;
   return j.dump();
 }
 

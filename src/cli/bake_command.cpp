@@ -239,6 +239,7 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   scene.subdivision.useCreases = args.subdivision.useCreases;
   scene.subdivision.edgeCreases = args.subdivision.edgeCreases;
   scene.subdivision.vertexCreases = args.subdivision.vertexCreases;
+  scene.subdivision.quality = args.subdivision.quality;
   if (!args.heightImage.empty()) {
     if (Status ok = parseName("--filter", args.filter, {"bilinear", "bicubic", "hermite"}); !ok) {
       return ok.error();

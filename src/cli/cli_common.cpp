@@ -209,8 +209,16 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
   CLI::Option* const noCreases = app.add_flag_callback(
       "--no-creases", [&options] { options.useCreases = false; },
       "Ignore the creases (the modifier's Use Creases off)");
+  CLI::Option* const quality =
+      app.add_option("--subdivision-quality", options.quality,
+                     "The modifier's Quality: the refinement level its patches isolate "
+                     "irregular and semi-sharp features to")
+          ->type_name("N")
+          ->check(CLI::Range(kMinSubdivisionQuality, kMaxSubdivisionQuality).description(""))
+          ->capture_default_str();
   if (!group.empty()) {  // CLI11 hides options of the empty group
-    for (CLI::Option* option : {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases}) {
+    for (CLI::Option* option :
+         {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases, quality}) {
       option->group(group);
     }
   }

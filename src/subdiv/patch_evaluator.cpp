@@ -19,9 +19,6 @@ namespace {
 using StencilTable = osd::Far::StencilTableReal<float>;
 using StencilTableFactory = osd::Far::StencilTableFactoryReal<float>;
 
-/// Blender's "Quality": the adaptive isolation level of its patches.
-constexpr int kBlenderQuality = 3;
-
 /// Owns a stencil table Far hands out by pointer.
 using StencilPtr = std::unique_ptr<const StencilTable>;
 
@@ -54,10 +51,10 @@ void applyStencils(const StencilTable* stencils, int coarse, int width, std::vec
 
 }  // namespace
 
-PatchEvaluator::PatchEvaluator(ControlMesh& control) : ptex_(*control.refiner) {
+PatchEvaluator::PatchEvaluator(ControlMesh& control, int quality) : ptex_(*control.refiner) {
   Refiner& refiner = *control.refiner;
   const int numChannels = refiner.GetNumFVarChannels();
-  Refiner::AdaptiveOptions adaptive(kBlenderQuality);
+  Refiner::AdaptiveOptions adaptive(quality);
   adaptive.considerFVarChannels = numChannels > 0;
   adaptive.useInfSharpPatch = true;
   refiner.RefineAdaptive(adaptive);
@@ -66,7 +63,7 @@ PatchEvaluator::PatchEvaluator(ControlMesh& control) : ptex_(*control.refiner) {
   std::vector<StencilPtr> channelStencils;
   for (int c = 0; c < numChannels; ++c) channelStencils.push_back(refinedStencils(refiner, c));
 
-  osd::Far::PatchTableFactory::Options options(kBlenderQuality);
+  osd::Far::PatchTableFactory::Options options(quality);
   options.SetEndCapType(osd::Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
   options.useInfSharpPatch = true;
   options.generateFVarTables = numChannels > 0;

@@ -2,7 +2,7 @@
 /// @brief Private to src/subdiv: the limit surface evaluated the way Blender's Subdivision Surface
 /// modifier evaluates it, so that subdivideMesh's floats are Blender's, bit for bit.
 ///
-/// Blender does not use Bfr: it refines the control mesh adaptively to its "Quality" (3),
+/// Blender does not use Bfr: it refines the control mesh adaptively to its "Quality" (3 unless set),
 /// builds a Far patch table (Gregory-basis end caps, infinitely sharp patches, face-varying
 /// patches for the UVs), computes every patch point with Far stencil tables in float, and
 /// evaluates one point at a time with Osd's CPU evaluator at a Ptex face's (u, v). The patches
@@ -26,10 +26,10 @@ namespace sgbake::subdiv_detail {
 
 class PatchEvaluator {
  public:
-  /// The patches of @p control's topology (its refiner is refined adaptively here: Bfr cannot
-  /// use it afterwards), with the control points and face-varying values of @p control in
-  /// float. Throws std::bad_alloc.
-  explicit PatchEvaluator(ControlMesh& control);
+  /// The patches of @p control's topology isolated to level @p quality (Blender's "Quality"; its
+  /// refiner is refined adaptively here: Bfr cannot use it afterwards), with the control points
+  /// and face-varying values of @p control in float. Throws std::bad_alloc.
+  PatchEvaluator(ControlMesh& control, int quality);
   ~PatchEvaluator();
   PatchEvaluator(const PatchEvaluator&) = delete;
   PatchEvaluator& operator=(const PatchEvaluator&) = delete;

@@ -131,7 +131,7 @@ constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_
 /// The subdivided mesh (see subdivideMesh) of @p coarse as OpenSubdiv sees it (@p control),
 /// and where its corners lie on the limit surface when @p parameters is not null. Throws
 /// std::bad_alloc, or EvaluationFailed when no patch covers a point.
-Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level, int quality,
                     SurfaceParameters* parameters);
 
 }  // namespace
@@ -142,6 +142,11 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
   if (options.level < 0 || options.level > kMaxSubdivisionLevel) {
     return Error::badInput(name + ": subdivision level " + std::to_string(options.level) +
                            " is out of range (0.." + std::to_string(kMaxSubdivisionLevel) + ")");
+  }
+  if (options.quality < kMinSubdivisionQuality || options.quality > kMaxSubdivisionQuality) {
+    return Error::badInput(name + ": subdivision quality " + std::to_string(options.quality) +
+                           " is out of range (" + std::to_string(kMinSubdivisionQuality) + ".." +
+                           std::to_string(kMaxSubdivisionQuality) + ")");
   }
   if (options.level == 0) {
     if (parameters != nullptr) {  // each corner at its own corner of its face
@@ -169,7 +174,7 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
                            std::to_string(kMaxSubdividedCorners / 4) + ")");
   }
   try {
-    return subdivideGrids(coarse, *control, level, parameters);
+    return subdivideGrids(coarse, *control, level, options.quality, parameters);
   } catch (const EvaluationFailed&) {
     return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
   } catch (const std::bad_alloc&) {
@@ -180,7 +185,7 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
 
 namespace {
 
-Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level, int quality,
                     SurfaceParameters* parameters) {
   const Refiner* const refiner = control.refiner.get();
   const std::vector<FVarChannel>& channels = control.channels;
@@ -252,7 +257,7 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
     parameters->cornerSubFace.resize(4 * fineFaces);
     parameters->cornerCoord.resize(4 * fineFaces);
   }
-  const PatchEvaluator patches(control);
+  const PatchEvaluator patches(control, quality);
   tbb::enumerable_thread_specific<std::vector<Vec2f>> gridUvsTls;
   std::atomic<bool> failed{false};
   tbb::parallel_for(std::size_t{0}, nf, [&](std::size_t f) {

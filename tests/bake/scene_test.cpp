@@ -454,6 +454,25 @@ TEST(Scene, CreasesAreInTheSubdivisionParametersOnlyWhenThereAreAny) {
       << describeSubdivision(subdivision);
 }
 
+TEST(Scene, QualityIsParsedAndInTheParametersOnlyWhenNotTheDefault) {
+  const auto withSubdivision = [](const std::string& block) {
+    return R"({"mesh": "m.obj", "subdivision": )" + block +
+           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+  };
+  Result<Scene> scene = parseScene(withSubdivision(R"({"level": 2, "quality": 5})"), options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->subdivision.options().quality, 5);
+  EXPECT_NE(describeSubdivision(scene->subdivision).find("quality 5"), std::string::npos);
+  const std::string five = subdivisionParametersJson(scene->subdivision);
+  EXPECT_NE(five.find("\"quality\":5"), std::string::npos) << five;
+  scene->subdivision.quality = 3;  // the default: the text (and manifest hash) of old scenes
+  EXPECT_EQ(subdivisionParametersJson(scene->subdivision).find("quality"), std::string::npos);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 2, "quality": 0})")),
+            "scene.json: subdivision: quality 0 is out of range 1..10");
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 2, "quality": 11})")),
+            "scene.json: subdivision: quality 11 is out of range 1..10");
+}
+
 TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   Scene scene;
   scene.mesh = "m.obj";

@@ -15,7 +15,7 @@ Builds nine coarse meshes with bpy, all smooth shaded, with their own UVs:
              the cube with two neighbouring faces flat-shaded, Suzanne with every third face
              flat (their OBJ files mark them with `s 0` / `s 1` as Blender's exporter does)
 and writes each as OUT_DIR/MESH.obj (objio.write_obj: exact floats, one vt and vn per corner,
-n-gons kept). Then, for every case in CASES, it gives the object a Subdivision Surface modifier
+n-gons kept). Then, for every case in ALL_CASES, it gives the object a Subdivision Surface modifier
 (Catmull-Clark, Use Limit Surface on, Quality 3, the case's Levels, UV Smooth, Boundary
 Smooth and Use Creases), evaluates it, lets Blender compute split normals and MikkTSpace tangents of the
 subdivided mesh (`Mesh.calc_normals_split()`, `Mesh.calc_tangents()`), and writes
@@ -165,9 +165,21 @@ CASES = (
 )
 
 
-def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True):
+# Cases with a Quality other than a new modifier's 3 (the cases above): (mesh, level, uv_smooth,
+# boundary_smooth, use_creases, quality). Quality is the level the patches isolate irregular
+# vertices and semi-sharp creases to: 5 resolves the creased cube's corners further, 1 barely
+# at all, and 6 moves the grid's open boundary corners.
+QUALITY_CASES = [
+    ("cube_creased", 2, "PRESERVE_BOUNDARIES", "ALL", True, 5),
+    ("suzanne", 1, "SMOOTH_ALL", "ALL", True, 1),
+    ("grid", 1, "PRESERVE_BOUNDARIES", "ALL", True, 6),
+]
+ALL_CASES = [case + (3,) for case in CASES] + QUALITY_CASES
+
+
+def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True, quality=3):
     return (f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
-            + ("" if use_creases else "_nocreases"))
+            + ("" if use_creases else "_nocreases") + ("" if quality == 3 else f"_Q{quality}"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -199,10 +211,12 @@ def write_coarse(name, ob, out_dir):
             "vertex_creases": vertex_creases}
 
 
-def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, out_dir):
+def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
+               out_dir):
     """Evaluates the object with the modifier set to the case; writes TAG.npz."""
     import numpy as np
 
+    mod.quality = quality
     mod.levels = level
     mod.render_levels = level
     mod.uv_smooth = uv_smooth
@@ -215,14 +229,14 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, ou
     me.calc_tangents(uvmap=me.uv_layers.active.name)
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
-    tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases)
+    tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases, quality)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
              uvs=arrays["uvs"], normals=arrays["normals"], tangents=tangents, signs=signs,
              smooth=np.array([p.use_smooth for p in me.polygons], dtype=bool))
     info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
             "boundary_smooth": boundary_smooth, "use_creases": use_creases,
-            "vertices": len(me.vertices),
+            "quality": quality, "vertices": len(me.vertices),
             "faces": len(me.polygons), "corners": len(me.loops)}
     bpy.data.meshes.remove(me)
     return info
@@ -250,12 +264,11 @@ def main():
         mod = ob.modifiers.new("Subdivision", "SUBSURF")
         mod.subdivision_type = "CATMULL_CLARK"
         mod.use_limit_surface = True
-        mod.quality = 3
-        for mesh, level, uv_smooth, boundary_smooth, use_creases in CASES:
+        for mesh, level, uv_smooth, boundary_smooth, use_creases, quality in ALL_CASES:
             if mesh != name:
                 continue
             info = write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases,
-                              out_dir)
+                              quality, out_dir)
             manifest["cases"].append(info)
             print("case %-45s vertices %6d faces %6d corners %6d"
                   % (info["tag"], info["vertices"], info["faces"], info["corners"]))

@@ -47,7 +47,9 @@
                 normal check must fail (62 deg off);
      sharpness 10c  sgbake given sqrt(c) for every crease c, i.e. sharpness 10 c instead of
                 Blender's 10 c^2, against the creased cube (level 1): the position check must
-                fail (0.20 off).
+                fail (0.20 off);
+     quality    sgbake at the default Quality 3 against Blender's creased cube at Quality 5
+                (level 2): the position check must fail.
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -109,6 +111,8 @@ CONTROLS = [
      "positions"),
     ("flat faces", "suzanne_flat_L1_PRESERVE_BOUNDARIES_ALL", {"smoothing": "strip"},
      "normals"),
+    ("quality", "cube_creased_L2_PRESERVE_BOUNDARIES_ALL_Q5", {"--subdivision-quality": None},
+     "positions"),
 ]
 
 
@@ -166,6 +170,8 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
     }
     if not case.get("use_creases", True):
         options["--no-creases"] = ""
+    if case.get("quality", 3) != 3:
+        options["--subdivision-quality"] = str(case["quality"])
     options.update(overrides)
     obj = os.path.join(work, out_name + ".sgbake.obj")
     csv = os.path.join(work, out_name + ".sgbake.csv")

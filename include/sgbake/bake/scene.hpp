@@ -91,13 +91,14 @@ struct SceneSubdivision {
   bool useCreases = true;                   ///< "use_creases"
   std::vector<EdgeCrease> edgeCreases;      ///< "edge_creases": [[a, b, c], ...]
   std::vector<VertexCrease> vertexCreases;  ///< "vertex_creases": [[v, c], ...]
+  int quality = 3;                          ///< "quality": Blender's Quality, 1 … 10
   /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
   bool requested() const { return present && (limit || level > 0); }
   /// @brief Whether the samples are shaded on the exact limit surface ("level": "limit").
   bool limitSurface() const { return present && limit; }
   /// @brief The options of subdivideMesh this block stands for (a number of levels).
   SubdivisionOptions options() const {
-    return {level, uvSmooth, boundary, useCreases, edgeCreases, vertexCreases};
+    return {level, uvSmooth, boundary, useCreases, edgeCreases, vertexCreases, quality};
   }
 };
 

@@ -67,7 +67,15 @@ struct SubdivisionOptions {
   bool useCreases = true;  ///< Blender's "Use Creases"; false ignores both lists below
   std::vector<EdgeCrease> edgeCreases{};      ///< at most one per edge; edges not listed: 0
   std::vector<VertexCrease> vertexCreases{};  ///< at most one per vertex; others: 0
+  /// Blender's "Quality" (kMinSubdivisionQuality … kMaxSubdivisionQuality): the refinement level
+  /// to which the patches isolate irregular and semi-sharp features (3, a new modifier's, unless
+  /// set); higher follows the exact limit more closely there.
+  int quality = 3;
 };
+
+/// @brief The range of SubdivisionOptions::quality (Blender's "Quality" field).
+inline constexpr int kMinSubdivisionQuality = 1;
+inline constexpr int kMaxSubdivisionQuality = 10;
 
 /// @brief OpenSubdiv's sharpness of a Blender crease @p crease ∈ [0, 1], as Blender 3.4's
 /// converter computes it in float: 10·c², so that c = 1 is infinitely sharp (Sdc's
@@ -129,7 +137,7 @@ struct SurfaceParameters {
 /// coarse face, in coarse order, each face's grids in corner order, cells row by row.
 ///
 /// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
-///         is out of range, a crease does not fit the mesh (findCreaseIssue) or the mesh cannot
+///         or the quality is out of range, a crease does not fit the mesh (findCreaseIssue) or the mesh cannot
 ///         be subdivided (a face using one vertex twice, or a topology OpenSubdiv rejects).
 /// @param[out] parameters when not null, where each new corner lies (SurfaceParameters); at
 ///             level 0, only faceOrigin (the identity)
