@@ -231,15 +231,7 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   Scene scene;
   scene.mesh = args.mesh;
   scene.uvSet = args.uvSet;
-  scene.subdivision.present = args.subdivision.level > 0 || args.limitSurface;
-  scene.subdivision.limit = args.limitSurface;
-  scene.subdivision.level = args.subdivision.level;
-  scene.subdivision.uvSmooth = args.subdivision.uvSmooth;
-  scene.subdivision.boundary = args.subdivision.boundary;
-  scene.subdivision.useCreases = args.subdivision.useCreases;
-  scene.subdivision.edgeCreases = args.subdivision.edgeCreases;
-  scene.subdivision.vertexCreases = args.subdivision.vertexCreases;
-  scene.subdivision.quality = args.subdivision.quality;
+  scene.subdivision = SceneSubdivision::of(args.subdivision, args.limitSurface);
   if (!args.heightImage.empty()) {
     if (Status ok = parseName("--filter", args.filter, {"bilinear", "bicubic", "hermite"}); !ok) {
       return ok.error();

@@ -473,6 +473,33 @@ TEST(Scene, QualityIsParsedAndInTheParametersOnlyWhenNotTheDefault) {
             "scene.json: subdivision: quality 11 is out of range 1..10");
 }
 
+TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
+  // Every field away from its default, so that a field one side forgets shows.
+  SubdivisionOptions o;
+  o.level = 4;
+  o.uvSmooth = SubdivisionUvSmooth::kAll;
+  o.boundary = SubdivisionBoundary::kKeepCorners;
+  o.useCreases = false;
+  o.edgeCreases = {{1, 2, 0.5f}};
+  o.vertexCreases = {{3, 0.25f}};
+  o.quality = 7;
+  const SceneSubdivision block = SceneSubdivision::of(o, false);
+  EXPECT_TRUE(block.requested());
+  EXPECT_FALSE(block.limitSurface());
+  const SubdivisionOptions back = block.options();
+  EXPECT_EQ(back.level, o.level);
+  EXPECT_EQ(back.uvSmooth, o.uvSmooth);
+  EXPECT_EQ(back.boundary, o.boundary);
+  EXPECT_EQ(back.useCreases, o.useCreases);
+  ASSERT_EQ(back.edgeCreases.size(), 1u);
+  EXPECT_EQ(back.edgeCreases[0].v1, 2u);
+  ASSERT_EQ(back.vertexCreases.size(), 1u);
+  EXPECT_EQ(back.vertexCreases[0].crease, 0.25f);
+  EXPECT_EQ(back.quality, o.quality);
+  EXPECT_TRUE(SceneSubdivision::of({0}, true).limitSurface());
+  EXPECT_FALSE(SceneSubdivision::of({0}, false).requested());
+}
+
 TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   Scene scene;
   scene.mesh = "m.obj";

@@ -100,6 +100,13 @@ struct SceneSubdivision {
   SubdivisionOptions options() const {
     return {level, uvSmooth, boundary, useCreases, edgeCreases, vertexCreases, quality};
   }
+  /// @brief The block of @p options (a number of levels), or of the limit surface under them
+  /// when @p limitSurface: options()'s inverse. Present when it asks for any subdivision.
+  static SceneSubdivision of(const SubdivisionOptions& options, bool limitSurface) {
+    return {options.level > 0 || limitSurface, limitSurface, options.level, options.uvSmooth,
+            options.boundary, options.useCreases, options.edgeCreases, options.vertexCreases,
+            options.quality};
+  }
 };
 
 /// @brief A layer's optional "mask": a scalar image on a UV set that scales its Γ (LayerMask).
