@@ -112,6 +112,31 @@ std::optional<VertexCrease> parseVertexCrease(const std::string& text) {
   return VertexCrease{*v, *c};
 }
 
+/// A repeatable option whose every value @p parse reads into one more entry of @p list (each
+/// checked first: a value it refuses is "'VALUE' is not @p expected").
+template <class Crease>
+CLI::Option* addCreaseOption(CLI::App& app, const std::string& name, std::vector<Crease>& list,
+                             std::optional<Crease> (*parse)(const std::string&),
+                             const std::string& help, const std::string& typeName,
+                             const std::string& expected) {
+  return app
+      .add_option_function<std::vector<std::string>>(
+          name,
+          [&list, parse](const std::vector<std::string>& values) {
+            for (const std::string& value : values) list.push_back(*parse(value));
+          },
+          help)
+      ->type_name(typeName)
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::Validator(
+          [parse, expected](std::string& value) -> std::string {
+            if (parse(value)) return {};
+            return "'" + value + "' is not " + expected;
+          },
+          ""));
+}
+
 }  // namespace
 
 void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std::string& group,
@@ -169,43 +194,15 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
   options.useCreases = true;
   options.edgeCreases.clear();
   options.vertexCreases.clear();
-  CLI::Option* const edgeCrease =
-      app.add_option_function<std::vector<std::string>>(
-             "--edge-crease",
-             [&options](const std::vector<std::string>& values) {
-               for (const std::string& value : values) {
-                 options.edgeCreases.push_back(*parseEdgeCrease(value));
-               }
-             },
-             "Crease of the edge between vertices A and B (0-based, in the file's order), "
-             "C in [0, 1] as Blender's Edge Crease; repeatable")
-          ->type_name("A,B,C")
-          ->expected(1)
-          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-          ->check(CLI::Validator(
-              [](std::string& value) -> std::string {
-                if (parseEdgeCrease(value)) return {};
-                return "'" + value + "' is not A,B,C (two vertex indices >= 0, a crease in [0, 1])";
-              },
-              ""));
-  CLI::Option* const vertexCrease =
-      app.add_option_function<std::vector<std::string>>(
-             "--vertex-crease",
-             [&options](const std::vector<std::string>& values) {
-               for (const std::string& value : values) {
-                 options.vertexCreases.push_back(*parseVertexCrease(value));
-               }
-             },
-             "Crease of vertex V (0-based), C in [0, 1] as Blender's Vertex Crease; repeatable")
-          ->type_name("V,C")
-          ->expected(1)
-          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-          ->check(CLI::Validator(
-              [](std::string& value) -> std::string {
-                if (parseVertexCrease(value)) return {};
-                return "'" + value + "' is not V,C (a vertex index >= 0, a crease in [0, 1])";
-              },
-              ""));
+  CLI::Option* const edgeCrease = addCreaseOption(
+      app, "--edge-crease", options.edgeCreases, parseEdgeCrease,
+      "Crease of the edge between vertices A and B (0-based, in the file's order), "
+      "C in [0, 1] as Blender's Edge Crease; repeatable",
+      "A,B,C", "A,B,C (two vertex indices >= 0, a crease in [0, 1])");
+  CLI::Option* const vertexCrease = addCreaseOption(
+      app, "--vertex-crease", options.vertexCreases, parseVertexCrease,
+      "Crease of vertex V (0-based), C in [0, 1] as Blender's Vertex Crease; repeatable", "V,C",
+      "V,C (a vertex index >= 0, a crease in [0, 1])");
   CLI::Option* const noCreases = app.add_flag_callback(
       "--no-creases", [&options] { options.useCreases = false; },
       "Ignore the creases (the modifier's Use Creases off)");
