@@ -31,12 +31,15 @@
      normals    per matched corner, the angle between sgbake's `vn` and Blender's split normal
                 <= 0.05 deg (0.0017 deg measured; flat-shaded faces included);
      uvs        per matched corner, max |du|, |dv| <= 2.5e-7, and the corners whose UV is not
-                Blender's float are counted (0 in a run measured on Blender 3.4.1): Blender
+                Blender's float are counted (0 but on the grid, there up to ~28 a run): Blender
                 gives a face-varying value shared by corners with nearly equal UVs the UV of
                 whichever corner its threads write last, which changes from run to run (the
                 grid: 28 of 192 corners); sgbake takes the one written last in order;
      tangents   max angle <= 0.05 deg and identical bitangent signs, every case (measured
-                <= 0.002 deg: MikkTSpace's float rounding).
+                <= 0.002 deg: MikkTSpace's float rounding), except at the corners of a vertex
+                of the faces around a vertex where this Blender run gave a corner a UV an ulp
+                off (see uvs): MikkTSpace welds that vertex differently, which joins its faces
+                differently (up to 0.52 deg seen on the grid); the t columns show every corner.
 3. Negative controls, which must FAIL, or the checks could not tell right from wrong:
      boundary   sgbake --boundary-smooth keep-corners against Blender's grid made with ALL
                 (level 1): the position check must fail;
@@ -368,14 +371,26 @@ def compare(case, ref, obj, csv):
         failures.append(("normals", f"corner normals differ by up to {fig['n_max']:.4f} deg "
                                     f"(> {NORMAL_MAX_DEG} deg)"))
     angle = angles_deg(tangents[ours_corners], BT[blender_corners])
-    sign_diff = int((np.sign(signs[ours_corners]) != np.sign(BS[blender_corners])).sum())
-    fig.update(uv_max=float(uv_error.max()), uv_inexact=int((ours_uv != blender_uv).any(1).sum()),
+    same_sign = np.sign(signs[ours_corners]) == np.sign(BS[blender_corners])
+    uv_inexact = (ours_uv != blender_uv).any(1)
+    # Where this Blender run gave a corner a UV one ulp off (see UV_MAX), MikkTSpace welds that
+    # vertex's corners differently, in Blender or in sgbake, and so joins the faces around it
+    # differently: the tangents are asserted at every vertex but those of the faces around such
+    # a vertex (at all of them when every UV is Blender's).
+    inexact_vertices = np.unique(corner_vertex[ours_corners[uv_inexact]])
+    face_of = np.repeat(np.arange(len(face_size)), face_size)
+    near_faces = np.unique(face_of[np.isin(corner_vertex, inexact_vertices)])
+    excluded = np.unique(corner_vertex[np.isin(face_of, near_faces)])
+    asserted = ~np.isin(corner_vertex[ours_corners], excluded)
+    sign_diff = int((~same_sign[asserted]).sum())
+    fig.update(uv_max=float(uv_error.max()), uv_inexact=int(uv_inexact.sum()),
                t_median=float(np.median(angle)), t_p99=float(np.percentile(angle, 99)),
                t_max=float(angle.max()), sign_diff=sign_diff)
+    t_asserted = float(angle[asserted].max()) if asserted.any() else 0.0
     if fig["uv_max"] > UV_MAX:
         failures.append(("uvs", f"UVs differ by up to {fig['uv_max']:.3g} (> {UV_MAX:g})"))
-    if fig["t_max"] > TANGENT_MAX_DEG:
-        failures.append(("tangents", f"tangents differ by up to {fig['t_max']:.4f} deg "
+    if t_asserted > TANGENT_MAX_DEG:
+        failures.append(("tangents", f"tangents differ by up to {t_asserted:.4f} deg "
                                      f"(> {TANGENT_MAX_DEG} deg)"))
     if sign_diff:
         failures.append(("tangents", f"{sign_diff} bitangent signs differ"))
