@@ -15,6 +15,7 @@
 #include <tbb/global_control.h>
 
 #include "cli.hpp"
+#include "sgbake/io/image_io.hpp"
 #include "sgbake/sgbake.h"
 
 namespace sgbake::cli {
@@ -165,6 +166,9 @@ int main(int argc, char** argv) {
   // run while workers are still being torn down.
   tbb::task_scheduler_handle scheduler{tbb::attach{}};
   const int code = runCatchingEverything(argc, argv);
+  // A bad-input error can end a run while the image module is still loading (preloadImageIo):
+  // the process must not exit while that thread is inside dlopen.
+  sgbake::finishImageIoPreload();
   tbb::finalize(scheduler, std::nothrow);  // false (nothing joined) is harmless
   return code;
 }

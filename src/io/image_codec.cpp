@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <future>
 #include <mutex>
@@ -45,6 +46,7 @@ LoadedModule loadModule() {
 
 std::once_flag started;
 std::shared_future<LoadedModule> loading;
+std::atomic<bool> loadingSet{false};  ///< `loading` holds a started load
 
 /// Starts loadModule on a thread of its own, once; where no thread can be made, the first
 /// waiter runs it.
@@ -55,10 +57,15 @@ void startLoading() {
     } catch (const std::system_error&) {
       loading = std::async(std::launch::deferred, loadModule).share();
     }
+    loadingSet.store(true, std::memory_order_release);
   });
 }
 
 }  // namespace
+
+void finishLoading() {
+  if (loadingSet.load(std::memory_order_acquire)) loading.wait();
+}
 
 Result<const ImageCodec*> imageCodec() {
   startLoading();
@@ -88,6 +95,8 @@ std::string oneLineReason(std::string text) {
 }  // namespace io_detail
 
 void preloadImageIo() { io_detail::startLoading(); }
+
+void finishImageIoPreload() { io_detail::finishLoading(); }
 
 std::filesystem::path imageIoModulePath() {
   if (const char* path = std::getenv("SGBAKE_IMAGE_IO_MODULE"); path != nullptr && *path != 0) {

@@ -111,6 +111,9 @@ class ImageCodec {
 /// @return kInternal naming the module's file when it cannot be loaded.
 Result<const ImageCodec*> imageCodec();
 
+/// Waits for a load startLoading began (finishImageIoPreload, sgbake/io/image_io.hpp).
+void finishLoading();
+
 /// A codec error as one line: line breaks become "; ", control characters '?', trailing blanks
 /// go; "unknown error" when empty.
 std::string oneLineReason(std::string text);

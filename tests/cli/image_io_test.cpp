@@ -30,8 +30,14 @@ TEST(ImageIo, LoadsTheModuleBesideTheLibraryOnlyWhenAnImageIsUsed) {
   EXPECT_FALSE(mapped("libOpenImageIO")) << "OpenImageIO is loaded before any image is used";
   EXPECT_FALSE(mapped("libsgbake_oiio.so"));
 
+  finishImageIoPreload();  // nothing was started: it must not load the module itself
+  EXPECT_FALSE(mapped("libsgbake_oiio.so"));
+
   preloadImageIo();
   preloadImageIo();  // a second call does nothing
+  finishImageIoPreload();  // returns once the module is in the process
+  EXPECT_TRUE(mapped("libsgbake_oiio.so"));
+  EXPECT_TRUE(mapped("libOpenImageIO"));
 
   // A round trip through the module: EXR float keeps every value.
   const fs::path path = fs::temp_directory_path() /

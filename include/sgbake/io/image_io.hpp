@@ -19,6 +19,12 @@ namespace sgbake {
 /// again, or after the module was loaded, does nothing. Thread-safe.
 void preloadImageIo();
 
+/// @brief Waits until a load preloadImageIo started has finished; does nothing when none was
+/// started. A program that may exit soon after preloading (an early bad-input error) calls it
+/// before exiting: a process that exits while another thread is inside `dlopen` runs its exit
+/// handlers against half-initialized libraries. Thread-safe.
+void finishImageIoPreload();
+
 /// @brief The module's file: the environment variable `SGBAKE_IMAGE_IO_MODULE` when set and not
 /// empty, else `libsgbake_oiio.so` in the directory libsgbake was loaded from.
 std::filesystem::path imageIoModulePath();
