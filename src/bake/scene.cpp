@@ -331,7 +331,7 @@ std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key
 const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers", "outputs"};
 const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
                                                    "use_creases", "edge_creases", "vertex_creases",
-                                                   "quality"};
+                                                   "quality",     "use_limit_surface"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
@@ -500,6 +500,13 @@ SceneSubdivision parseSubdivision(const json& value) {
   if (reader.has("quality")) {
     subdivision.quality =
         reader.smallInteger("quality", kMinSubdivisionQuality, kMaxSubdivisionQuality);
+  }
+  if (reader.has("use_limit_surface")) {
+    subdivision.useLimitSurface = reader.boolean("use_limit_surface");
+    if (subdivision.limit && !subdivision.useLimitSurface) {
+      fail(reader.where(), "\"level\": \"limit\" shades the limit surface itself; it cannot be "
+                           "combined with \"use_limit_surface\": false");
+    }
   }
   return subdivision;
 }
@@ -1053,8 +1060,10 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
       subdivision.quality == SubdivisionOptions{}.quality
           ? std::string()
           : ", quality " + std::to_string(subdivision.quality);
+  const std::string refinement =
+      subdivision.useLimitSurface ? std::string() : ", without the limit surface";
   return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
-         nameIn(kBoundaries, subdivision.boundary) + creases + quality + ")";
+         nameIn(kBoundaries, subdivision.boundary) + creases + quality + refinement + ")";
 }
 
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
@@ -1076,6 +1085,7 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
   }
   // Likewise the quality, unless it is not the default.
   if (subdivision.quality != SubdivisionOptions{}.quality) j["quality"] = subdivision.quality;
+  if (!subdivision.useLimitSurface) j["use_limit_surface"] = false;
   return j.dump();
 }
 

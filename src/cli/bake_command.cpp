@@ -64,7 +64,8 @@ constexpr const char* kFooter =
     "    \"subdivision\": {\"level\": 2 (or \"limit\"), \"uv_smooth\": \"keep-boundaries\", "
     "\"boundary\": \"all\",\n"
     "                    \"use_creases\": true, \"edge_creases\": [[A, B, C], ...], "
-    "\"vertex_creases\": [[V, C], ...]},\n"
+    "\"vertex_creases\": [[V, C], ...],\n"
+    "                    \"quality\": 3, \"use_limit_surface\": true},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -122,7 +123,8 @@ const char* const kOneMapOptions[] = {
     "--samples", "--uv",           "--green",        "--height",    "--height-scale", "--filter",
     "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
     "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth",
-    "--edge-crease", "--vertex-crease", "--no-creases"};
+    "--edge-crease", "--vertex-crease", "--no-creases", "--subdivision-quality",
+    "--no-limit-surface"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 
@@ -334,6 +336,9 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   }
   if (oneMap && !args.outDir.empty()) {
     return Error::badInput("bake: --out-dir applies to scene files only");
+  }
+  if (Status ok = checkSubdivisionOptions("bake", args.subdivision, args.limitSurface); !ok) {
+    return ok;
   }
 
   Result<Scene> scene = oneMap ? oneMapScene(args) : loadScene(args.scene, args.outDir);

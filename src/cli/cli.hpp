@@ -71,6 +71,11 @@ extern const CLI::Validator kNonNegativeInteger;
 void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
                            const std::string& group = {}, bool* limit = nullptr);
 
+/// @brief What addSubdivisionOptions cannot check while parsing: --no-limit-surface with
+/// --subdivide limit (@p limit) is bad input, reported for @p command.
+Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
+                               bool limit);
+
 /// @brief Measures wall-clock seconds since construction or the last lap().
 class Stopwatch {
  public:

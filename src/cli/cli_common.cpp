@@ -213,12 +213,27 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
           ->type_name("N")
           ->check(CLI::Range(kMinSubdivisionQuality, kMaxSubdivisionQuality).description(""))
           ->capture_default_str();
+  options.useLimitSurface = true;
+  CLI::Option* const noLimitSurface = app.add_flag_callback(
+      "--no-limit-surface", [&options] { options.useLimitSurface = false; },
+      "Stop at the refined cage, its points not moved to the limit surface (the modifier's "
+      "Use Limit Surface off; --subdivision-quality is then unused)");
   if (!group.empty()) {  // CLI11 hides options of the empty group
-    for (CLI::Option* option :
-         {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases, quality}) {
+    for (CLI::Option* option : {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases,
+                                quality, noLimitSurface}) {
       option->group(group);
     }
   }
+}
+
+Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
+                               bool limit) {
+  if (limit && !options.useLimitSurface) {
+    return Error::badInput(command +
+                           ": --no-limit-surface cannot be combined with --subdivide limit, "
+                           "which shades the limit surface itself");
+  }
+  return Ok{};
 }
 
 ExitCode exitCodeFor(ErrorCode code) {

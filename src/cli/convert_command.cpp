@@ -84,6 +84,9 @@ Status runConvert(const ConvertArguments& args) {
   const ThreadLimit threadLimit(args.threads);
   preloadImageIo();  // the image codec loads while the arguments are checked and the mesh read
 
+  if (Status ok = checkSubdivisionOptions("convert", args.subdivision, args.limitSurface); !ok) {
+    return ok;
+  }
   Result<NormalSpace> from = parseNormalSpace(args.from);
   if (!from) return Error::badInput("convert: --from: " + from.error().message);
   Result<NormalSpace> to = parseNormalSpace(args.to);

@@ -24,10 +24,11 @@ using StencilPtr = std::unique_ptr<const StencilTable>;
 
 /// The stencils of every refined vertex (or face-varying value of @p channel, when not -1),
 /// each relative to the control mesh, as Blender builds them.
-StencilPtr refinedStencils(const Refiner& refiner, int channel) {
+StencilPtr refinedStencils(const Refiner& refiner, bool adaptive, int channel) {
   StencilTableFactory::Options options;
   options.generateOffsets = true;
-  options.generateIntermediateLevels = true;
+  // Uniform patches index the control points and the last level only.
+  options.generateIntermediateLevels = adaptive;
   if (channel >= 0) {
     options.interpolationMode = StencilTableFactory::INTERPOLATE_FACE_VARYING;
     options.fvarChannel = static_cast<unsigned>(channel);
@@ -51,23 +52,34 @@ void applyStencils(const StencilTable* stencils, int coarse, int width, std::vec
 
 }  // namespace
 
-PatchEvaluator::PatchEvaluator(ControlMesh& control, int quality) : ptex_(*control.refiner) {
+PatchEvaluator::PatchEvaluator(ControlMesh& control, Refinement refinement)
+    : ptex_(*control.refiner) {
   Refiner& refiner = *control.refiner;
   const int numChannels = refiner.GetNumFVarChannels();
-  Refiner::AdaptiveOptions adaptive(quality);
-  adaptive.considerFVarChannels = numChannels > 0;
-  adaptive.useInfSharpPatch = true;
-  refiner.RefineAdaptive(adaptive);
+  const int level = refinement.level;
+  if (refinement.adaptive) {
+    Refiner::AdaptiveOptions adaptive(level);
+    adaptive.considerFVarChannels = numChannels > 0;
+    adaptive.useInfSharpPatch = true;
+    refiner.RefineAdaptive(adaptive);
+  } else {
+    refiner.RefineUniform(Refiner::UniformOptions(level));
+  }
 
-  StencilPtr vertexStencils = refinedStencils(refiner, -1);
+  StencilPtr vertexStencils = refinedStencils(refiner, refinement.adaptive, -1);
   std::vector<StencilPtr> channelStencils;
-  for (int c = 0; c < numChannels; ++c) channelStencils.push_back(refinedStencils(refiner, c));
+  for (int c = 0; c < numChannels; ++c) {
+    channelStencils.push_back(refinedStencils(refiner, refinement.adaptive, c));
+  }
 
-  osd::Far::PatchTableFactory::Options options(quality);
+  osd::Far::PatchTableFactory::Options options(level);
   options.SetEndCapType(osd::Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
   options.useInfSharpPatch = true;
   options.generateFVarTables = numChannels > 0;
   options.generateFVarLegacyLinearPatches = false;
+  // Uniform patches: face-varying indices count the control values too, as vertex ones do
+  // (the values are stored control first, then the last level's).
+  options.includeFVarBaseLevelIndices = !refinement.adaptive;
   patches_.reset(osd::Far::PatchTableFactory::Create(refiner, options));
 
   // Local points (the end caps' control points) after the refined ones.

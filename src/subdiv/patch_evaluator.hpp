@@ -2,7 +2,9 @@
 /// @brief Private to src/subdiv: the limit surface evaluated the way Blender's Subdivision Surface
 /// modifier evaluates it, so that subdivideMesh's floats are Blender's, bit for bit.
 ///
-/// Blender does not use Bfr: it refines the control mesh adaptively to its "Quality" (3 unless set),
+/// Blender does not use Bfr: it refines the control mesh adaptively to its "Quality" (3 unless set;
+/// uniformly to the modifier's level when "Use Limit Surface" is off, then the patches are
+/// bilinear quads through the refined points),
 /// builds a Far patch table (Gregory-basis end caps, infinitely sharp patches, face-varying
 /// patches for the UVs), computes every patch point with Far stencil tables in float, and
 /// evaluates one point at a time with Osd's CPU evaluator at a Ptex face's (u, v). The patches
@@ -26,10 +28,19 @@ namespace sgbake::subdiv_detail {
 
 class PatchEvaluator {
  public:
-  /// The patches of @p control's topology isolated to level @p quality (Blender's "Quality"; its
-  /// refiner is refined adaptively here: Bfr cannot use it afterwards), with the control points
-  /// and face-varying values of @p control in float. Throws std::bad_alloc.
-  PatchEvaluator(ControlMesh& control, int quality);
+  /// How the control mesh is refined before its patches are built: Blender's
+  /// `SubdivSettings::is_adaptive` and `level`.
+  struct Refinement {
+    /// true: "Use Limit Surface" (refined adaptively: bicubic patches of the limit surface);
+    /// false: refined uniformly, the patches are the bilinear quads of the last level
+    bool adaptive = true;
+    int level = 3;  ///< adaptive: the "Quality"; uniform: the modifier's "Levels"
+  };
+
+  /// The patches of @p control's topology refined as @p refinement says (its refiner is refined
+  /// here: Bfr cannot use it afterwards), with the control points and face-varying values of
+  /// @p control in float. Throws std::bad_alloc.
+  PatchEvaluator(ControlMesh& control, Refinement refinement);
   ~PatchEvaluator();
   PatchEvaluator(const PatchEvaluator&) = delete;
   PatchEvaluator& operator=(const PatchEvaluator&) = delete;

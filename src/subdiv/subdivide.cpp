@@ -131,8 +131,8 @@ constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_
 /// The subdivided mesh (see subdivideMesh) of @p coarse as OpenSubdiv sees it (@p control),
 /// and where its corners lie on the limit surface when @p parameters is not null. Throws
 /// std::bad_alloc, or EvaluationFailed when no patch covers a point.
-Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level, int quality,
-                    SurfaceParameters* parameters);
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
+                    PatchEvaluator::Refinement refinement, SurfaceParameters* parameters);
 
 }  // namespace
 
@@ -174,7 +174,11 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
                            std::to_string(kMaxSubdividedCorners / 4) + ")");
   }
   try {
-    return subdivideGrids(coarse, *control, level, options.quality, parameters);
+    // Blender's SubdivSettings: adaptive to the Quality on the limit surface, else uniform.
+    const PatchEvaluator::Refinement refinement =
+        options.useLimitSurface ? PatchEvaluator::Refinement{true, options.quality}
+                                : PatchEvaluator::Refinement{false, level};
+    return subdivideGrids(coarse, *control, level, refinement, parameters);
   } catch (const EvaluationFailed&) {
     return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
   } catch (const std::bad_alloc&) {
@@ -185,8 +189,8 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
 
 namespace {
 
-Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level, int quality,
-                    SurfaceParameters* parameters) {
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
+                    PatchEvaluator::Refinement refinement, SurfaceParameters* parameters) {
   const Refiner* const refiner = control.refiner.get();
   const std::vector<FVarChannel>& channels = control.channels;
   const std::vector<int>& faceSizes = control.faceSizes;
@@ -257,7 +261,7 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level, int qua
     parameters->cornerSubFace.resize(4 * fineFaces);
     parameters->cornerCoord.resize(4 * fineFaces);
   }
-  const PatchEvaluator patches(control, quality);
+  const PatchEvaluator patches(control, refinement);
   tbb::enumerable_thread_specific<std::vector<Vec2f>> gridUvsTls;
   std::atomic<bool> failed{false};
   tbb::parallel_for(std::size_t{0}, nf, [&](std::size_t f) {

@@ -473,6 +473,29 @@ TEST(Scene, QualityIsParsedAndInTheParametersOnlyWhenNotTheDefault) {
             "scene.json: subdivision: quality 11 is out of range 1..10");
 }
 
+TEST(Scene, UseLimitSurfaceIsParsedAndInTheParametersOnlyWhenOff) {
+  const auto withSubdivision = [](const std::string& block) {
+    return R"({"mesh": "m.obj", "subdivision": )" + block +
+           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+  };
+  Result<Scene> scene =
+      parseScene(withSubdivision(R"({"level": 2, "use_limit_surface": false})"), options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_FALSE(scene->subdivision.options().useLimitSurface);
+  EXPECT_NE(describeSubdivision(scene->subdivision).find("without the limit surface"),
+            std::string::npos);
+  const std::string off = subdivisionParametersJson(scene->subdivision);
+  EXPECT_NE(off.find("\"use_limit_surface\":false"), std::string::npos) << off;
+  scene->subdivision.useLimitSurface = true;  // the default: the text of older scenes
+  EXPECT_EQ(subdivisionParametersJson(scene->subdivision).find("use_limit_surface"),
+            std::string::npos);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": "limit", "use_limit_surface": false})")),
+            "scene.json: subdivision: \"level\": \"limit\" shades the limit surface itself; "
+            "it cannot be combined with \"use_limit_surface\": false");
+  EXPECT_TRUE(parseScene(withSubdivision(R"({"level": "limit", "use_limit_surface": true})"),
+                         options()));
+}
+
 TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   // Every field away from its default, so that a field one side forgets shows.
   SubdivisionOptions o;
@@ -483,6 +506,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   o.edgeCreases = {{1, 2, 0.5f}};
   o.vertexCreases = {{3, 0.25f}};
   o.quality = 7;
+  o.useLimitSurface = false;
   const SceneSubdivision block = SceneSubdivision::of(o, false);
   EXPECT_TRUE(block.requested());
   EXPECT_FALSE(block.limitSurface());
@@ -496,6 +520,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   ASSERT_EQ(back.vertexCreases.size(), 1u);
   EXPECT_EQ(back.vertexCreases[0].crease, 0.25f);
   EXPECT_EQ(back.quality, o.quality);
+  EXPECT_EQ(back.useLimitSurface, o.useLimitSurface);
   EXPECT_TRUE(SceneSubdivision::of({0}, true).limitSurface());
   EXPECT_FALSE(SceneSubdivision::of({0}, false).requested());
 }

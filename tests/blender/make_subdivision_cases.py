@@ -174,12 +174,25 @@ QUALITY_CASES = [
     ("suzanne", 1, "SMOOTH_ALL", "ALL", True, 1),
     ("grid", 1, "PRESERVE_BOUNDARIES", "ALL", True, 6),
 ]
-ALL_CASES = [case + (3,) for case in CASES] + QUALITY_CASES
+# Cases with Use Limit Surface off: (mesh, level, uv_smooth, boundary_smooth, use_creases,
+# quality, use_limit_surface). The modifier then refines the cage uniformly `level` times and
+# keeps the refined points (Quality unused): quads and triangles, n-gons, creases, an open
+# boundary with its corners kept, UVs linear.
+LIMIT_OFF_CASES = [
+    ("suzanne", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, False),
+    ("cylinder", 1, "SMOOTH_ALL", "ALL", True, 3, False),
+    ("cube_creased", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, False),
+    ("grid", 2, "NONE", "PRESERVE_CORNERS", True, 3, False),
+]
+ALL_CASES = ([case + (3, True) for case in CASES] + [case + (True,) for case in QUALITY_CASES]
+             + LIMIT_OFF_CASES)
 
 
-def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True, quality=3):
+def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True, quality=3,
+             use_limit_surface=True):
     return (f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
-            + ("" if use_creases else "_nocreases") + ("" if quality == 3 else f"_Q{quality}"))
+            + ("" if use_creases else "_nocreases") + ("" if quality == 3 else f"_Q{quality}")
+            + ("" if use_limit_surface else "_nolimit"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -212,10 +225,11 @@ def write_coarse(name, ob, out_dir):
 
 
 def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-               out_dir):
+               use_limit_surface, out_dir):
     """Evaluates the object with the modifier set to the case; writes TAG.npz."""
     import numpy as np
 
+    mod.use_limit_surface = use_limit_surface
     mod.quality = quality
     mod.levels = level
     mod.render_levels = level
@@ -229,14 +243,16 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
     me.calc_tangents(uvmap=me.uv_layers.active.name)
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
-    tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases, quality)
+    tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
+                   use_limit_surface)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
              uvs=arrays["uvs"], normals=arrays["normals"], tangents=tangents, signs=signs,
              smooth=np.array([p.use_smooth for p in me.polygons], dtype=bool))
     info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
             "boundary_smooth": boundary_smooth, "use_creases": use_creases,
-            "quality": quality, "vertices": len(me.vertices),
+            "quality": quality, "use_limit_surface": use_limit_surface,
+            "vertices": len(me.vertices),
             "faces": len(me.polygons), "corners": len(me.loops)}
     bpy.data.meshes.remove(me)
     return info
@@ -263,12 +279,10 @@ def main():
         manifest["meshes"][name] = write_coarse(name, ob, out_dir)
         mod = ob.modifiers.new("Subdivision", "SUBSURF")
         mod.subdivision_type = "CATMULL_CLARK"
-        mod.use_limit_surface = True
-        for mesh, level, uv_smooth, boundary_smooth, use_creases, quality in ALL_CASES:
-            if mesh != name:
+        for case in ALL_CASES:
+            if case[0] != name:
                 continue
-            info = write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases,
-                              quality, out_dir)
+            info = write_case(ob, mod, *case, out_dir)
             manifest["cases"].append(info)
             print("case %-45s vertices %6d faces %6d corners %6d"
                   % (info["tag"], info["vertices"], info["faces"], info["corners"]))

@@ -9,13 +9,14 @@
    with n-gon caps; a wavy open grid; creased copies of the cube, Suzanne and the cylinder,
    with Edge and Vertex Creases; the cube and Suzanne with some faces flat-shaded, marked with
    `s 0` / `s 1`) as OBJ, with their creases in cases.json, and, for each case
-   (mesh, level, UV Smooth, Boundary Smooth, Use Creases), the mesh Blender's modifier makes
-   (Catmull-Clark, Use Limit Surface on) with its MikkTSpace tangents (`Mesh.calc_tangents()`)
+   (mesh, level, UV Smooth, Boundary Smooth, Use Creases, Quality, Use Limit Surface), the mesh
+   Blender's modifier makes (Catmull-Clark) with its MikkTSpace tangents (`Mesh.calc_tangents()`)
    as NPZ.
 2. For each case runs
      sgbake tangents MESH.obj --subdivide L --uv-smooth U --boundary-smooth B
                     [--edge-crease A,B,C ... --vertex-crease V,C ... (the mesh's creases)]
-                    [--no-creases (Use Creases off)]
+                    [--no-creases (Use Creases off)] [--subdivision-quality Q]
+                    [--no-limit-surface (Use Limit Surface off)]
                     --mesh-out TAG.sgbake.obj -o TAG.sgbake.csv
    and compares sgbake's subdivided mesh and tangents with Blender's (numpy, no Blender; when
    the python3 running this has no numpy, e.g. a pyenv one under CTest, it hands the comparison
@@ -52,7 +53,9 @@
                 Blender's 10 c^2, against the creased cube (level 1): the position check must
                 fail (0.20 off);
      quality    sgbake at the default Quality 3 against Blender's creased cube at Quality 5
-                (level 2): the position check must fail.
+                (level 2): the position check must fail;
+     limit surface  sgbake on the limit surface against Blender's Suzanne with Use Limit
+                Surface off (level 2): the position check must fail.
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -116,6 +119,8 @@ CONTROLS = [
      "normals"),
     ("quality", "cube_creased_L2_PRESERVE_BOUNDARIES_ALL_Q5", {"--subdivision-quality": None},
      "positions"),
+    ("limit surface", "suzanne_L2_PRESERVE_BOUNDARIES_ALL_nolimit", {"--no-limit-surface": None},
+     "positions"),
 ]
 
 
@@ -175,6 +180,8 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
         options["--no-creases"] = ""
     if case.get("quality", 3) != 3:
         options["--subdivision-quality"] = str(case["quality"])
+    if not case.get("use_limit_surface", True):
+        options["--no-limit-surface"] = ""
     options.update(overrides)
     obj = os.path.join(work, out_name + ".sgbake.obj")
     csv = os.path.join(work, out_name + ".sgbake.csv")

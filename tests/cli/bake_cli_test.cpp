@@ -417,6 +417,20 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
                                   "--no-manifest", "-o", (dir_ / "limit_flag.exr").string()});
   ASSERT_EQ(flag.exitCode, 0) << flag.err;
   EXPECT_TRUE(readPixels(dir_ / "limit_flag.exr") == limit);
+  // "use_limit_surface": false (the refined cage, not the limit) is another bake; the flag
+  // --no-limit-surface gives the same file.
+  const std::string cageScene =
+      R"({"mesh": "cube.obj", "subdivision": {"level": 2, "use_limit_surface": false}, )"
+      R"("outputs": [{"map": "object-normal", "file": "cage.exr", "size": 64, "margin": 0, )"
+      R"("bit_depth": 32}]})";
+  ASSERT_EQ(bakeScene(cageScene).exitCode, 0);
+  EXPECT_FALSE(readPixels(dir_ / "cage.exr") == l2);
+  const ProcessResult cageFlag =
+      run({"bake", "--mesh", mesh, "--map", "object-normal", "--size", "64", "--margin", "0",
+           "--bit-depth", "32", "--subdivide", "2", "--no-limit-surface", "--no-manifest", "-o",
+           (dir_ / "cage_flag.exr").string()});
+  ASSERT_EQ(cageFlag.exitCode, 0) << cageFlag.err;
+  EXPECT_TRUE(readPixels(dir_ / "cage_flag.exr") == readPixels(dir_ / "cage.exr"));
   // A different level is a different bake (the manifest hashes the subdivision block).
   const ProcessResult same = bakeScene(scene(2, "l2.exr"));
   EXPECT_NE(same.out.find("up to date: " + (dir_ / "l2.exr").string()), std::string::npos)
@@ -447,12 +461,25 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
            {"convert", "--mesh", mesh, "--subdivide", "1", "--boundary-smooth", "none", "--from",
             "object", "--to", "tangent", (dir_ / "l0.exr").string(), "-o",
             (dir_ / "c.exr").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "limit", "--no-limit-surface", "-o",
+            (dir_ / "o.png").string()},
+           {"convert", "--mesh", mesh, "--subdivide", "limit", "--no-limit-surface", "--from",
+            "object", "--to", "tangent", (dir_ / "l0.exr").string(), "-o",
+            (dir_ / "c.exr").string()},
+           // Subdivision flags belong to the one-map shorthand, not to a scene file.
+           {"bake", (dir_ / "scene.json").string(), "--subdivision-quality", "5"},
+           {"bake", (dir_ / "scene.json").string(), "--no-limit-surface"},
        }) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args[2] << ": " << r.err;
     expectOneErrorLine(r);
   }
   EXPECT_EQ(listDirectory(dir_), before);
+  const ProcessResult both = run({"bake", "--mesh", mesh, "--subdivide", "limit",
+                                  "--no-limit-surface", "-o", (dir_ / "o.png").string()});
+  EXPECT_NE(both.err.find("bake: --no-limit-surface cannot be combined with --subdivide limit"),
+            std::string::npos)
+      << both.err;
 }
 
 TEST_F(BakeCliTest, CreasesFromSceneAndFlags) {

@@ -187,6 +187,36 @@ TEST(Subdivide, LinearUvsInterpolateEachFaceBilinearly) {
   }
 }
 
+TEST(Subdivide, WithoutTheLimitSurfaceThePointsAreTheRefinedCage) {
+  // "Use Limit Surface" off: one round of Catmull-Clark on the cube [-1,1]³, the points not
+  // moved to the limit. Corner (1,1,1): (Q + 2R + (n-3)S)/n with n = 3, Q the mean of the face
+  // points (1/3 each), R of the edge midpoints (2/3 each): 5/9. Edge (1,1,1)-(1,-1,1): the mean
+  // of its ends and its two face points, (3/4, 0, 3/4). Face +z: its centre (0, 0, 1).
+  SubdivisionOptions options{1, SubdivisionUvSmooth::kNone};
+  options.useLimitSurface = false;
+  Result<Mesh> cage = subdivideMesh(cube(), options);
+  ASSERT_TRUE(cage) << cage.error().message;
+  EXPECT_NEAR(length(at(*cage, 6) - Vec3d{5.0 / 9, 5.0 / 9, 5.0 / 9}), 0.0, 1e-6);
+  EXPECT_NEAR(nearest(*cage, {0.75, 0, 0.75}).second, 0.0, 1e-6);
+  EXPECT_NEAR(nearest(*cage, {0, 0, 1}).second, 0.0, 1e-6);
+  // On the limit surface the corner lies elsewhere: the option changes the result.
+  Result<Mesh> limit = subdivideMesh(cube(), {1, SubdivisionUvSmooth::kNone});
+  ASSERT_TRUE(limit) << limit.error().message;
+  EXPECT_GT(length(at(*limit, 6) - at(*cage, 6)), 0.05);
+  EXPECT_EQ(limit->numFaces(), cage->numFaces());
+  // Level 2 refines the level-1 cage once more: its corner is (Q + 2R)/3 of the level-1 cage's
+  // valence-3 corner, and the Quality is not used (Blender greys it out).
+  options.level = 2;
+  Result<Mesh> two = subdivideMesh(cube(), options);
+  ASSERT_TRUE(two) << two.error().message;
+  EXPECT_LT(length(at(*two, 6)), length(at(*cage, 6)));
+  options.quality = 7;
+  Result<Mesh> otherQuality = subdivideMesh(cube(), options);
+  ASSERT_TRUE(otherQuality) << otherQuality.error().message;
+  EXPECT_EQ(otherQuality->positions, two->positions);
+  EXPECT_EQ(otherQuality->uvSets[0].uvs, two->uvSets[0].uvs);
+}
+
 TEST(Subdivide, CornersWithNearlyEqualUvsShareTheLastCornersUv) {
   // Two quads side by side; the second gives the shared vertices 1 and 4 UVs 1e-5 away from the
   // first's (within Blender's 1e-4 connect limit): one face-varying value per vertex, whose

@@ -71,6 +71,10 @@ struct SubdivisionOptions {
   /// to which the patches isolate irregular and semi-sharp features (3, a new modifier's, unless
   /// set); higher follows the exact limit more closely there.
   int quality = 3;
+  /// Blender's "Use Limit Surface" (on in a new modifier). Off, the points are those of
+  /// `level` rounds of Catmull-Clark refinement, not moved to the limit, and `quality` is
+  /// unused (Blender greys it out).
+  bool useLimitSurface = true;
 };
 
 /// @brief The range of SubdivisionOptions::quality (Blender's "Quality" field).
@@ -110,8 +114,8 @@ struct SurfaceParameters {
   std::vector<Vec2f> cornerCoord;            ///< per new corner: (s, t) ∈ [0,1]² on that sub-face
 };
 
-/// @brief The mesh Blender's Subdivision Surface modifier makes of @p coarse (Catmull-Clark,
-/// "Use Limit Surface" on, as a new modifier has it), with every UV set subdivided.
+/// @brief The mesh Blender's Subdivision Surface modifier makes of @p coarse (Catmull-Clark),
+/// with every UV set subdivided.
 ///
 /// What Blender does, and so this:
 ///  - Each quad becomes a (2^level)² grid of quads; any other face of n corners becomes n
@@ -125,6 +129,9 @@ struct SurfaceParameters {
 ///    same UV winding) share one face-varying value, the UV of the last of them.
 ///  - Each new quad starts at the corner nearest its face's first corner in the face's own
 ///    parameterization, so that it splits into triangles along the same diagonal as Blender's.
+///  - With "Use Limit Surface" off (SubdivisionOptions::useLimitSurface), the control mesh is
+///    refined uniformly `level` times instead and every vertex and UV is the refined point, as
+///    Blender's bilinear patches over that level give it.
 ///  - Edge and vertex creases (when useCreases) become OpenSubdiv sharpness creaseSharpness(c)
 ///    of the edge or vertex, with uniform creasing, as Blender's converter sets them.
 ///  - Each new face keeps its coarse face's flat/smooth flag (Mesh::faceFlat). Corners of smooth
