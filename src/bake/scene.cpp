@@ -331,7 +331,8 @@ std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key
 const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers", "outputs"};
 const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
                                                    "use_creases", "edge_creases", "vertex_creases",
-                                                   "quality",     "use_limit_surface"};
+                                                   "quality",     "use_limit_surface",
+                                                   "type"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
@@ -492,6 +493,7 @@ SceneSubdivision parseSubdivision(const json& value) {
       subdivision.level = reader.smallInteger("level", 0, 6);
     }
   }
+  reader.optionalName("type", kSubdivisionTypeNames, subdivision.type);
   reader.optionalName("uv_smooth", kUvSmooths, subdivision.uvSmooth);
   reader.optionalName("boundary", kBoundaries, subdivision.boundary);
   if (reader.has("use_creases")) subdivision.useCreases = reader.boolean("use_creases");
@@ -500,6 +502,10 @@ SceneSubdivision parseSubdivision(const json& value) {
   if (reader.has("quality")) {
     subdivision.quality =
         reader.smallInteger("quality", kMinSubdivisionQuality, kMaxSubdivisionQuality);
+  }
+  if (subdivision.limit && subdivision.type == SubdivisionType::kSimple) {
+    fail(reader.where(), "\"level\": \"limit\" is the Catmull-Clark limit surface; it cannot "
+                         "be combined with \"type\": \"simple\"");
   }
   if (reader.has("use_limit_surface")) {
     subdivision.useLimitSurface = reader.boolean("use_limit_surface");
@@ -1061,7 +1067,8 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
           ? std::string()
           : ", quality " + std::to_string(subdivision.quality);
   const std::string refinement =
-      subdivision.useLimitSurface ? std::string() : ", without the limit surface";
+      std::string(subdivision.useLimitSurface ? "" : ", without the limit surface") +
+      (subdivision.type == SubdivisionType::kSimple ? ", simple" : "");
   return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
          nameIn(kBoundaries, subdivision.boundary) + creases + quality + refinement + ")";
 }
@@ -1086,6 +1093,9 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
   // Likewise the quality, unless it is not the default.
   if (subdivision.quality != SubdivisionOptions{}.quality) j["quality"] = subdivision.quality;
   if (!subdivision.useLimitSurface) j["use_limit_surface"] = false;
+  if (subdivision.type != SubdivisionType::kCatmullClark) {
+    j["type"] = nameIn(kSubdivisionTypeNames, subdivision.type);
+  }
   return j.dump();
 }
 

@@ -65,7 +65,8 @@ constexpr const char* kFooter =
     "\"boundary\": \"all\",\n"
     "                    \"use_creases\": true, \"edge_creases\": [[A, B, C], ...], "
     "\"vertex_creases\": [[V, C], ...],\n"
-    "                    \"quality\": 3, \"use_limit_surface\": true},\n"
+    "                    \"quality\": 3, \"use_limit_surface\": true, \"type\": "
+    "\"catmull-clark\"},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -124,7 +125,7 @@ const char* const kOneMapOptions[] = {
     "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
     "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth",
     "--edge-crease", "--vertex-crease", "--no-creases", "--subdivision-quality",
-    "--no-limit-surface"};
+    "--no-limit-surface", "--subdivision-type"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 

@@ -213,6 +213,12 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
           ->type_name("N")
           ->check(CLI::Range(kMinSubdivisionQuality, kMaxSubdivisionQuality).description(""))
           ->capture_default_str();
+  CLI::Option* const type = app.add_option("--subdivision-type", options.type,
+                 "The modifier's type: catmull-clark, simple (faces split, shape kept)")
+      ->type_name("NAME")
+      ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionTypeNames), CLI::ignore_case)
+                      .description(""))
+      ->default_str("catmull-clark");
   options.useLimitSurface = true;
   CLI::Option* const noLimitSurface = app.add_flag_callback(
       "--no-limit-surface", [&options] { options.useLimitSurface = false; },
@@ -220,7 +226,7 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
       "Use Limit Surface off; --subdivision-quality is then unused)");
   if (!group.empty()) {  // CLI11 hides options of the empty group
     for (CLI::Option* option : {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases,
-                                quality, noLimitSurface}) {
+                                quality, noLimitSurface, type}) {
       option->group(group);
     }
   }
@@ -232,6 +238,11 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
     return Error::badInput(command +
                            ": --no-limit-surface cannot be combined with --subdivide limit, "
                            "which shades the limit surface itself");
+  }
+  if (limit && options.type == SubdivisionType::kSimple) {
+    return Error::badInput(command +
+                           ": --subdivision-type simple cannot be combined with --subdivide "
+                           "limit, the Catmull-Clark limit surface");
   }
   return Ok{};
 }

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -145,7 +146,33 @@ struct Creases {
   std::vector<float> vertexSharpness;
 };
 
-Creases farCreases(const SubdivisionOptions& options) {
+/// Blender's "Simple" subdivision: Catmull-Clark with every edge and vertex infinitely sharp
+/// (measured against Blender 3.4: not OpenSubdiv's bilinear scheme, which places the points
+/// inside n-gons and triangles elsewhere), whatever the creases.
+Creases allInfinitelySharp(const Mesh& coarse) {
+  constexpr float kInfinitelySharp = 10.0f;  // Sdc's SHARPNESS_INFINITE
+  Creases creases;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::size_t f = 0; f < coarse.numFaces(); ++f) {
+    const std::size_t n = coarse.faceSize(f);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t a = coarse.cornerVertex[coarse.faceStart[f] + k];
+      const std::uint32_t b = coarse.cornerVertex[coarse.faceStart[f] + (k + 1) % n];
+      if (!edges.insert(std::minmax(a, b)).second) continue;
+      creases.edgeVertices.push_back(static_cast<int>(a));
+      creases.edgeVertices.push_back(static_cast<int>(b));
+      creases.edgeSharpness.push_back(kInfinitelySharp);
+    }
+  }
+  for (std::size_t v = 0; v < coarse.numVertices(); ++v) {
+    creases.vertices.push_back(static_cast<int>(v));
+    creases.vertexSharpness.push_back(kInfinitelySharp);
+  }
+  return creases;
+}
+
+Creases farCreases(const Mesh& coarse, const SubdivisionOptions& options) {
+  if (options.type == SubdivisionType::kSimple) return allInfinitelySharp(coarse);
   Creases creases;
   if (!options.useCreases) return creases;
   for (const EdgeCrease& edge : options.edgeCreases) {
@@ -277,7 +304,7 @@ Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOption
   descriptor.numFVarChannels = static_cast<int>(fvarDescriptors.size());
   descriptor.fvarChannels = fvarDescriptors.empty() ? nullptr : fvarDescriptors.data();
   // Creases: Blender hands OpenSubdiv the sharpness of every edge and vertex; zero is no crease.
-  const Creases creases = farCreases(options);
+  const Creases creases = farCreases(coarse, options);
   descriptor.numCreases = static_cast<int>(creases.edgeSharpness.size());
   descriptor.creaseVertexIndexPairs =
       creases.edgeVertices.empty() ? nullptr : creases.edgeVertices.data();

@@ -175,9 +175,10 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
   }
   try {
     // Blender's SubdivSettings: adaptive to the Quality on the limit surface, else uniform.
-    const PatchEvaluator::Refinement refinement =
-        options.useLimitSurface ? PatchEvaluator::Refinement{true, options.quality}
-                                : PatchEvaluator::Refinement{false, level};
+    // (Simple: refined to level 1, whichever way.)
+    const int refinementLevel =
+        options.type == SubdivisionType::kSimple ? 1 : (options.useLimitSurface ? options.quality : level);
+    const PatchEvaluator::Refinement refinement{options.useLimitSurface, refinementLevel};
     return subdivideGrids(coarse, *control, level, refinement, parameters);
   } catch (const EvaluationFailed&) {
     return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");

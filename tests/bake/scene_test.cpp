@@ -496,6 +496,26 @@ TEST(Scene, UseLimitSurfaceIsParsedAndInTheParametersOnlyWhenOff) {
                          options()));
 }
 
+TEST(Scene, SubdivisionTypeIsParsedAndInTheParametersOnlyWhenSimple) {
+  const auto withSubdivision = [](const std::string& block) {
+    return R"({"mesh": "m.obj", "subdivision": )" + block +
+           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+  };
+  Result<Scene> scene = parseScene(withSubdivision(R"({"level": 2, "type": "simple"})"), options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->subdivision.options().type, SubdivisionType::kSimple);
+  EXPECT_NE(describeSubdivision(scene->subdivision).find("simple"), std::string::npos);
+  const std::string simple = subdivisionParametersJson(scene->subdivision);
+  EXPECT_NE(simple.find("\"type\":\"simple\""), std::string::npos) << simple;
+  scene->subdivision.type = SubdivisionType::kCatmullClark;  // the default: older scenes' text
+  EXPECT_EQ(subdivisionParametersJson(scene->subdivision).find("type"), std::string::npos);
+  EXPECT_NE(parseError(withSubdivision(R"({"level": 2, "type": "smooth"})")).find("smooth"),
+            std::string::npos);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": "limit", "type": "simple"})")),
+            "scene.json: subdivision: \"level\": \"limit\" is the Catmull-Clark limit "
+            "surface; it cannot be combined with \"type\": \"simple\"");
+}
+
 TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   // Every field away from its default, so that a field one side forgets shows.
   SubdivisionOptions o;
@@ -507,6 +527,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   o.vertexCreases = {{3, 0.25f}};
   o.quality = 7;
   o.useLimitSurface = false;
+  o.type = SubdivisionType::kSimple;
   const SceneSubdivision block = SceneSubdivision::of(o, false);
   EXPECT_TRUE(block.requested());
   EXPECT_FALSE(block.limitSurface());
@@ -521,6 +542,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   EXPECT_EQ(back.vertexCreases[0].crease, 0.25f);
   EXPECT_EQ(back.quality, o.quality);
   EXPECT_EQ(back.useLimitSurface, o.useLimitSurface);
+  EXPECT_EQ(back.type, o.type);
   EXPECT_TRUE(SceneSubdivision::of({0}, true).limitSurface());
   EXPECT_FALSE(SceneSubdivision::of({0}, false).requested());
 }

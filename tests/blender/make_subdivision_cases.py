@@ -184,15 +184,25 @@ LIMIT_OFF_CASES = [
     ("cube_creased", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, False),
     ("grid", 2, "NONE", "PRESERVE_CORNERS", True, 3, False),
 ]
-ALL_CASES = ([case + (3, True) for case in CASES] + [case + (True,) for case in QUALITY_CASES]
-             + LIMIT_OFF_CASES)
+# Cases of subdivision type Simple (faces split, the cage's shape kept; creases and Quality
+# unused), with (…, use_limit_surface, subdivision_type) last: n-gons and triangles, creases
+# (which must make no difference), UVs smoothed (which must not be), limit surface off.
+SIMPLE_CASES = [
+    ("suzanne", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "SIMPLE"),
+    ("cylinder_creased", 2, "SMOOTH_ALL", "ALL", True, 3, True, "SIMPLE"),
+    ("grid", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, False, "SIMPLE"),
+]
+ALL_CASES = ([case + (3, True, "CATMULL_CLARK") for case in CASES]
+             + [case + (True, "CATMULL_CLARK") for case in QUALITY_CASES]
+             + [case + ("CATMULL_CLARK",) for case in LIMIT_OFF_CASES] + SIMPLE_CASES)
 
 
 def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True, quality=3,
-             use_limit_surface=True):
+             use_limit_surface=True, subdivision_type="CATMULL_CLARK"):
     return (f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
             + ("" if use_creases else "_nocreases") + ("" if quality == 3 else f"_Q{quality}")
-            + ("" if use_limit_surface else "_nolimit"))
+            + ("" if use_limit_surface else "_nolimit")
+            + ("" if subdivision_type == "CATMULL_CLARK" else "_simple"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -225,10 +235,11 @@ def write_coarse(name, ob, out_dir):
 
 
 def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-               use_limit_surface, out_dir):
+               use_limit_surface, subdivision_type, out_dir):
     """Evaluates the object with the modifier set to the case; writes TAG.npz."""
     import numpy as np
 
+    mod.subdivision_type = subdivision_type
     mod.use_limit_surface = use_limit_surface
     mod.quality = quality
     mod.levels = level
@@ -244,7 +255,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
     tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-                   use_limit_surface)
+                   use_limit_surface, subdivision_type)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
              uvs=arrays["uvs"], normals=arrays["normals"], tangents=tangents, signs=signs,
@@ -252,6 +263,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
     info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
             "boundary_smooth": boundary_smooth, "use_creases": use_creases,
             "quality": quality, "use_limit_surface": use_limit_surface,
+            "subdivision_type": subdivision_type,
             "vertices": len(me.vertices),
             "faces": len(me.polygons), "corners": len(me.loops)}
     bpy.data.meshes.remove(me)
@@ -278,7 +290,6 @@ def main():
                 ob.data.polygons[f].use_smooth = False
         manifest["meshes"][name] = write_coarse(name, ob, out_dir)
         mod = ob.modifiers.new("Subdivision", "SUBSURF")
-        mod.subdivision_type = "CATMULL_CLARK"
         for case in ALL_CASES:
             if case[0] != name:
                 continue

@@ -9,20 +9,21 @@
    with n-gon caps; a wavy open grid; creased copies of the cube, Suzanne and the cylinder,
    with Edge and Vertex Creases; the cube and Suzanne with some faces flat-shaded, marked with
    `s 0` / `s 1`) as OBJ, with their creases in cases.json, and, for each case
-   (mesh, level, UV Smooth, Boundary Smooth, Use Creases, Quality, Use Limit Surface), the mesh
-   Blender's modifier makes (Catmull-Clark) with its MikkTSpace tangents (`Mesh.calc_tangents()`)
+   (mesh, level, UV Smooth, Boundary Smooth, Use Creases, Quality, Use Limit Surface, type
+   Catmull-Clark or Simple), the mesh Blender's modifier makes with its MikkTSpace tangents (`Mesh.calc_tangents()`)
    as NPZ.
 2. For each case runs
      sgbake tangents MESH.obj --subdivide L --uv-smooth U --boundary-smooth B
                     [--edge-crease A,B,C ... --vertex-crease V,C ... (the mesh's creases)]
                     [--no-creases (Use Creases off)] [--subdivision-quality Q]
-                    [--no-limit-surface (Use Limit Surface off)]
+                    [--no-limit-surface (Use Limit Surface off)] [--subdivision-type simple]
                     --mesh-out TAG.sgbake.obj -o TAG.sgbake.csv
    and compares sgbake's subdivided mesh and tangents with Blender's (numpy, no Blender; when
    the python3 running this has no numpy, e.g. a pyenv one under CTest, it hands the comparison
    to Blender's own Python interpreter, which has numpy, as `--compare-only DIR`):
      counts     the same numbers of vertices and faces;
-     vertices   each sgbake vertex's nearest Blender vertex is a different one (bijective);
+     vertices   each sgbake vertex's nearest Blender vertex is a different one (bijective;
+                vertices at exactly the same place on both sides are paired in index order);
      positions  every vertex is Blender's float32, bit for bit (sgbake evaluates Blender's
                 way: Far patches refined to Quality 3, Osd's CPU evaluator in float, the
                 same Ptex face and (u, v) for every point; see docs/subdivision.md);
@@ -55,7 +56,9 @@
      quality    sgbake at the default Quality 3 against Blender's creased cube at Quality 5
                 (level 2): the position check must fail;
      limit surface  sgbake on the limit surface against Blender's Suzanne with Use Limit
-                Surface off (level 2): the position check must fail.
+                Surface off (level 2): the position check must fail;
+     simple     sgbake's Catmull-Clark against Blender's Simple creased cylinder (level 2): the
+                position check must fail.
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -121,6 +124,8 @@ CONTROLS = [
      "positions"),
     ("limit surface", "suzanne_L2_PRESERVE_BOUNDARIES_ALL_nolimit", {"--no-limit-surface": None},
      "positions"),
+    ("simple", "cylinder_creased_L2_SMOOTH_ALL_ALL_simple", {"--subdivision-type": None},
+     "positions"),
 ]
 
 
@@ -182,6 +187,8 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
         options["--subdivision-quality"] = str(case["quality"])
     if not case.get("use_limit_surface", True):
         options["--no-limit-surface"] = ""
+    if case.get("subdivision_type", "CATMULL_CLARK") == "SIMPLE":
+        options["--subdivision-type"] = "simple"
     options.update(overrides)
     obj = os.path.join(work, out_name + ".sgbake.obj")
     csv = os.path.join(work, out_name + ".sgbake.csv")
@@ -283,6 +290,23 @@ def nearest(points, reference):
     return index, np.linalg.norm(points - reference[index], axis=1)
 
 
+def split_coincident(points, reference, index):
+    """Where several points took the same nearest reference point and the reference has
+    exactly that many points at that place (coincident vertices, e.g. Suzanne's two pairs, kept
+    coincident by Simple subdivision), pairs them in index order: position cannot tell them
+    apart, and both meshes number vertices in the same order."""
+    import numpy as np
+    index = index.copy()
+    points, reference = points.astype(np.float32), reference.astype(np.float32)
+    targets, counts = np.unique(index, return_counts=True)
+    for target in targets[counts > 1]:
+        mine = np.flatnonzero(index == target)
+        theirs = np.flatnonzero((reference == reference[target]).all(1))
+        if len(theirs) == len(mine) and (points[mine] == reference[target]).all():
+            index[mine] = theirs
+    return index
+
+
 def angles_deg(a, b):
     """Angles between the rows of a and b in degrees, accurate for tiny angles (atan2)."""
     import numpy as np
@@ -309,6 +333,8 @@ def compare(case, ref, obj, csv):
 
     # Vertices: nearest Blender vertex, bijective; positions relative to the bbox diagonal.
     index, dist = nearest(P, BP)
+    index = split_coincident(P, BP, index)
+    dist = np.linalg.norm(P - BP[index], axis=1)
     matched = len(np.unique(index))
     if matched != len(P):
         failures.append(("vertices", f"{len(P) - matched} sgbake vertices share their nearest "

@@ -431,6 +431,20 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
            (dir_ / "cage_flag.exr").string()});
   ASSERT_EQ(cageFlag.exitCode, 0) << cageFlag.err;
   EXPECT_TRUE(readPixels(dir_ / "cage_flag.exr") == readPixels(dir_ / "cage.exr"));
+  // "type": "simple" (the cube split, not rounded) is another bake; --subdivision-type simple
+  // gives the same file.
+  const std::string simpleScene =
+      R"({"mesh": "cube.obj", "subdivision": {"level": 2, "type": "simple"}, )"
+      R"("outputs": [{"map": "object-normal", "file": "simple.exr", "size": 64, "margin": 0, )"
+      R"("bit_depth": 32}]})";
+  ASSERT_EQ(bakeScene(simpleScene).exitCode, 0);
+  EXPECT_FALSE(readPixels(dir_ / "simple.exr") == l2);
+  const ProcessResult simpleFlag =
+      run({"bake", "--mesh", mesh, "--map", "object-normal", "--size", "64", "--margin", "0",
+           "--bit-depth", "32", "--subdivide", "2", "--subdivision-type", "simple",
+           "--no-manifest", "-o", (dir_ / "simple_flag.exr").string()});
+  ASSERT_EQ(simpleFlag.exitCode, 0) << simpleFlag.err;
+  EXPECT_TRUE(readPixels(dir_ / "simple_flag.exr") == readPixels(dir_ / "simple.exr"));
   // A different level is a different bake (the manifest hashes the subdivision block).
   const ProcessResult same = bakeScene(scene(2, "l2.exr"));
   EXPECT_NE(same.out.find("up to date: " + (dir_ / "l2.exr").string()), std::string::npos)
@@ -469,6 +483,10 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
            // Subdivision flags belong to the one-map shorthand, not to a scene file.
            {"bake", (dir_ / "scene.json").string(), "--subdivision-quality", "5"},
            {"bake", (dir_ / "scene.json").string(), "--no-limit-surface"},
+           {"bake", "--mesh", mesh, "--subdivide", "limit", "--subdivision-type", "simple", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "1", "--subdivision-type", "smooth", "-o",
+            (dir_ / "o.png").string()},
        }) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args[2] << ": " << r.err;

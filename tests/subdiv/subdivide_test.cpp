@@ -333,6 +333,30 @@ double deepestInsideCube(const Mesh& mesh) {
   return deepest;
 }
 
+TEST(Subdivide, SimpleSplitsFacesAndKeepsTheShapeWhateverTheCreases) {
+  // Blender's "Simple": the cube stays the cube. Every new point lies on a face of [-1,1]³, the
+  // corners stay put, and the middle of face +z's grid is its centre; creases change nothing.
+  SubdivisionOptions options{2};
+  options.type = SubdivisionType::kSimple;
+  Result<Mesh> simple = subdivideMesh(cube(), options);
+  ASSERT_TRUE(simple) << simple.error().message;
+  ASSERT_EQ(simple->numFaces(), 6u * 16u);
+  for (std::size_t v = 0; v < simple->numVertices(); ++v) {
+    const Vec3d p = at(*simple, static_cast<std::uint32_t>(v));
+    const double face = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    EXPECT_NEAR(face, 1.0, 1e-6) << "vertex " << v;
+  }
+  EXPECT_NEAR(length(at(*simple, 6) - Vec3d{1, 1, 1}), 0.0, 1e-6);
+  EXPECT_NEAR(nearest(*simple, {0, 0, 1}).second, 0.0, 1e-6);
+  Result<Mesh> creased = subdivideMesh(cube(), creasedEdges(cube(), options, 0.3f));
+  ASSERT_TRUE(creased) << creased.error().message;
+  EXPECT_EQ(creased->positions, simple->positions);
+  // Catmull-Clark rounds the same cube.
+  Result<Mesh> smooth = subdivideMesh(cube(), {2});
+  ASSERT_TRUE(smooth) << smooth.error().message;
+  EXPECT_GT(length(at(*smooth, 6) - at(*simple, 6)), 0.1);
+}
+
 TEST(SubdivideCreases, SharpnessIsBlendersTenTimesCreaseSquared) {
   EXPECT_EQ(creaseSharpness(0.0f), 0.0f);
   EXPECT_EQ(creaseSharpness(1.0f), 10.0f);  // Sdc's SHARPNESS_INFINITE

@@ -32,6 +32,18 @@ enum class SubdivisionBoundary {
   kKeepCorners,  ///< "keep-corners": boundary corners stay sharp (VTX_BOUNDARY_EDGE_AND_CORNER)
 };
 
+/// @brief Blender's subdivision type.
+enum class SubdivisionType {
+  kCatmullClark,  ///< "catmull-clark", Blender's default (OpenSubdiv's Catmull-Clark scheme)
+  kSimple,  ///< "simple": faces are split, the cage's shape kept. As in Blender 3.4: Catmull-
+            ///< Clark with every edge and vertex infinitely sharp, Quality 1 (not OpenSubdiv's
+            ///< bilinear scheme); the mesh's creases and the Quality do not apply
+};
+
+/// @brief How scene files ("type") and the CLI (--subdivision-type) spell SubdivisionType.
+inline constexpr Named<SubdivisionType> kSubdivisionTypeNames[] = {
+    {"catmull-clark", SubdivisionType::kCatmullClark}, {"simple", SubdivisionType::kSimple}};
+
 /// @brief How scene files ("uv_smooth") and the CLI (--uv-smooth) spell SubdivisionUvSmooth.
 inline constexpr Named<SubdivisionUvSmooth> kSubdivisionUvSmoothNames[] = {
     {"none", SubdivisionUvSmooth::kNone},
@@ -75,6 +87,7 @@ struct SubdivisionOptions {
   /// `level` rounds of Catmull-Clark refinement, not moved to the limit, and `quality` is
   /// unused (Blender greys it out).
   bool useLimitSurface = true;
+  SubdivisionType type = SubdivisionType::kCatmullClark;
 };
 
 /// @brief The range of SubdivisionOptions::quality (Blender's "Quality" field).
@@ -114,8 +127,8 @@ struct SurfaceParameters {
   std::vector<Vec2f> cornerCoord;            ///< per new corner: (s, t) ∈ [0,1]² on that sub-face
 };
 
-/// @brief The mesh Blender's Subdivision Surface modifier makes of @p coarse (Catmull-Clark),
-/// with every UV set subdivided.
+/// @brief The mesh Blender's Subdivision Surface modifier makes of @p coarse (Catmull-Clark,
+/// or Simple: SubdivisionOptions::type), with every UV set subdivided.
 ///
 /// What Blender does, and so this:
 ///  - Each quad becomes a (2^level)² grid of quads; any other face of n corners becomes n
