@@ -332,7 +332,7 @@ const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers"
 const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
                                                    "use_creases", "edge_creases", "vertex_creases",
                                                    "quality",     "use_limit_surface",
-                                                   "type"};
+                                                   "type",        "auto_smooth"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
@@ -502,6 +502,18 @@ SceneSubdivision parseSubdivision(const json& value) {
   if (reader.has("quality")) {
     subdivision.quality =
         reader.smallInteger("quality", kMinSubdivisionQuality, kMaxSubdivisionQuality);
+  }
+  if (reader.has("auto_smooth")) {
+    const double degrees = reader.numberAtLeast("auto_smooth", 0, false);
+    if (degrees > 180) {
+      fail(reader.where(), "auto_smooth " + reader.at("auto_smooth").dump() +
+                               " must be at most 180 (degrees)");
+    }
+    subdivision.autoSmoothDegrees = degrees;
+    if (subdivision.limit) {
+      fail(reader.where(), "\"level\": \"limit\" shades the exact surface's own normals; it "
+                           "cannot be combined with \"auto_smooth\"");
+    }
   }
   if (subdivision.limit && subdivision.type == SubdivisionType::kSimple) {
     fail(reader.where(), "\"level\": \"limit\" is the Catmull-Clark limit surface; it cannot "
@@ -1069,8 +1081,15 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
   const std::string refinement =
       std::string(subdivision.useLimitSurface ? "" : ", without the limit surface") +
       (subdivision.type == SubdivisionType::kSimple ? ", simple" : "");
+  std::string autoSmooth;
+  if (subdivision.autoSmoothDegrees) {
+    std::ostringstream text;
+    text << ", auto smooth " << *subdivision.autoSmoothDegrees << " deg";
+    autoSmooth = text.str();
+  }
   return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
-         nameIn(kBoundaries, subdivision.boundary) + creases + quality + refinement + ")";
+         nameIn(kBoundaries, subdivision.boundary) + creases + quality + refinement + autoSmooth +
+         ")";
 }
 
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
@@ -1096,6 +1115,7 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
   if (subdivision.type != SubdivisionType::kCatmullClark) {
     j["type"] = nameIn(kSubdivisionTypeNames, subdivision.type);
   }
+  if (subdivision.autoSmoothDegrees) j["auto_smooth"] = *subdivision.autoSmoothDegrees;
   return j.dump();
 }
 

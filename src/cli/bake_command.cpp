@@ -66,7 +66,7 @@ constexpr const char* kFooter =
     "                    \"use_creases\": true, \"edge_creases\": [[A, B, C], ...], "
     "\"vertex_creases\": [[V, C], ...],\n"
     "                    \"quality\": 3, \"use_limit_surface\": true, \"type\": "
-    "\"catmull-clark\"},\n"
+    "\"catmull-clark\", \"auto_smooth\": 30},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -125,7 +125,7 @@ const char* const kOneMapOptions[] = {
     "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
     "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth",
     "--edge-crease", "--vertex-crease", "--no-creases", "--subdivision-quality",
-    "--no-limit-surface", "--subdivision-type"};
+    "--no-limit-surface", "--subdivision-type", "--auto-smooth"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 

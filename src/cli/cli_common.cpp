@@ -219,6 +219,14 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
       ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionTypeNames), CLI::ignore_case)
                       .description(""))
       ->default_str("catmull-clark");
+  options.autoSmoothDegrees.reset();
+  CLI::Option* const autoSmooth =
+      app.add_option_function<double>(
+             "--auto-smooth", [&options](double degrees) { options.autoSmoothDegrees = degrees; },
+             "The mesh's Auto Smooth angle in degrees: the subdivided mesh's normals are split "
+             "where its faces meet at more than this (default: Auto Smooth off)")
+          ->type_name("DEG")
+          ->check(CLI::Range(0.0, 180.0).description(""));
   options.useLimitSurface = true;
   CLI::Option* const noLimitSurface = app.add_flag_callback(
       "--no-limit-surface", [&options] { options.useLimitSurface = false; },
@@ -226,7 +234,7 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
       "Use Limit Surface off; --subdivision-quality is then unused)");
   if (!group.empty()) {  // CLI11 hides options of the empty group
     for (CLI::Option* option : {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases,
-                                quality, noLimitSurface, type}) {
+                                quality, noLimitSurface, type, autoSmooth}) {
       option->group(group);
     }
   }
@@ -243,6 +251,11 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
     return Error::badInput(command +
                            ": --subdivision-type simple cannot be combined with --subdivide "
                            "limit, the Catmull-Clark limit surface");
+  }
+  if (limit && options.autoSmoothDegrees) {
+    return Error::badInput(command +
+                           ": --auto-smooth cannot be combined with --subdivide limit, which "
+                           "shades the exact surface's own normals");
   }
   return Ok{};
 }

@@ -15,10 +15,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 #include <string>
+#include <tuple>
 
 #include "mesh/validate.hpp"
 #include "sgbake/core/math.hpp"
@@ -78,6 +80,49 @@ double cornerAngle(Vec3d toPrev, Vec3d toNext) {
   return angleBetween(a, b);
 }
 
+/// Each corner's face normal weighted by the face's interior angle there (in parallel).
+std::vector<Vec3d> weightedCornerNormals(const MeshView& view) {
+  std::vector<Vec3d> weighted(view.cornerVertex.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, view.numFaces(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& faces) {
+    for (std::size_t f = faces.begin(); f != faces.end(); ++f) {
+      const Vec3d normal = normalizeOr(faceNormalDirection(view, f), kZeroAreaNormal);
+      const std::uint32_t b = view.faceStart[f];
+      const std::uint32_t n = view.faceSize(f);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const Vec3d prev = cornerPosition(view, b + (i + n - 1) % n);
+        const Vec3d curr = cornerPosition(view, b + i);
+        const Vec3d next = cornerPosition(view, b + (i + 1) % n);
+        weighted[b + i] = cornerAngle(prev - curr, next - curr) * normal;
+      }
+    }
+  });
+  return weighted;
+}
+
+/// The normalized sum, or Blender's fallback for a vanishing one: the vertex's normalized
+/// position, (0, 0, 1) at the origin.
+Vec3f normalOfSum(const Vec3d& sum, const Vec3f& position) {
+  return cast<float>(normalizeOr(sum, normalizeOr(cast<double>(position), kOriginVertexNormal)));
+}
+
+/// Union-find over corners, with path halving.
+struct CornerSets {
+  std::vector<std::uint32_t> parent;
+  explicit CornerSets(std::size_t n) : parent(n) {
+    for (std::uint32_t c = 0; c < n; ++c) parent[c] = c;
+  }
+  std::uint32_t find(std::uint32_t c) {
+    while (parent[c] != c) c = parent[c] = parent[parent[c]];
+    return c;
+  }
+  void join(std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
 }  // namespace
 
 std::vector<Vec3f> computeFaceNormals(const MeshView& mesh) {
@@ -103,22 +148,7 @@ VertexCorners cornersByVertex(std::span<const std::uint32_t> cornerVertex,
 void computeSmoothNormals(Mesh& mesh) {
   const MeshView view = mesh.view();
   const std::size_t numCorners = mesh.numCorners(), numVertices = mesh.numVertices();
-  // Each corner's weighted face normal, face by face in parallel.
-  std::vector<Vec3d> weighted(numCorners);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, view.numFaces(), 1024),
-                    [&](const tbb::blocked_range<std::size_t>& faces) {
-    for (std::size_t f = faces.begin(); f != faces.end(); ++f) {
-      const Vec3d normal = normalizeOr(faceNormalDirection(view, f), kZeroAreaNormal);
-      const std::uint32_t b = view.faceStart[f];
-      const std::uint32_t n = view.faceSize(f);
-      for (std::uint32_t i = 0; i < n; ++i) {
-        const Vec3d prev = cornerPosition(view, b + (i + n - 1) % n);
-        const Vec3d curr = cornerPosition(view, b + i);
-        const Vec3d next = cornerPosition(view, b + (i + 1) % n);
-        weighted[b + i] = cornerAngle(prev - curr, next - curr) * normal;
-      }
-    }
-  });
+  const std::vector<Vec3d> weighted = weightedCornerNormals(view);
   // Each vertex's corners in corner order (a counting sort), so that its sum adds them in the
   // same order whatever the threads: the normals do not depend on the number of threads.
   const VertexCorners byVertex = cornersByVertex(mesh.cornerVertex, numVertices);
@@ -128,8 +158,7 @@ void computeSmoothNormals(Mesh& mesh) {
     for (std::size_t v = vertices.begin(); v != vertices.end(); ++v) {
       Vec3d sum{0, 0, 0};
       for (const std::uint32_t c : byVertex.of(v)) sum += weighted[c];
-      const Vec3d fallback = normalizeOr(cast<double>(mesh.positions[v]), kOriginVertexNormal);
-      vertexNormals[v] = cast<float>(normalizeOr(sum, fallback));
+      vertexNormals[v] = normalOfSum(sum, mesh.positions[v]);
     }
   });
   mesh.cornerNormals.resize(numCorners);
@@ -139,6 +168,66 @@ void computeSmoothNormals(Mesh& mesh) {
       mesh.cornerNormals[c] = vertexNormals[mesh.cornerVertex[c]];
     }
   });
+  mesh.normalSource = NormalSource::kComputed;
+}
+
+void computeSplitNormals(Mesh& mesh, double angle) {
+  const MeshView view = mesh.view();
+  const std::size_t numCorners = mesh.numCorners();
+  const std::vector<Vec3d> weighted = weightedCornerNormals(view);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(view);
+  std::vector<std::uint32_t> cornerFace(numCorners);
+  for (std::size_t f = 0; f < view.numFaces(); ++f) {
+    for (std::uint32_t c = view.faceStart[f]; c < view.faceStart[f + 1]; ++c) {
+      cornerFace[c] = static_cast<std::uint32_t>(f);
+    }
+  }
+  const auto nextCorner = [&](std::uint32_t c) {
+    const std::uint32_t f = cornerFace[c];
+    return c + 1 < view.faceStart[f + 1] ? c + 1 : view.faceStart[f];
+  };
+  // Every edge as (lower vertex, higher vertex, the corner it starts at), sorted: the corners
+  // that run along one edge are then neighbours.
+  struct EdgeCorner {
+    std::uint32_t a, b, corner;
+  };
+  std::vector<EdgeCorner> edges(numCorners);
+  for (std::uint32_t c = 0; c < numCorners; ++c) {
+    const std::uint32_t v0 = mesh.cornerVertex[c], v1 = mesh.cornerVertex[nextCorner(c)];
+    edges[c] = {std::min(v0, v1), std::max(v0, v1), c};
+  }
+  std::sort(edges.begin(), edges.end(), [](const EdgeCorner& x, const EdgeCorner& y) {
+    return std::tie(x.a, x.b, x.corner) < std::tie(y.a, y.b, y.corner);
+  });
+  // A smooth edge joins, at each of its ends, the corners of its two faces there. The test is
+  // Blender's, in float: the float normals' dot product against cosf of the float angle (so
+  // that faces at right angles stay smooth at 90 degrees, cosf(90°) being just below 0).
+  const float cosAngle = std::cos(static_cast<float>(angle));
+  CornerSets fans(numCorners);
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
+    if (j - i == 2) {
+      const std::uint32_t c1 = edges[i].corner, c2 = edges[i + 1].corner;
+      const std::uint32_t f1 = cornerFace[c1], f2 = cornerFace[c2];
+      const bool opposite = mesh.cornerVertex[c1] != mesh.cornerVertex[c2];
+      const bool smooth =
+          opposite && !mesh.isFlat(f1) && !mesh.isFlat(f2) &&
+          !(dot(faceNormals[f1], faceNormals[f2]) < cosAngle);
+      if (smooth) {  // c1 runs u→v, c2 v→u: c1 pairs with c2's next corner and vice versa
+        fans.join(c1, nextCorner(c2));
+        fans.join(nextCorner(c1), c2);
+      }
+    }
+    i = j;
+  }
+  std::vector<Vec3d> fanSum(numCorners, Vec3d{0, 0, 0});
+  for (std::uint32_t c = 0; c < numCorners; ++c) fanSum[fans.find(c)] += weighted[c];
+  mesh.cornerNormals.resize(numCorners);
+  for (std::uint32_t c = 0; c < numCorners; ++c) {
+    mesh.cornerNormals[c] =
+        normalOfSum(fanSum[fans.find(c)], mesh.positions[mesh.cornerVertex[c]]);
+  }
   mesh.normalSource = NormalSource::kComputed;
 }
 

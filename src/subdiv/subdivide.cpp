@@ -12,9 +12,12 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "sgbake/core/math.hpp"
 #include "sgbake/mesh/normals.hpp"
 #include "subdiv/control_mesh.hpp"
 #include "subdiv/patch_evaluator.hpp"
@@ -132,7 +135,8 @@ constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_
 /// and where its corners lie on the limit surface when @p parameters is not null. Throws
 /// std::bad_alloc, or EvaluationFailed when no patch covers a point.
 Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
-                    PatchEvaluator::Refinement refinement, SurfaceParameters* parameters);
+                    PatchEvaluator::Refinement refinement,
+                    std::optional<double> autoSmoothDegrees, SurfaceParameters* parameters);
 
 }  // namespace
 
@@ -147,6 +151,13 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
     return Error::badInput(name + ": subdivision quality " + std::to_string(options.quality) +
                            " is out of range (" + std::to_string(kMinSubdivisionQuality) + ".." +
                            std::to_string(kMaxSubdivisionQuality) + ")");
+  }
+  if (options.autoSmoothDegrees &&
+      !(*options.autoSmoothDegrees >= 0 && *options.autoSmoothDegrees <= 180)) {
+    std::ostringstream angle;
+    angle << *options.autoSmoothDegrees;
+    return Error::badInput(name + ": Auto Smooth angle " + angle.str() +
+                           " is out of range (0..180 degrees)");
   }
   if (options.level == 0) {
     if (parameters != nullptr) {  // each corner at its own corner of its face
@@ -179,7 +190,8 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
     const int refinementLevel =
         options.type == SubdivisionType::kSimple ? 1 : (options.useLimitSurface ? options.quality : level);
     const PatchEvaluator::Refinement refinement{options.useLimitSurface, refinementLevel};
-    return subdivideGrids(coarse, *control, level, refinement, parameters);
+    return subdivideGrids(coarse, *control, level, refinement, options.autoSmoothDegrees,
+                          parameters);
   } catch (const EvaluationFailed&) {
     return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
   } catch (const std::bad_alloc&) {
@@ -191,7 +203,8 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
 namespace {
 
 Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
-                    PatchEvaluator::Refinement refinement, SurfaceParameters* parameters) {
+                    PatchEvaluator::Refinement refinement,
+                    std::optional<double> autoSmoothDegrees, SurfaceParameters* parameters) {
   const Refiner* const refiner = control.refiner.get();
   const std::vector<FVarChannel>& channels = control.channels;
   const std::vector<int>& faceSizes = control.faceSizes;
@@ -350,16 +363,23 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
   // keeps its coarse face's flat/smooth flag; corners of smooth faces get the vertex normal
   // (angle-weighted over every face at the vertex, flat ones included), corners of flat faces
   // their own face's normal.
-  fine.cornerNormals.resize(fine.cornerVertex.size());
-  computeSmoothNormals(fine);
-  if (std::any_of(coarse.faceFlat.begin(), coarse.faceFlat.end(),
-                  [](std::uint8_t flat) { return flat != 0; })) {
+  // With Auto Smooth, Blender's split normals of the new mesh instead.
+  const bool anyFlat = std::any_of(coarse.faceFlat.begin(), coarse.faceFlat.end(),
+                                   [](std::uint8_t flat) { return flat != 0; });
+  if (anyFlat) {
     fine.faceFlat.resize(fineFaces);
     for (std::size_t f = 0; f < nf; ++f) {
       std::fill(fine.faceFlat.begin() + static_cast<std::ptrdiff_t>(cellStart[f]),
                 fine.faceFlat.begin() + static_cast<std::ptrdiff_t>(cellStart[f + 1]),
                 coarse.isFlat(f) ? 1 : 0);
     }
+  }
+  if (autoSmoothDegrees) {
+    computeSplitNormals(fine, *autoSmoothDegrees * (kPi / 180));
+    return fine;
+  }
+  computeSmoothNormals(fine);
+  if (anyFlat) {
     const std::vector<Vec3f> faceNormals = computeFaceNormals(fine.view());
     for (std::size_t f = 0; f < fineFaces; ++f) {
       if (!fine.faceFlat[f]) continue;

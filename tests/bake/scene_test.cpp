@@ -516,6 +516,30 @@ TEST(Scene, SubdivisionTypeIsParsedAndInTheParametersOnlyWhenSimple) {
             "surface; it cannot be combined with \"type\": \"simple\"");
 }
 
+TEST(Scene, AutoSmoothIsParsedInDegreesAndInTheParametersOnlyWhenSet) {
+  const auto withSubdivision = [](const std::string& block) {
+    return R"({"mesh": "m.obj", "subdivision": )" + block +
+           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+  };
+  Result<Scene> scene =
+      parseScene(withSubdivision(R"({"level": 1, "auto_smooth": 30})"), options());
+  ASSERT_TRUE(scene) << scene.error().message;
+  ASSERT_TRUE(scene->subdivision.options().autoSmoothDegrees.has_value());
+  EXPECT_EQ(*scene->subdivision.options().autoSmoothDegrees, 30.0);
+  EXPECT_NE(describeSubdivision(scene->subdivision).find("auto smooth 30 deg"), std::string::npos);
+  const std::string set = subdivisionParametersJson(scene->subdivision);
+  EXPECT_NE(set.find("\"auto_smooth\":30"), std::string::npos) << set;
+  scene->subdivision.autoSmoothDegrees.reset();  // off: older scenes' text
+  EXPECT_EQ(subdivisionParametersJson(scene->subdivision).find("auto_smooth"), std::string::npos);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 1, "auto_smooth": 181})")),
+            "scene.json: subdivision: auto_smooth 181 must be at most 180 (degrees)");
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 1, "auto_smooth": -1})")),
+            "scene.json: subdivision: auto_smooth -1 must be at least 0");
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": "limit", "auto_smooth": 30})")),
+            "scene.json: subdivision: \"level\": \"limit\" shades the exact surface's own "
+            "normals; it cannot be combined with \"auto_smooth\"");
+}
+
 TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   // Every field away from its default, so that a field one side forgets shows.
   SubdivisionOptions o;
@@ -528,6 +552,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   o.quality = 7;
   o.useLimitSurface = false;
   o.type = SubdivisionType::kSimple;
+  o.autoSmoothDegrees = 42.5;
   const SceneSubdivision block = SceneSubdivision::of(o, false);
   EXPECT_TRUE(block.requested());
   EXPECT_FALSE(block.limitSurface());
@@ -543,6 +568,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   EXPECT_EQ(back.quality, o.quality);
   EXPECT_EQ(back.useLimitSurface, o.useLimitSurface);
   EXPECT_EQ(back.type, o.type);
+  EXPECT_EQ(back.autoSmoothDegrees, o.autoSmoothDegrees);
   EXPECT_TRUE(SceneSubdivision::of({0}, true).limitSurface());
   EXPECT_FALSE(SceneSubdivision::of({0}, false).requested());
 }

@@ -192,17 +192,28 @@ SIMPLE_CASES = [
     ("cylinder_creased", 2, "SMOOTH_ALL", "ALL", True, 3, True, "SIMPLE"),
     ("grid", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, False, "SIMPLE"),
 ]
-ALL_CASES = ([case + (3, True, "CATMULL_CLARK") for case in CASES]
-             + [case + (True, "CATMULL_CLARK") for case in QUALITY_CASES]
-             + [case + ("CATMULL_CLARK",) for case in LIMIT_OFF_CASES] + SIMPLE_CASES)
+# Cases with the mesh's Auto Smooth on, with (…, subdivision_type, auto_smooth degrees) last:
+# the subdivided mesh's split normals, split along infinitely sharp creases (cube, cylinder),
+# around flat faces (Suzanne) and wherever the subdivided faces meet at a wide angle.
+AUTO_SMOOTH_CASES = [
+    ("cube_creased", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 30.0),
+    ("cylinder_creased", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 30.0),
+    ("suzanne_flat", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 20.0),
+    ("cylinder", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "SIMPLE", 45.0),
+]
+ALL_CASES = ([case + (3, True, "CATMULL_CLARK", None) for case in CASES]
+             + [case + (True, "CATMULL_CLARK", None) for case in QUALITY_CASES]
+             + [case + ("CATMULL_CLARK", None) for case in LIMIT_OFF_CASES]
+             + [case + (None,) for case in SIMPLE_CASES] + AUTO_SMOOTH_CASES)
 
 
 def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True, quality=3,
-             use_limit_surface=True, subdivision_type="CATMULL_CLARK"):
+             use_limit_surface=True, subdivision_type="CATMULL_CLARK", auto_smooth=None):
     return (f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
             + ("" if use_creases else "_nocreases") + ("" if quality == 3 else f"_Q{quality}")
             + ("" if use_limit_surface else "_nolimit")
-            + ("" if subdivision_type == "CATMULL_CLARK" else "_simple"))
+            + ("" if subdivision_type == "CATMULL_CLARK" else "_simple")
+            + ("" if auto_smooth is None else f"_autosmooth{auto_smooth:g}"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -235,10 +246,14 @@ def write_coarse(name, ob, out_dir):
 
 
 def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-               use_limit_surface, subdivision_type, out_dir):
+               use_limit_surface, subdivision_type, auto_smooth, out_dir):
     """Evaluates the object with the modifier set to the case; writes TAG.npz."""
+    import math
+
     import numpy as np
 
+    ob.data.use_auto_smooth = auto_smooth is not None
+    ob.data.auto_smooth_angle = math.radians(auto_smooth if auto_smooth is not None else 30.0)
     mod.subdivision_type = subdivision_type
     mod.use_limit_surface = use_limit_surface
     mod.quality = quality
@@ -255,7 +270,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
     tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-                   use_limit_surface, subdivision_type)
+                   use_limit_surface, subdivision_type, auto_smooth)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
              uvs=arrays["uvs"], normals=arrays["normals"], tangents=tangents, signs=signs,
@@ -263,7 +278,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
     info = {"tag": tag, "mesh": mesh, "level": level, "uv_smooth": uv_smooth,
             "boundary_smooth": boundary_smooth, "use_creases": use_creases,
             "quality": quality, "use_limit_surface": use_limit_surface,
-            "subdivision_type": subdivision_type,
+            "subdivision_type": subdivision_type, "auto_smooth": auto_smooth,
             "vertices": len(me.vertices),
             "faces": len(me.polygons), "corners": len(me.loops)}
     bpy.data.meshes.remove(me)

@@ -10,13 +10,14 @@
    with Edge and Vertex Creases; the cube and Suzanne with some faces flat-shaded, marked with
    `s 0` / `s 1`) as OBJ, with their creases in cases.json, and, for each case
    (mesh, level, UV Smooth, Boundary Smooth, Use Creases, Quality, Use Limit Surface, type
-   Catmull-Clark or Simple), the mesh Blender's modifier makes with its MikkTSpace tangents (`Mesh.calc_tangents()`)
+   Catmull-Clark or Simple, the mesh's Auto Smooth), the mesh Blender's modifier makes with its MikkTSpace tangents (`Mesh.calc_tangents()`)
    as NPZ.
 2. For each case runs
      sgbake tangents MESH.obj --subdivide L --uv-smooth U --boundary-smooth B
                     [--edge-crease A,B,C ... --vertex-crease V,C ... (the mesh's creases)]
                     [--no-creases (Use Creases off)] [--subdivision-quality Q]
                     [--no-limit-surface (Use Limit Surface off)] [--subdivision-type simple]
+                    [--auto-smooth DEG (the mesh's Auto Smooth)]
                     --mesh-out TAG.sgbake.obj -o TAG.sgbake.csv
    and compares sgbake's subdivided mesh and tangents with Blender's (numpy, no Blender; when
    the python3 running this has no numpy, e.g. a pyenv one under CTest, it hands the comparison
@@ -58,7 +59,10 @@
      limit surface  sgbake on the limit surface against Blender's Suzanne with Use Limit
                 Surface off (level 2): the position check must fail;
      simple     sgbake's Catmull-Clark against Blender's Simple creased cylinder (level 2): the
-                position check must fail.
+                position check must fail;
+     auto smooth  sgbake without --auto-smooth against Blender's creased cube with Auto Smooth
+                30 deg, and at 40 deg against Blender's flat-faced Suzanne at 20 deg: the normal
+                check must fail.
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -126,6 +130,10 @@ CONTROLS = [
      "positions"),
     ("simple", "cylinder_creased_L2_SMOOTH_ALL_ALL_simple", {"--subdivision-type": None},
      "positions"),
+    ("auto smooth", "cube_creased_L2_PRESERVE_BOUNDARIES_ALL_autosmooth30",
+     {"--auto-smooth": None}, "normals"),
+    ("auto smooth angle", "suzanne_flat_L1_PRESERVE_BOUNDARIES_ALL_autosmooth20",
+     {"--auto-smooth": "40"}, "normals"),
 ]
 
 
@@ -189,6 +197,8 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
         options["--no-limit-surface"] = ""
     if case.get("subdivision_type", "CATMULL_CLARK") == "SIMPLE":
         options["--subdivision-type"] = "simple"
+    if case.get("auto_smooth") is not None:
+        options["--auto-smooth"] = repr(case["auto_smooth"])
     options.update(overrides)
     obj = os.path.join(work, out_name + ".sgbake.obj")
     csv = os.path.join(work, out_name + ".sgbake.csv")

@@ -487,6 +487,12 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
             (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--subdivide", "1", "--subdivision-type", "smooth", "-o",
             (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "1", "--auto-smooth", "200", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", (dir_ / "scene.json").string(), "--auto-smooth", "30"},
+           {"convert", "--mesh", mesh, "--subdivide", "limit", "--auto-smooth", "30", "--from",
+            "object", "--to", "tangent", (dir_ / "l0.exr").string(), "-o",
+            (dir_ / "c.exr").string()},
        }) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args[2] << ": " << r.err;

@@ -226,6 +226,59 @@ TEST(MeshNormals, SmoothNormalsDoNotDependOnTheNumberOfThreads) {
   EXPECT_TRUE(parallel.cornerNormals == serial.cornerNormals);
 }
 
+Mesh unitCube() {
+  return makeMesh({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                   {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
+                  {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6},
+                   {3, 0, 4, 7}});
+}
+
+TEST(MeshNormals, SplitNormalsSplitWhereFacesMeetAtMoreThanTheAngle) {
+  // The cube's faces meet at 90 degrees: at 30 (Blender's default) every corner is its face's
+  // normal; at 90 exactly the edges stay smooth (sharp only above the angle) and the normals
+  // are the smooth ones, bit for bit (same weights, same order).
+  Mesh split = unitCube();
+  computeSplitNormals(split, 30 * kPi / 180);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(split.view());
+  for (std::size_t f = 0; f < split.numFaces(); ++f) {
+    for (std::uint32_t c = split.faceStart[f]; c < split.faceStart[f + 1]; ++c) {
+      EXPECT_EQ(split.cornerNormals[c], faceNormals[f]) << "corner " << c;
+    }
+  }
+  EXPECT_EQ(split.normalSource, NormalSource::kComputed);
+  Mesh smooth = unitCube(), wide = unitCube();
+  computeSmoothNormals(smooth);
+  computeSplitNormals(wide, kPi / 2);
+  EXPECT_TRUE(wide.cornerNormals == smooth.cornerNormals);
+  Mesh sphere = uvSphere(24, 12), sphereSmooth = sphere;
+  computeSplitNormals(sphere, kPi);
+  computeSmoothNormals(sphereSmooth);
+  EXPECT_TRUE(sphere.cornerNormals == sphereSmooth.cornerNormals);
+}
+
+TEST(MeshNormals, SplitNormalsSeparateFlatFacesAndEachSideOfASharpEdge) {
+  // A prism seen end-on: a roof of two quads sloping at 60 degrees, so that their normals are
+  // 120 degrees apart, and a third quad flat-shaded beside them. At 150 degrees the ridge is
+  // smooth: both roof quads share the ridge normal (their normalized sum). The flat quad keeps its own normal, and the roof corner
+  // next to it does not take it in.
+  Mesh roof = makeMesh({{0, 0, 0}, {0, 1, 0}, {1, 0, std::sqrt(3.0f)}, {1, 1, std::sqrt(3.0f)},
+                        {2, 0, 0}, {2, 1, 0}, {3, 0, 0}, {3, 1, 0}},
+                       {{0, 2, 3, 1}, {2, 4, 5, 3}, {4, 6, 7, 5}});
+  roof.faceFlat = {0, 0, 1};
+  computeSplitNormals(roof, 5 * kPi / 6);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(roof.view());
+  const Vec3d ridge =
+      normalizeOr(cast<double>(faceNormals[0]) + cast<double>(faceNormals[1]), Vec3d{});
+  expectNear(roof.cornerNormals[1], ridge);  // face 0 at vertex 2
+  expectNear(roof.cornerNormals[4], ridge);  // face 1 at vertex 2
+  for (std::uint32_t c = 8; c < 12; ++c) EXPECT_EQ(roof.cornerNormals[c], faceNormals[2]);
+  expectNear(roof.cornerNormals[5], cast<double>(faceNormals[1]));  // face 1 at vertex 4
+  // At 90 degrees the ridge is sharp: each roof quad is flat.
+  computeSplitNormals(roof, kPi / 2);
+  expectNear(roof.cornerNormals[1], cast<double>(faceNormals[0]));
+  expectNear(roof.cornerNormals[4], cast<double>(faceNormals[1]));
+}
+
 TEST(MeshNormals, ValidateReportsEachBrokenInvariantOnOneLine) {
   Mesh good = makeMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
   computeSmoothNormals(good);

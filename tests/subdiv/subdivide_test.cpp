@@ -357,6 +357,34 @@ TEST(Subdivide, SimpleSplitsFacesAndKeepsTheShapeWhateverTheCreases) {
   EXPECT_GT(length(at(*smooth, 6) - at(*simple, 6)), 0.1);
 }
 
+TEST(SubdivideCreases, AutoSmoothSplitsTheNormalsAlongInfinitelySharpCreases) {
+  // Every edge of the cube infinitely sharp: the subdivided cube is the cube, its faces meet at
+  // 90 degrees on the old edges. Without Auto Smooth the corners there are averaged; with Auto
+  // Smooth 30 degrees every corner is its face's normal, an axis.
+  SubdivisionOptions options = creasedEdges(cube(), {2}, 1.0f);
+  Result<Mesh> smooth = subdivideMesh(cube(), options);
+  ASSERT_TRUE(smooth) << smooth.error().message;
+  options.autoSmoothDegrees = 30.0;
+  Result<Mesh> split = subdivideMesh(cube(), options);
+  ASSERT_TRUE(split) << split.error().message;
+  EXPECT_EQ(split->positions, smooth->positions);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(split->view());
+  double worstSplit = 0, worstSmooth = 0;
+  for (std::size_t f = 0; f < split->numFaces(); ++f) {
+    for (std::uint32_t c = split->faceStart[f]; c < split->faceStart[f + 1]; ++c) {
+      const Vec3d face = cast<double>(faceNormals[f]);
+      worstSplit = std::max(worstSplit, length(cast<double>(split->cornerNormals[c]) - face));
+      worstSmooth = std::max(worstSmooth, length(cast<double>(smooth->cornerNormals[c]) - face));
+    }
+  }
+  EXPECT_LT(worstSplit, 1e-6);
+  EXPECT_GT(worstSmooth, 0.5);
+  for (const double bad : {-1.0, 180.5}) {
+    options.autoSmoothDegrees = bad;
+    EXPECT_FALSE(subdivideMesh(cube(), options));
+  }
+}
+
 TEST(SubdivideCreases, SharpnessIsBlendersTenTimesCreaseSquared) {
   EXPECT_EQ(creaseSharpness(0.0f), 0.0f);
   EXPECT_EQ(creaseSharpness(1.0f), 10.0f);  // Sdc's SHARPNESS_INFINITE

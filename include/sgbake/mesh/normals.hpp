@@ -27,6 +27,16 @@ std::vector<Vec3f> computeFaceNormals(const MeshView& mesh);
 /// finite; normals are not read).
 void computeSmoothNormals(Mesh& mesh);
 
+/// @brief Blender's Auto Smooth (split normals, Mesh.use_auto_smooth): corners around a vertex
+/// are grouped into fans separated by sharp edges, and each corner gets the normalized sum of
+/// its fan's angle-weighted face normals (computeSmoothNormals's weights). An edge is sharp
+/// when its two faces' unit normals (computeFaceNormals) meet at more than @p angle radians
+/// (their float dot product below cosf of the angle in float, as Blender tests it), when a face on it is flat (Mesh::faceFlat), when it
+/// has one face or more than two, or when its two faces run along it the same way. Writes every
+/// corner of @p mesh and sets normalSource to kComputed.
+/// @note Precondition: as computeSmoothNormals.
+void computeSplitNormals(Mesh& mesh, double angle);
+
 /// @brief A given normal (read from a file, or handed to the C ABI) as a corner normal: kept
 /// bit-exact when its length is 1 within eight float ulps (about 9.5e-7; a normal normalized in
 /// float stays as it is), normalized in double otherwise.

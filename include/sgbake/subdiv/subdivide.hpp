@@ -88,6 +88,10 @@ struct SubdivisionOptions {
   /// unused (Blender greys it out).
   bool useLimitSurface = true;
   SubdivisionType type = SubdivisionType::kCatmullClark;
+  /// The mesh's Auto Smooth angle in degrees, 0 … 180 (Blender keeps it on the mesh:
+  /// Mesh.use_auto_smooth, auto_smooth_angle), applied to the subdivided mesh's normals
+  /// (computeSplitNormals); unset: Auto Smooth off.
+  std::optional<double> autoSmoothDegrees{};
 };
 
 /// @brief The range of SubdivisionOptions::quality (Blender's "Quality" field).
@@ -150,14 +154,16 @@ struct SurfaceParameters {
 ///  - Each new face keeps its coarse face's flat/smooth flag (Mesh::faceFlat). Corners of smooth
 ///    faces get computeSmoothNormals of the new faces (angle-weighted over every face at the
 ///    vertex, flat ones included), corners of flat faces their face's normal: Blender's normals
-///    of the modified mesh with Auto Smooth off. The coarse mesh's normals are not used.
+///    of the modified mesh with Auto Smooth off. With autoSmoothDegrees, Blender's split normals
+///    of the new faces instead (computeSplitNormals: fans split where the new faces meet at more
+///    than the angle, and around flat faces). The coarse mesh's normals are not used.
 ///
 /// The coarse vertices keep their indices (as in Blender); the points inside each coarse edge
 /// follow (in OpenSubdiv's edge order), then those inside each coarse face. Faces are grouped by
 /// coarse face, in coarse order, each face's grids in corner order, cells row by row.
 ///
 /// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
-///         or the quality is out of range, a crease does not fit the mesh (findCreaseIssue) or the mesh cannot
+///         or the quality or the Auto Smooth angle is out of range, a crease does not fit the mesh (findCreaseIssue) or the mesh cannot
 ///         be subdivided (a face using one vertex twice, or a topology OpenSubdiv rejects).
 /// @param[out] parameters when not null, where each new corner lies (SurfaceParameters); at
 ///             level 0, only faceOrigin (the identity)
