@@ -4,6 +4,7 @@
 #include <dlfcn.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <future>
 #include <mutex>
@@ -64,7 +65,10 @@ void startLoading() {
 }  // namespace
 
 void finishLoading() {
-  if (loadingSet.load(std::memory_order_acquire)) loading.wait();
+  if (!loadingSet.load(std::memory_order_acquire)) return;
+  // A deferred load (no thread could be made) has not started: waiting would run it.
+  if (loading.wait_for(std::chrono::seconds(0)) == std::future_status::deferred) return;
+  loading.wait();
 }
 
 Result<const ImageCodec*> imageCodec() {

@@ -31,9 +31,10 @@ void computeSmoothNormals(Mesh& mesh);
 /// are grouped into fans separated by sharp edges, and each corner gets the normalized sum of
 /// its fan's angle-weighted face normals (computeSmoothNormals's weights). An edge is sharp
 /// when its two faces' unit normals (computeFaceNormals) meet at more than @p angle radians
-/// (their float dot product below cosf of the angle in float, as Blender tests it), when a face on it is flat (Mesh::faceFlat), when it
-/// has one face or more than two, or when its two faces run along it the same way. Writes every
-/// corner of @p mesh and sets normalSource to kComputed.
+/// (their float dot product below cosf of the angle in float, as Blender tests it), when a
+/// face on it is flat (Mesh::faceFlat), when it has one face or more than two, or when its two
+/// faces run along it the same way. Writes every corner of @p mesh and sets normalSource to
+/// kComputed.
 /// @note Precondition: as computeSmoothNormals.
 void computeSplitNormals(Mesh& mesh, double angle);
 

@@ -35,9 +35,10 @@ enum class SubdivisionBoundary {
 /// @brief Blender's subdivision type.
 enum class SubdivisionType {
   kCatmullClark,  ///< "catmull-clark", Blender's default (OpenSubdiv's Catmull-Clark scheme)
-  kSimple,  ///< "simple": faces are split, the cage's shape kept. As in Blender 3.4: Catmull-
-            ///< Clark with every edge and vertex infinitely sharp, Quality 1 (not OpenSubdiv's
-            ///< bilinear scheme); the mesh's creases and the Quality do not apply
+  /// "simple": faces are split, the cage's shape kept. As Blender 3.4 computes it: Catmull-Clark
+  /// with every edge and vertex infinitely sharp at Quality 1 (not OpenSubdiv's bilinear
+  /// scheme); the mesh's creases and the Quality do not apply.
+  kSimple,
 };
 
 /// @brief How scene files ("type") and the CLI (--subdivision-type) spell SubdivisionType.
@@ -162,9 +163,10 @@ struct SurfaceParameters {
 /// follow (in OpenSubdiv's edge order), then those inside each coarse face. Faces are grouped by
 /// coarse face, in coarse order, each face's grids in corner order, cells row by row.
 ///
-/// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the level
-///         or the quality or the Auto Smooth angle is out of range, a crease does not fit the mesh (findCreaseIssue) or the mesh cannot
-///         be subdivided (a face using one vertex twice, or a topology OpenSubdiv rejects).
+/// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the
+///         level, the quality or the Auto Smooth angle is out of range, a crease does not fit
+///         the mesh (findCreaseIssue) or the mesh cannot be subdivided (a face using one vertex
+///         twice, or a topology OpenSubdiv rejects).
 /// @param[out] parameters when not null, where each new corner lies (SurfaceParameters); at
 ///             level 0, only faceOrigin (the identity)
 Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options,
