@@ -25,8 +25,7 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
   }
   // Creases that do not fit the mesh are the scene's mistake: name its key.
   if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, subdivision.options())) {
-    return Error::badInput(scenePrefix(scene) + "subdivision." +
-                           (issue->edge ? "edge_creases[" : "vertex_creases[") +
+    return Error::badInput(scenePrefix(scene) + "subdivision." + issue->key() + "[" +
                            std::to_string(issue->index) + "]: " + issue->what +
                            (scene.inMemory ? std::string() : " (" + scene.mesh.string() + ")"));
   }

@@ -332,7 +332,8 @@ const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers"
 const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
                                                    "use_creases", "edge_creases", "vertex_creases",
                                                    "quality",     "use_limit_surface",
-                                                   "type",        "auto_smooth"};
+                                                   "type",        "auto_smooth",
+                                                   "sharp_edges"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
@@ -458,6 +459,19 @@ std::vector<EdgeCrease> parseEdgeCreases(const ObjectReader& reader) {
   return creases;
 }
 
+/// "sharp_edges": [[a, b], ...] (whether each is an edge of the mesh, and listed once, is
+/// checked against the mesh: findCreaseIssue).
+std::vector<SharpEdge> parseSharpEdges(const ObjectReader& reader) {
+  const json& list = creaseList(reader, "sharp_edges", 2, "[a, b] (two vertex indices)");
+  std::vector<SharpEdge> edges;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where =
+        appendPath(reader.where(), "sharp_edges") + "[" + std::to_string(i) + "]";
+    edges.push_back({creaseVertex(list[i][0], where), creaseVertex(list[i][1], where)});
+  }
+  return edges;
+}
+
 /// "vertex_creases": [[v, c], ...], each vertex once.
 std::vector<VertexCrease> parseVertexCreases(const ObjectReader& reader) {
   const json& list =
@@ -498,6 +512,7 @@ SceneSubdivision parseSubdivision(const json& value) {
   reader.optionalName("boundary", kBoundaries, subdivision.boundary);
   if (reader.has("use_creases")) subdivision.useCreases = reader.boolean("use_creases");
   if (reader.has("edge_creases")) subdivision.edgeCreases = parseEdgeCreases(reader);
+  if (reader.has("sharp_edges")) subdivision.sharpEdges = parseSharpEdges(reader);
   if (reader.has("vertex_creases")) subdivision.vertexCreases = parseVertexCreases(reader);
   if (reader.has("quality")) {
     subdivision.quality =
@@ -1085,6 +1100,9 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
   if (subdivision.autoSmoothDegrees) {
     std::ostringstream text;
     text << ", auto smooth " << *subdivision.autoSmoothDegrees << " deg";
+    if (!subdivision.sharpEdges.empty()) {
+      text << " and " << subdivision.sharpEdges.size() << " sharp edge(s)";
+    }
     autoSmooth = text.str();
   }
   return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
@@ -1116,6 +1134,11 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
     j["type"] = nameIn(kSubdivisionTypeNames, subdivision.type);
   }
   if (subdivision.autoSmoothDegrees) j["auto_smooth"] = *subdivision.autoSmoothDegrees;
+  if (!subdivision.sharpEdges.empty()) {
+    json edges = json::array();
+    for (const SharpEdge& e : subdivision.sharpEdges) edges.push_back({e.v0, e.v1});
+    j["sharp_edges"] = std::move(edges);
+  }
   return j.dump();
 }
 

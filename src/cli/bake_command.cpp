@@ -66,7 +66,8 @@ constexpr const char* kFooter =
     "                    \"use_creases\": true, \"edge_creases\": [[A, B, C], ...], "
     "\"vertex_creases\": [[V, C], ...],\n"
     "                    \"quality\": 3, \"use_limit_surface\": true, \"type\": "
-    "\"catmull-clark\", \"auto_smooth\": 30},\n"
+    "\"catmull-clark\", \"auto_smooth\": 30,\n"
+    "                    \"sharp_edges\": [[A, B], ...]},\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -125,7 +126,7 @@ const char* const kOneMapOptions[] = {
     "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
     "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth",
     "--edge-crease", "--vertex-crease", "--no-creases", "--subdivision-quality",
-    "--no-limit-surface", "--subdivision-type", "--auto-smooth"};
+    "--no-limit-surface", "--subdivision-type", "--auto-smooth", "--sharp-edge"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 

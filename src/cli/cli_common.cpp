@@ -112,6 +112,15 @@ std::optional<VertexCrease> parseVertexCrease(const std::string& text) {
   return VertexCrease{*v, *c};
 }
 
+/// "A,B" of --sharp-edge.
+std::optional<SharpEdge> parseSharpEdge(const std::string& text) {
+  const std::vector<std::string> parts = splitCommas(text);
+  if (parts.size() != 2) return std::nullopt;
+  const auto v0 = creaseVertex(parts[0]), v1 = creaseVertex(parts[1]);
+  if (!v0 || !v1) return std::nullopt;
+  return SharpEdge{*v0, *v1};
+}
+
 /// A repeatable option whose every value @p parse reads into one more entry of @p list (each
 /// checked first: a value it refuses is "'VALUE' is not @p expected").
 template <class Crease>
@@ -227,6 +236,12 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
              "where its faces meet at more than this (default: Auto Smooth off)")
           ->type_name("DEG")
           ->check(CLI::Range(0.0, 180.0).description(""));
+  options.sharpEdges.clear();
+  CLI::Option* const sharpEdge = addCreaseOption(
+      app, "--sharp-edge", options.sharpEdges, parseSharpEdge,
+      "Mark the edge between vertices A and B (0-based) sharp, as Blender's Mark Sharp: with "
+      "--auto-smooth, the normals split along it; repeatable",
+      "A,B", "A,B (two vertex indices >= 0)");
   options.useLimitSurface = true;
   CLI::Option* const noLimitSurface = app.add_flag_callback(
       "--no-limit-surface", [&options] { options.useLimitSurface = false; },
@@ -234,7 +249,7 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
       "Use Limit Surface off; --subdivision-quality is then unused)");
   if (!group.empty()) {  // CLI11 hides options of the empty group
     for (CLI::Option* option : {level, uvSmooth, boundary, edgeCrease, vertexCrease, noCreases,
-                                quality, noLimitSurface, type, autoSmooth}) {
+                                quality, noLimitSurface, type, autoSmooth, sharpEdge}) {
       option->group(group);
     }
   }

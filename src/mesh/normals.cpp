@@ -171,7 +171,8 @@ void computeSmoothNormals(Mesh& mesh) {
   mesh.normalSource = NormalSource::kComputed;
 }
 
-void computeSplitNormals(Mesh& mesh, double angle) {
+void computeSplitNormals(Mesh& mesh, double angle,
+                         std::span<const std::pair<std::uint32_t, std::uint32_t>> sharpEdges) {
   const MeshView view = mesh.view();
   const std::size_t numCorners = mesh.numCorners();
   const std::vector<Vec3d> weighted = weightedCornerNormals(view);
@@ -211,8 +212,10 @@ void computeSplitNormals(Mesh& mesh, double angle) {
       const std::uint32_t c1 = edges[i].corner, c2 = edges[i + 1].corner;
       const std::uint32_t f1 = cornerFace[c1], f2 = cornerFace[c2];
       const bool opposite = mesh.cornerVertex[c1] != mesh.cornerVertex[c2];
+      const bool marked = std::binary_search(sharpEdges.begin(), sharpEdges.end(),
+                                             std::make_pair(edges[i].a, edges[i].b));
       const bool smooth =
-          opposite && !mesh.isFlat(f1) && !mesh.isFlat(f2) &&
+          opposite && !marked && !mesh.isFlat(f1) && !mesh.isFlat(f2) &&
           !(dot(faceNormals[f1], faceNormals[f2]) < cosAngle);
       if (smooth) {  // c1 runs u→v, c2 v→u: c1 pairs with c2's next corner and vice versa
         fans.join(c1, nextCorner(c2));

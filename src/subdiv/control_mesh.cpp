@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -246,6 +247,30 @@ std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOp
     }
     if (first) return first;
   }
+  if (!options.sharpEdges.empty()) {
+    const std::vector<EdgeKey> edges = subdiv_detail::meshEdges(mesh);
+    std::map<EdgeKey, std::size_t> seen;
+    for (std::size_t i = 0; i < options.sharpEdges.size(); ++i) {
+      const SharpEdge& e = options.sharpEdges[i];
+      for (const std::uint32_t v : {e.v0, e.v1}) {
+        if (v >= nv) return CreaseIssue{true, i, outOfRange(v), true};
+      }
+      const EdgeKey key = subdiv_detail::edgeKey(e.v0, e.v1);
+      if (!std::binary_search(edges.begin(), edges.end(), key)) {
+        return CreaseIssue{true, i,
+                           "vertices " + std::to_string(e.v0) + " and " + std::to_string(e.v1) +
+                               " are not the ends of an edge of the mesh",
+                           true};
+      }
+      if (const auto [it, added] = seen.emplace(key, i); !added) {
+        return CreaseIssue{true, i,
+                           "the edge " + std::to_string(key.first) + "-" +
+                               std::to_string(key.second) + " is also listed by entry " +
+                               std::to_string(it->second),
+                           true};
+      }
+    }
+  }
   std::vector<std::int64_t> listedAt(options.vertexCreases.empty() ? 0 : nv, -1);
   for (std::size_t i = 0; i < options.vertexCreases.size(); ++i) {
     const VertexCrease& c = options.vertexCreases[i];
@@ -270,8 +295,8 @@ namespace sgbake::subdiv_detail {
 Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOptions& options) {
   const std::string& name = coarse.source;
   if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, options)) {
-    return Error::badInput(name + ": " + (issue->edge ? "edge" : "vertex") + " crease " +
-                           std::to_string(issue->index) + ": " + issue->what);
+    return Error::badInput(name + ": " + issue->noun() + " " + std::to_string(issue->index) +
+                           ": " + issue->what);
   }
   const std::size_t nf = coarse.numFaces();
   for (std::size_t f = 0; f < nf; ++f) {

@@ -76,6 +76,14 @@ class VertexNumbering {
 
   std::uint32_t count() const { return count_; }
 
+  /// The coarse edge (OpenSubdiv's base-level index) whose inside new vertex @p v lies on, or -1
+  /// (a coarse vertex, or inside a face).
+  int edgeOf(std::uint32_t v) const {
+    const std::uint32_t perEdge = static_cast<std::uint32_t>(edgeSide_ - 2);
+    if (v < edgeBase_ || (faceBase_.empty() ? v >= count_ : v >= faceBase_[0])) return -1;
+    return static_cast<int>((v - edgeBase_) / perEdge);
+  }
+
   /// The vertex of point (i, j) of grid g on face @p f (see FaceGrid).
   std::uint32_t vertex(const Mesh& mesh, const Refiner& refiner, std::size_t f, int g, int i,
                        int j) const {
@@ -125,6 +133,43 @@ class VertexNumbering {
   std::uint32_t count_ = 0;
 };
 
+/// The edges of @p fine along coarse edges marked sharp (as Blender copies a coarse edge's
+/// flags to the new edges along it), as sorted vertex pairs, lower index first.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> sharpAlongMarkedEdges(
+    const Mesh& fine, const Refiner& refiner, const VertexNumbering& numbering,
+    const std::vector<SharpEdge>& marked) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> sharp;
+  if (marked.empty()) return sharp;
+  const auto& base = refiner.GetLevel(0);
+  std::vector<std::uint8_t> isMarked(static_cast<std::size_t>(base.GetNumEdges()), 0);
+  for (const SharpEdge& e : marked) {
+    const int edge = base.FindEdge(static_cast<int>(e.v0), static_cast<int>(e.v1));
+    if (edge >= 0) isMarked[static_cast<std::size_t>(edge)] = 1;
+  }
+  // A new edge lies along coarse edge e when both its ends are inside e, or one is inside e and
+  // the other is one of e's ends.
+  const auto endsAt = [&](int edge, std::uint32_t v) {
+    const auto ends = base.GetEdgeVertices(edge);
+    return static_cast<std::uint32_t>(ends[0]) == v || static_cast<std::uint32_t>(ends[1]) == v;
+  };
+  for (std::size_t f = 0; f < fine.numFaces(); ++f) {
+    const std::uint32_t b = fine.faceStart[f], n = fine.faceStart[f + 1] - b;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t u = fine.cornerVertex[b + k], v = fine.cornerVertex[b + (k + 1) % n];
+      const int eu = numbering.edgeOf(u), ev = numbering.edgeOf(v);
+      int edge = -1;
+      if (eu >= 0 && (eu == ev || (ev < 0 && endsAt(eu, v)))) edge = eu;
+      if (ev >= 0 && eu < 0 && endsAt(ev, u)) edge = ev;
+      if (edge >= 0 && isMarked[static_cast<std::size_t>(edge)]) {
+        sharp.emplace_back(std::min(u, v), std::max(u, v));
+      }
+    }
+  }
+  std::sort(sharp.begin(), sharp.end());
+  sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
+  return sharp;
+}
+
 /// subdivideGrids could not evaluate a face's limit surface.
 struct EvaluationFailed {};
 
@@ -134,9 +179,8 @@ constexpr std::uint64_t kMaxSubdividedCorners = std::numeric_limits<std::uint32_
 /// The subdivided mesh (see subdivideMesh) of @p coarse as OpenSubdiv sees it (@p control),
 /// and where its corners lie on the limit surface when @p parameters is not null. Throws
 /// std::bad_alloc, or EvaluationFailed when no patch covers a point.
-Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
-                    PatchEvaluator::Refinement refinement,
-                    std::optional<double> autoSmoothDegrees, SurfaceParameters* parameters);
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionOptions& options,
+                    PatchEvaluator::Refinement refinement, SurfaceParameters* parameters);
 
 }  // namespace
 
@@ -190,8 +234,7 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
     const int refinementLevel =
         options.type == SubdivisionType::kSimple ? 1 : (options.useLimitSurface ? options.quality : level);
     const PatchEvaluator::Refinement refinement{options.useLimitSurface, refinementLevel};
-    return subdivideGrids(coarse, *control, level, refinement, options.autoSmoothDegrees,
-                          parameters);
+    return subdivideGrids(coarse, *control, options, refinement, parameters);
   } catch (const EvaluationFailed&) {
     return Error::badInput(name + ": OpenSubdiv cannot evaluate the limit surface of a face");
   } catch (const std::bad_alloc&) {
@@ -202,9 +245,9 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
 
 namespace {
 
-Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
-                    PatchEvaluator::Refinement refinement,
-                    std::optional<double> autoSmoothDegrees, SurfaceParameters* parameters) {
+Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionOptions& options,
+                    PatchEvaluator::Refinement refinement, SurfaceParameters* parameters) {
+  const int level = options.level;
   const Refiner* const refiner = control.refiner.get();
   const std::vector<FVarChannel>& channels = control.channels;
   const std::vector<int>& faceSizes = control.faceSizes;
@@ -374,8 +417,9 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, int level,
                 coarse.isFlat(f) ? 1 : 0);
     }
   }
-  if (autoSmoothDegrees) {
-    computeSplitNormals(fine, *autoSmoothDegrees * (kPi / 180));
+  if (options.autoSmoothDegrees) {
+    computeSplitNormals(fine, *options.autoSmoothDegrees * (kPi / 180),
+                        sharpAlongMarkedEdges(fine, *refiner, numbering, options.sharpEdges));
     return fine;
   }
   computeSmoothNormals(fine);

@@ -535,6 +535,18 @@ TEST(Scene, AutoSmoothIsParsedInDegreesAndInTheParametersOnlyWhenSet) {
             "scene.json: subdivision: auto_smooth 181 must be at most 180 (degrees)");
   EXPECT_EQ(parseError(withSubdivision(R"({"level": 1, "auto_smooth": -1})")),
             "scene.json: subdivision: auto_smooth -1 must be at least 0");
+  Result<Scene> sharp = parseScene(
+      withSubdivision(R"({"level": 1, "auto_smooth": 30, "sharp_edges": [[0, 1], [2, 1]]})"),
+      options());
+  ASSERT_TRUE(sharp) << sharp.error().message;
+  ASSERT_EQ(sharp->subdivision.sharpEdges.size(), 2u);
+  EXPECT_EQ(sharp->subdivision.sharpEdges[1].v0, 2u);
+  EXPECT_NE(subdivisionParametersJson(sharp->subdivision).find("\"sharp_edges\":[[0,1],[2,1]]"),
+            std::string::npos);
+  EXPECT_NE(describeSubdivision(sharp->subdivision).find("2 sharp edge(s)"), std::string::npos);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 1, "sharp_edges": [[0, 1, 2]]})")),
+            "scene.json: subdivision.sharp_edges[0]: expected [a, b] (two vertex indices), not "
+            "an array of 3");
   EXPECT_EQ(parseError(withSubdivision(R"({"level": "limit", "auto_smooth": 30})")),
             "scene.json: subdivision: \"level\": \"limit\" shades the exact surface's own "
             "normals; it cannot be combined with \"auto_smooth\"");
@@ -553,6 +565,7 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   o.useLimitSurface = false;
   o.type = SubdivisionType::kSimple;
   o.autoSmoothDegrees = 42.5;
+  o.sharpEdges = {{7, 8}};
   const SceneSubdivision block = SceneSubdivision::of(o, false);
   EXPECT_TRUE(block.requested());
   EXPECT_FALSE(block.limitSurface());
@@ -569,6 +582,8 @@ TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   EXPECT_EQ(back.useLimitSurface, o.useLimitSurface);
   EXPECT_EQ(back.type, o.type);
   EXPECT_EQ(back.autoSmoothDegrees, o.autoSmoothDegrees);
+  ASSERT_EQ(back.sharpEdges.size(), 1u);
+  EXPECT_EQ(back.sharpEdges[0].v1, 8u);
   EXPECT_TRUE(SceneSubdivision::of({0}, true).limitSurface());
   EXPECT_FALSE(SceneSubdivision::of({0}, false).requested());
 }

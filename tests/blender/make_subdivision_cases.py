@@ -201,19 +201,28 @@ AUTO_SMOOTH_CASES = [
     ("suzanne_flat", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 20.0),
     ("cylinder", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "SIMPLE", 45.0),
 ]
-ALL_CASES = ([case + (3, True, "CATMULL_CLARK", None) for case in CASES]
-             + [case + (True, "CATMULL_CLARK", None) for case in QUALITY_CASES]
-             + [case + ("CATMULL_CLARK", None) for case in LIMIT_OFF_CASES]
-             + [case + (None,) for case in SIMPLE_CASES] + AUTO_SMOOTH_CASES)
+# Cases with edges marked sharp (every k-th edge of the mesh), with (…, auto_smooth, k) last:
+# at 180 degrees only the marks split the normals.
+SHARP_CASES = [
+    ("suzanne", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 180.0, 5),
+    ("cylinder", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 60.0, 4),
+]
+ALL_CASES = ([case + (3, True, "CATMULL_CLARK", None, 0) for case in CASES]
+             + [case + (True, "CATMULL_CLARK", None, 0) for case in QUALITY_CASES]
+             + [case + ("CATMULL_CLARK", None, 0) for case in LIMIT_OFF_CASES]
+             + [case + (None, 0) for case in SIMPLE_CASES]
+             + [case + (0,) for case in AUTO_SMOOTH_CASES] + SHARP_CASES)
 
 
 def case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases=True, quality=3,
-             use_limit_surface=True, subdivision_type="CATMULL_CLARK", auto_smooth=None):
+             use_limit_surface=True, subdivision_type="CATMULL_CLARK", auto_smooth=None,
+             sharp_every=0):
     return (f"{mesh}_L{level}_{uv_smooth}_{boundary_smooth}"
             + ("" if use_creases else "_nocreases") + ("" if quality == 3 else f"_Q{quality}")
             + ("" if use_limit_surface else "_nolimit")
             + ("" if subdivision_type == "CATMULL_CLARK" else "_simple")
-            + ("" if auto_smooth is None else f"_autosmooth{auto_smooth:g}"))
+            + ("" if auto_smooth is None else f"_autosmooth{auto_smooth:g}")
+            + ("" if not sharp_every else f"_sharp{sharp_every}"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -246,12 +255,17 @@ def write_coarse(name, ob, out_dir):
 
 
 def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-               use_limit_surface, subdivision_type, auto_smooth, out_dir):
+               use_limit_surface, subdivision_type, auto_smooth, sharp_every, out_dir):
     """Evaluates the object with the modifier set to the case; writes TAG.npz."""
     import math
 
     import numpy as np
 
+    sharp_edges = []
+    for i, e in enumerate(ob.data.edges):
+        e.use_edge_sharp = bool(sharp_every) and i % sharp_every == 0
+        if e.use_edge_sharp:
+            sharp_edges.append([int(e.vertices[0]), int(e.vertices[1])])
     ob.data.use_auto_smooth = auto_smooth is not None
     ob.data.auto_smooth_angle = math.radians(auto_smooth if auto_smooth is not None else 30.0)
     mod.subdivision_type = subdivision_type
@@ -270,7 +284,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
     tag = case_tag(mesh, level, uv_smooth, boundary_smooth, use_creases, quality,
-                   use_limit_surface, subdivision_type, auto_smooth)
+                   use_limit_surface, subdivision_type, auto_smooth, sharp_every)
     np.savez(os.path.join(out_dir, tag + ".npz"), positions=arrays["positions"],
              face_size=arrays["face_size"], corner_vertex=arrays["corner_vertex"],
              uvs=arrays["uvs"], normals=arrays["normals"], tangents=tangents, signs=signs,
@@ -279,6 +293,7 @@ def write_case(ob, mod, mesh, level, uv_smooth, boundary_smooth, use_creases, qu
             "boundary_smooth": boundary_smooth, "use_creases": use_creases,
             "quality": quality, "use_limit_surface": use_limit_surface,
             "subdivision_type": subdivision_type, "auto_smooth": auto_smooth,
+            "sharp_edges": sharp_edges,
             "vertices": len(me.vertices),
             "faces": len(me.polygons), "corners": len(me.loops)}
     bpy.data.meshes.remove(me)

@@ -17,7 +17,7 @@
                     [--edge-crease A,B,C ... --vertex-crease V,C ... (the mesh's creases)]
                     [--no-creases (Use Creases off)] [--subdivision-quality Q]
                     [--no-limit-surface (Use Limit Surface off)] [--subdivision-type simple]
-                    [--auto-smooth DEG (the mesh's Auto Smooth)]
+                    [--auto-smooth DEG (the mesh's Auto Smooth)] [--sharp-edge A,B ...]
                     --mesh-out TAG.sgbake.obj -o TAG.sgbake.csv
    and compares sgbake's subdivided mesh and tangents with Blender's (numpy, no Blender; when
    the python3 running this has no numpy, e.g. a pyenv one under CTest, it hands the comparison
@@ -62,7 +62,9 @@
                 position check must fail;
      auto smooth  sgbake without --auto-smooth against Blender's creased cube with Auto Smooth
                 30 deg, and at 40 deg against Blender's flat-faced Suzanne at 20 deg: the normal
-                check must fail.
+                check must fail;
+     sharp edges  sgbake without the --sharp-edge marks against Blender's Suzanne with every
+                5th edge marked sharp (Auto Smooth 180 deg): the normal check must fail.
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -134,6 +136,8 @@ CONTROLS = [
      {"--auto-smooth": None}, "normals"),
     ("auto smooth angle", "suzanne_flat_L1_PRESERVE_BOUNDARIES_ALL_autosmooth20",
      {"--auto-smooth": "40"}, "normals"),
+    ("sharp edges", "suzanne_L1_PRESERVE_BOUNDARIES_ALL_autosmooth180_sharp5",
+     {"no sharp edges": True}, "normals"),
 ]
 
 
@@ -177,6 +181,7 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
     mesh's creases (and the overrides); returns (OBJ path, CSV path) or an error message."""
     overrides = dict(overrides)
     sharpness = overrides.pop("sharpness", "10c^2")
+    sharp_edges = [] if overrides.pop("no sharp edges", False) else case.get("sharp_edges", [])
     mesh_obj = os.path.join(work, case["mesh"] + ".obj")
     if overrides.pop("smoothing", None) == "strip":  # the OBJ without its `s` lines
         with open(mesh_obj, encoding="ascii") as f:
@@ -204,6 +209,8 @@ def run_sgbake(cli, work, case, mesh, overrides, out_name):
     csv = os.path.join(work, out_name + ".sgbake.csv")
     cmd = [cli, "tangents", mesh_obj]
     cmd += crease_options(mesh, sharpness)
+    for v0, v1 in sharp_edges:
+        cmd += ["--sharp-edge", f"{v0},{v1}"]
     for key, value in options.items():
         if value is not None:
             cmd += [key, value] if value != "" else [key]

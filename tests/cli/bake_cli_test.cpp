@@ -572,6 +572,12 @@ TEST_F(BakeCliTest, CreasesFromSceneAndFlags) {
   expectBadScene(bakeScene(scene(R"(, "edge_creases": [[0, 9, 1]])", "bad.exr", "\"limit\"")),
                  sceneFile + ": subdivision.edge_creases[0]: vertex 9 is out of range", before,
                  dir_);
+  expectBadScene(bakeScene(scene(R"(, "auto_smooth": 30, "sharp_edges": [[0, 6]])", "bad.exr")),
+                 sceneFile +
+                     ": subdivision.sharp_edges[0]: vertices 0 and 6 are not the ends of an "
+                     "edge of the mesh (" +
+                     mesh + ")",
+                 before, dir_);
   expectBadScene(bakeScene(scene(R"(, "edge_creases": [[0, 1, 2]])", "bad.exr")),
                  sceneFile + ": subdivision.edge_creases[0]: crease 2 is out of range 0..1", before,
                  dir_);

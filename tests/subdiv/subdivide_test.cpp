@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -383,6 +385,47 @@ TEST(SubdivideCreases, AutoSmoothSplitsTheNormalsAlongInfinitelySharpCreases) {
     options.autoSmoothDegrees = bad;
     EXPECT_FALSE(subdivideMesh(cube(), options));
   }
+}
+
+TEST(SubdivideCreases, EdgesMarkedSharpSplitTheNormalsAlongThemWithAutoSmooth) {
+  // Auto Smooth at 180 degrees splits nothing by angle: only the new edges along the coarse
+  // edge 4-5 (marked sharp) split. The points inside it get two normals each (the sharp line
+  // runs through them); its ends keep one (a single sharp edge does not cut a vertex's fan in
+  // two), as every other vertex. Without Auto Smooth the mark does nothing (Blender).
+  SubdivisionOptions options{2};
+  options.sharpEdges = {{5, 4}};
+  Result<Mesh> unmarked = subdivideMesh(cube(), options);
+  options.autoSmoothDegrees = 180.0;
+  Result<Mesh> marked = subdivideMesh(cube(), options);
+  ASSERT_TRUE(marked && unmarked);
+  std::vector<std::set<std::tuple<float, float, float>>> normals(marked->numVertices());
+  for (std::size_t c = 0; c < marked->numCorners(); ++c) {
+    const Vec3f n = marked->cornerNormals[c];
+    normals[marked->cornerVertex[c]].insert({n.x, n.y, n.z});
+  }
+  std::size_t split = 0;
+  for (std::size_t v = 0; v < normals.size(); ++v) {
+    ASSERT_LE(normals[v].size(), 2u) << "vertex " << v;
+    if (normals[v].size() == 2) {
+      ++split;
+      // On the rounded edge from (-1,-1,1) to (1,-1,1): symmetric about the plane y = -z.
+      const Vec3d p = at(*marked, static_cast<std::uint32_t>(v));
+      EXPECT_NEAR(p.y, -p.z, 1e-6) << "vertex " << v;
+      EXPECT_LT(p.y, -0.5) << "vertex " << v;
+    }
+  }
+  EXPECT_EQ(split, 3u);  // the 3 points inside the edge, at level 2
+  EXPECT_EQ(unmarked->cornerNormals, [&] {
+    Mesh smooth = *unmarked;
+    computeSmoothNormals(smooth);
+    return smooth.cornerNormals;
+  }());
+  // A mark that is not an edge of the mesh is named.
+  options.sharpEdges = {{0, 6}};
+  Result<Mesh> bad = subdivideMesh(cube(), options);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message,
+            "test.obj: sharp edge 0: vertices 0 and 6 are not the ends of an edge of the mesh");
 }
 
 TEST(SubdivideCreases, SharpnessIsBlendersTenTimesCreaseSquared) {

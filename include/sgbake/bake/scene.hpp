@@ -95,21 +95,23 @@ struct SceneSubdivision {
   bool useLimitSurface = true;  ///< "use_limit_surface": Blender's "Use Limit Surface"
   SubdivisionType type = SubdivisionType::kCatmullClark;  ///< "type": "catmull-clark" | "simple"
   std::optional<double> autoSmoothDegrees;  ///< "auto_smooth": the mesh's Auto Smooth angle
+  std::vector<SharpEdge> sharpEdges;        ///< "sharp_edges": [[a, b], ...]
   /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
   bool requested() const { return present && (limit || level > 0); }
   /// @brief Whether the samples are shaded on the exact limit surface ("level": "limit").
   bool limitSurface() const { return present && limit; }
   /// @brief The options of subdivideMesh this block stands for (a number of levels).
   SubdivisionOptions options() const {
-    return {level,   uvSmooth,        boundary, useCreases,       edgeCreases, vertexCreases,
-            quality, useLimitSurface, type,     autoSmoothDegrees};
+    return {level,   uvSmooth,        boundary, useCreases,        edgeCreases, vertexCreases,
+            quality, useLimitSurface, type,     autoSmoothDegrees, sharpEdges};
   }
   /// @brief The block of @p options (a number of levels), or of the limit surface under them
   /// when @p limitSurface: options()'s inverse. Present when it asks for any subdivision.
   static SceneSubdivision of(const SubdivisionOptions& options, bool limitSurface) {
     return {options.level > 0 || limitSurface, limitSurface, options.level, options.uvSmooth,
             options.boundary, options.useCreases, options.edgeCreases, options.vertexCreases,
-            options.quality, options.useLimitSurface, options.type, options.autoSmoothDegrees};
+            options.quality, options.useLimitSurface, options.type, options.autoSmoothDegrees,
+            options.sharpEdges};
   }
 };
 

@@ -2,6 +2,9 @@
 /// @brief Face and vertex normals computed the way Blender computes them.
 #pragma once
 
+#include <cstdint>
+#include <span>
+#include <utility>
 #include <vector>
 
 #include "sgbake/core/result.hpp"
@@ -33,10 +36,13 @@ void computeSmoothNormals(Mesh& mesh);
 /// when its two faces' unit normals (computeFaceNormals) meet at more than @p angle radians
 /// (their float dot product below cosf of the angle in float, as Blender tests it), when a
 /// face on it is flat (Mesh::faceFlat), when it has one face or more than two, or when its two
-/// faces run along it the same way. Writes every corner of @p mesh and sets normalSource to
-/// kComputed.
+/// faces run along it the same way, or when it is one of @p sharpEdges (vertex pairs, lower
+/// index first, sorted: Blender's edges marked sharp). Writes every corner of @p mesh and sets
+/// normalSource to kComputed.
 /// @note Precondition: as computeSmoothNormals.
-void computeSplitNormals(Mesh& mesh, double angle);
+void computeSplitNormals(
+    Mesh& mesh, double angle,
+    std::span<const std::pair<std::uint32_t, std::uint32_t>> sharpEdges = {});
 
 /// @brief A given normal (read from a file, or handed to the C ABI) as a corner normal: kept
 /// bit-exact when its length is 1 within eight float ulps (about 9.5e-7; a normal normalized in

@@ -65,6 +65,13 @@ struct EdgeCrease {
   float crease = 0;      ///< in [0, 1]; OpenSubdiv sharpness creaseSharpness(crease)
 };
 
+/// @brief An edge Blender marks sharp ("Mark Sharp", MeshEdge.use_edge_sharp): with Auto Smooth,
+/// the subdivided edges along it split the normals.
+struct SharpEdge {
+  std::uint32_t v0 = 0;  ///< one end: a 0-based vertex index, in the mesh's vertex order
+  std::uint32_t v1 = 0;  ///< the other end (either order)
+};
+
 /// @brief Blender's crease of one vertex ("Vertex Crease", `Mesh.vertex_creases`).
 struct VertexCrease {
   std::uint32_t vertex = 0;  ///< 0-based vertex index, in the mesh's vertex order
@@ -93,6 +100,9 @@ struct SubdivisionOptions {
   /// Mesh.use_auto_smooth, auto_smooth_angle), applied to the subdivided mesh's normals
   /// (computeSplitNormals); unset: Auto Smooth off.
   std::optional<double> autoSmoothDegrees{};
+  /// Edges marked sharp (each an edge of the mesh); they matter only with autoSmoothDegrees, as
+  /// in Blender, where every subdivided edge along one is sharp too.
+  std::vector<SharpEdge> sharpEdges{};
 };
 
 /// @brief The range of SubdivisionOptions::quality (Blender's "Quality" field).
@@ -104,17 +114,26 @@ inline constexpr int kMaxSubdivisionQuality = 10;
 /// SHARPNESS_INFINITE = 10) and sharpness s needs c = √(s/10).
 inline float creaseSharpness(float crease) { return crease * crease * 10.0f; }
 
-/// @brief What is wrong with one crease of SubdivisionOptions for a given mesh.
+/// @brief What is wrong with one crease (or sharp edge) of SubdivisionOptions for a given mesh.
 struct CreaseIssue {
-  bool edge = true;       ///< an entry of edgeCreases (else of vertexCreases)
+  bool edge = true;       ///< an entry of edgeCreases (else of vertexCreases), unless sharp
   std::size_t index = 0;  ///< its index in that list
   std::string what;       ///< e.g. "vertices 3 and 7 are not the ends of an edge of the mesh"
+  bool sharp = false;     ///< an entry of sharpEdges
+  /// @brief The list's scene key: "edge_creases", "vertex_creases" or "sharp_edges".
+  const char* key() const {
+    return sharp ? "sharp_edges" : edge ? "edge_creases" : "vertex_creases";
+  }
+  /// @brief The list's entries in words: "edge crease", "vertex crease" or "sharp edge".
+  const char* noun() const {
+    return sharp ? "sharp edge" : edge ? "edge crease" : "vertex crease";
+  }
 };
 
-/// @brief The first crease of @p options that does not fit @p mesh: a vertex index out of
-/// range, an edge that is not an edge of the mesh (two consecutive corners of a face), a crease
-/// outside [0, 1] (or not finite), an edge or vertex listed twice. Checked even when
-/// useCreases is false.
+/// @brief The first crease or sharp edge of @p options that does not fit @p mesh: a vertex
+/// index out of range, an edge that is not an edge of the mesh (two consecutive corners of a
+/// face), a crease outside [0, 1] (or not finite), an edge or vertex listed twice. Checked even
+/// when useCreases is false (or Auto Smooth is off).
 /// @return std::nullopt when every crease fits
 std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOptions& options);
 
@@ -157,16 +176,17 @@ struct SurfaceParameters {
 ///    vertex, flat ones included), corners of flat faces their face's normal: Blender's normals
 ///    of the modified mesh with Auto Smooth off. With autoSmoothDegrees, Blender's split normals
 ///    of the new faces instead (computeSplitNormals: fans split where the new faces meet at more
-///    than the angle, and around flat faces). The coarse mesh's normals are not used.
+///    than the angle, around flat faces and along edges marked sharp). The coarse mesh's
+///    normals are not used.
 ///
 /// The coarse vertices keep their indices (as in Blender); the points inside each coarse edge
 /// follow (in OpenSubdiv's edge order), then those inside each coarse face. Faces are grouped by
 /// coarse face, in coarse order, each face's grids in corner order, cells row by row.
 ///
 /// @return the subdivided mesh (source kept), or kBadInput naming @p coarse.source when the
-///         level, the quality or the Auto Smooth angle is out of range, a crease does not fit
-///         the mesh (findCreaseIssue) or the mesh cannot be subdivided (a face using one vertex
-///         twice, or a topology OpenSubdiv rejects).
+///         level, the quality or the Auto Smooth angle is out of range, a crease or a sharp
+///         edge does not fit the mesh (findCreaseIssue) or the mesh cannot be subdivided (a
+///         face using one vertex twice, or a topology OpenSubdiv rejects).
 /// @param[out] parameters when not null, where each new corner lies (SurfaceParameters); at
 ///             level 0, only faceOrigin (the identity)
 Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options,
