@@ -71,9 +71,10 @@ extern const CLI::Validator kNonNegativeInteger;
 void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
                            const std::string& group = {}, bool* limit = nullptr);
 
-/// @brief What addSubdivisionOptions cannot check while parsing: --no-limit-surface,
-/// --subdivision-type simple or --auto-smooth with --subdivide limit (@p limit) is bad input,
-/// reported for @p command.
+/// @brief What addSubdivisionOptions cannot check while parsing, bad input reported for
+/// @p command: --no-limit-surface, --subdivision-type simple or --auto-smooth with --subdivide
+/// limit (@p limit); creases, sharp edges, --auto-smooth, --no-limit-surface or
+/// --subdivision-type simple without any --subdivide.
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
                                bool limit);
 

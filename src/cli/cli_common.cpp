@@ -257,6 +257,20 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
 
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
                                bool limit) {
+  // Options that only shape a subdivision, given without one: a forgotten --subdivide.
+  if (options.level == 0 && !limit) {
+    const char* given = !options.edgeCreases.empty()     ? "--edge-crease"
+                        : !options.vertexCreases.empty() ? "--vertex-crease"
+                        : !options.sharpEdges.empty()    ? "--sharp-edge"
+                        : options.autoSmoothDegrees      ? "--auto-smooth"
+                        : !options.useLimitSurface       ? "--no-limit-surface"
+                        : options.type == SubdivisionType::kSimple ? "--subdivision-type simple"
+                                                                   : nullptr;
+    if (given != nullptr) {
+      return Error::badInput(command + ": " + given +
+                             " applies to a subdivided mesh; add --subdivide N");
+    }
+  }
   if (limit && !options.useLimitSurface) {
     return Error::badInput(command +
                            ": --no-limit-surface cannot be combined with --subdivide limit, "

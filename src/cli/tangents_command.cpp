@@ -138,6 +138,7 @@ Status writeCsv(const Mesh& mesh, const CornerTangents& frames, Output& output) 
 Status runTangents(const TangentsArguments& args) {
   Stopwatch total;
   const ThreadLimit threadLimit(args.threads);
+  if (Status ok = checkSubdivisionOptions("tangents", args.subdivision, false); !ok) return ok;
 
   // Open the output first: an unwritable destination is reported before any work is done.
   Result<Output> output = Output::open(args.output);

@@ -490,6 +490,11 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
            {"bake", "--mesh", mesh, "--subdivide", "1", "--auto-smooth", "200", "-o",
             (dir_ / "o.png").string()},
            {"bake", (dir_ / "scene.json").string(), "--auto-smooth", "30"},
+           // Subdivision shaping without --subdivide: a forgotten level, not silently ignored.
+           {"bake", "--mesh", mesh, "--edge-crease", "0,1,1", "-o", (dir_ / "o.png").string()},
+           {"tangents", mesh, "--auto-smooth", "30", "-o", (dir_ / "t.csv").string()},
+           {"convert", "--mesh", mesh, "--sharp-edge", "0,1", "--from", "object", "--to",
+            "tangent", (dir_ / "l0.exr").string(), "-o", (dir_ / "c.exr").string()},
            {"convert", "--mesh", mesh, "--subdivide", "limit", "--auto-smooth", "30", "--from",
             "object", "--to", "tangent", (dir_ / "l0.exr").string(), "-o",
             (dir_ / "c.exr").string()},
@@ -499,6 +504,12 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
     expectOneErrorLine(r);
   }
   EXPECT_EQ(listDirectory(dir_), before);
+  const ProcessResult forgotten =
+      run({"tangents", mesh, "--auto-smooth", "30", "-o", (dir_ / "t.csv").string()});
+  EXPECT_NE(forgotten.err.find(
+                "tangents: --auto-smooth applies to a subdivided mesh; add --subdivide N"),
+            std::string::npos)
+      << forgotten.err;
   const ProcessResult both = run({"bake", "--mesh", mesh, "--subdivide", "limit",
                                   "--no-limit-surface", "-o", (dir_ / "o.png").string()});
   EXPECT_NE(both.err.find("bake: --no-limit-surface cannot be combined with --subdivide limit"),
