@@ -133,6 +133,15 @@ std::vector<Vec3f> computeFaceNormals(const MeshView& mesh) {
   return normals;
 }
 
+std::vector<std::uint32_t> cornerFaces(std::span<const std::uint32_t> faceStart) {
+  std::vector<std::uint32_t> faces(faceStart.empty() ? 0 : faceStart.back());
+  for (std::size_t f = 0; f + 1 < faceStart.size(); ++f) {
+    std::fill(faces.begin() + faceStart[f], faces.begin() + faceStart[f + 1],
+              static_cast<std::uint32_t>(f));
+  }
+  return faces;
+}
+
 VertexCorners cornersByVertex(std::span<const std::uint32_t> cornerVertex,
                               std::size_t numVertices) {
   VertexCorners result;
@@ -177,12 +186,7 @@ void computeSplitNormals(Mesh& mesh, double angle,
   const std::size_t numCorners = mesh.numCorners();
   const std::vector<Vec3d> weighted = weightedCornerNormals(view);
   const std::vector<Vec3f> faceNormals = computeFaceNormals(view);
-  std::vector<std::uint32_t> cornerFace(numCorners);
-  for (std::size_t f = 0; f < view.numFaces(); ++f) {
-    for (std::uint32_t c = view.faceStart[f]; c < view.faceStart[f + 1]; ++c) {
-      cornerFace[c] = static_cast<std::uint32_t>(f);
-    }
-  }
+  const std::vector<std::uint32_t> cornerFace = cornerFaces(view.faceStart);
   const auto nextCorner = [&](std::uint32_t c) {
     const std::uint32_t f = cornerFace[c];
     return c + 1 < view.faceStart[f + 1] ? c + 1 : view.faceStart[f];

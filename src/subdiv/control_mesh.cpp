@@ -9,8 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <map>
-#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -75,12 +73,7 @@ std::vector<bool> uvWindings(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
 FVarChannel weldUvs(const Mesh& mesh, const std::vector<Vec2f>& uvs) {
   const VertexCorners byVertex = cornersByVertex(mesh.cornerVertex, mesh.numVertices());
   const std::vector<bool> winding = uvWindings(mesh, uvs);
-  std::vector<std::uint32_t> cornerFace(mesh.numCorners());
-  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
-    for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
-      cornerFace[c] = static_cast<std::uint32_t>(f);
-    }
-  }
+  const std::vector<std::uint32_t> cornerFace = cornerFaces(mesh.faceStart);
   FVarChannel channel;
   channel.cornerValue.assign(mesh.numCorners(), -1);
   std::vector<std::uint32_t> corners;
@@ -153,17 +146,10 @@ struct Creases {
 Creases allInfinitelySharp(const Mesh& coarse) {
   constexpr float kInfinitelySharp = 10.0f;  // Sdc's SHARPNESS_INFINITE
   Creases creases;
-  std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
-  for (std::size_t f = 0; f < coarse.numFaces(); ++f) {
-    const std::size_t n = coarse.faceSize(f);
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::uint32_t a = coarse.cornerVertex[coarse.faceStart[f] + k];
-      const std::uint32_t b = coarse.cornerVertex[coarse.faceStart[f] + (k + 1) % n];
-      if (!edges.insert(std::minmax(a, b)).second) continue;
-      creases.edgeVertices.push_back(static_cast<int>(a));
-      creases.edgeVertices.push_back(static_cast<int>(b));
-      creases.edgeSharpness.push_back(kInfinitelySharp);
-    }
+  for (const auto& [a, b] : meshEdges(coarse)) {
+    creases.edgeVertices.push_back(static_cast<int>(a));
+    creases.edgeVertices.push_back(static_cast<int>(b));
+    creases.edgeSharpness.push_back(kInfinitelySharp);
   }
   for (std::size_t v = 0; v < coarse.numVertices(); ++v) {
     creases.vertices.push_back(static_cast<int>(v));
@@ -212,24 +198,29 @@ std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOp
     return vertexName(v) + " is out of range (the mesh has " + std::to_string(nv) +
            " vertices, numbered from 0)";
   };
-  if (!options.edgeCreases.empty()) {
-    const std::vector<EdgeKey> edges = subdiv_detail::meshEdges(mesh);
-    std::vector<std::pair<EdgeKey, std::size_t>> seen;  // edge, first index listing it
-    seen.reserve(options.edgeCreases.size());
-    for (std::size_t i = 0; i < options.edgeCreases.size(); ++i) {
-      const EdgeCrease& e = options.edgeCreases[i];
+  // Edge lists (creases, sharp marks): entry by entry, vertices in range, an edge of the mesh,
+  // then @p entryIssue's own check; after that, the first entry naming an edge listed before.
+  std::vector<EdgeKey> edges;
+  if (!options.edgeCreases.empty() || !options.sharpEdges.empty()) {
+    edges = subdiv_detail::meshEdges(mesh);
+  }
+  const auto edgeListIssue = [&](const auto& list, bool sharp, const char* listedBy,
+                                 const auto& entryIssue) -> std::optional<CreaseIssue> {
+    std::vector<std::pair<EdgeKey, std::size_t>> seen;  // edge, index listing it
+    seen.reserve(list.size());
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const auto& e = list[i];
       for (const std::uint32_t v : {e.v0, e.v1}) {
-        if (v >= nv) return CreaseIssue{true, i, outOfRange(v)};
+        if (v >= nv) return CreaseIssue{true, i, outOfRange(v), sharp};
       }
       const EdgeKey key = subdiv_detail::edgeKey(e.v0, e.v1);
       if (!std::binary_search(edges.begin(), edges.end(), key)) {
         return CreaseIssue{true, i,
                            "vertices " + std::to_string(e.v0) + " and " + std::to_string(e.v1) +
-                               " are not the ends of an edge of the mesh"};
+                               " are not the ends of an edge of the mesh",
+                           sharp};
       }
-      if (std::string why = subdiv_detail::badCreaseValue(e.crease); !why.empty()) {
-        return CreaseIssue{true, i, why};
-      }
+      if (std::string why = entryIssue(e); !why.empty()) return CreaseIssue{true, i, why, sharp};
       seen.emplace_back(key, i);
     }
     std::stable_sort(seen.begin(), seen.end(),
@@ -241,35 +232,22 @@ std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOp
       if (!first || later < first->index) {
         first = CreaseIssue{true, later,
                             "the edge " + std::to_string(seen[k].first.first) + "-" +
-                                std::to_string(seen[k].first.second) +
-                                " is also creased by entry " + std::to_string(seen[k - 1].second)};
+                                std::to_string(seen[k].first.second) + " is also " + listedBy +
+                                " by entry " + std::to_string(seen[k - 1].second),
+                            sharp};
       }
     }
-    if (first) return first;
+    return first;
+  };
+  if (auto issue = edgeListIssue(options.edgeCreases, false, "creased",
+                                 [](const EdgeCrease& e) {
+                                   return subdiv_detail::badCreaseValue(e.crease);
+                                 })) {
+    return issue;
   }
-  if (!options.sharpEdges.empty()) {
-    const std::vector<EdgeKey> edges = subdiv_detail::meshEdges(mesh);
-    std::map<EdgeKey, std::size_t> seen;
-    for (std::size_t i = 0; i < options.sharpEdges.size(); ++i) {
-      const SharpEdge& e = options.sharpEdges[i];
-      for (const std::uint32_t v : {e.v0, e.v1}) {
-        if (v >= nv) return CreaseIssue{true, i, outOfRange(v), true};
-      }
-      const EdgeKey key = subdiv_detail::edgeKey(e.v0, e.v1);
-      if (!std::binary_search(edges.begin(), edges.end(), key)) {
-        return CreaseIssue{true, i,
-                           "vertices " + std::to_string(e.v0) + " and " + std::to_string(e.v1) +
-                               " are not the ends of an edge of the mesh",
-                           true};
-      }
-      if (const auto [it, added] = seen.emplace(key, i); !added) {
-        return CreaseIssue{true, i,
-                           "the edge " + std::to_string(key.first) + "-" +
-                               std::to_string(key.second) + " is also listed by entry " +
-                               std::to_string(it->second),
-                           true};
-      }
-    }
+  if (auto issue = edgeListIssue(options.sharpEdges, true, "listed",
+                                 [](const SharpEdge&) { return std::string(); })) {
+    return issue;
   }
   std::vector<std::int64_t> listedAt(options.vertexCreases.empty() ? 0 : nv, -1);
   for (std::size_t i = 0; i < options.vertexCreases.size(); ++i) {

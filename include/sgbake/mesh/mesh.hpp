@@ -91,4 +91,7 @@ struct VertexCorners {
 /// @brief The corners of every vertex of @p mesh (whose corner vertices are < @p numVertices).
 VertexCorners cornersByVertex(std::span<const std::uint32_t> cornerVertex, std::size_t numVertices);
 
+/// @brief The face of every corner (#C), from @p faceStart (#F+1 offsets).
+std::vector<std::uint32_t> cornerFaces(std::span<const std::uint32_t> faceStart);
+
 }  // namespace sgbake
