@@ -121,6 +121,18 @@ std::optional<SharpEdge> parseSharpEdge(const std::string& text) {
   return SharpEdge{*v0, *v1};
 }
 
+/// An option taking one of @p names (any case) into @p target, shown as NAME with the default
+/// @p defaultName.
+template <class Enum, std::size_t N>
+CLI::Option* addNamedOption(CLI::App& app, const std::string& name, Enum& target,
+                            const Named<Enum> (&names)[N], const std::string& help,
+                            const std::string& defaultName) {
+  return app.add_option(name, target, help)
+      ->type_name("NAME")
+      ->transform(CLI::CheckedTransformer(nameMap(names), CLI::ignore_case).description(""))
+      ->default_str(defaultName);
+}
+
 /// A repeatable option whose every value @p parse reads into one more entry of @p list (each
 /// checked first: a value it refuses is "'VALUE' is not @p expected").
 template <class Crease>
@@ -187,19 +199,14 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
                     ""))
                 ->default_str("0");
   }
-  CLI::Option* const uvSmooth = app.add_option("--uv-smooth", options.uvSmooth,
-                 "The modifier's UV Smooth: none, keep-corners, keep-corners-junctions, "
-                 "keep-corners-junctions-concave, keep-boundaries, all")
-      ->type_name("NAME")
-      ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionUvSmoothNames), CLI::ignore_case)
-                      .description(""))
-      ->default_str("keep-boundaries");
-  CLI::Option* const boundary = app.add_option("--boundary-smooth", options.boundary,
-                 "The modifier's Boundary Smooth: all, keep-corners")
-      ->type_name("NAME")
-      ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionBoundaryNames), CLI::ignore_case)
-                      .description(""))
-      ->default_str("all");
+  CLI::Option* const uvSmooth = addNamedOption(
+      app, "--uv-smooth", options.uvSmooth, kSubdivisionUvSmoothNames,
+      "The modifier's UV Smooth: none, keep-corners, keep-corners-junctions, "
+      "keep-corners-junctions-concave, keep-boundaries, all",
+      "keep-boundaries");
+  CLI::Option* const boundary =
+      addNamedOption(app, "--boundary-smooth", options.boundary, kSubdivisionBoundaryNames,
+                     "The modifier's Boundary Smooth: all, keep-corners", "all");
   options.useCreases = true;
   options.edgeCreases.clear();
   options.vertexCreases.clear();
@@ -222,12 +229,10 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
           ->type_name("N")
           ->check(CLI::Range(kMinSubdivisionQuality, kMaxSubdivisionQuality).description(""))
           ->capture_default_str();
-  CLI::Option* const type = app.add_option("--subdivision-type", options.type,
-                 "The modifier's type: catmull-clark, simple (faces split, shape kept)")
-      ->type_name("NAME")
-      ->transform(CLI::CheckedTransformer(nameMap(kSubdivisionTypeNames), CLI::ignore_case)
-                      .description(""))
-      ->default_str("catmull-clark");
+  CLI::Option* const type =
+      addNamedOption(app, "--subdivision-type", options.type, kSubdivisionTypeNames,
+                     "The modifier's type: catmull-clark, simple (faces split, shape kept)",
+                     "catmull-clark");
   options.autoSmoothDegrees.reset();
   CLI::Option* const autoSmooth =
       app.add_option_function<double>(
