@@ -31,6 +31,12 @@ SceneParseOptions options(const std::string& base = "scenes") {
   return o;
 }
 
+/// A scene with subdivision block @p block (JSON text) and one mask output.
+std::string withSubdivision(const std::string& block) {
+  return R"({"mesh": "m.obj", "subdivision": )" + block +
+         R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+}
+
 /// Parses @p text, expecting failure; returns the message.
 std::string parseError(const std::string& text) {
   Result<Scene> scene = parseScene(text, options());
@@ -364,10 +370,6 @@ TEST(Scene, SubdivisionIsParsedAndValidated) {
 }
 
 TEST(Scene, CreasesAreParsedAndValidated) {
-  const auto withSubdivision = [](const std::string& block) {
-    return R"({"mesh": "m.obj", "subdivision": )" + block +
-           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
-  };
   Result<Scene> scene = parseScene(withSubdivision(R"({"level": 2, "use_creases": false,
                           "edge_creases": [[0, 1, 0.5], [3, 2, 1], [4, 5, 0]],
                           "vertex_creases": [[7, 0.25]]})"),
@@ -455,10 +457,6 @@ TEST(Scene, CreasesAreInTheSubdivisionParametersOnlyWhenThereAreAny) {
 }
 
 TEST(Scene, QualityIsParsedAndInTheParametersOnlyWhenNotTheDefault) {
-  const auto withSubdivision = [](const std::string& block) {
-    return R"({"mesh": "m.obj", "subdivision": )" + block +
-           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
-  };
   Result<Scene> scene = parseScene(withSubdivision(R"({"level": 2, "quality": 5})"), options());
   ASSERT_TRUE(scene) << scene.error().message;
   EXPECT_EQ(scene->subdivision.options().quality, 5);
@@ -474,10 +472,6 @@ TEST(Scene, QualityIsParsedAndInTheParametersOnlyWhenNotTheDefault) {
 }
 
 TEST(Scene, UseLimitSurfaceIsParsedAndInTheParametersOnlyWhenOff) {
-  const auto withSubdivision = [](const std::string& block) {
-    return R"({"mesh": "m.obj", "subdivision": )" + block +
-           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
-  };
   Result<Scene> scene =
       parseScene(withSubdivision(R"({"level": 2, "use_limit_surface": false})"), options());
   ASSERT_TRUE(scene) << scene.error().message;
@@ -497,10 +491,6 @@ TEST(Scene, UseLimitSurfaceIsParsedAndInTheParametersOnlyWhenOff) {
 }
 
 TEST(Scene, SubdivisionTypeIsParsedAndInTheParametersOnlyWhenSimple) {
-  const auto withSubdivision = [](const std::string& block) {
-    return R"({"mesh": "m.obj", "subdivision": )" + block +
-           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
-  };
   Result<Scene> scene = parseScene(withSubdivision(R"({"level": 2, "type": "simple"})"), options());
   ASSERT_TRUE(scene) << scene.error().message;
   EXPECT_EQ(scene->subdivision.options().type, SubdivisionType::kSimple);
@@ -517,10 +507,6 @@ TEST(Scene, SubdivisionTypeIsParsedAndInTheParametersOnlyWhenSimple) {
 }
 
 TEST(Scene, AutoSmoothIsParsedInDegreesAndInTheParametersOnlyWhenSet) {
-  const auto withSubdivision = [](const std::string& block) {
-    return R"({"mesh": "m.obj", "subdivision": )" + block +
-           R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
-  };
   Result<Scene> scene =
       parseScene(withSubdivision(R"({"level": 1, "auto_smooth": 30})"), options());
   ASSERT_TRUE(scene) << scene.error().message;

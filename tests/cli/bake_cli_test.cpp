@@ -417,34 +417,31 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
                                   "--no-manifest", "-o", (dir_ / "limit_flag.exr").string()});
   ASSERT_EQ(flag.exitCode, 0) << flag.err;
   EXPECT_TRUE(readPixels(dir_ / "limit_flag.exr") == limit);
-  // "use_limit_surface": false (the refined cage, not the limit) is another bake; the flag
-  // --no-limit-surface gives the same file.
-  const std::string cageScene =
-      R"({"mesh": "cube.obj", "subdivision": {"level": 2, "use_limit_surface": false}, )"
-      R"("outputs": [{"map": "object-normal", "file": "cage.exr", "size": 64, "margin": 0, )"
-      R"("bit_depth": 32}]})";
-  ASSERT_EQ(bakeScene(cageScene).exitCode, 0);
-  EXPECT_FALSE(readPixels(dir_ / "cage.exr") == l2);
-  const ProcessResult cageFlag =
-      run({"bake", "--mesh", mesh, "--map", "object-normal", "--size", "64", "--margin", "0",
-           "--bit-depth", "32", "--subdivide", "2", "--no-limit-surface", "--no-manifest", "-o",
-           (dir_ / "cage_flag.exr").string()});
-  ASSERT_EQ(cageFlag.exitCode, 0) << cageFlag.err;
-  EXPECT_TRUE(readPixels(dir_ / "cage_flag.exr") == readPixels(dir_ / "cage.exr"));
-  // "type": "simple" (the cube split, not rounded) is another bake; --subdivision-type simple
-  // gives the same file.
-  const std::string simpleScene =
-      R"({"mesh": "cube.obj", "subdivision": {"level": 2, "type": "simple"}, )"
-      R"("outputs": [{"map": "object-normal", "file": "simple.exr", "size": 64, "margin": 0, )"
-      R"("bit_depth": 32}]})";
-  ASSERT_EQ(bakeScene(simpleScene).exitCode, 0);
-  EXPECT_FALSE(readPixels(dir_ / "simple.exr") == l2);
-  const ProcessResult simpleFlag =
-      run({"bake", "--mesh", mesh, "--map", "object-normal", "--size", "64", "--margin", "0",
-           "--bit-depth", "32", "--subdivide", "2", "--subdivision-type", "simple",
-           "--no-manifest", "-o", (dir_ / "simple_flag.exr").string()});
-  ASSERT_EQ(simpleFlag.exitCode, 0) << simpleFlag.err;
-  EXPECT_TRUE(readPixels(dir_ / "simple_flag.exr") == readPixels(dir_ / "simple.exr"));
+  // A subdivision block beside "level": 2 bakes another map than level 2 alone, and its flags
+  // on the one-map shorthand bake the same file.
+  const auto expectSceneKeyEqualsFlag = [&](const std::string& key, const std::string& name,
+                                           const std::vector<std::string>& flags) {
+    ASSERT_EQ(bakeScene(R"({"mesh": "cube.obj", "subdivision": {"level": 2, )" + key +
+                        R"(}, "outputs": [{"map": "object-normal", "file": ")" + name +
+                        R"(.exr", "size": 64, "margin": 0, "bit_depth": 32}]})")
+                  .exitCode,
+              0);
+    const std::vector<float> fromScene = readPixels(dir_ / (name + ".exr"));
+    EXPECT_FALSE(fromScene == l2) << key;
+    std::vector<std::string> args = {"bake",     "--mesh",       mesh, "--map", "object-normal",
+                                     "--size",   "64",           "--margin",    "0",
+                                     "--bit-depth", "32",        "--subdivide", "2"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    const fs::path out = dir_ / (name + "_flag.exr");
+    args.insert(args.end(), {"--no-manifest", "-o", out.string()});
+    const ProcessResult r = run(args);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(readPixels(out) == fromScene) << key;
+  };
+  // "use_limit_surface": false: the refined cage, not the limit.
+  expectSceneKeyEqualsFlag(R"("use_limit_surface": false)", "cage", {"--no-limit-surface"});
+  // "type": "simple": the cube split, not rounded.
+  expectSceneKeyEqualsFlag(R"("type": "simple")", "simple", {"--subdivision-type", "simple"});
   // A different level is a different bake (the manifest hashes the subdivision block).
   const ProcessResult same = bakeScene(scene(2, "l2.exr"));
   EXPECT_NE(same.out.find("up to date: " + (dir_ / "l2.exr").string()), std::string::npos)
