@@ -8,17 +8,18 @@
 
 #include "sgbake/gradient/filters.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <string>
 
+#include "gradient/parallel_rows.hpp"
+
 namespace sgbake {
 namespace {
+
+using gradient_detail::forEachRow;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -223,17 +224,6 @@ Filtered<1> hermite(const ImageScalarTexture::HermiteTexel* texels, int width, i
 // ---------------------------------------------------------------------------------------------
 // Hermite derivative data
 
-// Grain of the parallel loops over rows (rows are independent; results do not depend on it).
-constexpr std::size_t kRowGrain = 16;
-
-template <class Body>
-void forEachRow(int height, const Body& body) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, height, kRowGrain),
-                    [&](const tbb::blocked_range<int>& rows) {
-                      for (int y = rows.begin(); y != rows.end(); ++y) body(y);
-                    });
-}
-
 // A height plane with wrapped reads.
 struct Plane {
   const std::vector<float>& h;
@@ -321,18 +311,13 @@ std::string channelsText(int n) { return std::to_string(n) + (n == 1 ? " channel
 
 // The first non-finite value of channels [first, first + count) of @p image, as an error.
 Status checkFinite(const Image& image, int first, int count, const char* what) {
-  for (int y = 0; y < image.height(); ++y) {
-    for (int x = 0; x < image.width(); ++x) {
-      for (int c = first; c < first + count; ++c) {
-        if (!std::isfinite(image.at(x, y, c))) {
-          return Error::badInput(std::string(what) + ": texel (" + std::to_string(x) + ", " +
-                                 std::to_string(y) + ") channel " + std::to_string(c) +
-                                 " is not a finite number");
-        }
-      }
-    }
-  }
-  return Ok{};
+  const std::ptrdiff_t bad = findNonFinite(image, first, count);
+  if (bad < 0) return Ok{};
+  const auto texel = static_cast<std::size_t>(bad) / static_cast<std::size_t>(image.channels());
+  const auto width = static_cast<std::size_t>(image.width());
+  return Error::badInput(std::string(what) + ": texel (" + std::to_string(texel % width) + ", " +
+                         std::to_string(texel / width) + ") channel " +
+                         std::to_string(bad % image.channels()) + " is not a finite number");
 }
 
 Status checkScalarSource(const Image& image, const ScalarTextureOptions& options) {
@@ -346,13 +331,16 @@ Status checkScalarSource(const Image& image, const ScalarTextureOptions& options
 }
 
 std::vector<float> extractChannel(const Image& image, int channel) {
-  std::vector<float> plane(static_cast<std::size_t>(image.width()) *
-                           static_cast<std::size_t>(image.height()));
-  const std::span<const float> pixels = image.pixels();
+  const auto width = static_cast<std::size_t>(image.width());
+  std::vector<float> plane(width * static_cast<std::size_t>(image.height()));
+  const float* pixels = image.pixels().data();
   const auto stride = static_cast<std::size_t>(image.channels());
-  for (std::size_t i = 0; i < plane.size(); ++i) {
-    plane[i] = pixels[i * stride + static_cast<std::size_t>(channel)];
-  }
+  forEachRow(image.height(), [&](int y) {
+    const std::size_t row = static_cast<std::size_t>(y) * width;
+    for (std::size_t x = row; x < row + width; ++x) {
+      plane[x] = pixels[x * stride + static_cast<std::size_t>(channel)];
+    }
+  });
   return plane;
 }
 

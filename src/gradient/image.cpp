@@ -2,15 +2,21 @@
 
 #include "sgbake/gradient/image.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <new>
 #include <string>
-#include <utility>
 #include <string_view>
 #include <system_error>
+#include <utility>
 
+#include "gradient/parallel_rows.hpp"
 #include "io/image_codec.hpp"
 
 namespace sgbake {
@@ -24,6 +30,16 @@ Image::Image(int width, int height, int channels)
 }
 
 namespace {
+
+using gradient_detail::forEachRow;
+using gradient_detail::kRowGrain;
+
+/// Whether a float is NaN or ±infinity: all exponent bits set. An integer test without a branch,
+/// so a loop that ORs it over a row vectorizes.
+inline bool nonFinite(float v) {
+  constexpr std::uint32_t kExponent = 0x7f800000u;
+  return (std::bit_cast<std::uint32_t>(v) & kExponent) == kExponent;
+}
 
 // Rec. 709 luma weights (Blender's default OCIO config, `rgb_to_y` in Cycles).
 constexpr double kLumaR = 0.2126;
@@ -111,18 +127,15 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
   in.reset();
 
   // Non-finite values (possible in float formats) would poison every filtered sample.
-  const std::span<const float> values = read.pixels();
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (!std::isfinite(values[i])) {
-      const std::size_t texel = i / static_cast<std::size_t>(readChannels);
-      const auto x = static_cast<int>(texel % static_cast<std::size_t>(width));
-      const auto y = static_cast<int>(texel / static_cast<std::size_t>(width));
-      return fileError(path, "pixel at column " + std::to_string(x) + ", row " +
-                                 std::to_string(read.yFromFileRow(y)) +
-                                 " (from the top), channel " +
-                                 std::to_string(i % static_cast<std::size_t>(readChannels)) +
-                                 " is not a finite number");
-    }
+  if (const std::ptrdiff_t bad = findNonFinite(read); bad >= 0) {
+    const auto i = static_cast<std::size_t>(bad);
+    const std::size_t texel = i / static_cast<std::size_t>(readChannels);
+    const auto x = static_cast<int>(texel % static_cast<std::size_t>(width));
+    const auto y = static_cast<int>(texel / static_cast<std::size_t>(width));
+    return fileError(path, "pixel at column " + std::to_string(x) + ", row " +
+                               std::to_string(read.yFromFileRow(y)) + " (from the top), channel " +
+                               std::to_string(i % static_cast<std::size_t>(readChannels)) +
+                               " is not a finite number");
   }
 
   // The file's channels were read as the selection needs them; only luminance is left to do.
@@ -137,18 +150,68 @@ Image selectImageChannels(Image image, ImageChannels selection) {
   if (keep == have) return image;
   const bool luminance = selection == ImageChannels::kLuminance && have >= 3;
   Image selected(image.width(), image.height(), keep);
-  for (int y = 0; y < image.height(); ++y) {
-    for (int x = 0; x < image.width(); ++x) {
+  const std::size_t width = static_cast<std::size_t>(image.width());
+  const std::size_t from = static_cast<std::size_t>(have);
+  const std::size_t to = static_cast<std::size_t>(keep);
+  const float* source = image.pixels().data();
+  float* target = selected.pixels().data();
+  forEachRow(image.height(), [&](int y) {
+    const std::size_t row = static_cast<std::size_t>(y) * width;
+    const float* in = source + row * from;
+    float* out = target + row * to;
+    for (std::size_t x = 0; x < width; ++x) {
       if (luminance) {
-        const double luma = kLumaR * image.at(x, y, 0) + kLumaG * image.at(x, y, 1) +
-                            kLumaB * image.at(x, y, 2);
-        selected.at(x, y) = static_cast<float>(luma);
+        const double luma = kLumaR * in[x * from] + kLumaG * in[x * from + 1] +
+                            kLumaB * in[x * from + 2];
+        out[x] = static_cast<float>(luma);
       } else {
-        for (int c = 0; c < keep; ++c) selected.at(x, y, c) = image.at(x, y, c);
+        for (std::size_t c = 0; c < to; ++c) out[x * to + c] = in[x * from + c];
       }
     }
-  }
+  });
   return selected;
+}
+
+std::ptrdiff_t findNonFinite(const Image& image, int first, int count) {
+  const int channels = image.channels();
+  if (count < 0) count = channels - first;
+  assert(first >= 0 && count >= 0 && first + count <= channels);
+  if (image.empty() || count == 0) return -1;
+  const std::size_t rowValues =
+      static_cast<std::size_t>(image.width()) * static_cast<std::size_t>(channels);
+  const float* pixels = image.pixels().data();
+  const auto stride = static_cast<std::size_t>(channels);
+  const auto c0 = static_cast<std::size_t>(first);
+  const auto cn = static_cast<std::size_t>(count);
+  // Whether value i of a row is tested; with every channel tested, a plain run of values.
+  const bool allChannels = count == channels;
+  auto tested = [&](std::size_t i) { return i % stride - c0 < cn; };
+  constexpr std::ptrdiff_t kNone = -1;
+  auto earlier = [](std::ptrdiff_t a, std::ptrdiff_t b) {
+    return a < 0 ? b : b < 0 ? a : std::min(a, b);
+  };
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, image.height(), kRowGrain), kNone,
+      [&](const tbb::blocked_range<int>& rows, std::ptrdiff_t found) {
+        for (int y = rows.begin(); y != rows.end() && found < 0; ++y) {
+          const float* row = pixels + static_cast<std::size_t>(y) * rowValues;
+          bool any = false;  // one branch-free pass; the exact place only when there is one
+          if (allChannels) {
+            for (std::size_t i = 0; i < rowValues; ++i) any |= nonFinite(row[i]);
+          } else {
+            for (std::size_t i = 0; i < rowValues; ++i) any |= tested(i) && nonFinite(row[i]);
+          }
+          if (!any) continue;
+          for (std::size_t i = 0; i < rowValues; ++i) {
+            if (tested(i) && nonFinite(row[i])) {
+              found = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * rowValues + i);
+              break;
+            }
+          }
+        }
+        return found;
+      },
+      earlier);
 }
 
 }  // namespace sgbake

@@ -5,8 +5,11 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
+#include <random>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -253,6 +256,28 @@ TEST(LoadImage, BadFilesAreOneLineBadInputErrors) {
   expectFileError(loadImage(huge), huge, "image is too large (70000x2; at most 65536 per side)");
 }
 
+TEST(LoadImage, NonFiniteTexelsAreNamedFromTheTop) {
+  const fs::path dir = testDir();
+  // 5×4 RGB float EXR; one bad value at column 3, file row 1, channel 2 (a later one too).
+  const int w = 5, h = 4;
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity()}) {
+    std::vector<float> pixels(static_cast<std::size_t>(w * h * 3), 0.25f);
+    pixels[static_cast<std::size_t>((1 * w + 3) * 3 + 2)] = bad;
+    pixels[static_cast<std::size_t>((3 * w + 0) * 3 + 0)] = bad;
+    const fs::path path = dir / "bad.exr";
+    writeImage(path, w, h, 3, OIIO::TypeDesc::FLOAT, pixels);
+    // Rows are stored bottom-up: file row 3 is searched first, so its texel is the one named.
+    expectFileError(loadImage(path), path,
+                    "pixel at column 0, row 3 (from the top), channel 0 is not a finite number");
+    pixels[static_cast<std::size_t>((3 * w + 0) * 3 + 0)] = 0.5f;
+    writeImage(path, w, h, 3, OIIO::TypeDesc::FLOAT, pixels);
+    expectFileError(loadImage(path), path,
+                    "pixel at column 3, row 1 (from the top), channel 2 is not a finite number");
+  }
+}
+
 TEST(LoadImage, ControlCharactersInTheNameStayOnOneLine) {
   const fs::path path = testDir() / "evil\nname.png";
   const Result<Image> image = loadImage(path);
@@ -268,6 +293,45 @@ TEST(Image, StorageIsBottomUpAndInterleaved) {
   EXPECT_EQ(image.pixels().front(), 7.0f);
   EXPECT_EQ(image.yFromFileRow(0), 1);
   EXPECT_EQ(image.texelCentre(0, 0), (Vec2d{0.5 / 3, 0.25}));
+}
+
+// findNonFinite against a plain scan with std::isfinite: random bad values in an image tall
+// enough to be searched by several tasks, for every channel range.
+TEST(Image, FindNonFiniteIsTheFirstBadValueInStorageOrder) {
+  const float kBad[] = {std::numeric_limits<float>::quiet_NaN(),
+                        std::numeric_limits<float>::infinity(),
+                        -std::numeric_limits<float>::infinity()};
+  // Finite extremes must pass: the largest float, a subnormal, −0.
+  const float kFinite[] = {std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
+                           std::numeric_limits<float>::denorm_min(), -0.0f, 1.0f};
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int channels = 1 + trial % 4;
+    Image image(13, 150, channels);
+    std::span<float> values = image.pixels();
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = kFinite[random() % 5];
+    const int bads = trial % 5;  // 0: all finite
+    for (int b = 0; b < bads; ++b) values[random() % values.size()] = kBad[random() % 3];
+    for (int first = 0; first < channels; ++first) {
+      for (int count = 0; first + count <= channels; ++count) {
+        std::ptrdiff_t expected = -1;
+        for (std::size_t i = 0; i < values.size() && expected < 0; ++i) {
+          const int c = static_cast<int>(i % static_cast<std::size_t>(channels));
+          if (c >= first && c < first + count && !std::isfinite(values[i])) {
+            expected = static_cast<std::ptrdiff_t>(i);
+          }
+        }
+        EXPECT_EQ(findNonFinite(image, first, count), expected)
+            << "trial " << trial << ", channels [" << first << ", " << first + count << ")";
+      }
+    }
+    std::ptrdiff_t all = -1;
+    for (std::size_t i = 0; i < values.size() && all < 0; ++i) {
+      if (!std::isfinite(values[i])) all = static_cast<std::ptrdiff_t>(i);
+    }
+    EXPECT_EQ(findNonFinite(image), all) << "trial " << trial;
+  }
+  EXPECT_EQ(findNonFinite(Image()), -1);
 }
 
 }  // namespace

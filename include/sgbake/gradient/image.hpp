@@ -121,4 +121,15 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
 /// @note Precondition for kRgb: at least three channels (callers check and report it).
 Image selectImageChannels(Image image, ImageChannels selection);
 
+/// @brief The first value that is not a finite number (NaN or ±infinity) among channels
+/// [first, first + count) of @p image, in the order of pixels() (bottom row first).
+///
+/// Rows are searched in parallel with a branch-free test that the compiler vectorizes: a
+/// 2048² RGB image takes a few milliseconds instead of tens.
+/// @param[in] image the image
+/// @param[in] first the first channel to test (0 ≤ first < C)
+/// @param[in] count how many channels from @p first (first + count ≤ C); -1: all the rest
+/// @return the value's index in pixels(), or -1 when every tested value is finite
+std::ptrdiff_t findNonFinite(const Image& image, int first = 0, int count = -1);
+
 }  // namespace sgbake
