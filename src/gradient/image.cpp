@@ -34,12 +34,9 @@ namespace {
 using gradient_detail::forEachRow;
 using gradient_detail::kRowGrain;
 
-/// Whether a float is NaN or ±infinity: all exponent bits set. An integer test without a branch,
-/// so a loop that ORs it over a row vectorizes.
-inline bool nonFinite(float v) {
-  constexpr std::uint32_t kExponent = 0x7f800000u;
-  return (std::bit_cast<std::uint32_t>(v) & kExponent) == kExponent;
-}
+/// The exponent bits of a float: all set (kExponentBits) exactly when it is NaN or ±infinity.
+constexpr std::uint32_t kExponentBits = 0x7f800000u;
+inline std::uint32_t exponentBits(float v) { return std::bit_cast<std::uint32_t>(v) & kExponentBits; }
 
 // Rec. 709 luma weights (Blender's default OCIO config, `rgb_to_y` in Cycles).
 constexpr double kLumaR = 0.2126;
@@ -195,15 +192,22 @@ std::ptrdiff_t findNonFinite(const Image& image, int first, int count) {
       [&](const tbb::blocked_range<int>& rows, std::ptrdiff_t found) {
         for (int y = rows.begin(); y != rows.end() && found < 0; ++y) {
           const float* row = pixels + static_cast<std::size_t>(y) * rowValues;
-          bool any = false;  // one branch-free pass; the exact place only when there is one
+          // One pass without branches (a vectorized maximum); the exact place only when the
+          // largest exponent field of the row is all ones.
+          std::uint32_t largest = 0;
           if (allChannels) {
-            for (std::size_t i = 0; i < rowValues; ++i) any |= nonFinite(row[i]);
+            for (std::size_t i = 0; i < rowValues; ++i) {
+              largest = std::max(largest, exponentBits(row[i]));
+            }
           } else {
-            for (std::size_t i = 0; i < rowValues; ++i) any |= tested(i) && nonFinite(row[i]);
+            for (std::size_t i = 0; i < rowValues; ++i) {
+              largest = std::max(largest, tested(i) ? exponentBits(row[i]) : 0u);
+            }
           }
+          const bool any = largest == kExponentBits;
           if (!any) continue;
           for (std::size_t i = 0; i < rowValues; ++i) {
-            if (tested(i) && nonFinite(row[i])) {
+            if (tested(i) && exponentBits(row[i]) == kExponentBits) {
               found = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * rowValues + i);
               break;
             }
