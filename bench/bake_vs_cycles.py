@@ -43,7 +43,10 @@ Prints one JSON line:
   sgbake_s (target >= 25), write_s (OIIO alone), writer_thread_s, total_over_write = sgbake_s /
   write_s (target <= 2), oiio_start_s, oiio_process_s, total_over_oiio_process,
   t1_s, t2_s (wall, --threads 1 / 2), t1_compute_s, t2_compute_s, scaling = t1_compute_s /
-  t2_compute_s (target >= 1.8), plus size, margin, format, bit_depth, faces, height_size,
+  t2_compute_s (target >= 1.8), wall_scaling = t1_s / t2_s; one_core_s (--threads 1 pinned to
+  one CPU with taskset; null without taskset), one_core_wall_scaling = one_core_s / t2_s,
+  one_core_after_load_s and t2_after_load_s (total_s - load_s from --stats: everything after
+  the inputs are loaded, writing included), after_load_scaling = their ratio; plus size, margin, format, bit_depth, faces, height_size,
   the 1-minute load average before and after (measure on an idle machine: with the load above
   the core count the figures, above all the scaling, are meaningless) and sgbake's stats of
   the best all-core run.
@@ -51,7 +54,9 @@ Prints one JSON line:
 (else wall - load_s - write_s); bake_s excludes the waits for the writer thread. The scaling
 target is about the compute: writing a PNG is serial zlib, and as total_over_write <= 2 lets
 writing be up to half the wall time, whole-process scaling could never reach 1.8
-(wall_scaling is reported too). With two cores the writer thread shares them with the
+(wall_scaling is reported too). --threads 1 bounds the bake's threads, not the writer's, which
+runs on the second core: the one-core run takes that core away, and after_load_scaling is then
+what the second core buys for everything after loading (writing included). With two cores the writer thread shares them with the
 compute, so the 2-thread compute gets less than two cores; the library benchmark
 `sgbake_bench_bake` (BM_TangentNormal/threads:1 vs 2, no I/O) measures the kernel alone.
 sgbake runs with --no-manifest: otherwise its incremental manifest would skip every run after
@@ -63,6 +68,7 @@ Exit 2 on usage errors or a failed run, 77 when Blender is not installed.
 import argparse
 import json
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -118,10 +124,15 @@ def run_blender_half(args, work):
     return None
 
 
-def time_sgbake(args, work, scale, threads):
-    """Runs the bake --runs times; returns (best wall s, stats of that run) or None."""
-    out = os.path.join(work, f"sgbake_t{threads or 'all'}.{args.format}")
-    cmd = [args.cli, "bake", "--mesh", os.path.join(work, "mesh.obj"),
+def time_sgbake(args, work, scale, threads, one_core=False):
+    """Runs the bake --runs times; returns (best wall s, stats of that run) or None. one_core:
+    the process may run on one CPU only (taskset), every thread of it included."""
+    out = os.path.join(work, f"sgbake_t{threads or 'all'}{'_1core' if one_core else ''}"
+                             f".{args.format}")
+    pin = []
+    if one_core:
+        pin = ["taskset", "-c", str(min(os.sched_getaffinity(0)))]
+    cmd = pin + [args.cli, "bake", "--mesh", os.path.join(work, "mesh.obj"),
            "--height", os.path.join(work, "height.exr"), "--height-scale", repr(scale),
            "--filter", "bilinear", "--map", "tangent-normal", "--size", str(args.size),
            "--margin", str(args.margin), "--samples", "1", "-o", out, "--stats",
@@ -150,6 +161,16 @@ def compute_s(wall, stats):
     io = [stats.get(k) for k in ("load_s", "write_s")]
     if all(isinstance(p, (int, float)) for p in io):
         return wall - float(sum(io))
+    return None
+
+
+def after_load_s(run):
+    """What a run spends once its inputs are loaded (tangents, bake, padding, conversion and the
+    rest of the write), from its --stats: total_s - load_s, or None."""
+    stats = run[1]
+    if isinstance(stats.get("total_s"), (int, float)) and isinstance(stats.get("load_s"),
+                                                                     (int, float)):
+        return stats["total_s"] - stats["load_s"]
     return None
 
 
@@ -207,6 +228,11 @@ def main():
             if result is None:
                 return 2
             timed[threads] = result
+        one_core = None
+        if shutil.which("taskset"):
+            one_core = time_sgbake(args, work, scale, 1, one_core=True)
+            if one_core is None:
+                return 2
         written = os.path.join(work, f"sgbake_tall.{args.format}")
         proc = bc.run_tool([args.write_bench, written, str(args.runs)], timeout=900)
         if proc is None or proc.returncode != 0:
@@ -245,6 +271,16 @@ def main():
         "t1_compute_s": c1, "t2_compute_s": c2,
         "scaling": c1 / c2 if c1 and c2 else None,
         "wall_scaling": t1[0] / t2[0],
+        # --threads 1 still has the writer thread beside the bake, on the second core. Pinned
+        # to one core, the same run shows what a second core buys: the whole process, and the
+        # part after loading (which the serial module load and image decode do not dilute).
+        "one_core_s": one_core[0] if one_core else None,
+        "one_core_wall_scaling": one_core[0] / t2[0] if one_core else None,
+        "one_core_after_load_s": after_load_s(one_core) if one_core else None,
+        "t2_after_load_s": after_load_s(t2),
+        "after_load_scaling": (after_load_s(one_core) / after_load_s(t2)
+                               if one_core and after_load_s(one_core) and after_load_s(t2)
+                               else None),
         "size": args.size, "margin": args.margin, "format": args.format,
         "bit_depth": args.bit_depth,
         "height_size": args.height_size, "faces": blender["faces"],
