@@ -35,7 +35,7 @@ struct AxisPosition {
 
 // s (texture units) → cell and fraction along an axis of n texels (u = s·n − 0.5).
 // @note Precondition: s is finite.
-AxisPosition locate(double s, int n, Wrap wrap) {
+[[gnu::always_inline]] inline AxisPosition locate(double s, int n, Wrap wrap) {
   const double size = n;
   if (wrap == Wrap::kRepeat) {
     // s − floor(s) is exact; it may round up to 1.0 for tiny negative s, which is the same
@@ -90,10 +90,13 @@ struct Filtered {
   std::array<double, N> dv{};
 };
 
-// Bilinear: taps (x0, x1) × (y0, y1).
+// Bilinear: taps (x0, x1) × (y0, y1). Always inlined, like locate(): as calls returning their
+// result through memory they cost a 4096² tangent-normal bake ~8 % (BM_TangentNormalBands:
+// 378–384 → 350 ms on one thread, 194–201 → 179–180 ms on two; the same bits).
 template <int N>
-Filtered<N> bilinear(const float* texels, int width, int height, Wrap wrap, int cellX, double fx,
-                     int cellY, double fy) {
+[[gnu::always_inline]] inline Filtered<N> bilinear(const float* texels, int width, int height,
+                                                   Wrap wrap, int cellX, double fx, int cellY,
+                                                   double fy) {
   const int x0 = resolveIndex(cellX, width, wrap);
   const int x1 = resolveIndex(cellX + 1, width, wrap);
   const int y0 = resolveIndex(cellY, height, wrap);
