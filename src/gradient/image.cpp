@@ -36,7 +36,9 @@ using gradient_detail::kRowGrain;
 
 /// The exponent bits of a float: all set (kExponentBits) exactly when it is NaN or ±infinity.
 constexpr std::uint32_t kExponentBits = 0x7f800000u;
-inline std::uint32_t exponentBits(float v) { return std::bit_cast<std::uint32_t>(v) & kExponentBits; }
+inline std::uint32_t exponentBits(float v) {
+  return std::bit_cast<std::uint32_t>(v) & kExponentBits;
+}
 
 // Rec. 709 luma weights (Blender's default OCIO config, `rgb_to_y` in Cycles).
 constexpr double kLumaR = 0.2126;
@@ -158,8 +160,8 @@ Image selectImageChannels(Image image, ImageChannels selection) {
     float* out = target + row * to;
     for (std::size_t x = 0; x < width; ++x) {
       if (luminance) {
-        const double luma = kLumaR * in[x * from] + kLumaG * in[x * from + 1] +
-                            kLumaB * in[x * from + 2];
+        const double luma =
+            kLumaR * in[x * from] + kLumaG * in[x * from + 1] + kLumaB * in[x * from + 2];
         out[x] = static_cast<float>(luma);
       } else {
         for (std::size_t c = 0; c < to; ++c) out[x * to + c] = in[x * from + c];

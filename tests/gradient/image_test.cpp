@@ -8,9 +8,9 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -258,11 +258,12 @@ TEST(LoadImage, BadFilesAreOneLineBadInputErrors) {
 
 TEST(LoadImage, NonFiniteTexelsAreNamedFromTheTop) {
   const fs::path dir = testDir();
-  // 5×4 RGB float EXR; one bad value at column 3, file row 1, channel 2 (a later one too).
+  // 5×4 RGB float EXR: bad values at column 3, file row 1, channel 2 and at column 0 of file
+  // row 3, channel 0.
   const int w = 5, h = 4;
-  for (const float bad : {std::numeric_limits<float>::quiet_NaN(),
-                          std::numeric_limits<float>::infinity(),
-                          -std::numeric_limits<float>::infinity()}) {
+  for (const float bad :
+       {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+        -std::numeric_limits<float>::infinity()}) {
     std::vector<float> pixels(static_cast<std::size_t>(w * h * 3), 0.25f);
     pixels[static_cast<std::size_t>((1 * w + 3) * 3 + 2)] = bad;
     pixels[static_cast<std::size_t>((3 * w + 0) * 3 + 0)] = bad;
