@@ -16,6 +16,8 @@
 #include <memory>
 #include <new>
 #include <set>
+#include <sstream>
+#include <string>
 #include <system_error>
 #include <tuple>
 #include <utility>
@@ -255,6 +257,17 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
                ": every sample is shaded on the exact surface, found through a level-" +
                std::to_string(kLimitTessellationLevel) + " tessellation",
            "the scene's \"subdivision\": {\"level\": \"limit\"}"});
+    } else if (scene.subdivision.requested() && scene.subdivision.level == 0) {
+      std::ostringstream angle;
+      angle << *scene.subdivision.autoSmoothDegrees;
+      plan.steps.push_back(
+          {"split the mesh's normals by Auto Smooth at " + angle.str() + " deg" +
+               (scene.subdivision.sharpEdges.empty()
+                    ? std::string()
+                    : " and " + std::to_string(scene.subdivision.sharpEdges.size()) +
+                          " sharp edge(s)") +
+               " (not subdivided)",
+           "the scene's \"subdivision\": {\"level\": 0, \"auto_smooth\": ...}"});
     } else if (scene.subdivision.requested()) {
       plan.steps.push_back({"subdivide the mesh " + describeSubdivision(scene.subdivision),
                             "the scene's \"subdivision\" block (Blender's Subdivision Surface "

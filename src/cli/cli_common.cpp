@@ -237,8 +237,9 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
   CLI::Option* const autoSmooth =
       app.add_option_function<double>(
              "--auto-smooth", [&options](double degrees) { options.autoSmoothDegrees = degrees; },
-             "The mesh's Auto Smooth angle in degrees: the subdivided mesh's normals are split "
-             "where its faces meet at more than this (default: Auto Smooth off)")
+             "The mesh's Auto Smooth angle in degrees: the normals of the mesh (subdivided or "
+             "not) are split where its faces meet at more than this, replacing any the file "
+             "gives (default: Auto Smooth off)")
           ->type_name("DEG")
           ->check(CLI::Range(0.0, 180.0).description(""));
   options.sharpEdges.clear();
@@ -263,17 +264,21 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
                                bool limit) {
   // Options that only shape a subdivision, given without one: a forgotten --subdivide.
+  // (--auto-smooth shades the mesh as it is too; --sharp-edge then marks its edges.)
   if (options.level == 0 && !limit) {
     const char* given = !options.edgeCreases.empty()     ? "--edge-crease"
                         : !options.vertexCreases.empty() ? "--vertex-crease"
-                        : !options.sharpEdges.empty()    ? "--sharp-edge"
-                        : options.autoSmoothDegrees      ? "--auto-smooth"
                         : !options.useLimitSurface       ? "--no-limit-surface"
                         : options.type == SubdivisionType::kSimple ? "--subdivision-type simple"
                                                                    : nullptr;
     if (given != nullptr) {
       return Error::badInput(command + ": " + given +
                              " applies to a subdivided mesh; add --subdivide N");
+    }
+    if (!options.sharpEdges.empty() && !options.autoSmoothDegrees) {
+      return Error::badInput(command +
+                             ": --sharp-edge without --subdivide needs --auto-smooth DEG (edges "
+                             "marked sharp split the normals only with Auto Smooth)");
     }
   }
   if (limit && !options.useLimitSurface) {

@@ -150,7 +150,7 @@ Status runTangents(const TangentsArguments& args) {
   Result<Mesh> mesh = loadMesh(args.mesh, loadOptions);
   if (!mesh) return mesh.error();
   const double loadSeconds = step.lap();
-  if (args.subdivision.level > 0) {  // timed on its own (--stats)
+  if (args.subdivision.changesMesh()) {  // timed on its own (--stats)
     mesh = subdivideMesh(*mesh, args.subdivision);
     if (!mesh) return mesh.error();
   }

@@ -277,7 +277,7 @@ Result<Mesh> loadMeshFromMemory(std::string_view bytes, std::string_view extensi
   if (Status s = validate(*mesh); !s) {
     return Error::internal("loaded mesh breaks an invariant: " + s.error().message);
   }
-  if (options.subdivision.level > 0) return subdivideMesh(*mesh, options.subdivision);
+  if (options.subdivision.changesMesh()) return subdivideMesh(*mesh, options.subdivision);
   return mesh;
 }
 

@@ -270,12 +270,17 @@ std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOp
 
 namespace sgbake::subdiv_detail {
 
+Status checkCreases(const Mesh& coarse, const SubdivisionOptions& options) {
+  if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, options)) {
+    return Error::badInput(coarse.source + ": " + issue->noun() + " " +
+                           std::to_string(issue->index) + ": " + issue->what);
+  }
+  return Ok{};
+}
+
 Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOptions& options) {
   const std::string& name = coarse.source;
-  if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, options)) {
-    return Error::badInput(name + ": " + issue->noun() + " " + std::to_string(issue->index) +
-                           ": " + issue->what);
-  }
+  if (Status ok = checkCreases(coarse, options); !ok) return ok.error();
   const std::size_t nf = coarse.numFaces();
   for (std::size_t f = 0; f < nf; ++f) {
     const auto first = coarse.cornerVertex.begin() + coarse.faceStart[f];

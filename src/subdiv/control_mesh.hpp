@@ -35,6 +35,10 @@ struct ControlMesh {
   std::vector<double> points;         ///< 3 per vertex, the positions in double
 };
 
+/// kBadInput naming coarse.source and the entry for the first crease or sharp edge of
+/// @p options that does not fit @p coarse (findCreaseIssue).
+Status checkCreases(const Mesh& coarse, const SubdivisionOptions& options);
+
 /// The Far topology of @p coarse with Blender's options (see shared/CONVENTIONS.md).
 /// @return kBadInput naming coarse.source for a face that uses a vertex twice or a topology
 ///         OpenSubdiv rejects

@@ -210,7 +210,18 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
         parameters->faceOrigin.push_back(static_cast<std::uint32_t>(f));
       }
     }
-    return coarse;
+    if (!options.autoSmoothDegrees) return coarse;
+    // The modifier at level 0 returns the mesh as it is, and the mesh's Auto Smooth splits its
+    // normals, along its own edges marked sharp.
+    if (Status ok = checkCreases(coarse, options); !ok) return ok.error();
+    Mesh shaded = coarse;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> sharp;
+    for (const SharpEdge& e : options.sharpEdges) {
+      sharp.emplace_back(std::min(e.v0, e.v1), std::max(e.v0, e.v1));
+    }
+    std::sort(sharp.begin(), sharp.end());
+    computeSplitNormals(shaded, *options.autoSmoothDegrees * (kPi / 180), sharp);
+    return shaded;
   }
   Result<ControlMesh> control = buildControlMesh(coarse, options);
   if (!control) return control.error();

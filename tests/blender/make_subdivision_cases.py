@@ -194,8 +194,12 @@ SIMPLE_CASES = [
 ]
 # Cases with the mesh's Auto Smooth on, with (…, subdivision_type, auto_smooth degrees) last:
 # the subdivided mesh's split normals, split along infinitely sharp creases (cube, cylinder),
-# around flat faces (Suzanne) and wherever the subdivided faces meet at a wide angle.
+# around flat faces (Suzanne) and wherever the subdivided faces meet at a wide angle; at level
+# 0 (the modifier leaves the mesh as it is) the coarse mesh's own split normals (meshes of
+# triangles and quads: Blender's calc_tangents refuses n-gons).
 AUTO_SMOOTH_CASES = [
+    ("suzanne_flat", 0, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 20.0),
+    ("suzanne", 0, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 45.0),
     ("cube_creased", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 30.0),
     ("cylinder_creased", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 30.0),
     ("suzanne_flat", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 20.0),
@@ -204,6 +208,7 @@ AUTO_SMOOTH_CASES = [
 # Cases with edges marked sharp (every k-th edge of the mesh), with (…, auto_smooth, k) last:
 # at 180 degrees only the marks split the normals.
 SHARP_CASES = [
+    ("suzanne", 0, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 180.0, 5),
     ("suzanne", 1, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 180.0, 5),
     ("cylinder", 2, "PRESERVE_BOUNDARIES", "ALL", True, 3, True, "CATMULL_CLARK", 60.0, 4),
 ]

@@ -64,7 +64,10 @@
                 30 deg, and at 40 deg against Blender's flat-faced Suzanne at 20 deg: the normal
                 check must fail;
      sharp edges  sgbake without the --sharp-edge marks against Blender's Suzanne with every
-                5th edge marked sharp (Auto Smooth 180 deg): the normal check must fail.
+                5th edge marked sharp (Auto Smooth 180 deg): the normal check must fail;
+     level 0    the same two at level 0 (the mesh as it is, with its own split normals):
+                sgbake without --auto-smooth (the OBJ's normals) against Blender's flat-faced
+                Suzanne at 20 deg, and without the marks against Suzanne's every 5th edge.
 
 Prints one line of figures per case (D, the largest position error and the vertices that
 differ, unmatched faces and diagonal mismatches, UV max and the corners that differ, tangent
@@ -137,6 +140,10 @@ CONTROLS = [
     ("auto smooth angle", "suzanne_flat_L1_PRESERVE_BOUNDARIES_ALL_autosmooth20",
      {"--auto-smooth": "40"}, "normals"),
     ("sharp edges", "suzanne_L1_PRESERVE_BOUNDARIES_ALL_autosmooth180_sharp5",
+     {"no sharp edges": True}, "normals"),
+    ("auto smooth level 0", "suzanne_flat_L0_PRESERVE_BOUNDARIES_ALL_autosmooth20",
+     {"--auto-smooth": None}, "normals"),
+    ("sharp edges level 0", "suzanne_L0_PRESERVE_BOUNDARIES_ALL_autosmooth180_sharp5",
      {"no sharp edges": True}, "normals"),
 ]
 

@@ -18,6 +18,7 @@
 #include <iterator>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -489,7 +490,7 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
            {"bake", (dir_ / "scene.json").string(), "--auto-smooth", "30"},
            // Subdivision shaping without --subdivide: a forgotten level, not silently ignored.
            {"bake", "--mesh", mesh, "--edge-crease", "0,1,1", "-o", (dir_ / "o.png").string()},
-           {"tangents", mesh, "--auto-smooth", "30", "-o", (dir_ / "t.csv").string()},
+           {"tangents", mesh, "--sharp-edge", "0,1", "-o", (dir_ / "t.csv").string()},
            {"convert", "--mesh", mesh, "--sharp-edge", "0,1", "--from", "object", "--to",
             "tangent", (dir_ / "l0.exr").string(), "-o", (dir_ / "c.exr").string()},
            {"convert", "--mesh", mesh, "--subdivide", "limit", "--auto-smooth", "30", "--from",
@@ -502,16 +503,84 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   }
   EXPECT_EQ(listDirectory(dir_), before);
   const ProcessResult forgotten =
-      run({"tangents", mesh, "--auto-smooth", "30", "-o", (dir_ / "t.csv").string()});
-  EXPECT_NE(forgotten.err.find(
-                "tangents: --auto-smooth applies to a subdivided mesh; add --subdivide N"),
+      run({"tangents", mesh, "--sharp-edge", "0,1", "-o", (dir_ / "t.csv").string()});
+  EXPECT_NE(forgotten.err.find("tangents: --sharp-edge without --subdivide needs --auto-smooth "
+                               "DEG (edges marked sharp split the normals only with Auto "
+                               "Smooth)"),
             std::string::npos)
       << forgotten.err;
+  // --auto-smooth alone shades the mesh as it is: the cube's faces meet at 90 degrees, so at
+  // 30 every corner's normal in the mesh written is its face's axis (no diagonal component).
+  const fs::path shaded = dir_ / "shaded.obj";
+  const ProcessResult autoSmooth = run({"tangents", mesh, "--auto-smooth", "30", "--mesh-out",
+                                        shaded.string(), "-o", (dir_ / "t.csv").string()});
+  ASSERT_EQ(autoSmooth.exitCode, 0) << autoSmooth.err;
+  std::istringstream lines(readFile(shaded));
+  int normals = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("vn ", 0) != 0) continue;
+    std::istringstream values(line.substr(3));
+    double x = 0, y = 0, z = 0;
+    values >> x >> y >> z;
+    EXPECT_EQ(std::abs(x) + std::abs(y) + std::abs(z), 1.0) << line;
+    ++normals;
+  }
+  EXPECT_EQ(normals, 24);
+  fs::remove(shaded);
+  fs::remove(dir_ / "t.csv");
   const ProcessResult both = run({"bake", "--mesh", mesh, "--subdivide", "limit",
                                   "--no-limit-surface", "-o", (dir_ / "o.png").string()});
   EXPECT_NE(both.err.find("bake: --no-limit-surface cannot be combined with --subdivide limit"),
             std::string::npos)
       << both.err;
+}
+
+// Auto Smooth without subdivision ("level": 0, or --auto-smooth alone): the cube's faces meet
+// at 90 degrees, so at 30 every texel's object-space normal is its face's axis, encoded as
+// channels 0.5 ± 0.5 on that axis and 0.5 on the others; without Auto Smooth the normals are
+// the cube's smooth vertex normals, which are not.
+TEST_F(BakeCliTest, AutoSmoothWithoutSubdivisionFromSceneAndFlag) {
+  writeFile(dir_ / "cube.obj", kCubeObj);
+  const auto scene = [](const std::string& subdivision, const std::string& file) {
+    return R"({"mesh": "cube.obj")" + subdivision +
+           R"(, "outputs": [{"map": "object-normal", "file": ")" + file +
+           R"(", "size": 32, "margin": 0, "bit_depth": 32, "alpha": true}]})";
+  };
+  const std::string level0 = R"(, "subdivision": {"level": 0, "auto_smooth": 30})";
+  const ProcessResult explained = bakeScene(scene(level0, "split.exr"), {"--explain"});
+  ASSERT_EQ(explained.exitCode, 0) << explained.err;
+  EXPECT_NE(explained.out.find("split the mesh's normals by Auto Smooth at 30 deg (not "
+                               "subdivided)"),
+            std::string::npos)
+      << explained.out;
+  ASSERT_EQ(bakeScene(scene(level0, "split.exr")).exitCode, 0);
+  ASSERT_EQ(bakeScene(scene("", "smooth.exr")).exitCode, 0);
+  const std::vector<float> split = readPixels(dir_ / "split.exr");
+  const std::vector<float> smooth = readPixels(dir_ / "smooth.exr");
+  ASSERT_EQ(split.size(), std::size_t{32 * 32 * 4});
+  ASSERT_EQ(smooth.size(), split.size());
+  int covered = 0, smoothOffAxis = 0;
+  for (std::size_t t = 0; t < split.size() / 4; ++t) {
+    if (split[4 * t + 3] == 0) continue;  // alpha: coverage
+    ++covered;
+    int onAxis = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const float v = split[4 * t + c];
+      EXPECT_TRUE(v == 0.5f || v == 0.0f || v == 1.0f) << "texel " << t << " channel " << c;
+      onAxis += v != 0.5f;
+      smoothOffAxis += c == 0 && smooth[4 * t] != 0.5f && smooth[4 * t + 1] != 0.5f;
+    }
+    EXPECT_EQ(onAxis, 1) << "texel " << t;
+  }
+  EXPECT_GT(covered, 100);
+  EXPECT_GT(smoothOffAxis, covered / 2);
+  // The flag bakes the same file; --sharp-edge alone is refused (see SubdivisionFromScene…).
+  const ProcessResult flag =
+      run({"bake", "--mesh", (dir_ / "cube.obj").string(), "--map", "object-normal", "--size",
+           "32", "--margin", "0", "--bit-depth", "32", "--alpha", "--auto-smooth", "30", "-o",
+           (dir_ / "split_flag.exr").string()});
+  ASSERT_EQ(flag.exitCode, 0) << flag.err;
+  EXPECT_EQ(readPixels(dir_ / "split_flag.exr"), split);
 }
 
 TEST_F(BakeCliTest, CreasesFromSceneAndFlags) {

@@ -387,6 +387,16 @@ TEST(SubdivideCreases, AutoSmoothSplitsTheNormalsAlongInfinitelySharpCreases) {
   }
 }
 
+/// The distinct corner normals at each vertex of @p mesh.
+std::vector<std::set<std::tuple<float, float, float>>> normalsPerVertex(const Mesh& mesh) {
+  std::vector<std::set<std::tuple<float, float, float>>> normals(mesh.numVertices());
+  for (std::size_t c = 0; c < mesh.numCorners(); ++c) {
+    const Vec3f n = mesh.cornerNormals[c];
+    normals[mesh.cornerVertex[c]].insert({n.x, n.y, n.z});
+  }
+  return normals;
+}
+
 TEST(SubdivideCreases, EdgesMarkedSharpSplitTheNormalsAlongThemWithAutoSmooth) {
   // Auto Smooth at 180 degrees splits nothing by angle: only the new edges along the coarse
   // edge 4-5 (marked sharp) split. The points inside it get two normals each (the sharp line
@@ -398,11 +408,7 @@ TEST(SubdivideCreases, EdgesMarkedSharpSplitTheNormalsAlongThemWithAutoSmooth) {
   options.autoSmoothDegrees = 180.0;
   Result<Mesh> marked = subdivideMesh(cube(), options);
   ASSERT_TRUE(marked && unmarked);
-  std::vector<std::set<std::tuple<float, float, float>>> normals(marked->numVertices());
-  for (std::size_t c = 0; c < marked->numCorners(); ++c) {
-    const Vec3f n = marked->cornerNormals[c];
-    normals[marked->cornerVertex[c]].insert({n.x, n.y, n.z});
-  }
+  std::vector<std::set<std::tuple<float, float, float>>> normals = normalsPerVertex(*marked);
   std::size_t split = 0;
   for (std::size_t v = 0; v < normals.size(); ++v) {
     ASSERT_LE(normals[v].size(), 2u) << "vertex " << v;
@@ -426,6 +432,62 @@ TEST(SubdivideCreases, EdgesMarkedSharpSplitTheNormalsAlongThemWithAutoSmooth) {
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().message,
             "test.obj: sharp edge 0: vertices 0 and 6 are not the ends of an edge of the mesh");
+}
+
+TEST(SubdivideCreases, AtLevelZeroAutoSmoothSplitsTheMeshsOwnNormals) {
+  // The modifier at level 0 leaves the cube as it is; Auto Smooth still shades it. Below 90
+  // degrees every edge is sharp: each corner is its face's normal. Above, nothing splits: the
+  // smooth vertex normals, (±1, ±1, ±1)/√3, replacing the normals the mesh came with. At 180
+  // degrees with the edge 4-5 marked sharp, only the ends of that edge (its two faces meet
+  // there) get two normals; a mark that is not an edge is named.
+  Mesh given = cube();
+  std::fill(given.cornerNormals.begin(), given.cornerNormals.end(), Vec3f{0, 0, 1});
+  SubdivisionOptions options{0};
+  options.autoSmoothDegrees = 30.0;
+  Result<Mesh> split = subdivideMesh(given, options);
+  ASSERT_TRUE(split) << split.error().message;
+  EXPECT_EQ(split->positions, given.positions);
+  EXPECT_EQ(split->cornerVertex, given.cornerVertex);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(split->view());
+  for (std::size_t f = 0; f < split->numFaces(); ++f) {
+    for (std::uint32_t c = split->faceStart[f]; c < split->faceStart[f + 1]; ++c) {
+      EXPECT_EQ(split->cornerNormals[c], faceNormals[f]) << "corner " << c;
+    }
+  }
+  options.autoSmoothDegrees = 100.0;
+  Result<Mesh> smooth = subdivideMesh(given, options);
+  ASSERT_TRUE(smooth);
+  for (std::size_t c = 0; c < smooth->numCorners(); ++c) {
+    const Vec3d n = cast<double>(smooth->cornerNormals[c]);
+    const Vec3d p = at(*smooth, smooth->cornerVertex[c]);
+    const Vec3d expected = p * (1 / length(p));
+    EXPECT_LT(length(n - expected), 1e-6) << "corner " << c;
+  }
+  options.autoSmoothDegrees = 180.0;
+  options.sharpEdges = {{5, 4}};
+  Result<Mesh> marked = subdivideMesh(given, options);
+  ASSERT_TRUE(marked);
+  std::vector<std::set<std::tuple<float, float, float>>> normals = normalsPerVertex(*marked);
+  for (std::uint32_t v = 0; v < normals.size(); ++v) {
+    EXPECT_EQ(normals[v].size(), 1u) << "vertex " << v;  // one mark cuts no fan in two
+  }
+  options.sharpEdges = {{5, 4}, {4, 7}, {5, 6}};  // three marks: 4 and 5 each on two
+  marked = subdivideMesh(given, options);
+  ASSERT_TRUE(marked);
+  normals = normalsPerVertex(*marked);
+  for (std::uint32_t v = 0; v < normals.size(); ++v) {
+    EXPECT_EQ(normals[v].size(), v == 4 || v == 5 ? 2u : 1u) << "vertex " << v;
+  }
+  options.sharpEdges = {{0, 6}};
+  Result<Mesh> bad = subdivideMesh(given, options);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message,
+            "test.obj: sharp edge 0: vertices 0 and 6 are not the ends of an edge of the mesh");
+  // Without Auto Smooth, level 0 is the mesh itself, its normals included.
+  options.autoSmoothDegrees.reset();
+  Result<Mesh> same = subdivideMesh(given, options);
+  ASSERT_TRUE(same);
+  EXPECT_EQ(same->cornerNormals, given.cornerNormals);
 }
 
 TEST(SubdivideCreases, SharpnessIsBlendersTenTimesCreaseSquared) {

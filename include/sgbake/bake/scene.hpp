@@ -96,8 +96,9 @@ struct SceneSubdivision {
   SubdivisionType type = SubdivisionType::kCatmullClark;  ///< "type": "catmull-clark" | "simple"
   std::optional<double> autoSmoothDegrees;  ///< "auto_smooth": the mesh's Auto Smooth angle
   std::vector<SharpEdge> sharpEdges;        ///< "sharp_edges": [[a, b], ...]
-  /// @brief Whether the block asks for any subdivision (level > 0 or the limit surface).
-  bool requested() const { return present && (limit || level > 0); }
+  /// @brief Whether the block changes the mesh: a subdivision (level > 0 or the limit surface),
+  /// or Auto Smooth at level 0.
+  bool requested() const { return present && (limit || options().changesMesh()); }
   /// @brief Whether the samples are shaded on the exact limit surface ("level": "limit").
   bool limitSurface() const { return present && limit; }
   /// @brief The options of subdivideMesh this block stands for (a number of levels).
@@ -106,9 +107,9 @@ struct SceneSubdivision {
             quality, useLimitSurface, type,     autoSmoothDegrees, sharpEdges};
   }
   /// @brief The block of @p options (a number of levels), or of the limit surface under them
-  /// when @p limitSurface: options()'s inverse. Present when it asks for any subdivision.
+  /// when @p limitSurface: options()'s inverse. Present when it changes the mesh (requested()).
   static SceneSubdivision of(const SubdivisionOptions& options, bool limitSurface) {
-    return {options.level > 0 || limitSurface, limitSurface, options.level, options.uvSmooth,
+    return {options.changesMesh() || limitSurface, limitSurface, options.level, options.uvSmooth,
             options.boundary, options.useCreases, options.edgeCreases, options.vertexCreases,
             options.quality, options.useLimitSurface, options.type, options.autoSmoothDegrees,
             options.sharpEdges};

@@ -81,7 +81,9 @@ struct VertexCrease {
 /// @brief The options of subdivideMesh: those of Blender's modifier that change the result,
 /// and the creases of the mesh (which Blender keeps on the mesh, not on the modifier).
 struct SubdivisionOptions {
-  int level = 1;  ///< Blender's "Levels" (1..kMaxSubdivisionLevel); 0 returns the mesh unchanged
+  /// Blender's "Levels" (1..kMaxSubdivisionLevel); 0 leaves the mesh as it is, as the modifier
+  /// does, but for autoSmoothDegrees
+  int level = 1;
   SubdivisionUvSmooth uvSmooth = SubdivisionUvSmooth::kKeepBoundaries;
   SubdivisionBoundary boundary = SubdivisionBoundary::kAll;
   bool useCreases = true;  ///< Blender's "Use Creases"; false ignores both lists below
@@ -98,11 +100,16 @@ struct SubdivisionOptions {
   SubdivisionType type = SubdivisionType::kCatmullClark;
   /// The mesh's Auto Smooth angle in degrees, 0 … 180 (Blender keeps it on the mesh:
   /// Mesh.use_auto_smooth, auto_smooth_angle), applied to the subdivided mesh's normals
-  /// (computeSplitNormals); unset: Auto Smooth off.
+  /// (computeSplitNormals), or at level 0 to the mesh's own (replacing any normals its file
+  /// gave, as subdivision does); unset: Auto Smooth off.
   std::optional<double> autoSmoothDegrees{};
   /// Edges marked sharp (each an edge of the mesh); they matter only with autoSmoothDegrees, as
   /// in Blender, where every subdivided edge along one is sharp too.
   std::vector<SharpEdge> sharpEdges{};
+
+  /// @brief Whether subdivideMesh changes the mesh: it subdivides (level > 0), or it splits the
+  /// normals of the mesh as it is by Auto Smooth (level 0).
+  bool changesMesh() const { return level > 0 || autoSmoothDegrees.has_value(); }
 };
 
 /// @brief The range of SubdivisionOptions::quality (Blender's "Quality" field).
