@@ -54,9 +54,10 @@ Prints one JSON line:
 (else wall - load_s - write_s); bake_s excludes the waits for the writer thread. The scaling
 target is about the compute: writing a PNG is serial zlib, and as total_over_write <= 2 lets
 writing be up to half the wall time, whole-process scaling could never reach 1.8
-(wall_scaling is reported too). --threads 1 bounds the bake's threads, not the writer's, which
-runs on the second core: the one-core run takes that core away, and after_load_scaling is then
-what the second core buys for everything after loading (writing included). With two cores the writer thread shares them with the
+(wall_scaling is reported too). --threads 1 bakes and writes on one thread, but the module
+load, the mesh parse and OpenImageIO's EXR decode still overlap on others: the one-core run
+pins the whole process to one CPU, and after_load_scaling is what the second core buys for
+everything after loading (writing included). With two cores the writer thread shares them with the
 compute, so the 2-thread compute gets less than two cores; the library benchmark
 `sgbake_bench_bake` (BM_TangentNormal/threads:1 vs 2, no I/O) measures the kernel alone.
 sgbake runs with --no-manifest: otherwise its incremental manifest would skip every run after
@@ -271,9 +272,9 @@ def main():
         "t1_compute_s": c1, "t2_compute_s": c2,
         "scaling": c1 / c2 if c1 and c2 else None,
         "wall_scaling": t1[0] / t2[0],
-        # --threads 1 still has the writer thread beside the bake, on the second core. Pinned
-        # to one core, the same run shows what a second core buys: the whole process, and the
-        # part after loading (which the serial module load and image decode do not dilute).
+        # Pinned to one core (the loading's threads included), the --threads 1 run shows what
+        # a second core buys: the whole process, and the part after loading (which the serial
+        # module load and image decode do not dilute).
         "one_core_s": one_core[0] if one_core else None,
         "one_core_wall_scaling": one_core[0] / t2[0] if one_core else None,
         "one_core_after_load_s": after_load_s(one_core) if one_core else None,

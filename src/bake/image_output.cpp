@@ -236,20 +236,24 @@ struct ImageFileWriter::State {
       const bool skip = failed || abandoned;
       lock.unlock();
       changed.notify_all();  // room in the queue
-      bool ok = true;
-      const Clock::time_point start = Clock::now();
-      if (!skip) {
-        ok = out->writeRows(strip.row, strip.row + strip.rows, stripType, strip.data.data());
-      }
-      const double seconds = secondsSince(start);
-      lock.lock();
-      fileSeconds += seconds;
-      spare.push_back(std::move(strip.data));
-      if (!ok && !failed) {
-        failed = true;
-        failure = oneLineReason(out->error());
-      }
+      write(std::move(strip), skip, lock);
       changed.notify_all();
+    }
+  }
+
+  /// Writes @p strip to the file unless @p skip (the writer failed or was abandoned) and
+  /// records the time and any failure; called with @p lock released, returns it held.
+  void write(Strip strip, bool skip, std::unique_lock<std::mutex>& lock) {
+    bool ok = true;
+    const Clock::time_point start = Clock::now();
+    if (!skip) ok = out->writeRows(strip.row, strip.row + strip.rows, stripType, strip.data.data());
+    const double seconds = secondsSince(start);
+    lock.lock();
+    fileSeconds += seconds;
+    spare.push_back(std::move(strip.data));
+    if (!ok && !failed) {
+      failed = true;
+      failure = oneLineReason(out->error());
     }
   }
 
@@ -348,8 +352,10 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
     return fileError(ErrorCode::kInternal, path,
                      "cannot write " + upperName(format) + " image (" + oneLineReason(reason) + ")");
   }
-  State* raw = state.get();
-  state->thread = std::thread([raw] { raw->run(); });
+  if (options.threads != 1) {  // one thread asked for: writeRows writes each strip itself
+    State* raw = state.get();
+    state->thread = std::thread([raw] { raw->run(); });
+  }
   return ImageFileWriter(std::move(state));
 }
 
@@ -428,6 +434,14 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
                         for (std::size_t r = range.begin(); r != range.end(); ++r) convertRow(r);
                       });
   });
+  if (!thread.joinable()) {  // no writer thread (threads == 1): write the strip here
+    const Clock::time_point start = Clock::now();
+    std::unique_lock lock(mutex, std::defer_lock);
+    write(std::move(strip), failed, lock);
+    waitSeconds += secondsSince(start);  // the caller is held up by the file, as by a wait
+    if (failed) return writeFailure();
+    return Ok{};
+  }
   const Clock::time_point start = Clock::now();
   std::unique_lock lock(mutex);
   changed.wait(lock, [&] { return failed || queue.size() < kMaxQueuedStrips; });

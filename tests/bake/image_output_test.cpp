@@ -323,28 +323,41 @@ TEST_F(ImageOutputTest, IntegerCodesRoundHalfAwayFromZero) {
   }
 }
 
+// With the writer's own thread (threads 0) and without it (threads 1: each strip written by
+// writeRows itself, before it returns).
 TEST_F(ImageOutputTest, StripsWrittenInTurnEqualTheWholeImage) {
   const FloatImage image = rampImage(7, 9, 3);
   ASSERT_TRUE(writeImage(image, dir_ / "whole.png"));
-  ImageWriteOptions options;
-  options.alpha = true;
-  Result<ImageFileWriter> writer = ImageFileWriter::open(dir_ / "strips.png", 7, 9, 3, options);
-  ASSERT_TRUE(writer.ok());
-  EXPECT_EQ(listDirectory(dir_).count("strips.png"), 0u);  // nothing at the target yet
-  const std::span<const float> pixels(image.pixels), coverage(image.coverage);
-  int row = 0;
-  for (const int rows : {2, 0, 4, 3}) {
-    ASSERT_TRUE(writer->writeRows(row, rows, pixels.subspan(std::size_t(row) * 21, std::size_t(rows) * 21),
-                                  coverage.subspan(std::size_t(row) * 7, std::size_t(rows) * 7)));
-    row += rows;
+  const ReadBack whole = readBack(dir_ / "whole.png");
+  for (const int threads : {0, 1}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    const fs::path path = dir_ / ("strips" + std::to_string(threads) + ".png");
+    ImageWriteOptions options;
+    options.alpha = true;
+    options.threads = threads;
+    Result<ImageFileWriter> writer = ImageFileWriter::open(path, 7, 9, 3, options);
+    ASSERT_TRUE(writer.ok());
+    EXPECT_EQ(listDirectory(dir_).count(path.filename().string()), 0u);  // nothing there yet
+    const std::span<const float> pixels(image.pixels), coverage(image.coverage);
+    int row = 0;
+    for (const int rows : {2, 0, 4, 3}) {
+      ASSERT_TRUE(writer->writeRows(row, rows,
+                                    pixels.subspan(std::size_t(row) * 21, std::size_t(rows) * 21),
+                                    coverage.subspan(std::size_t(row) * 7, std::size_t(rows) * 7)));
+      row += rows;
+      if (threads == 1) {
+        EXPECT_GT(writer->fileSeconds(), 0.0);  // written already
+      }
+    }
+    ASSERT_TRUE(writer->commit());
+    EXPECT_GE(writer->fileSeconds(), 0.0);
+    const ReadBack strips = readBack(path);
+    ASSERT_EQ(strips.spec.nchannels, 4);
+    for (int r = 0; r < 9; ++r)
+      for (int x = 0; x < 7; ++x)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(strips.at(x, r, c), whole.at(x, r, c)) << x << "," << r;
   }
-  ASSERT_TRUE(writer->commit());
-  EXPECT_GE(writer->fileSeconds(), 0.0);
-  const ReadBack whole = readBack(dir_ / "whole.png"), strips = readBack(dir_ / "strips.png");
-  ASSERT_EQ(strips.spec.nchannels, 4);
-  for (int r = 0; r < 9; ++r)
-    for (int x = 0; x < 7; ++x)
-      for (int c = 0; c < 3; ++c) ASSERT_EQ(strips.at(x, r, c), whole.at(x, r, c)) << x << "," << r;
 }
 
 TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
@@ -355,8 +368,11 @@ TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
   }
   const FloatImage image = rampImage(4, 4, 1);
   const std::span<const float> pixels(image.pixels);
-  {
-    Result<ImageFileWriter> writer = ImageFileWriter::open(path, 4, 4, 1);
+  for (const int threads : {0, 1}) {  // the writer's own thread, or none (see above)
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    ImageWriteOptions options;
+    options.threads = threads;
+    Result<ImageFileWriter> writer = ImageFileWriter::open(path, 4, 4, 1, options);
     ASSERT_TRUE(writer.ok());
     ASSERT_TRUE(writer->writeRows(0, 1, pixels.subspan(0, 4), {}));
     const Status gap = writer->writeRows(2, 1, pixels.subspan(8, 4), {});  // row 1 skipped
@@ -367,11 +383,13 @@ TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
     ASSERT_FALSE(incomplete);
     EXPECT_TRUE(incomplete.error().message.starts_with(path.string() + ": ")) << incomplete.error().message;
   }
-  {
-    Result<ImageFileWriter> abandoned = ImageFileWriter::open(path, 4, 4, 1);
+  for (const int threads : {0, 1}) {
+    ImageWriteOptions options;
+    options.threads = threads;
+    Result<ImageFileWriter> abandoned = ImageFileWriter::open(path, 4, 4, 1, options);
     ASSERT_TRUE(abandoned.ok());
     ASSERT_TRUE(abandoned->writeRows(0, 4, pixels, {}));
-  }  // destroyed without commit
+  }  // each destroyed without commit
   EXPECT_EQ(readFile(path), "previous content");
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"n.png"});
 }

@@ -67,7 +67,8 @@ struct ImageWriteOptions {
   /// multiplied by it; PNG gets `oiio:UnassociatedAlpha = 1`).
   bool alpha = false;
   /// Most threads converting pixels to the file's type (0 = all cores). The file itself is
-  /// written by one thread of its own (see ImageFileWriter).
+  /// written by one thread of its own (see ImageFileWriter), except with 1: then writeRows
+  /// writes each strip itself, so that one thread means one busy thread.
   int threads = 0;
 };
 
@@ -94,7 +95,9 @@ Status writeImage(const FloatImage& image, const std::filesystem::path& path,
 /// writeRows converts a strip of rows to the file's pixel type (in parallel) and queues it; a
 /// thread of the writer's own compresses and writes the queued strips in order (PNG's zlib, for
 /// one, is serial), so a caller that bakes strip k+1 while strip k is written overlaps the two.
-/// At most a few strips wait in the queue: writeRows blocks while it is full. commit() waits for
+/// At most a few strips wait in the queue: writeRows blocks while it is full. (With
+/// ImageWriteOptions::threads 1 there is no such thread: writeRows writes each strip before it
+/// returns.) commit() waits for
 /// the queue, closes the file and renames it over the target; a writer destroyed without a
 /// successful commit removes its temporary and leaves the target as it was.
 ///
@@ -128,9 +131,11 @@ class ImageFileWriter {
   /// rename fails; the target is then untouched
   Status commit();
 
-  /// Seconds the writer's thread spent inside OpenImageIO (compressing and writing) so far.
+  /// Seconds the writer's thread (or writeRows, without one) spent inside OpenImageIO
+  /// (compressing and writing) so far.
   double fileSeconds() const;
-  /// Seconds writeRows and commit spent waiting for the writer's thread so far.
+  /// Seconds writeRows and commit spent waiting for the writer's thread, or writing the strips
+  /// themselves without one, so far: how long the caller was held up by the file.
   double waitSeconds() const;
 
  private:
