@@ -16,7 +16,6 @@
 #include <memory>
 #include <new>
 #include <set>
-#include <sstream>
 #include <string>
 #include <system_error>
 #include <tuple>
@@ -258,16 +257,9 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
                std::to_string(kLimitTessellationLevel) + " tessellation",
            "the scene's \"subdivision\": {\"level\": \"limit\"}"});
     } else if (scene.subdivision.requested() && scene.subdivision.level == 0) {
-      std::ostringstream angle;
-      angle << *scene.subdivision.autoSmoothDegrees;
-      plan.steps.push_back(
-          {"split the mesh's normals by Auto Smooth at " + angle.str() + " deg" +
-               (scene.subdivision.sharpEdges.empty()
-                    ? std::string()
-                    : " and " + std::to_string(scene.subdivision.sharpEdges.size()) +
-                          " sharp edge(s)") +
-               " (not subdivided)",
-           "the scene's \"subdivision\": {\"level\": 0, \"auto_smooth\": ...}"});
+      plan.steps.push_back({"split the mesh's normals by Auto Smooth at " +
+                                describeAutoSmooth(scene.subdivision) + " (not subdivided)",
+                            "the scene's \"subdivision\": {\"level\": 0, \"auto_smooth\": ...}"});
     } else if (scene.subdivision.requested()) {
       plan.steps.push_back({"subdivide the mesh " + describeSubdivision(scene.subdivision),
                             "the scene's \"subdivision\" block (Blender's Subdivision Surface "

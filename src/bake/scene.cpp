@@ -1080,6 +1080,15 @@ std::string outputParametersJson(const SceneOutput& output) {
   return j.dump();
 }
 
+std::string describeAutoSmooth(const SceneSubdivision& subdivision) {
+  std::ostringstream text;
+  text << *subdivision.autoSmoothDegrees << " deg";
+  if (!subdivision.sharpEdges.empty()) {
+    text << " and " << subdivision.sharpEdges.size() << " sharp edge(s)";
+  }
+  return text.str();
+}
+
 std::string describeSubdivision(const SceneSubdivision& subdivision) {
   const std::string level = subdivision.limit ? std::string("the limit surface")
                                               : "level " + std::to_string(subdivision.level);
@@ -1096,15 +1105,9 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
   const std::string refinement =
       std::string(subdivision.useLimitSurface ? "" : ", without the limit surface") +
       (subdivision.type == SubdivisionType::kSimple ? ", simple" : "");
-  std::string autoSmooth;
-  if (subdivision.autoSmoothDegrees) {
-    std::ostringstream text;
-    text << ", auto smooth " << *subdivision.autoSmoothDegrees << " deg";
-    if (!subdivision.sharpEdges.empty()) {
-      text << " and " << subdivision.sharpEdges.size() << " sharp edge(s)";
-    }
-    autoSmooth = text.str();
-  }
+  const std::string autoSmooth = subdivision.autoSmoothDegrees
+                                     ? ", auto smooth " + describeAutoSmooth(subdivision)
+                                     : std::string();
   return "to " + level + " (uv_smooth " + nameIn(kUvSmooths, subdivision.uvSmooth) + ", boundary " +
          nameIn(kBoundaries, subdivision.boundary) + creases + quality + refinement + autoSmooth +
          ")";

@@ -133,12 +133,22 @@ class VertexNumbering {
   std::uint32_t count_ = 0;
 };
 
+using SharpPairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+/// Shades @p mesh with the Auto Smooth of @p options (set): Blender's split normals, split also
+/// along @p sharp (vertex pairs, lower index first, in any order).
+void shadeAutoSmooth(Mesh& mesh, const SubdivisionOptions& options, SharpPairs sharp) {
+  std::sort(sharp.begin(), sharp.end());
+  sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
+  computeSplitNormals(mesh, *options.autoSmoothDegrees * (kPi / 180), sharp);
+}
+
 /// The edges of @p fine along coarse edges marked sharp (as Blender copies a coarse edge's
-/// flags to the new edges along it), as sorted vertex pairs, lower index first.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> sharpAlongMarkedEdges(
-    const Mesh& fine, const Refiner& refiner, const VertexNumbering& numbering,
-    const std::vector<SharpEdge>& marked) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> sharp;
+/// flags to the new edges along it), as vertex pairs, lower index first.
+SharpPairs sharpAlongMarkedEdges(const Mesh& fine, const Refiner& refiner,
+                                 const VertexNumbering& numbering,
+                                 const std::vector<SharpEdge>& marked) {
+  SharpPairs sharp;
   if (marked.empty()) return sharp;
   const auto& base = refiner.GetLevel(0);
   std::vector<std::uint8_t> isMarked(static_cast<std::size_t>(base.GetNumEdges()), 0);
@@ -165,8 +175,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> sharpAlongMarkedEdges(
       }
     }
   }
-  std::sort(sharp.begin(), sharp.end());
-  sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
   return sharp;
 }
 
@@ -215,12 +223,11 @@ Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options
     // normals, along its own edges marked sharp.
     if (Status ok = checkCreases(coarse, options); !ok) return ok.error();
     Mesh shaded = coarse;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> sharp;
+    SharpPairs sharp;
     for (const SharpEdge& e : options.sharpEdges) {
       sharp.emplace_back(std::min(e.v0, e.v1), std::max(e.v0, e.v1));
     }
-    std::sort(sharp.begin(), sharp.end());
-    computeSplitNormals(shaded, *options.autoSmoothDegrees * (kPi / 180), sharp);
+    shadeAutoSmooth(shaded, options, std::move(sharp));
     return shaded;
   }
   Result<ControlMesh> control = buildControlMesh(coarse, options);
@@ -429,8 +436,8 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionO
     }
   }
   if (options.autoSmoothDegrees) {
-    computeSplitNormals(fine, *options.autoSmoothDegrees * (kPi / 180),
-                        sharpAlongMarkedEdges(fine, *refiner, numbering, options.sharpEdges));
+    shadeAutoSmooth(fine, options,
+                    sharpAlongMarkedEdges(fine, *refiner, numbering, options.sharpEdges));
     return fine;
   }
   computeSmoothNormals(fine);

@@ -278,6 +278,10 @@ std::string subdivisionParametersJson(const SceneSubdivision& subdivision);
 /// all)".
 std::string describeSubdivision(const SceneSubdivision& subdivision);
 
+/// @brief The block's Auto Smooth in words, for --explain: "30 deg and 2 sharp edge(s)".
+/// @note Precondition: autoSmoothDegrees is set.
+std::string describeAutoSmooth(const SceneSubdivision& subdivision);
+
 /// @brief @p path made absolute and canonical as far as it exists (weakly_canonical); the
 /// lexically normal absolute path when that fails.
 std::filesystem::path canonicalPath(const std::filesystem::path& path);
