@@ -491,6 +491,44 @@ std::vector<VertexCrease> parseVertexCreases(const ObjectReader& reader) {
   return creases;
 }
 
+/// Refuses settings of a subdivision block that do nothing or contradict each other
+/// (findSubdivisionConflict: the command line refuses the same, in its flags' words).
+void checkSubdivisionConflict(const ObjectReader& reader, const SceneSubdivision& subdivision) {
+  const auto unsubdivided = [&](const char* given) {
+    fail(reader.where(), std::string(given) +
+                             " applies to a subdivided mesh; set \"level\" to 1 or more (at "
+                             "\"level\": 0 nothing is subdivided)");
+  };
+  switch (findSubdivisionConflict(subdivision.options(), subdivision.limit)) {
+    case SubdivisionConflict::kNone:
+      return;
+    case SubdivisionConflict::kEdgeCreasesUnsubdivided:
+      return unsubdivided("\"edge_creases\"");
+    case SubdivisionConflict::kVertexCreasesUnsubdivided:
+      return unsubdivided("\"vertex_creases\"");
+    case SubdivisionConflict::kNoLimitSurfaceUnsubdivided:
+      return unsubdivided("\"use_limit_surface\": false");
+    case SubdivisionConflict::kSimpleUnsubdivided:
+      return unsubdivided("\"type\": \"simple\"");
+    case SubdivisionConflict::kSharpEdgesWithoutAutoSmooth:
+      fail(reader.where(),
+           "\"sharp_edges\" at \"level\": 0 need \"auto_smooth\" (edges marked "
+           "sharp split the normals only with Auto Smooth)");
+    case SubdivisionConflict::kLimitWithoutLimitSurface:
+      fail(reader.where(),
+           "\"level\": \"limit\" shades the limit surface itself; it cannot be "
+           "combined with \"use_limit_surface\": false");
+    case SubdivisionConflict::kLimitSimple:
+      fail(reader.where(),
+           "\"level\": \"limit\" is the Catmull-Clark limit surface; it cannot "
+           "be combined with \"type\": \"simple\"");
+    case SubdivisionConflict::kLimitAutoSmooth:
+      fail(reader.where(),
+           "\"level\": \"limit\" shades the exact surface's own normals; it "
+           "cannot be combined with \"auto_smooth\"");
+  }
+}
+
 SceneSubdivision parseSubdivision(const json& value) {
   const ObjectReader reader(value, "subdivision", "the subdivision block");
   reader.checkKeys(kSubdivisionKeys);
@@ -525,22 +563,11 @@ SceneSubdivision parseSubdivision(const json& value) {
                                " must be at most 180 (degrees)");
     }
     subdivision.autoSmoothDegrees = degrees;
-    if (subdivision.limit) {
-      fail(reader.where(), "\"level\": \"limit\" shades the exact surface's own normals; it "
-                           "cannot be combined with \"auto_smooth\"");
-    }
-  }
-  if (subdivision.limit && subdivision.type == SubdivisionType::kSimple) {
-    fail(reader.where(), "\"level\": \"limit\" is the Catmull-Clark limit surface; it cannot "
-                         "be combined with \"type\": \"simple\"");
   }
   if (reader.has("use_limit_surface")) {
     subdivision.useLimitSurface = reader.boolean("use_limit_surface");
-    if (subdivision.limit && !subdivision.useLimitSurface) {
-      fail(reader.where(), "\"level\": \"limit\" shades the limit surface itself; it cannot be "
-                           "combined with \"use_limit_surface\": false");
-    }
   }
+  checkSubdivisionConflict(reader, subdivision);
   return subdivision;
 }
 

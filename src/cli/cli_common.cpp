@@ -265,36 +265,37 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
                                bool limit) {
   // Options that only shape a subdivision, given without one: a forgotten --subdivide.
   // (--auto-smooth shades the mesh as it is too; --sharp-edge then marks its edges.)
-  if (options.level == 0 && !limit) {
-    const char* given = !options.edgeCreases.empty()     ? "--edge-crease"
-                        : !options.vertexCreases.empty() ? "--vertex-crease"
-                        : !options.useLimitSurface       ? "--no-limit-surface"
-                        : options.type == SubdivisionType::kSimple ? "--subdivision-type simple"
-                                                                   : nullptr;
-    if (given != nullptr) {
-      return Error::badInput(command + ": " + given +
-                             " applies to a subdivided mesh; add --subdivide N");
-    }
-    if (!options.sharpEdges.empty() && !options.autoSmoothDegrees) {
+  const auto unsubdivided = [&](const char* given) {
+    return Error::badInput(command + ": " + given +
+                           " applies to a subdivided mesh; add --subdivide N");
+  };
+  switch (findSubdivisionConflict(options, limit)) {
+    case SubdivisionConflict::kNone:
+      return Ok{};
+    case SubdivisionConflict::kEdgeCreasesUnsubdivided:
+      return unsubdivided("--edge-crease");
+    case SubdivisionConflict::kVertexCreasesUnsubdivided:
+      return unsubdivided("--vertex-crease");
+    case SubdivisionConflict::kNoLimitSurfaceUnsubdivided:
+      return unsubdivided("--no-limit-surface");
+    case SubdivisionConflict::kSimpleUnsubdivided:
+      return unsubdivided("--subdivision-type simple");
+    case SubdivisionConflict::kSharpEdgesWithoutAutoSmooth:
       return Error::badInput(command +
                              ": --sharp-edge without --subdivide needs --auto-smooth DEG (edges "
                              "marked sharp split the normals only with Auto Smooth)");
-    }
-  }
-  if (limit && !options.useLimitSurface) {
-    return Error::badInput(command +
-                           ": --no-limit-surface cannot be combined with --subdivide limit, "
-                           "which shades the limit surface itself");
-  }
-  if (limit && options.type == SubdivisionType::kSimple) {
-    return Error::badInput(command +
-                           ": --subdivision-type simple cannot be combined with --subdivide "
-                           "limit, the Catmull-Clark limit surface");
-  }
-  if (limit && options.autoSmoothDegrees) {
-    return Error::badInput(command +
-                           ": --auto-smooth cannot be combined with --subdivide limit, which "
-                           "shades the exact surface's own normals");
+    case SubdivisionConflict::kLimitWithoutLimitSurface:
+      return Error::badInput(command +
+                             ": --no-limit-surface cannot be combined with --subdivide limit, "
+                             "which shades the limit surface itself");
+    case SubdivisionConflict::kLimitSimple:
+      return Error::badInput(command +
+                             ": --subdivision-type simple cannot be combined with --subdivide "
+                             "limit, the Catmull-Clark limit surface");
+    case SubdivisionConflict::kLimitAutoSmooth:
+      return Error::badInput(command +
+                             ": --auto-smooth cannot be combined with --subdivide limit, which "
+                             "shades the exact surface's own normals");
   }
   return Ok{};
 }

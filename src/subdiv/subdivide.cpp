@@ -192,6 +192,25 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionO
 
 }  // namespace
 
+SubdivisionConflict findSubdivisionConflict(const SubdivisionOptions& options, bool limit) {
+  using C = SubdivisionConflict;
+  if (limit) {
+    if (!options.useLimitSurface) return C::kLimitWithoutLimitSurface;
+    if (options.type == SubdivisionType::kSimple) return C::kLimitSimple;
+    if (options.autoSmoothDegrees) return C::kLimitAutoSmooth;
+    return C::kNone;
+  }
+  if (options.level != 0) return C::kNone;
+  if (!options.edgeCreases.empty()) return C::kEdgeCreasesUnsubdivided;
+  if (!options.vertexCreases.empty()) return C::kVertexCreasesUnsubdivided;
+  if (!options.useLimitSurface) return C::kNoLimitSurfaceUnsubdivided;
+  if (options.type == SubdivisionType::kSimple) return C::kSimpleUnsubdivided;
+  if (!options.sharpEdges.empty() && !options.autoSmoothDegrees) {
+    return C::kSharpEdgesWithoutAutoSmooth;
+  }
+  return C::kNone;
+}
+
 Result<Mesh> subdivideMesh(const Mesh& coarse, const SubdivisionOptions& options,
                            SurfaceParameters* parameters) {
   const std::string& name = coarse.source;

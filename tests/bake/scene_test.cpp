@@ -538,6 +538,41 @@ TEST(Scene, AutoSmoothIsParsedInDegreesAndInTheParametersOnlyWhenSet) {
             "normals; it cannot be combined with \"auto_smooth\"");
 }
 
+TEST(Scene, SettingsThatDoNothingWithoutSubdivisionAreRefused) {
+  // As the command line refuses --edge-crease or --sharp-edge without --subdivide (Blender
+  // accepts them at level 0 and changes nothing).
+  const std::string where = "scene.json: subdivision: ";
+  const std::string fix =
+      " applies to a subdivided mesh; set \"level\" to 1 or more (at "
+      "\"level\": 0 nothing is subdivided)";
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 0, "edge_creases": [[0, 1, 0.5]]})")),
+            where + "\"edge_creases\"" + fix);
+  EXPECT_EQ(parseError(withSubdivision(R"({"vertex_creases": [[0, 1]]})")),  // level 0 unsaid
+            where + "\"vertex_creases\"" + fix);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 0, "use_limit_surface": false})")),
+            where + "\"use_limit_surface\": false" + fix);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 0, "type": "simple"})")),
+            where + "\"type\": \"simple\"" + fix);
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 0, "sharp_edges": [[0, 1]]})")),
+            where +
+                "\"sharp_edges\" at \"level\": 0 need \"auto_smooth\" (edges marked "
+                "sharp split the normals only with Auto Smooth)");
+  // What does something at level 0 stays accepted: Auto Smooth, with or without sharp edges,
+  // and the settings whose defaults cannot be told from their absence.
+  for (const char* accepted :
+       {R"({"level": 0, "auto_smooth": 30, "sharp_edges": [[0, 1]]})",
+        R"({"level": 0, "auto_smooth": 30})", R"({"level": 0, "use_creases": false})",
+        R"({"level": 0, "type": "catmull-clark", "use_limit_surface": true, "quality": 4})"}) {
+    Result<Scene> scene = parseScene(withSubdivision(accepted), options());
+    EXPECT_TRUE(scene) << accepted << ": " << scene.error().message;
+  }
+  // A subdivided mesh takes every one of them.
+  EXPECT_TRUE(parseScene(withSubdivision(R"({"level": 1, "edge_creases": [[0, 1, 0.5]],
+      "vertex_creases": [[0, 1]], "sharp_edges": [[0, 1]], "use_limit_surface": false,
+      "type": "simple"})"),
+                         options()));
+}
+
 TEST(Scene, SubdivisionOfOptionsIsTheInverseOfOptions) {
   // Every field away from its default, so that a field one side forgets shows.
   SubdivisionOptions o;

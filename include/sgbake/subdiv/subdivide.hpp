@@ -144,6 +144,27 @@ struct CreaseIssue {
 /// @return std::nullopt when every crease fits
 std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOptions& options);
 
+/// @brief A setting of SubdivisionOptions that does nothing, or contradicts another, as given.
+/// Blender accepts each of these silently; the command line and scene files refuse them, each
+/// naming the setting in its own words (findSubdivisionConflict finds them for both).
+enum class SubdivisionConflict {
+  kNone,
+  kEdgeCreasesUnsubdivided,      ///< edge creases at level 0, where nothing is subdivided
+  kVertexCreasesUnsubdivided,    ///< vertex creases at level 0
+  kNoLimitSurfaceUnsubdivided,   ///< Use Limit Surface off at level 0
+  kSimpleUnsubdivided,           ///< type Simple at level 0
+  kSharpEdgesWithoutAutoSmooth,  ///< sharp edges at level 0 without Auto Smooth: they split nothing
+  kLimitWithoutLimitSurface,     ///< the exact limit surface with Use Limit Surface off
+  kLimitSimple,                  ///< the exact limit surface (Catmull-Clark's) with type Simple
+  kLimitAutoSmooth,              ///< the exact limit surface, which shades its own normals, with
+                                 ///< Auto Smooth
+};
+
+/// @brief The first conflict of @p options, shaded as a subdivision to options.level or, when
+/// @p limit, on the exact limit surface (level is then unused); kNone when there is none. The
+/// order is the enumeration's.
+SubdivisionConflict findSubdivisionConflict(const SubdivisionOptions& options, bool limit);
+
 /// @brief The highest level subdivideMesh accepts (a quad becomes 4⁶ = 4096 quads).
 inline constexpr int kMaxSubdivisionLevel = 6;
 
