@@ -187,6 +187,36 @@ def set_smooth(ob, smooth):
     ob.data.update()
 
 
+def set_creases(ob, edge_creases, vertex_creases):
+    """Blender's Edge Crease of the edges given by index, (edge, crease) pairs, and Vertex
+    Crease of the vertices, (vertex, crease) pairs (the vertex crease layer is made with
+    bmesh: Blender 3.4's Python API has no other way to add it)."""
+    import bmesh
+    me = ob.data
+    bm = bmesh.new()
+    bm.from_mesh(me)
+    layer = bm.verts.layers.crease.verify()
+    bm.verts.ensure_lookup_table()
+    for v, crease in vertex_creases:
+        bm.verts[v][layer] = crease
+    bm.to_mesh(me)
+    bm.free()
+    for e, crease in edge_creases:
+        me.edges[e].crease = crease
+    me.update()
+
+
+def read_creases(me):
+    """The creases of mesh `me` as Blender holds them (float32), by vertex indices:
+    ([[v0, v1, crease], ...] of every creased edge, [[v, crease], ...] of every creased
+    vertex)."""
+    edge_creases = [[int(e.vertices[0]), int(e.vertices[1]), float(e.crease)]
+                    for e in me.edges if e.crease != 0.0]
+    vertex_creases = ([[v, float(d.value)] for v, d in enumerate(me.vertex_creases[0].data)
+                       if d.value != 0.0] if len(me.vertex_creases) else [])
+    return edge_creases, vertex_creases
+
+
 def new_float_image(name, width, height, array=None, colour=(0.0, 0.0, 0.0, 1.0)):
     """A 32-bit float, Non-Color (is_data) RGBA image. `array` (H, W, 1..4), rows top first,
     fills it (missing channels: RGB repeat the first, alpha 1); otherwise the flat `colour`."""

@@ -76,30 +76,11 @@ def mesh_grid():
     return ob
 
 
-def set_creases(ob, edge_creases, vertex_creases):
-    """Blender's Edge Crease of the edges given by index, (edge, crease) pairs, and Vertex
-    Crease of the vertices, (vertex, crease) pairs (the vertex crease layer is made with
-    bmesh: Blender 3.4's Python API has no other way to add it)."""
-    import bmesh
-    me = ob.data
-    bm = bmesh.new()
-    bm.from_mesh(me)
-    layer = bm.verts.layers.crease.verify()
-    bm.verts.ensure_lookup_table()
-    for v, crease in vertex_creases:
-        bm.verts[v][layer] = crease
-    bm.to_mesh(me)
-    bm.free()
-    for e, crease in edge_creases:
-        me.edges[e].crease = crease
-    me.update()
-
-
 def mesh_cube_creased():
     """The cube with creases 0.3, 0.7 and 1.0 on three edges around one face, 0.5 on an edge
     of the opposite face, and vertex creases 0.6 and 1.0 (one on a creased edge, one not)."""
     ob = mesh_cube()
-    set_creases(ob, [(0, 0.3), (1, 0.7), (2, 1.0), (8, 0.5)], [(5, 0.6), (2, 1.0)])
+    bake_common.set_creases(ob, [(0, 0.3), (1, 0.7), (2, 1.0), (8, 0.5)], [(5, 0.6), (2, 1.0)])
     return ob
 
 
@@ -107,7 +88,7 @@ def mesh_suzanne_creased():
     """Suzanne with a few creased edges (0.3, 0.7, 1.0, chains and single edges, on triangles
     and quads) and two creased vertices."""
     ob = mesh_suzanne()
-    set_creases(ob, [(e, (0.3, 0.7, 1.0)[e % 3]) for e in range(0, 120, 7)]
+    bake_common.set_creases(ob, [(e, (0.3, 0.7, 1.0)[e % 3]) for e in range(0, 120, 7)]
                 + [(300, 1.0), (301, 1.0), (302, 1.0), (640, 0.45)],
                 [(10, 1.0), (200, 0.4)])
     return ob
@@ -122,7 +103,7 @@ def mesh_cylinder_creased():
     rim = [(e.index, 1.0 if me.vertices[e.vertices[0]].co.z == top else 0.5)
            for e in me.edges
            if me.vertices[e.vertices[0]].co.z == me.vertices[e.vertices[1]].co.z]
-    set_creases(ob, rim, [])
+    bake_common.set_creases(ob, rim, [])
     return ob
 
 
@@ -249,11 +230,7 @@ def write_coarse(name, ob, out_dir):
     edge_vertices = np.empty(len(me.edges) * 2, np.int32)
     me.edges.foreach_get("vertices", edge_vertices)
     valence = np.bincount(edge_vertices, minlength=len(me.vertices))
-    # The creases as Blender holds them (float32), by vertex indices.
-    edge_creases = [[int(e.vertices[0]), int(e.vertices[1]), float(e.crease)]
-                    for e in me.edges if e.crease != 0.0]
-    vertex_creases = ([[v, float(d.value)] for v, d in enumerate(me.vertex_creases[0].data)
-                       if d.value != 0.0] if len(me.vertex_creases) else [])
+    edge_creases, vertex_creases = bake_common.read_creases(me)
     return {"vertices": len(me.vertices), "edges": len(me.edges), "faces": len(me.polygons),
             "valence2": int((valence == 2).sum()), "edge_creases": edge_creases,
             "vertex_creases": vertex_creases}
