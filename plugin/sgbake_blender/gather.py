@@ -5,6 +5,7 @@ vertex or texel); the tiles of a UDIM image go in through files (write_tiles). P
 the user's data raise BakeInputError with a message meant for the operator's error report.
 """
 
+import contextlib
 import os
 import shutil
 import tempfile
@@ -77,6 +78,57 @@ def mesh_arrays(mesh, uv_names):
         normals = normals.reshape(-1, 3)[order].reshape(-1)
         uvs = [uv.reshape(-1, 2)[order].reshape(-1) for uv in uvs]
     return positions, face_start.astype(np.uint32), corner_vertex, normals, uvs
+
+
+def limit_modifier(ob):
+    """The Subdivision Surface modifier whose exact limit surface a "limit" bake reads: the
+    object's last modifier, which must be one, Catmull-Clark (anything after it would change
+    the surface; Simple subdivision has no surface beyond the mesh's faces)."""
+    if len(ob.modifiers) == 0:
+        raise BakeInputError("has no modifiers: the exact limit surface is that of a "
+                             "Subdivision Surface modifier, last in the object's stack")
+    modifier = ob.modifiers[-1]
+    if modifier.type != "SUBSURF":
+        raise BakeInputError(f"has modifier '{modifier.name}' last: the exact limit surface "
+                             "is that of a Subdivision Surface modifier, last in the stack")
+    if modifier.subdivision_type != "CATMULL_CLARK":
+        raise BakeInputError(f"has Subdivision Surface modifier '{modifier.name}' set to "
+                             "Simple: only Catmull-Clark has a limit surface")
+    return modifier
+
+
+@contextlib.contextmanager
+def modifier_hidden(modifier):
+    """Evaluates the object without `modifier` (shown again afterwards, as it was); does
+    nothing when it is None."""
+    if modifier is None:
+        yield
+        return
+    shown = modifier.show_viewport
+    modifier.show_viewport = False
+    try:
+        yield
+    finally:
+        modifier.show_viewport = shown
+
+
+def creases(mesh):
+    """The mesh's Edge Crease and Vertex Crease as a scene's lists: [[a, b, crease], ...] of
+    every creased edge (by its vertices) and [[v, crease], ...] of every creased vertex, the
+    creases as Blender holds them."""
+    edge_vertices = np.empty(len(mesh.edges) * 2, np.int64)
+    mesh.edges.foreach_get("vertices", edge_vertices)
+    edge_crease = np.empty(len(mesh.edges), np.float32)
+    mesh.edges.foreach_get("crease", edge_crease)
+    creased = np.flatnonzero(edge_crease)
+    ends = edge_vertices.reshape(-1, 2)
+    edges = [[int(ends[e, 0]), int(ends[e, 1]), float(edge_crease[e])] for e in creased]
+    vertices = []
+    if len(mesh.vertex_creases) > 0:
+        vertex_crease = np.empty(len(mesh.vertices), np.float32)
+        mesh.vertex_creases[0].data.foreach_get("value", vertex_crease)
+        vertices = [[int(v), float(vertex_crease[v])] for v in np.flatnonzero(vertex_crease)]
+    return edges, vertices
 
 
 def _srgb_to_linear(values):

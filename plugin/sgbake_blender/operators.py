@@ -35,19 +35,32 @@ class BakeJob:
 
         if ob.mode == "EDIT":
             ob.update_from_editmode()
-        ob_eval = ob.evaluated_get(context.evaluated_depsgraph_get())
-        mesh = ob_eval.to_mesh()
-        try:
+        # The exact limit surface is that of the mesh under the last modifier (sgbake
+        # evaluates it): the mesh is evaluated without that modifier.
+        self.surface = settings.surface
+        modifier = None
+        if self.surface == "limit":
             try:
-                uv_names, bake_uv = gather.uv_sets(mesh, settings.uv_map, layers)
+                modifier = gather.limit_modifier(ob)
             except gather.BakeInputError as exc:
                 raise gather.BakeInputError(f"object '{ob.name}' {exc}") from None
-            if len(mesh.polygons) == 0:
-                raise gather.BakeInputError(f"object '{ob.name}' has no faces")
-            mesh.calc_normals_split()
-            self.arrays = gather.mesh_arrays(mesh, uv_names)
-        finally:
-            ob_eval.to_mesh_clear()
+        subdivision = None
+        with gather.modifier_hidden(modifier):
+            ob_eval = ob.evaluated_get(context.evaluated_depsgraph_get())
+            mesh = ob_eval.to_mesh()
+            try:
+                try:
+                    uv_names, bake_uv = gather.uv_sets(mesh, settings.uv_map, layers)
+                except gather.BakeInputError as exc:
+                    raise gather.BakeInputError(f"object '{ob.name}' {exc}") from None
+                if len(mesh.polygons) == 0:
+                    raise gather.BakeInputError(f"object '{ob.name}' has no faces")
+                mesh.calc_normals_split()
+                self.arrays = gather.mesh_arrays(mesh, uv_names)
+                if modifier is not None:
+                    subdivision = scene.limit_subdivision_json(modifier, *gather.creases(mesh))
+            finally:
+                ob_eval.to_mesh_clear()
 
         self.lib = library.get(context)
         self.threads = settings.threads
@@ -59,7 +72,8 @@ class BakeJob:
         image = bpy.data.images.get(self.target or self.default_name)
         self.tiled = image is not None and image.source == "TILED"
         self.tiles = gather.image_tiles(image)
-        self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile)
+        self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
+                                              subdivision)
                        for tile in self.tiles}
         self.scene = self.scenes[self.tiles[0]]
         self.uv_tiles = gather.uv_tiles(self.arrays[4][bake_uv], self.arrays[1])
@@ -191,8 +205,9 @@ class OBJECT_OT_sgbake_bake(bpy.types.Operator):
         level, tile_notes = job.tile_notes(image.name)
         tiles = (f" (UDIM tile(s) {_tile_list(job.tiles)}, packed into the .blend file)"
                  if job.tiled else "")
-        self.report({level}, "; ".join([f"sgbake: {job.map} {job.width} x {job.height} into "
-                                        f"'{image.name}'{tiles} in {job.seconds:.2f} s"]
+        surface = " of the exact limit surface" if job.surface == "limit" else ""
+        self.report({level}, "; ".join([f"sgbake: {job.map} {job.width} x {job.height}{surface} "
+                                        f"into '{image.name}'{tiles} in {job.seconds:.2f} s"]
                                        + notes + tile_notes))
         return {"FINISHED"}
 

@@ -117,6 +117,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
 class SgbakeSettings(bpy.types.PropertyGroup):
     """What to bake (scene.sgbake)."""
     map: EnumProperty(name="Map", items=scene.MAPS, default="tangent-normal")
+    surface: EnumProperty(name="Surface", items=scene.SURFACES, default="mesh",
+                          description="The surface the texels are baked on")
     width: IntProperty(name="Width", default=1024, min=1, max=65536, soft_max=16384,
                        subtype="PIXEL")
     height: IntProperty(name="Height", default=1024, min=1, max=65536, soft_max=16384,

@@ -35,6 +35,26 @@ LAYER_TYPES = (
 IMAGE_LAYER_TYPES = {"height", "normal", "planar", "triplanar"}
 UV_LAYER_TYPES = {"height", "normal"}  # layer types with their own "uv"
 
+SURFACES = (
+    ("mesh", "Evaluated Mesh",
+     "The mesh as the object's modifiers make it: what Blender itself bakes"),
+    ("limit", "Exact Limit Surface",
+     "The exact Catmull-Clark limit surface of the mesh under the object's last modifier, a "
+     "Subdivision Surface (its creases, UV Smooth and Boundary Smooth; its levels do not "
+     "matter): every texel on the smooth surface itself, not on a subdivided mesh"),
+)
+
+# A Subdivision Surface modifier's settings -> the scene's "uv_smooth" and "boundary" names.
+UV_SMOOTHS = {
+    "NONE": "none",
+    "PRESERVE_CORNERS": "keep-corners",
+    "PRESERVE_CORNERS_AND_JUNCTIONS": "keep-corners-junctions",
+    "PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE": "keep-corners-junctions-concave",
+    "PRESERVE_BOUNDARIES": "keep-boundaries",
+    "SMOOTH_ALL": "all",
+}
+BOUNDARY_SMOOTHS = {"ALL": "all", "PRESERVE_CORNERS": "keep-corners"}
+
 
 def _number(value):
     """A Blender float/int property as a JSON number (plain Python float/int)."""
@@ -117,9 +137,28 @@ def baked_layers(settings):
     return [] if settings.map in LAYERLESS_MAPS else list(settings.layers)
 
 
-def scene_json(settings, layers, bake_uv_set, uv_index, tile=1001):
+def limit_subdivision_json(modifier, edge_creases, vertex_creases):
+    """The "subdivision" block of a bake from the exact limit surface of the mesh under
+    `modifier`, a Catmull-Clark Subdivision Surface (its uv_smooth, boundary_smooth and
+    use_creases: its levels, quality and use_limit_surface do not change the limit surface),
+    with the mesh's creases as lists [[a, b, crease], ...] and [[v, crease], ...]."""
+    block = {"level": "limit", "uv_smooth": UV_SMOOTHS[modifier.uv_smooth],
+             "boundary": BOUNDARY_SMOOTHS[modifier.boundary_smooth],
+             "use_creases": bool(modifier.use_creases)}
+    if edge_creases:
+        block["edge_creases"] = edge_creases
+    if vertex_creases:
+        block["vertex_creases"] = vertex_creases
+    return block
+
+
+def scene_json(settings, layers, bake_uv_set, uv_index, tile=1001, subdivision=None):
     """The scene for sgbake_bake_map: the bake's UV set as the default of the layers and the
-    output ("uv"), the layers (baked_layers) and one output, of UDIM tile `tile`."""
-    return {"uv": bake_uv_set,
-            "layers": [layer_json(layer, uv_index) for layer in layers],
-            "outputs": [output_json(settings, tile)]}
+    output ("uv"), the layers (baked_layers) and one output, of UDIM tile `tile`, and the
+    "subdivision" block when one is given (limit_subdivision_json)."""
+    result = {"uv": bake_uv_set,
+              "layers": [layer_json(layer, uv_index) for layer in layers],
+              "outputs": [output_json(settings, tile)]}
+    if subdivision is not None:
+        result["subdivision"] = subdivision
+    return result

@@ -39,6 +39,7 @@ class SGBAKE_PT_bake(bpy.types.Panel):
 
         ob = context.active_object
         layout.prop(settings, "map")
+        layout.prop(settings, "surface")
         col = layout.column(align=True)
         col.prop(settings, "width", text="Size X")
         col.prop(settings, "height", text="Y")

@@ -36,6 +36,11 @@
    those values (as Blender holds them), and its tangent-normal bake is addon_options.npy.
    The CLI scenes are written from the same values (options.json), plus one per key without
    it (options_no_KEY_LAYER.json), the negative controls.
+   Exact limit surface (limit_case): a coarse Suzanne with edge and vertex creases and a live
+   Subdivision Surface modifier (level 1, UV Smooth All) is baked with Surface: Exact Limit
+   Surface (addon_limit.npy) and Evaluated Mesh (addon_limit_mesh.npy); mesh_limit.obj is the
+   coarse mesh. The modifier must be shown again afterwards, and a Displace modifier after it
+   must make the add-on refuse the bake.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -43,7 +48,10 @@
    with S the layer's scale as Blender holds it (float32 0.1), so both read the same number.
    The UDIM bake: `sgbake bake --mesh mesh_udim.obj ... -o cli_udim.<UDIM>.exr` (the tiles the
    UVs touch, 1001 and 1002) and a scene with "tile": 1011 for the empty tile; the layer
-   options: `sgbake bake options*.json`.
+   options: `sgbake bake options*.json`; the limit surface: `sgbake bake --mesh mesh_limit.obj
+   --subdivide limit --uv-smooth all --edge-crease A,B,C ... --vertex-crease V,C` (the creases
+   read from the mesh by the test, not by the add-on), and as negative controls the same
+   without the creases and with UV Smooth keep-boundaries.
 3. Blender half `compare` (Blender reads the EXRs; the python3 CTest finds may lack numpy):
    every texel's RGB (RGBA with alpha) of the add-on's image must equal the CLI's file within
    1e-5, and the mask exactly. Both are libsgbake's floats and the file stores float32
@@ -56,7 +64,9 @@
    tiles pass through files, and a 16-bit one would be 7.6e-6 off), and the add-on's tile
    1002 must differ from the CLI's 1001 by more than 1e-5 (negative control). The layer
    options bake must equal options.json's within 1e-5 and differ from every
-   options_no_*.json by more than that.
+   options_no_*.json by more than that. The limit surface bake must equal the CLI's within
+   1e-5 (it comes out bit-identical), and differ by more than that from the CLI's negative
+   controls and from the add-on's own bake of Blender's level-1 mesh.
 
 --sabotage bakes the add-on's tangent-normal cases with green DirectX: the test must FAIL.
 Prints per case the largest difference, where it is, and the texels compared.
@@ -64,7 +74,7 @@ Prints per case the largest difference, where it is, and the texels compared.
 Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed or
 the library is built with AddressSanitizer (SGBAKE_SANITIZE: ASan's runtime must come first
 in a process, and Blender does not start with it; CTest: SKIP_RETURN_CODE 77).
-Takes ~9 s (Blender starts twice; seventeen CLI bakes).
+Takes ~9 s (Blender starts twice; twenty CLI bakes).
 """
 
 import argparse
@@ -96,6 +106,7 @@ UDIM_TILES = [1001, 1002, 1011]
 # 1-ulp noise of the normals (~6e-8) and below that.
 UDIM_TOLERANCE = 1e-6
 OPTIONS_MAP = "tangent-normal"
+LIMIT_MAP = "tangent-normal"
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -503,6 +514,69 @@ def options_case(settings, height, work):
             "cli": [["bake", f"{name}.json", "--no-manifest"] for name in sorted(scenes)]}
 
 
+def limit_case(settings, ob, work, scale):
+    """Bakes LIMIT_MAP of a coarse, creased Suzanne with a live Subdivision Surface modifier
+    (UV Smooth All, level 1) from the exact limit surface (Surface: Exact Limit Surface) into
+    addon_limit.npy, and from Blender's evaluated mesh into addon_limit_mesh.npy (the negative
+    control); writes the coarse mesh as mesh_limit.obj. Returns the manifest entry: checks (the
+    modifier is shown again afterwards, the report names the limit surface, the add-on refuses
+    an object whose last modifier is not a Subdivision Surface) and the CLI command of the
+    same bake (`--subdivide limit` with the creases read from the mesh here)."""
+    import bpy
+    import numpy as np
+    bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
+    coarse = bpy.context.object
+    coarse.name = "SuzanneLimit"
+    bc.set_smooth(coarse, True)
+    bc.set_creases(coarse, [(e, (0.4, 1.0)[e % 2]) for e in range(0, 90, 9)], [(7, 0.8)])
+    me = coarse.data
+    me.calc_normals_split()
+    objio.write_obj(os.path.join(work, "mesh_limit.obj"), objio.mesh_arrays(me),
+                    comment="add-on test coarse creased Suzanne (limit surface)")
+    edge_creases, vertex_creases = bc.read_creases(me)
+    modifier = coarse.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels, modifier.uv_smooth = 1, "SMOOTH_ALL"
+    settings.map, settings.target_image = LIMIT_MAP, None
+    settings.width = settings.height = SIZE
+    settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+    settings.green = "opengl"
+    checks, results = [], {}
+    for surface, name in (("limit", "addon_limit"), ("mesh", "addon_limit_mesh")):
+        settings.surface = surface
+        try:
+            results[surface] = sorted(bpy.ops.object.sgbake_bake())
+        except RuntimeError as exc:
+            results[surface] = ["ERROR", str(exc).strip()]
+            continue
+        image = bpy.data.images[f"{coarse.name}_{LIMIT_MAP}"]
+        np.save(os.path.join(work, f"{name}.npy"), bc.image_array(image))
+    checks.append({"name": "the Subdivision Surface modifier is shown again after the bake",
+                   "ok": modifier.show_viewport, "expected": "show_viewport True",
+                   "message": f"show_viewport {modifier.show_viewport}"})
+    settings.surface = "limit"
+    coarse.modifiers.new("Displace", "DISPLACE")
+    checks.append(expect_error("exact limit surface under another modifier",
+                               "has modifier 'Displace' last", bpy.ops.object.sgbake_bake))
+    settings.surface = "mesh"
+    bpy.context.view_layer.objects.active = ob
+    def cli(output, uv_smooth="all", with_creases=True):
+        args = ["bake", "--mesh", "mesh_limit.obj", "--subdivide", "limit", "--uv-smooth",
+                uv_smooth, "--height", "height.exr", "--height-scale", repr(scale), "--filter",
+                "bilinear", "--map", LIMIT_MAP, "--size", str(SIZE), "--margin", "0",
+                "--bit-depth", "32", "--no-manifest", "-o", output]
+        for a, b, crease in edge_creases if with_creases else []:
+            args += ["--edge-crease", f"{a},{b},{crease!r}"]
+        for v, crease in vertex_creases if with_creases else []:
+            args += ["--vertex-crease", f"{v},{crease!r}"]
+        return args
+    # The bake, and as negative controls the same without the creases and with the default
+    # UV Smooth: the add-on must send both.
+    return {"map": LIMIT_MAP, "result": results, "checks": checks,
+            "cli": [cli("cli_limit.exr"), cli("cli_limit_no_creases.exr", with_creases=False),
+                    cli("cli_limit_keep_boundaries.exr", uv_smooth="keep-boundaries")],
+            "creases": [len(edge_creases), len(vertex_creases)]}
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -521,6 +595,7 @@ def blender_make(work, library_path, sabotage):
     manifest["udim"] = udim_case(settings, ob, work, sabotage)
     manifest["options"] = options_case(settings, height, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
+    manifest["limit"] = limit_case(settings, ob, work, manifest["scale"])
     manifest["errors"] = (worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
@@ -596,6 +671,13 @@ def extra_comparisons(work, manifest):
               UDIM_TOLERANCE) for t in manifest["udim"]["tiles"]]
     pairs.append(("UDIM negative control: add-on tile 1002 vs CLI tile 1001",
                   "addon_udim.1002.exr", "cli_udim.1001.exr", "differ", TOLERANCE))
+    pairs.append(("exact limit surface vs CLI --subdivide limit", "addon_limit.npy",
+                  "cli_limit.exr", "equal", TOLERANCE))
+    pairs.append(("limit negative control: Blender's level-1 mesh vs CLI --subdivide limit",
+                  "addon_limit_mesh.npy", "cli_limit.exr", "differ", TOLERANCE))
+    for control in ("no_creases", "keep_boundaries"):
+        pairs.append((f"limit negative control: exact limit surface vs CLI limit {control}",
+                      "addon_limit.npy", f"cli_limit_{control}.exr", "differ", TOLERANCE))
     for name in manifest["options"]["scenes"]:
         pairs.append((f"layer options vs CLI {name}.json", "addon_options.npy",
                       f"cli_{name}.exr", "equal" if name == "options" else "differ", TOLERANCE))
@@ -643,7 +725,7 @@ def run_cli(cli, work, manifest):
         proc = bc.run_tool(cmd, timeout=120)
         if proc is None or proc.returncode != 0:
             failed.append(" ".join(map(str, cmd)))
-    for part in ("udim", "options"):
+    for part in ("udim", "options", "limit"):
         for args in manifest[part]["cli"]:
             cmd = [cli] + [os.path.join(work, a) if a.endswith((".json", ".obj", ".exr"))
                            else a for a in args]
@@ -688,6 +770,10 @@ def evaluate(manifest, results):
         entry = manifest[part]
         if entry["result"] != ["FINISHED"]:
             failures.append(f"{part}: the add-on's bake returned {entry['result']}")
+    for surface, result in manifest["limit"]["result"].items():
+        if result != ["FINISHED"]:
+            failures.append(f"limit case, surface {surface}: the add-on's bake returned "
+                            f"{result}")
     for r in results["extra"]:
         if "error" in r:
             print(f"  {r['name']}: {r['error']}")
@@ -703,7 +789,7 @@ def evaluate(manifest, results):
                             f"{r['worst_at']}, expected to "
                             f"{'be within' if equal else 'exceed'} {tolerance:g}")
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
-                  + manifest["errors"]):
+                  + manifest["limit"]["checks"] + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
