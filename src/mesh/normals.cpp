@@ -177,6 +177,18 @@ void computeSmoothNormals(Mesh& mesh) {
       mesh.cornerNormals[c] = vertexNormals[mesh.cornerVertex[c]];
     }
   });
+  // Flat faces: their corners take the face's own normal (the vertex normals above still sum
+  // over them, as Blender's do).
+  if (std::any_of(mesh.faceFlat.begin(), mesh.faceFlat.end(),
+                  [](std::uint8_t flat) { return flat != 0; })) {
+    const std::vector<Vec3f> faceNormals = computeFaceNormals(view);
+    for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+      if (!mesh.isFlat(f)) continue;
+      for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
+        mesh.cornerNormals[c] = faceNormals[f];
+      }
+    }
+  }
   mesh.normalSource = NormalSource::kComputed;
 }
 

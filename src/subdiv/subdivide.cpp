@@ -460,15 +460,6 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionO
     return fine;
   }
   computeSmoothNormals(fine);
-  if (anyFlat) {
-    const std::vector<Vec3f> faceNormals = computeFaceNormals(fine.view());
-    for (std::size_t f = 0; f < fineFaces; ++f) {
-      if (!fine.faceFlat[f]) continue;
-      for (std::uint32_t c = fine.faceStart[f]; c < fine.faceStart[f + 1]; ++c) {
-        fine.cornerNormals[c] = faceNormals[f];
-      }
-    }
-  }
   return fine;
 }
 

@@ -90,6 +90,17 @@ def case_suzanne_subsurf2():
     return ob
 
 
+def case_suzanne_mixed_no_normals():
+    """Suzanne, every third face flat and the rest smooth, written without `vn` (with `s 0` /
+    `s 1` lines): the reader computes the normals, flat faces' from the face alone, as
+    Blender's importer does for such a file."""
+    ob = case_suzanne_smooth()
+    me = ob.data
+    me.polygons.foreach_set("use_smooth", [f % 3 != 0 for f in range(len(me.polygons))])
+    me.update()
+    return ob
+
+
 def case_uv_sphere():
     """UV sphere: quads plus triangle fans at the poles, one UV seam."""
     bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, calc_uvs=True)
@@ -215,6 +226,7 @@ CASES = [
     ("suzanne_flat", case_suzanne_flat),
     ("suzanne_smooth", case_suzanne_smooth),
     ("suzanne_subsurf2", case_suzanne_subsurf2),
+    ("suzanne_mixed_no_normals", case_suzanne_mixed_no_normals),
     ("uv_sphere", case_uv_sphere),
     ("torus", case_torus),
     ("torus_dense", case_torus_dense),
@@ -224,6 +236,10 @@ CASES = [
     ("collapsed_vertices", case_collapsed_vertices),
     ("collapsed_uvs", case_collapsed_uvs),
 ]
+
+
+# Cases written without `vn`: the OBJ then carries Blender's smooth flags instead.
+WITHOUT_NORMALS = {"suzanne_mixed_no_normals"}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -240,8 +256,14 @@ def write_case(name, ob, out_dir):
     arrays = objio.mesh_arrays(me)
     tangents, signs = objio.mesh_tangents(me)
     me.free_tangents()
+    with_normals = name not in WITHOUT_NORMALS
+    if not with_normals:  # the smooth flags then say how to shade
+        smooth = np.empty(len(me.polygons), bool)
+        me.polygons.foreach_get("use_smooth", smooth)
+        arrays["smooth"] = smooth
     objio.write_obj(os.path.join(out_dir, name + ".obj"), arrays,
-                    comment=f"sgbake tangent oracle case {name} (Blender {bpy.app.version_string})")
+                    comment=f"sgbake tangent oracle case {name} (Blender {bpy.app.version_string})",
+                    normals=with_normals)
     objio.write_tangent_csv(os.path.join(out_dir, name + ".tangents.csv"),
                             arrays["face_size"], tangents, signs)
     length = np.linalg.norm(tangents.astype(np.float64), axis=1)

@@ -122,8 +122,9 @@ def _format_rows(prefix, values):
     return [fmt % tuple(row) for row in values.tolist()]
 
 
-def write_obj(path, arrays, comment=None):
-    """Writes the arrays returned by mesh_arrays() as an OBJ file (see the module docstring)."""
+def write_obj(path, arrays, comment=None, normals=True):
+    """Writes the arrays returned by mesh_arrays() as an OBJ file (see the module docstring);
+    with normals=False, without `vn` (the reader then computes the normals)."""
     import numpy as np
     nc = len(arrays["corner_vertex"])
     lines = []
@@ -131,11 +132,13 @@ def write_obj(path, arrays, comment=None):
         lines.append("# " + comment)
     lines += _format_rows("v", arrays["positions"])
     lines += _format_rows("vt", arrays["uvs"])
-    lines += _format_rows("vn", arrays["normals"])
-    # One "v/vt/vn" token per corner (all indices 1-based), then one line per face.
+    if normals:
+        lines += _format_rows("vn", arrays["normals"])
+    # One "v/vt/vn" (or "v/vt") token per corner (all indices 1-based), then one line per face.
     corner_index = np.arange(1, nc + 1)
-    tokens = [f"{v}/{c}/{c}" for v, c in zip((arrays["corner_vertex"] + 1).tolist(),
-                                               corner_index.tolist())]
+    form = "{v}/{c}/{c}" if normals else "{v}/{c}"
+    tokens = [form.format(v=v, c=c) for v, c in zip((arrays["corner_vertex"] + 1).tolist(),
+                                                      corner_index.tolist())]
     # Blender's smooth flags, when given ("smooth" (F,) bool): `s 1` / `s 0` before each run of
     # smooth / flat faces, as Blender's exporter writes them.
     smooth = arrays.get("smooth")

@@ -256,6 +256,29 @@ TEST(MeshNormals, SplitNormalsSplitWhereFacesMeetAtMoreThanTheAngle) {
   EXPECT_TRUE(sphere.cornerNormals == sphereSmooth.cornerNormals);
 }
 
+TEST(MeshNormals, SmoothNormalsGiveFlatFacesTheirFaceNormal) {
+  // The roof of the test below, its third quad flat: that quad's corners take its own normal;
+  // the smooth quads' corners the vertex normal, which still sums the flat quad in (Blender's
+  // vertex normals do), so at vertex 4 it differs from the sum of the smooth faces alone.
+  Mesh roof = makeMesh({{0, 0, 0},
+                        {0, 1, 0},
+                        {1, 0, std::sqrt(3.0f)},
+                        {1, 1, std::sqrt(3.0f)},
+                        {2, 0, 0},
+                        {2, 1, 0},
+                        {3, 0, 0},
+                        {3, 1, 0}},
+                       {{0, 2, 3, 1}, {2, 4, 5, 3}, {4, 6, 7, 5}});
+  Mesh smooth = roof;
+  computeSmoothNormals(smooth);
+  roof.faceFlat = {0, 0, 1};
+  computeSmoothNormals(roof);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(roof.view());
+  for (std::uint32_t c = 8; c < 12; ++c) EXPECT_EQ(roof.cornerNormals[c], faceNormals[2]);
+  for (std::uint32_t c = 0; c < 8; ++c) EXPECT_EQ(roof.cornerNormals[c], smooth.cornerNormals[c]);
+  EXPECT_GT(angleDegrees(cast<double>(roof.cornerNormals[5]), cast<double>(faceNormals[1])), 1);
+}
+
 TEST(MeshNormals, SplitNormalsSeparateFlatFacesAndEachSideOfASharpEdge) {
   // A prism seen end-on: a roof of two quads sloping at 60 degrees, so that their normals are
   // 120 degrees apart, and a third quad flat-shaded beside them. At 150 degrees the ridge is

@@ -87,6 +87,31 @@ TEST(MeshObj, SmoothingStatementsMarkFlatFacesAsBlendersImporterDoes) {
   EXPECT_EQ(formatObj(unmarked).find("\ns "), std::string::npos);
 }
 
+TEST(MeshObj, WithoutNormalsFlatFacesAreShadedFlat) {
+  // Blender 3.4 imports an OBJ without `vn` with the normals it computes: a face after `s off`
+  // gets its own face normal (measured: the cube of flat quads imports with loop normals equal
+  // to its faces'), a smooth one the vertex normal.
+  const std::string cube =
+      "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\n"
+      "v -1 1 1\n";
+  const std::string faces =
+      "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n"
+      "f 4 1 5 8\n";
+  const Mesh flat = loadObjText(cube + "s off\n" + faces);
+  ASSERT_EQ(flat.cornerNormals.size(), 24u);
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(flat.view());
+  for (std::size_t f = 0; f < flat.numFaces(); ++f) {
+    for (std::uint32_t c = flat.faceStart[f]; c < flat.faceStart[f + 1]; ++c) {
+      EXPECT_EQ(flat.cornerNormals[c], faceNormals[f]) << "face " << f << ", corner " << c;
+    }
+  }
+  EXPECT_EQ(faceNormals[0], (Vec3f{0, 0, -1}));
+  // `s 1`: the corners of a vertex share its (diagonal) normal.
+  const Mesh smooth = loadObjText(cube + "s 1\n" + faces);
+  EXPECT_NEAR(smooth.cornerNormals[0].x, -1 / std::sqrt(3.0f), 1e-6f);
+  EXPECT_EQ(smooth.cornerNormals[0], smooth.cornerNormals[8]);  // vertex 1 in faces 0 and 2
+}
+
 TEST(MeshObj, SeamKeepsBothUvsOfASharedVertex) {
   const Mesh mesh = load(goodFile("seam.obj"));
   ASSERT_EQ(mesh.numFaces(), 2u);

@@ -56,8 +56,8 @@ struct Mesh {
   std::vector<UvSet> uvSets;           ///< zero or more sets of #C UVs
   NormalSource normalSource = NormalSource::kFile;
   /// #F, 1 for a flat-shaded face (Blender's smooth flag off: OBJ `s 0` / `s off`), or empty:
-  /// every face smooth. Only subdivideMesh reads it; the corner normals already say how a face
-  /// is shaded.
+  /// every face smooth. Read where sgbake computes normals (computeSmoothNormals, Auto Smooth,
+  /// subdivideMesh); normals read from the file already say how a face is shaded.
   std::vector<std::uint8_t> faceFlat;
   /// @brief Whether face @p f is flat-shaded (faceFlat says so).
   bool isFlat(std::size_t f) const { return f < faceFlat.size() && faceFlat[f] != 0; }

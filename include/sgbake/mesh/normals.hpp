@@ -24,8 +24,10 @@ std::vector<Vec3f> computeFaceNormals(const MeshView& mesh);
 /// and accumulated in double, stored as float. Degenerate cases follow Blender: a zero-area face
 /// contributes (0, 0, 1); a corner with a zero-length edge has weight π/2 (Blender's acos of the
 /// dot product with a zero vector). A vertex whose sum vanishes gets its normalized position
-/// (Blender's fallback), or (0, 0, 1) at the origin. Writes every corner of @p mesh and sets
-/// normalSource to kComputed.
+/// (Blender's fallback), or (0, 0, 1) at the origin. The corners of faces flagged flat
+/// (Mesh::faceFlat) take their face's normal (computeFaceNormals) instead, as Blender shades a
+/// flat face; the vertex normals still sum over flat faces too, as Blender's do. Writes every
+/// corner of @p mesh and sets normalSource to kComputed.
 /// @note Precondition: @p mesh satisfies the index invariants of Mesh (positions may be anything
 /// finite; normals are not read).
 void computeSmoothNormals(Mesh& mesh);
