@@ -1,10 +1,18 @@
 // libsgbake_oiio.so: the image I/O module, OpenImageIO behind the interface of image_codec.hpp.
 // Nothing else in sgbake includes OpenImageIO.
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "io/image_codec.hpp"
 
@@ -45,23 +53,121 @@ class OiioReader final : public ImageReader {
   std::unique_ptr<OIIO::ImageInput> in_;
 };
 
+/// An output file that remembers the first failed write. OpenImageIO's PNG writer writes
+/// through stdio and does not check fclose, so a full disk or a file-size limit there leaves a
+/// truncated file behind a successful close(); written through this proxy, the failure is
+/// seen. Writes go through a buffer (libpng writes in small pieces); seek, pwrite and close
+/// flush it first.
+class CheckedFileProxy final : public OIIO::Filesystem::IOProxy {
+ public:
+  explicit CheckedFileProxy(const std::string& path) : IOProxy(path, Write) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+    if (fd_ < 0) fail(errno);
+  }
+  ~CheckedFileProxy() override { close(); }
+
+  const char* proxytype() const override { return "sgbake-checked-file"; }
+  void close() override {
+    if (fd_ < 0) return;
+    flushBuffer();
+    if (::close(fd_) != 0) fail(errno);
+    fd_ = -1;
+    m_mode = Closed;
+  }
+  bool seek(int64_t offset) override {
+    if (offset < 0) return false;
+    m_pos = offset;
+    return true;
+  }
+  size_t write(const void* data, size_t size) override {
+    if (fd_ < 0) return 0;
+    if (buffer_.empty()) bufferStart_ = m_pos;
+    if (m_pos != bufferStart_ + static_cast<int64_t>(buffer_.size())) {
+      flushBuffer();
+      bufferStart_ = m_pos;
+    }
+    const char* bytes = static_cast<const char*>(data);
+    buffer_.insert(buffer_.end(), bytes, bytes + size);
+    m_pos += static_cast<int64_t>(size);
+    if (buffer_.size() >= kBufferBytes) flushBuffer();
+    return failed() ? 0 : size;
+  }
+  size_t pwrite(const void* data, size_t size, int64_t offset) override {
+    flushBuffer();
+    return writeAt(static_cast<const char*>(data), size, offset) ? size : 0;
+  }
+  size_t read(void*, size_t) override { return 0; }  // write only
+  size_t pread(void*, size_t, int64_t) override { return 0; }
+  size_t size() const override {
+    struct stat st {};
+    const int64_t onDisk = fd_ >= 0 && ::fstat(fd_, &st) == 0 ? st.st_size : 0;
+    return static_cast<size_t>(
+        std::max(onDisk, bufferStart_ + static_cast<int64_t>(buffer_.size())));
+  }
+
+  bool failed() const { return errno_ != 0; }
+  /// @brief Why the first write failed, e.g. "No space left on device".
+  std::string failure() const { return std::strerror(errno_); }
+
+ private:
+  static constexpr size_t kBufferBytes = 1 << 20;
+
+  void fail(int error) {
+    if (errno_ == 0) errno_ = error != 0 ? error : EIO;
+  }
+  bool writeAt(const char* data, size_t size, int64_t offset) {
+    while (size > 0 && fd_ >= 0 && !failed()) {
+      const ssize_t n = ::pwrite(fd_, data, size, offset);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        fail(n < 0 ? errno : EIO);
+        return false;
+      }
+      data += n;
+      size -= static_cast<size_t>(n);
+      offset += n;
+    }
+    return !failed();
+  }
+  void flushBuffer() {
+    if (!buffer_.empty()) writeAt(buffer_.data(), buffer_.size(), bufferStart_);
+    buffer_.clear();
+  }
+
+  int fd_ = -1;
+  int errno_ = 0;
+  std::vector<char> buffer_;
+  int64_t bufferStart_ = 0;  ///< file offset of buffer_[0]
+};
+
 class OiioWriter final : public ImageWriter {
  public:
-  explicit OiioWriter(std::unique_ptr<OIIO::ImageOutput> out) : out_(std::move(out)) {}
+  OiioWriter(std::unique_ptr<OIIO::ImageOutput> out, std::unique_ptr<CheckedFileProxy> proxy)
+      : proxy_(std::move(proxy)), out_(std::move(out)) {}
   ~OiioWriter() override {
     if (!closed_) out_->close();
   }
 
   bool writeRows(int begin, int end, PixelType type, const void* data) override {
-    return out_->write_scanlines(begin, end, 0, oiioType(type), data);
+    return out_->write_scanlines(begin, end, 0, oiioType(type), data) && !proxyFailed();
   }
   bool close() override {
     closed_ = true;
-    return out_->close();
+    const bool closed = out_->close();
+    if (proxy_) proxy_->close();
+    return closed && !proxyFailed();
   }
-  std::string error() override { return out_->geterror(); }
+  std::string error() override {
+    std::string error = out_->geterror();
+    if (proxyFailed()) error = proxy_->failure() + (error.empty() ? "" : "; " + error);
+    return error;
+  }
 
  private:
+  bool proxyFailed() const { return proxy_ && proxy_->failed(); }
+
+  // The proxy outlives the output that writes through it (members die in reverse order).
+  std::unique_ptr<CheckedFileProxy> proxy_;  ///< the file PNG output goes through, else null
   std::unique_ptr<OIIO::ImageOutput> out_;
   bool closed_ = false;
 };
@@ -101,11 +207,22 @@ class OiioCodec final : public ImageCodec {
       error = OIIO::geterror();
       return nullptr;
     }
+    // PNG through CheckedFileProxy (OpenImageIO's OpenEXR and TIFF writers report failed
+    // writes themselves).
+    std::unique_ptr<CheckedFileProxy> proxy;
+    if (spec.format == "png" && out->supports("ioproxy")) {
+      proxy = std::make_unique<CheckedFileProxy>(path.string());
+      if (proxy->failed()) {
+        error = proxy->failure();
+        return nullptr;
+      }
+      out->set_ioproxy(proxy.get());
+    }
     if (!out->open(path.string(), oiioSpec)) {
       error = out->geterror();
       return nullptr;
     }
-    return std::make_unique<OiioWriter>(std::move(out));
+    return std::make_unique<OiioWriter>(std::move(out), std::move(proxy));
   }
 };
 

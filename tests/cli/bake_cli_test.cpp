@@ -178,6 +178,26 @@ TEST_F(BakeCliTest, FailingBakeLeavesTheExistingOutputByteIdentical) {
   EXPECT_EQ(listDirectory(dir_), before);
 }
 
+TEST_F(BakeCliTest, FailedPngWriteIsAnErrorAndLeavesTheExistingOutput) {
+  // A file-size limit (as a full disk would) stops the PNG partway: OpenImageIO's PNG writer
+  // does not notice, so sgbake writes PNGs through a file that does. SIGXFSZ ignored, the
+  // write fails with EFBIG.
+  writeFile(dir_ / "out.png", "the previous bake");
+  const std::set<std::string> before = listDirectory(dir_);
+  const std::string command =
+      "trap '' XFSZ; ulimit -f 2; exec '" + std::string(SGBAKE_CLI) + "' bake --mesh '" +
+      (dir_ / "plane.obj").string() + "' --height '" + (dir_ / "h.png").string() +
+      "' --height-scale 0.3 --map object-normal --size 1024 --margin 0 --no-manifest -o '" +
+      (dir_ / "out.png").string() + "'";
+  const ProcessResult r = test::runProcess({"/bin/sh", "-c", command});
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  expectOneErrorLine(r);
+  EXPECT_NE(r.err.find("out.png: cannot write image (File too large"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("wrote"), std::string::npos) << r.out;
+  EXPECT_EQ(readFile(dir_ / "out.png"), "the previous bake");
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
 TEST_F(BakeCliTest, InterruptedBakeLeavesNoTemporaryAndNoOutput) {
   // A long bake (8192², 4×4 samples) is interrupted with SIGINT once its image's temporary
   // exists: the process dies of the signal and removes the temporary the library was writing.
