@@ -21,6 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sgbake/bake/planner.hpp"
+
 namespace sgbake {
 namespace {
 
@@ -866,9 +868,35 @@ std::string checkLayer(const SceneLayer& layer) {
   return {};
 }
 
+/// The extension of @p path in lower case, with its dot ("" when it has none).
+std::string lowerExtension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
+}
+
 std::string checkOutput(const SceneOutput& output, bool inMemory) {
   if (output.file.empty() && !inMemory) return "missing key 'file'";
-  if (output.kind == OutputKind::kCorners) return {};
+  if (!inMemory && output.file.filename() == kManifestName) {
+    return "file '" + output.file.string() +
+           "' has the name of the manifest sgbake keeps "
+           "beside its outputs";
+  }
+  if (output.kind == OutputKind::kCorners) {
+    if (inMemory) return {};
+    if (lowerExtension(output.file) != ".csv") {
+      return "file '" + output.file.string() +
+             "': the corners map is a CSV table, its file "
+             "must end in .csv";
+    }
+    if (hasUdimToken(output.file.string())) {
+      return "file '" + output.file.string() +
+             "': the corners map is one table for the whole "
+             "mesh, its file cannot hold " +
+             std::string(kUdimToken);
+    }
+    return {};
+  }
   if (output.width == output.height && (output.width < 1 || output.width > kMaxBakeSide)) {
     return rangeMessage("size", output.width, 1, kMaxBakeSide);
   }
@@ -895,10 +923,13 @@ std::string checkOutput(const SceneOutput& output, bool inMemory) {
   }
   if (inMemory) return {};  // no file: no format, no bit depth
   ImageFormat format = output.format;
+  Result<ImageFormat> fromPath = imageFormatFromPath(output.file);
   if (format == ImageFormat::kAuto) {
-    Result<ImageFormat> fromPath = imageFormatFromPath(output.file);
     if (!fromPath) return fromPath.error().message;
     format = *fromPath;
+  } else if (fromPath && *fromPath != format) {  // "format" is for names without a known one
+    return "format '" + std::string(imageFormatName(format)) + "' contradicts the extension of '" +
+           output.file.string() + "' (" + std::string(imageFormatName(*fromPath)) + ")";
   }
   const int depth = output.resolvedBitDepth();
   if (!formatSupportsBitDepth(format, depth)) {
@@ -1002,6 +1033,27 @@ std::filesystem::path canonicalPath(const std::filesystem::path& path) {
   if (!ec) return canonical;
   canonical = std::filesystem::absolute(path, ec);
   return (ec ? path : canonical).lexically_normal();
+}
+
+bool mayBeSameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+  const std::string as = a.string(), bs = b.string();
+  const bool aTiles = hasUdimToken(as), bTiles = hasUdimToken(bs);
+  if (aTiles && bTiles) return canonicalPath(a) == canonicalPath(b);
+  if (aTiles || bTiles) {
+    const std::filesystem::path single = canonicalPath(aTiles ? b : a);
+    const std::filesystem::path pattern = aTiles ? a : b;
+    const std::string name = pattern.filename().string();
+    const bool tokenInName = !hasUdimToken(pattern.parent_path().string());
+    if (tokenInName && canonicalPath(pattern.parent_path()) != single.parent_path()) return false;
+    for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+      if (tokenInName ? expandUdimToken(name, tile) == single.filename().string()
+                      : canonicalPath(expandUdimToken(pattern.string(), tile)) == single) {
+        return true;
+      }
+    }
+    return false;
+  }
+  return canonicalPath(a) == canonicalPath(b);
 }
 
 std::string describeLayer(const SceneLayer& layer) {
@@ -1186,6 +1238,24 @@ std::string closestMatch(std::string_view word, const std::vector<std::string>& 
   return bestDistance <= limit ? best : std::string();
 }
 
+namespace {
+
+/// The files a scene reads, each with how messages name it.
+std::vector<std::pair<std::filesystem::path, std::string>> sceneInputs(const Scene& scene) {
+  std::vector<std::pair<std::filesystem::path, std::string>> inputs;
+  if (!scene.source.empty()) inputs.emplace_back(scene.source, "the scene file");
+  inputs.emplace_back(scene.mesh, "the mesh");
+  for (std::size_t k = 0; k < scene.layers.size(); ++k) {
+    const SceneLayer& layer = scene.layers[k];
+    const std::string name = "layers[" + std::to_string(k) + "]";
+    if (!layer.image.empty()) inputs.emplace_back(layer.image, "the image of " + name);
+    if (layer.mask) inputs.emplace_back(layer.mask->image, "the mask of " + name);
+  }
+  return inputs;
+}
+
+}  // namespace
+
 Status validateScene(const Scene& scene) {
   const auto where = [](const char* list, std::size_t i) {
     return std::string(list) + "[" + std::to_string(i) + "]: ";
@@ -1204,10 +1274,18 @@ Status validateScene(const Scene& scene) {
     if (std::string why = checkOutput(scene.outputs[i], scene.inMemory); !why.empty()) {
       return Error::badInput(where("outputs", i) + why);
     }
-    for (std::size_t j = 0; j < i && !scene.inMemory; ++j) {
-      if (scene.outputs[j].file == scene.outputs[i].file) {
-        return Error::badInput(where("outputs", i) + "file '" + scene.outputs[i].file.string() +
+    if (scene.inMemory) continue;
+    const std::filesystem::path& file = scene.outputs[i].file;
+    for (std::size_t j = 0; j < i; ++j) {
+      if (mayBeSameFile(scene.outputs[j].file, file)) {
+        return Error::badInput(where("outputs", i) + "file '" + file.string() +
                                "' is also written by outputs[" + std::to_string(j) + "]");
+      }
+    }
+    for (const auto& [input, what] : sceneInputs(scene)) {
+      if (mayBeSameFile(file, input)) {
+        return Error::badInput(where("outputs", i) + "file '" + file.string() + "' is " + what +
+                               ", which the bake reads (write it elsewhere)");
       }
     }
   }

@@ -5,12 +5,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
 #include "sgbake/bake/convert.hpp"
 #include "sgbake/bake/image_output.hpp"
+#include "sgbake/bake/scene.hpp"
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/image.hpp"
 #include "sgbake/io/atomic_file.hpp"
@@ -94,6 +96,12 @@ Status runConvert(const ConvertArguments& args) {
   if (args.green != "opengl" && args.green != "directx") {
     return Error::badInput("convert: --green: unknown value '" + args.green +
                            "' (expected opengl or directx)");
+  }
+  for (const auto& [input, what] : {std::pair{args.input, "the image"}, {args.mesh, "the mesh"}}) {
+    if (mayBeSameFile(args.output, input)) {
+      return Error::badInput("convert: -o " + args.output + " is " + what +
+                             " it reads (write it elsewhere)");
+    }
   }
   Result<ImageFormat> format = imageFormatFromPath(args.output);
   if (!format) return format.error();

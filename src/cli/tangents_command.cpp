@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <span>
 #include <string>
@@ -14,6 +15,7 @@
 
 #include "cli.hpp"
 #include "float_format.hpp"
+#include "sgbake/bake/scene.hpp"
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/io/atomic_file.hpp"
 #include "sgbake/mesh/io.hpp"
@@ -139,6 +141,21 @@ Status runTangents(const TangentsArguments& args) {
   Stopwatch total;
   const ThreadLimit threadLimit(args.threads);
   if (Status ok = checkSubdivisionOptions("tangents", args.subdivision, false); !ok) return ok;
+  if (args.output != "-" && mayBeSameFile(args.output, args.mesh)) {
+    return Error::badInput("tangents: -o " + args.output + " is the mesh it reads");
+  }
+  if (!args.meshOut.empty()) {
+    if (std::filesystem::path(args.meshOut).extension() != ".obj") {
+      return Error::badInput("tangents: --mesh-out " + args.meshOut +
+                             ": the mesh is written as OBJ, its file must end in .obj");
+    }
+    if (mayBeSameFile(args.meshOut, args.mesh)) {
+      return Error::badInput("tangents: --mesh-out " + args.meshOut + " is the mesh it reads");
+    }
+    if (args.output != "-" && mayBeSameFile(args.meshOut, args.output)) {
+      return Error::badInput("tangents: --mesh-out and -o name the same file, " + args.output);
+    }
+  }
 
   // Open the output first: an unwritable destination is reported before any work is done.
   Result<Output> output = Output::open(args.output);

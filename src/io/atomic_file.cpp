@@ -129,6 +129,14 @@ Result<AtomicFile> AtomicFile::create(const std::filesystem::path& target,
   if (std::filesystem::is_directory(target, ec)) {
     return Error::badInput(target.string() + ": is a directory");
   }
+  // A device, pipe or socket (or a link to one, such as /dev/stdout) would be replaced by a
+  // regular file: refused. (A link to a regular file is replaced like one.)
+  const std::filesystem::file_status status = std::filesystem::status(target, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    return Error::badInput(target.string() +
+                           ": is not a regular file (a device, pipe or socket); sgbake writes "
+                           "files by replacing them");
+  }
 
   // Seeded per call from the OS: two processes (or two writers in one) never share a sequence.
   std::random_device entropy;

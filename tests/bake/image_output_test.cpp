@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -408,6 +409,31 @@ TEST_F(ImageOutputTest, RemoveTemporaryFilesTakesOnlyUnfinishedTemporaries) {
   EXPECT_EQ(readFile(dir_ / "done.txt"), "done");
   EXPECT_FALSE(open->commit());  // its temporary is gone: nothing appears at the target
   EXPECT_EQ(listDirectory(dir_), std::set<std::string>{"done.txt"});
+}
+
+TEST_F(ImageOutputTest, PipesAndLinksToThemAreRefusedAndLinksToFilesReplaced) {
+  // A FIFO (like a device) would be replaced by the rename: refused, and left as it is; so is
+  // a link to one (as /dev/stdout is). A link to a regular file is replaced by the new file.
+  const fs::path fifo = dir_ / "pipe.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  Result<AtomicFile> refused = AtomicFile::create(fifo);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::kBadInput);
+  EXPECT_NE(refused.error().message.find("pipe.csv: is not a regular file"), std::string::npos)
+      << refused.error().message;
+  fs::create_symlink("pipe.csv", dir_ / "to_pipe.csv");
+  EXPECT_FALSE(writeFileAtomically(dir_ / "to_pipe.csv", "x"));
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "to_pipe.csv")));
+
+  writeFile(dir_ / "kept.csv", "old");
+  fs::create_symlink("kept.csv", dir_ / "to_file.csv");
+  ASSERT_TRUE(writeFileAtomically(dir_ / "to_file.csv", "new"));
+  EXPECT_FALSE(fs::is_symlink(fs::symlink_status(dir_ / "to_file.csv")));
+  EXPECT_EQ(readFile(dir_ / "to_file.csv"), "new");
+  EXPECT_EQ(readFile(dir_ / "kept.csv"), "old");
+  EXPECT_EQ(listDirectory(dir_),
+            (std::set<std::string>{"kept.csv", "pipe.csv", "to_file.csv", "to_pipe.csv"}));
 }
 
 TEST(UdimToken, Expansion) {

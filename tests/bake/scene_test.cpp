@@ -309,6 +309,50 @@ TEST(Scene, FormatsAndBitDepths) {
             "scene.json: outputs[0]: key 'green' applies only to tangent-normal maps");
 }
 
+TEST(Scene, OutputsThatWouldOverwriteSomethingAreRefused) {
+  // Inputs, the manifest, a format contradicting the extension, a corners table in an image's
+  // name, and a UDIM output whose tile another output writes.
+  const std::string height = R"(, "layers": [{"type": "height", "image": "h.png",
+      "mask": {"image": "mask.png"}}]})";
+  const auto scene = [&](const std::string& output, const std::string& layers) {
+    return R"({"mesh": "m.obj", "outputs": [)" + output + "]" + layers;
+  };
+  EXPECT_NE(parseError(scene(R"({"map": "mask", "file": "h.png"})", height))
+                .find("outputs[0]: file 'scenes/h.png' is the image of layers[0], which the "
+                      "bake reads"),
+            std::string::npos);
+  EXPECT_NE(parseError(scene(R"({"map": "mask", "file": "./mask.png"})", height))
+                .find("is the mask of layers[0]"),
+            std::string::npos);
+  EXPECT_NE(parseError(scene(R"({"map": "mask", "file": "m.obj", "format": "png"})", "}"))
+                .find("is the mesh"),
+            std::string::npos);
+  EXPECT_NE(parseError(scene(R"({"map": "mask", "file": "h.<UDIM>.png"}, {"map": "mask",
+      "file": "h.1002.png"})",
+                             "}"))
+                .find("outputs[1]: file 'scenes/h.1002.png' is also written by outputs[0]"),
+            std::string::npos);
+  EXPECT_NE(parseError(withOutput(R"({"map": "corners", "file": ".sgbake-manifest.json"})"))
+                .find("has the name of the manifest"),
+            std::string::npos);
+  EXPECT_NE(parseError(withOutput(R"({"map": "corners", "file": "c.png"})"))
+                .find("the corners map is a CSV table, its file must end in .csv"),
+            std::string::npos);
+  EXPECT_NE(parseError(withOutput(R"({"map": "corners", "file": "c_<UDIM>.csv"})"))
+                .find("its file cannot hold <UDIM>"),
+            std::string::npos);
+  EXPECT_NE(parseError(withOutput(R"({"map": "mask", "file": "m.png", "format": "exr"})"))
+                .find("format 'exr' contradicts the extension of 'scenes/m.png' (png)"),
+            std::string::npos);
+  // Still accepted: the format for a name without a known extension, other tiles' names.
+  EXPECT_TRUE(
+      parseScene(withOutput(R"({"map": "mask", "file": "m.img", "format": "png"})"), options()));
+  EXPECT_TRUE(parseScene(scene(R"({"map": "mask", "file": "h.<UDIM>.png"}, {"map": "mask",
+      "file": "h.999.png"})",
+                               "}"),
+                         options()));
+}
+
 TEST(Scene, SignedMapsTakeARangeForIntegerFiles) {
   Result<Scene> scene = parseScene(withOutput(
       R"({"map": "derivative", "file": "d.png", "range": 0.25},

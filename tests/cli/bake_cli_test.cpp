@@ -736,6 +736,14 @@ TEST_F(BakeCliTest, ConvertErrors) {
             "tangent", (dir_ / "n.png").string(), "-o", (dir_ / "o.png").string()},
            {"convert", "--mesh", mesh, "--from", "object", "--to", "tangent",
             (dir_ / "n.png").string(), "-o", (dir_ / "missing" / "o.png").string()},
+           // Outputs that would overwrite an input: the image, the mesh (by its format).
+           {"convert", "--mesh", mesh, "--from", "object", "--to", "tangent",
+            (dir_ / "n.png").string(), "-o", (dir_ / "." / "n.png").string()},
+           {"tangents", mesh, "-o", mesh},
+           {"tangents", mesh, "--mesh-out", mesh},
+           {"tangents", mesh, "--mesh-out", (dir_ / "m.ply").string()},
+           {"tangents", mesh, "--mesh-out", (dir_ / "m.obj").string(), "-o",
+            (dir_ / "m.obj").string()},
        }) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args.back() << ": " << r.err;

@@ -286,6 +286,10 @@ std::string describeAutoSmooth(const SceneSubdivision& subdivision);
 /// lexically normal absolute path when that fails.
 std::filesystem::path canonicalPath(const std::filesystem::path& path);
 
+/// @brief Whether writing @p a may write the file @p b is: the same canonicalPath, or, for a
+/// path with kUdimToken, that of any of its tiles.
+bool mayBeSameFile(const std::filesystem::path& a, const std::filesystem::path& b);
+
 /// @brief The closest of @p candidates to @p word (edit distance at most 2 and less than half
 /// its length), or "" — for "did you mean" suggestions.
 std::string closestMatch(std::string_view word, const std::vector<std::string>& candidates);

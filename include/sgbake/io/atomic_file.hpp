@@ -32,7 +32,8 @@ struct AtomicFileOptions {
 /// call commit().
 ///
 /// Errors: a target that cannot be created (missing directory, no permission, a directory in its
-/// place) is ErrorCode::kBadInput; a failing write, sync or rename (disk full, I/O error) is
+/// place, or a device, pipe or socket — or a link to one — that the rename would replace) is
+/// ErrorCode::kBadInput; a failing write, sync or rename (disk full, I/O error) is
 /// ErrorCode::kInternal. Messages name the target path.
 ///
 /// @note Not thread-safe: one writer per thread. Move-only.
