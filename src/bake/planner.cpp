@@ -719,6 +719,13 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const
   return Ok{};
 }
 
+/// The file of tile @p tile of @p output (a corners table is one file).
+fs::path tileFile(const SceneOutput& output, int tile) {
+  return output.kind == OutputKind::kCorners
+             ? output.file
+             : fs::path(expandUdimToken(output.file.string(), tile));
+}
+
 /// Creates the directory of @p file when it is missing.
 Status ensureDirectory(const fs::path& file) {
   const fs::path dir = file.parent_path();
@@ -786,16 +793,6 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   }
   report.loadSeconds = secondsSince(start) - report.tangentsSeconds;
 
-  // Every output directory must exist (created here) and be writable before the long work.
-  for (const PlannedOutput& planned : plan.outputs) {
-    if (planned.upToDate) continue;
-    const fs::path file =
-        expandUdimToken(s.outputs[planned.sceneOutput].file.string(), kFirstUdimTile);
-    if (Status ok = ensureDirectory(file); !ok) return ok.error();
-    Result<AtomicFile> probe = AtomicFile::create(file);  // removed again when it goes out of scope
-    if (!probe) return probe.error();
-  }
-
   // 2. The tiles of every output to bake (known now that the mesh is loaded).
   std::vector<std::vector<int>> tiles(plan.outputs.size());
   for (std::size_t o = 0; o < plan.outputs.size(); ++o) {
@@ -813,6 +810,19 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     progress.addWork(tiles[o].size());
   }
 
+  // Every output directory (of every tile: "<UDIM>/n.png" has one per tile) must exist
+  // (created here) and be writable before the long work.
+  for (std::size_t o = 0; o < plan.outputs.size(); ++o) {
+    if (plan.outputs[o].upToDate) continue;
+    const SceneOutput& output = s.outputs[plan.outputs[o].sceneOutput];
+    for (const int tile : tiles[o]) {
+      const fs::path file = tileFile(output, tile);
+      if (Status ok = ensureDirectory(file); !ok) return ok.error();
+      Result<AtomicFile> probe = AtomicFile::create(file);  // removed when it goes out of scope
+      if (!probe) return probe.error();
+    }
+  }
+
   // 3. Bake, pad and write each output; record it in the manifest.
   for (std::size_t o = 0; o < plan.outputs.size(); ++o) {
     const PlannedOutput& planned = plan.outputs[o];
@@ -823,9 +833,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     json files = json::object();
 
     for (const int tile : tiles[o]) {
-      const fs::path file = output.kind == OutputKind::kCorners
-                                ? output.file
-                                : fs::path(expandUdimToken(output.file.string(), tile));
+      const fs::path file = tileFile(output, tile);
       progress.start("baking " + file.string());
       start = Clock::now();
       if (output.kind == OutputKind::kCorners) {

@@ -882,6 +882,11 @@ std::string checkOutput(const SceneOutput& output, bool inMemory) {
            "' has the name of the manifest sgbake keeps "
            "beside its outputs";
   }
+  if (!inMemory && hasUdimToken(output.file.parent_path().string())) {
+    return "file '" + output.file.string() + "': " + std::string(kUdimToken) +
+           " goes in the file's name, not in a directory (every tile's file, and the manifest, "
+           "are in one directory)";
+  }
   if (output.kind == OutputKind::kCorners) {
     if (inMemory) return {};
     if (lowerExtension(output.file) != ".csv") {

@@ -332,6 +332,9 @@ TEST(Scene, OutputsThatWouldOverwriteSomethingAreRefused) {
                              "}"))
                 .find("outputs[1]: file 'scenes/h.1002.png' is also written by outputs[0]"),
             std::string::npos);
+  EXPECT_NE(parseError(withOutput(R"({"map": "mask", "file": "<UDIM>/m.png"})"))
+                .find("<UDIM> goes in the file's name, not in a directory"),
+            std::string::npos);
   EXPECT_NE(parseError(withOutput(R"({"map": "corners", "file": ".sgbake-manifest.json"})"))
                 .find("has the name of the manifest"),
             std::string::npos);
