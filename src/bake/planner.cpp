@@ -90,6 +90,18 @@ std::string describeOutput(const SceneOutput& output) {
 
 // ---- Manifest ----------------------------------------------------------------------------------
 
+/// The manifest at @p path; an empty object when there is none, or when it is not a regular
+/// file, not valid JSON or not of this version (everything then re-bakes, and writing it
+/// reports what is wrong).
+json readManifest(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return json::object();
+  std::ifstream in(path, std::ios::binary);
+  json parsed = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (parsed.is_object() && parsed.value("sgbake_manifest", 0) == kManifestVersion) return parsed;
+  return json::object();
+}
+
 /// The manifests of the output directories, read once per plan.
 class ManifestCache {
  public:
@@ -106,16 +118,7 @@ class ManifestCache {
   const json& load(const fs::path& dir) {
     const std::string key = dir.string();
     if (const auto it = manifests_.find(key); it != manifests_.end()) return it->second;
-    json manifest = json::object();
-    std::ifstream in(dir / kManifestName, std::ios::binary);
-    if (in) {
-      // A manifest that is not ours or not valid JSON counts as empty: everything re-bakes.
-      json parsed = json::parse(in, nullptr, /*allow_exceptions=*/false);
-      if (parsed.is_object() && parsed.value("sgbake_manifest", 0) == kManifestVersion) {
-        manifest = std::move(parsed);
-      }
-    }
-    return manifests_.emplace(key, std::move(manifest)).first->second;
+    return manifests_.emplace(key, readManifest(dir / kManifestName)).first->second;
   }
 
   std::map<std::string, json> manifests_;
@@ -124,16 +127,7 @@ class ManifestCache {
 /// Records @p entry for @p file in its directory's manifest (read, modify, write atomically).
 Status recordInManifest(const fs::path& file, const json& entry) {
   const fs::path path = directoryOf(file) / kManifestName;
-  json manifest = json::object();
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (in) {
-      json parsed = json::parse(in, nullptr, /*allow_exceptions=*/false);
-      if (parsed.is_object() && parsed.value("sgbake_manifest", 0) == kManifestVersion) {
-        manifest = std::move(parsed);
-      }
-    }
-  }
+  json manifest = readManifest(path);
   manifest["sgbake_manifest"] = kManifestVersion;
   if (!manifest.contains("outputs") || !manifest["outputs"].is_object()) {
     manifest["outputs"] = json::object();
@@ -819,6 +813,10 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       const fs::path file = tileFile(output, tile);
       if (Status ok = ensureDirectory(file); !ok) return ok.error();
       Result<AtomicFile> probe = AtomicFile::create(file);  // removed when it goes out of scope
+      if (!probe) return probe.error();
+    }
+    if (plan.options.useManifest) {  // and so must its manifest
+      Result<AtomicFile> probe = AtomicFile::create(directoryOf(output.file) / kManifestName);
       if (!probe) return probe.error();
     }
   }

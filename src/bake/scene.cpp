@@ -816,9 +816,10 @@ json parseJson(std::string_view text) {
   json document;
   try {
     document = json::parse(text.begin(), text.end(), callback);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." → keep the part
-    // after the bracketed id.
+    // after the bracketed id. (A number too large for a double, 1e400, is an out_of_range
+    // error of the parse: bad input too.)
     std::string message = e.what();
     if (const std::size_t end = message.find("] "); end != std::string::npos) {
       message = message.substr(end + 2);

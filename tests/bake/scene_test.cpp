@@ -309,6 +309,11 @@ TEST(Scene, FormatsAndBitDepths) {
             "scene.json: outputs[0]: key 'green' applies only to tangent-normal maps");
 }
 
+TEST(Scene, NumbersBeyondADoubleAreInvalidJson) {
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "size": 1e400})")),
+            "scene.json: invalid JSON: number overflow parsing '1e400'");
+}
+
 TEST(Scene, OutputsThatWouldOverwriteSomethingAreRefused) {
   // Inputs, the manifest, a format contradicting the extension, a corners table in an image's
   // name, and a UDIM output whose tile another output writes.

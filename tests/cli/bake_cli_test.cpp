@@ -198,6 +198,18 @@ TEST_F(BakeCliTest, FailedPngWriteIsAnErrorAndLeavesTheExistingOutput) {
   EXPECT_EQ(listDirectory(dir_), before);
 }
 
+TEST_F(BakeCliTest, ManifestThatCannotBeWrittenIsReportedBeforeBaking) {
+  // A directory where the manifest goes: one line naming it, exit 2, nothing baked.
+  fs::create_directories(dir_ / "out" / ".sgbake-manifest.json");
+  const std::set<std::string> before = listDirectory(dir_ / "out");
+  const ProcessResult r = bakeScene(
+      planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "out/n.png", "size": 8})"));
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  expectOneErrorLine(r);
+  EXPECT_NE(r.err.find(".sgbake-manifest.json: is a directory"), std::string::npos) << r.err;
+  EXPECT_EQ(listDirectory(dir_ / "out"), before);
+}
+
 TEST_F(BakeCliTest, InterruptedBakeLeavesNoTemporaryAndNoOutput) {
   // A long bake (8192², 4×4 samples) is interrupted with SIGINT once its image's temporary
   // exists: the process dies of the signal and removes the temporary the library was writing.
