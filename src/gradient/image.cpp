@@ -4,11 +4,13 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <new>
 #include <string>
@@ -66,6 +68,20 @@ int channelsToRead(ImageChannels selection, int fileChannels) {
   return -1;
 }
 
+/// The machine's physical memory in bytes (0 when unknown).
+double physicalMemoryBytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && pageSize > 0 ? static_cast<double>(pages) * static_cast<double>(pageSize)
+                                   : 0.0;
+}
+
+/// @p bytes in GB with one decimal, e.g. "28.8".
+std::string gigabytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", bytes / 1e9);
+  return text;
+}
+
 }  // namespace
 
 Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOptions& options) {
@@ -107,6 +123,18 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
 
   const int width = spec.width;
   const int height = spec.height;
+  // A small compressed file can hold a huge image: refuse one that cannot be loaded here
+  // before allocating it, rather than swap until the system kills the process. Loading
+  // holds the floats read and, at most, the decoder's copy of the file's channels (counted
+  // at 4 bytes each).
+  const double texels = static_cast<double>(width) * static_cast<double>(height);
+  const double needed = texels * (readChannels + spec.channels) * sizeof(float);
+  if (const double memory = physicalMemoryBytes(); memory > 0 && needed > memory) {
+    return fileError(path, "image is too large to load on this machine (" + std::to_string(width) +
+                               "x" + std::to_string(height) + ", " + channelsText(spec.channels) +
+                               ": about " + gigabytes(needed) + " GB; the machine has " +
+                               gigabytes(memory) + " GB)");
+  }
   Image read;
   try {
     read = Image(width, height, readChannels);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdint>
@@ -254,6 +255,19 @@ TEST(LoadImage, BadFilesAreOneLineBadInputErrors) {
   const fs::path huge = dir / "huge.pgm";
   writeBytes(huge, "P5\n70000 2\n255\n");
   expectFileError(loadImage(huge), huge, "image is too large (70000x2; at most 65536 per side)");
+
+  // A header within the sides' limit whose image cannot fit in this machine's memory (a
+  // decompression bomb: a few MB of zeros decode to 60000² bytes): refused before any
+  // allocation. 65536² grey 16-bit needs ~34 GB as floats plus the decoder's copy.
+  const fs::path bomb = dir / "bomb.pgm";
+  writeBytes(bomb, "P5\n65536 65536\n65535\n");
+  const double memory = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
+                        static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (memory < 65536.0 * 65536.0 * 8) {
+    expectFileError(loadImage(bomb), bomb,
+                    "image is too large to load on this machine (65536x65536, 1 channel: about "
+                    "34.4 GB; the machine has");
+  }
 }
 
 TEST(LoadImage, NonFiniteTexelsAreNamedFromTheTop) {
