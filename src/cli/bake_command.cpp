@@ -9,10 +9,11 @@
 #include <condition_variable>
 #include <cstdio>
 #include <memory>
-#include <optional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -339,8 +340,20 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   if (oneMap && !args.outDir.empty()) {
     return Error::badInput("bake: --out-dir applies to scene files only");
   }
-  if (Status ok = checkSubdivisionOptions("bake", args.subdivision, args.limitSurface); !ok) {
+  if (Status ok = checkSubdivisionOptions("bake", args.subdivision, args.limitSurface, app); !ok) {
     return ok;
+  }
+  // Layer and output options that would change nothing, as a scene's keys would be refused.
+  const bool height = !args.heightImage.empty(), normal = !args.normalImage.empty();
+  for (const auto& [option, applies, needs] :
+       {std::tuple{"--height-scale", height, "--height"},
+        {"--filter", height || normal, "--height or --normal"},
+        {"--normal-space", normal, "--normal"},
+        {"--normal-green", normal, "--normal"},
+        {"--green", args.map == "tangent-normal", "--map tangent-normal"}}) {
+    if (!applies && app.count(option) > 0) {
+      return Error::badInput(std::string("bake: ") + option + " applies only with " + needs);
+    }
   }
 
   Result<Scene> scene = oneMap ? oneMapScene(args) : loadScene(args.scene, args.outDir);

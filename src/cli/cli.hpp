@@ -73,10 +73,11 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
 
 /// @brief What addSubdivisionOptions cannot check while parsing, bad input reported for
 /// @p command: --no-limit-surface, --subdivision-type simple or --auto-smooth with --subdivide
-/// limit (@p limit); creases, sharp edges, --auto-smooth, --no-limit-surface or
-/// --subdivision-type simple without any --subdivide.
+/// limit (@p limit); creases, sharp edges without --auto-smooth, --no-limit-surface,
+/// --subdivision-type simple without any --subdivide; --uv-smooth, --boundary-smooth,
+/// --subdivision-quality or --no-creases given on @p app without a --subdivide option.
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
-                               bool limit);
+                               bool limit, const CLI::App& app);
 
 /// @brief Measures wall-clock seconds since construction or the last lap().
 class Stopwatch {

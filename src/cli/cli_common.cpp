@@ -262,13 +262,21 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
 }
 
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
-                               bool limit) {
+                               bool limit, const CLI::App& app) {
   // Options that only shape a subdivision, given without one: a forgotten --subdivide.
   // (--auto-smooth shades the mesh as it is too; --sharp-edge then marks its edges.)
   const auto unsubdivided = [&](const char* given) {
     return Error::badInput(command + ": " + given +
                            " applies to a subdivided mesh; add --subdivide N");
   };
+  // Those whose values cannot tell they were given, without any --subdivide (an explicit
+  // --subdivide 0 may come with a script's copy of a modifier's settings, as Blender takes).
+  if (options.level == 0 && !limit && app.count("--subdivide") == 0) {
+    for (const char* option :
+         {"--uv-smooth", "--boundary-smooth", "--subdivision-quality", "--no-creases"}) {
+      if (app.count(option) > 0) return unsubdivided(option);
+    }
+  }
   switch (findSubdivisionConflict(options, limit)) {
     case SubdivisionConflict::kNone:
       return Ok{};

@@ -81,12 +81,13 @@ FloatImage toFloatImage(const Image& image, bool& hasAlpha) {
   return out;
 }
 
-Status runConvert(const ConvertArguments& args) {
+Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   Stopwatch total;
   const ThreadLimit threadLimit(args.threads);
   preloadImageIo();  // the image codec loads while the arguments are checked and the mesh read
 
-  if (Status ok = checkSubdivisionOptions("convert", args.subdivision, args.limitSurface); !ok) {
+  if (Status ok = checkSubdivisionOptions("convert", args.subdivision, args.limitSurface, app);
+      !ok) {
     return ok;
   }
   Result<NormalSpace> from = parseNormalSpace(args.from);
@@ -280,7 +281,7 @@ CommandAction defineConvertCommand(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--stats", args->stats,
                "Print timings and sizes as one line of JSON on standard error");
-  return [args] { return runConvert(*args); };
+  return [args, &app] { return runConvert(*args, app); };
 }
 
 }  // namespace sgbake::cli

@@ -137,10 +137,10 @@ Status writeCsv(const Mesh& mesh, const CornerTangents& frames, Output& output) 
   return output.finish();
 }
 
-Status runTangents(const TangentsArguments& args) {
+Status runTangents(const TangentsArguments& args, const CLI::App& app) {
   Stopwatch total;
   const ThreadLimit threadLimit(args.threads);
-  if (Status ok = checkSubdivisionOptions("tangents", args.subdivision, false); !ok) return ok;
+  if (Status ok = checkSubdivisionOptions("tangents", args.subdivision, false, app); !ok) return ok;
   if (args.output != "-" && mayBeSameFile(args.output, args.mesh)) {
     return Error::badInput("tangents: -o " + args.output + " is the mesh it reads");
   }
@@ -250,7 +250,7 @@ CommandAction defineTangentsCommand(CLI::App& app) {
       ->type_name("FILE");
   app.add_flag("--stats", args->stats,
                "Print timings and sizes as one line of JSON on standard error");
-  return [args] { return runTangents(*args); };
+  return [args, &app] { return runTangents(*args, app); };
 }
 
 }  // namespace sgbake::cli

@@ -373,12 +373,36 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
            {"bake", (dir_ / "scene.json").string(), "--mesh", mesh},
            {"bake"},
            {"bake", "--mesh", mesh, "--padding", "extnd", "-o", (dir_ / "o.png").string()},
+           // Options that would change nothing: no layer for them, another map, no subdivision.
+           {"bake", "--mesh", mesh, "--height-scale", "2", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--filter", "bicubic", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--normal-space",
+            "object", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "mask", "--green", "directx", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--uv-smooth", "all", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--subdivision-quality", "4", "-o", (dir_ / "o.png").string()},
        }) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args.back() << ": " << r.err;
     expectOneErrorLine(r);
   }
   EXPECT_EQ(listDirectory(dir_), before);
+  const ProcessResult green = run({"bake", "--mesh", mesh, "--map", "mask", "--green", "directx",
+                                   "-o", (dir_ / "o.png").string()});
+  EXPECT_NE(green.err.find("bake: --green applies only with --map tangent-normal"),
+            std::string::npos)
+      << green.err;
+  const ProcessResult smooth =
+      run({"bake", "--mesh", mesh, "--uv-smooth", "all", "-o", (dir_ / "o.png").string()});
+  EXPECT_NE(smooth.err.find("bake: --uv-smooth applies to a subdivided mesh; add --subdivide N"),
+            std::string::npos)
+      << smooth.err;
+  // A script's copy of a modifier at level 0 (--subdivide 0 given) is taken, as Blender does.
+  EXPECT_EQ(run({"bake", "--mesh", mesh, "--subdivide", "0", "--uv-smooth", "all", "--map", "mask",
+                 "--size", "8", "--no-manifest", "-o", (dir_ / "o.png").string()})
+                .exitCode,
+            0);
   const ProcessResult map =
       run({"bake", "--mesh", mesh, "--map", "tangent-normals", "-o", (dir_ / "o.png").string()});
   EXPECT_NE(map.err.find("unknown map"), std::string::npos) << map.err;
