@@ -79,6 +79,7 @@ Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not
 """
 
 import argparse
+import importlib.util
 import json
 import os
 import subprocess
@@ -105,16 +106,15 @@ UV_MAX = 2.5e-7
 TANGENT_MAX_DEG = 0.05
 NORMAL_MAX_DEG = 0.05
 
-# Blender's enum names -> sgbake's option values.
-UV_SMOOTH = {
-    "NONE": "none",
-    "PRESERVE_CORNERS": "keep-corners",
-    "PRESERVE_CORNERS_AND_JUNCTIONS": "keep-corners-junctions",
-    "PRESERVE_CORNERS_JUNCTIONS_AND_CONCAVE": "keep-corners-junctions-concave",
-    "PRESERVE_BOUNDARIES": "keep-boundaries",
-    "SMOOTH_ALL": "all",
-}
-BOUNDARY_SMOOTH = {"ALL": "all", "PRESERVE_CORNERS": "keep-corners"}
+# Blender's enum names -> sgbake's option values: the add-on's own table (plugin/, no bpy in
+# that module), so that these cases check it too.
+_ADDON_SCENE = importlib.util.spec_from_file_location(
+    "sgbake_addon_scene", os.path.join(os.path.dirname(os.path.dirname(HERE)), "plugin",
+                                       "sgbake_blender", "scene.py"))
+_addon_scene = importlib.util.module_from_spec(_ADDON_SCENE)
+_ADDON_SCENE.loader.exec_module(_addon_scene)
+UV_SMOOTH = _addon_scene.UV_SMOOTHS
+BOUNDARY_SMOOTH = _addon_scene.BOUNDARY_SMOOTHS
 
 # Negative controls: (name, Blender's case, sgbake option overrides, the check that must fail).
 # An override of None drops the option; "--no-creases": "" adds the flag.
