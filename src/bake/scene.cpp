@@ -514,8 +514,8 @@ void checkSubdivisionConflict(const ObjectReader& reader, const SceneSubdivision
       return unsubdivided("\"type\": \"simple\"");
     case SubdivisionConflict::kSharpEdgesWithoutAutoSmooth:
       fail(reader.where(),
-           "\"sharp_edges\" at \"level\": 0 need \"auto_smooth\" (edges marked "
-           "sharp split the normals only with Auto Smooth)");
+           "\"sharp_edges\" at \"level\": 0 need \"auto_smooth\" (edges "
+           "marked sharp split the normals only with Auto Smooth)");
     case SubdivisionConflict::kLimitWithoutLimitSurface:
       fail(reader.where(),
            "\"level\": \"limit\" shades the limit surface itself; it cannot be "
@@ -880,8 +880,7 @@ std::string checkOutput(const SceneOutput& output, bool inMemory) {
   if (output.file.empty() && !inMemory) return "missing key 'file'";
   if (!inMemory && output.file.filename() == kManifestName) {
     return "file '" + output.file.string() +
-           "' has the name of the manifest sgbake keeps "
-           "beside its outputs";
+           "' has the name of the manifest sgbake keeps beside its outputs";
   }
   if (!inMemory && hasUdimToken(output.file.parent_path().string())) {
     return "file '" + output.file.string() + "': " + std::string(kUdimToken) +
@@ -892,13 +891,11 @@ std::string checkOutput(const SceneOutput& output, bool inMemory) {
     if (inMemory) return {};
     if (lowerExtension(output.file) != ".csv") {
       return "file '" + output.file.string() +
-             "': the corners map is a CSV table, its file "
-             "must end in .csv";
+             "': the corners map is a CSV table, its file must end in .csv";
     }
     if (hasUdimToken(output.file.string())) {
       return "file '" + output.file.string() +
-             "': the corners map is one table for the whole "
-             "mesh, its file cannot hold " +
+             "': the corners map is one table for the whole mesh, its file cannot hold " +
              std::string(kUdimToken);
     }
     return {};
