@@ -93,7 +93,7 @@ std::string oneLineReason(std::string text) {
       line += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
     }
   }
-  return line.empty() ? std::string("unknown error") : line;
+  return line.empty() ? std::string("no reason given: the file may be truncated or damaged") : line;
 }
 
 }  // namespace io_detail

@@ -115,7 +115,7 @@ Result<const ImageCodec*> imageCodec();
 void finishLoading();
 
 /// A codec error as one line: line breaks become "; ", control characters '?', trailing blanks
-/// go; "unknown error" when empty.
+/// go; when empty, that no reason was given and the file may be truncated or damaged.
 std::string oneLineReason(std::string text);
 
 }  // namespace sgbake::io_detail

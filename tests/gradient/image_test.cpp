@@ -252,6 +252,12 @@ TEST(LoadImage, BadFilesAreOneLineBadInputErrors) {
   writeBytes(zero, "P5\n0 4\n255\n");
   expectFileError(loadImage(zero), zero, "image has zero size (0x4, 1 channel)");
 
+  // A header without its pixels: the library gives no reason, the message says what it means.
+  const fs::path headerOnly = dir / "header_only.pgm";
+  writeBytes(headerOnly, "P5\n4 4\n255\n");
+  expectFileError(loadImage(headerOnly), headerOnly,
+                  "cannot read image (no reason given: the file may be truncated or damaged)");
+
   const fs::path huge = dir / "huge.pgm";
   writeBytes(huge, "P5\n70000 2\n255\n");
   expectFileError(loadImage(huge), huge, "image is too large (70000x2; at most 65536 per side)");
