@@ -446,12 +446,12 @@ CommandAction defineBakeCommand(CLI::App& app) {
       ->group(oneMap);
   app.add_option("--size", args->size, "Width and height of the map, texels (1 to 65536)")
       ->type_name("N")
-      ->check(CLI::Range(1, kMaxBakeSide).description(""))
+      ->check(integerIn(1, kMaxBakeSide))
       ->capture_default_str()
       ->group(oneMap);
   app.add_option("--margin", args->margin, "Texels of edge padding around the UV islands")
       ->type_name("N")
-      ->check(CLI::Range(0, kMaxBakeSide).description(""))
+      ->check(integerIn(0, kMaxBakeSide))
       ->capture_default_str()
       ->group(oneMap);
   app.add_option("--padding", args->padding, "extend (by --margin) or push-pull (fill all)")
@@ -460,12 +460,12 @@ CommandAction defineBakeCommand(CLI::App& app) {
       ->group(oneMap);
   app.add_option("--samples", args->samples, "N: N x N samples per texel (1 to 16)")
       ->type_name("N")
-      ->check(CLI::Range(1, kMaxBakeSamples).description(""))
+      ->check(integerIn(1, kMaxBakeSamples))
       ->capture_default_str()
       ->group(oneMap);
   app.add_option("--uv", args->uvSet, "UV set of the map and its layers (0 = the first)")
       ->type_name("N")
-      ->check(CLI::Range(0, kMaxUvSets - 1).description(""))
+      ->check(integerIn(0, kMaxUvSets - 1))
       ->capture_default_str()
       ->group(oneMap);
   app.add_option("--green", args->green, "Green channel of a tangent-normal map: opengl or directx")

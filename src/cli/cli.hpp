@@ -59,8 +59,13 @@ CommandAction defineTangentsCommand(CLI::App& app);
 /// @brief The help-text block that ends every `--help`: what the exit codes mean.
 extern const char* const kExitCodeHelp;
 
-/// @brief CLI11 validator for options that take a count or an index: an integer >= 0.
+/// @brief CLI11 validator for options that take a count or an index: an integer >= 0 that fits
+/// in an int.
 extern const CLI::Validator kNonNegativeInteger;
+
+/// @brief A CLI11 check: the value is a whole integer (no trailing text, no exponent) in
+/// [@p min, @p max]; otherwise "'VALUE' is not an integer from MIN to MAX".
+CLI::Validator integerIn(long long min, long long max);
 
 /// @brief Adds --subdivide N, --uv-smooth NAME and --boundary-smooth NAME (Blender's
 /// Subdivision Surface modifier, see subdivideMesh), and --edge-crease A,B,C, --vertex-crease

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -29,20 +30,24 @@ const char* const kExitCodeHelp =
     "  1  internal error (a bug in sgbake, out of memory, disk full)\n"
     "  2  bad usage or bad input (unknown option, unreadable or invalid file)\n";
 
-const CLI::Validator kNonNegativeInteger(
-    [](std::string& value) -> std::string {
-      std::size_t used = 0;
-      try {
-        if (!value.empty() && value[0] != '-' && std::stoll(value, &used) >= 0 &&
-            used == value.size()) {
-          return {};
+CLI::Validator integerIn(long long min, long long max) {
+  return CLI::Validator(
+      [min, max](std::string& value) -> std::string {
+        std::size_t used = 0;
+        long long number = 0;
+        try {
+          number = std::stoll(value, &used);
+        } catch (const std::exception&) {
+          used = 0;  // not a number, or beyond long long: reported below
         }
-      } catch (const std::exception&) {
-        // Not a number or out of range: reported below.
-      }
-      return "'" + value + "' is not an integer >= 0";
-    },
-    /*validator_desc=*/"");
+        if (used > 0 && used == value.size() && number >= min && number <= max) return {};
+        return "'" + value + "' is not an integer from " + std::to_string(min) + " to " +
+               std::to_string(max);
+      },
+      /*validator_desc=*/"");
+}
+
+const CLI::Validator kNonNegativeInteger = integerIn(0, std::numeric_limits<int>::max());
 
 namespace {
 
@@ -127,9 +132,26 @@ template <class Enum, std::size_t N>
 CLI::Option* addNamedOption(CLI::App& app, const std::string& name, Enum& target,
                             const Named<Enum> (&names)[N], const std::string& help,
                             const std::string& defaultName) {
+  std::string expected;
+  for (std::size_t i = 0; i < N; ++i) {
+    expected += (i == 0 ? "" : i + 1 == N ? " or " : ", ") + std::string(names[i].name);
+  }
+  // The name becomes the enumerator's number, which CLI11 then stores (names only: numbers are
+  // not part of the interface).
   return app.add_option(name, target, help)
       ->type_name("NAME")
-      ->transform(CLI::CheckedTransformer(nameMap(names), CLI::ignore_case).description(""))
+      ->transform(CLI::Validator(
+          [map = nameMap(names), expected](std::string& value) -> std::string {
+            std::string lower = value;
+            for (char& c : lower)
+              c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            const auto found = map.find(lower);
+            if (found == map.end())
+              return "unknown value '" + value + "' (expected " + expected + ")";
+            value = std::to_string(static_cast<long long>(found->second));
+            return {};
+          },
+          /*validator_desc=*/""))
       ->default_str(defaultName);
 }
 
@@ -227,7 +249,7 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
                      "The modifier's Quality: the refinement level its patches isolate "
                      "irregular and semi-sharp features to")
           ->type_name("N")
-          ->check(CLI::Range(kMinSubdivisionQuality, kMaxSubdivisionQuality).description(""))
+          ->check(integerIn(kMinSubdivisionQuality, kMaxSubdivisionQuality))
           ->capture_default_str();
   CLI::Option* const type =
       addNamedOption(app, "--subdivision-type", options.type, kSubdivisionTypeNames,

@@ -398,6 +398,20 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
   EXPECT_NE(smooth.err.find("bake: --uv-smooth applies to a subdivided mesh; add --subdivide N"),
             std::string::npos)
       << smooth.err;
+  // Values CLI11 would describe in its own words: sgbake's say what is expected.
+  for (const auto& [args, expected] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--size", "1e1"}, "bake: --size: '1e1' is not an integer from 1 to 65536"},
+           {{"--threads", "99999999999"},
+            "bake: --threads: '99999999999' is not an integer from 0 to 2147483647"},
+           {{"--subdivide", "1", "--subdivision-type", "loop"},
+            "bake: --subdivision-type: unknown value 'loop' (expected catmull-clark or simple)"},
+       }) {
+    std::vector<std::string> command{"bake", "--mesh", mesh, "-o", (dir_ / "o.png").string()};
+    command.insert(command.end(), args.begin(), args.end());
+    const ProcessResult r = run(command);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
   // A script's copy of a modifier at level 0 (--subdivide 0 given) is taken, as Blender does.
   EXPECT_EQ(run({"bake", "--mesh", mesh, "--subdivide", "0", "--uv-smooth", "all", "--map", "mask",
                  "--size", "8", "--no-manifest", "-o", (dir_ / "o.png").string()})
