@@ -795,11 +795,28 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     const SceneOutput& output = s.outputs[planned.sceneOutput];
     if (output.kind == OutputKind::kCorners) {
       tiles[o] = {0};
-    } else if (hasUdimToken(output.file.string())) {
-      tiles[o] = udimTiles(loaded.mesh, output.uvSet);
-      if (tiles[o].empty()) tiles[o] = {kFirstUdimTile};
     } else {
-      tiles[o] = {output.tile};
+      // A map no UV triangle reaches holds only its background: said, not an error (a UV
+      // set still being laid out, say).
+      const std::vector<int> touched = udimTiles(loaded.mesh, output.uvSet);
+      const std::string uvSet = "UV set " + std::to_string(output.uvSet);
+      if (hasUdimToken(output.file.string())) {
+        tiles[o] = touched.empty() ? std::vector<int>{kFirstUdimTile} : touched;
+        if (touched.empty()) {
+          report.warnings.push_back(output.file.string() + ": no triangle of " + uvSet +
+                                    " lies in a UDIM tile (1001 to 2000); tile 1001 holds "
+                                    "only the background");
+        }
+      } else {
+        tiles[o] = {output.tile};
+        if (std::find(touched.begin(), touched.end(), output.tile) == touched.end()) {
+          report.warnings.push_back(
+              output.file.string() + ": no triangle of " + uvSet + " lies in " +
+              (output.tile == kFirstUdimTile ? std::string("the 0-1 UV square")
+                                             : "UDIM tile " + std::to_string(output.tile)) +
+              "; the map holds only the background");
+        }
+      }
     }
     progress.addWork(tiles[o].size());
   }

@@ -377,6 +377,9 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   Result<ExecuteReport> report = executePlan(*plan, executeOptions);
   bar.stop();
   if (!report) return report.error();
+  for (const std::string& warning : report->warnings) {
+    std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
+  }
   printOutcome(*report);
 
   if (args.stats) {

@@ -210,6 +210,37 @@ TEST_F(BakeCliTest, ManifestThatCannotBeWrittenIsReportedBeforeBaking) {
   EXPECT_EQ(listDirectory(dir_ / "out"), before);
 }
 
+TEST_F(BakeCliTest, MapsNoTriangleReachesAreBakedWithAWarning) {
+  // UVs all below 0: the 0-1 square and every UDIM tile are empty. The maps are written (the
+  // background), and stderr says so, one line each.
+  writeFile(dir_ / "away.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt -0.9 -0.9\nvt -0.1 -0.9\nvt -0.1 -0.1\n"
+            "vt -0.9 -0.1\nf 1/1 2/2 3/3 4/4\n");
+  const ProcessResult single =
+      run({"bake", "--mesh", (dir_ / "away.obj").string(), "--map", "mask", "--size", "8",
+           "--no-manifest", "-o", (dir_ / "m.png").string()});
+  EXPECT_EQ(single.exitCode, 0) << single.err;
+  EXPECT_NE(single.err.find("sgbake: warning: " + (dir_ / "m.png").string() +
+                            ": no triangle of UV set 0 lies in the 0-1 UV square; the map holds "
+                            "only the background\n"),
+            std::string::npos)
+      << single.err;
+  const ProcessResult tiles =
+      run({"bake", "--mesh", (dir_ / "away.obj").string(), "--map", "mask", "--size", "8",
+           "--no-manifest", "-o", (dir_ / "m_<UDIM>.png").string()});
+  EXPECT_EQ(tiles.exitCode, 0) << tiles.err;
+  EXPECT_NE(tiles.err.find("lies in a UDIM tile (1001 to 2000); tile 1001 holds only the "
+                           "background"),
+            std::string::npos)
+      << tiles.err;
+  EXPECT_TRUE(fs::exists(dir_ / "m_1001.png"));
+  // A mesh in the square: no warning.
+  const ProcessResult plane =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "mask", "--size", "8",
+           "--no-manifest", "-o", (dir_ / "p.png").string()});
+  EXPECT_EQ(plane.err, "");
+}
+
 TEST_F(BakeCliTest, InterruptedBakeLeavesNoTemporaryAndNoOutput) {
   // A long bake (8192², 4×4 samples) is interrupted with SIGINT once its image's temporary
   // exists: the process dies of the signal and removes the temporary the library was writing.

@@ -167,6 +167,8 @@ struct OutputReport {
 /// @brief Timings (seconds) and counts of an execution.
 struct ExecuteReport {
   std::vector<OutputReport> outputs;  ///< one per scene output, in scene order
+  /// What the user may not expect, in one line each (e.g. a map no UV triangle reaches)
+  std::vector<std::string> warnings;
   std::size_t imagesLoaded = 0;
   std::size_t texturesCreated = 0;
   bool tangentsComputed = false;
