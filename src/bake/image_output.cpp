@@ -453,7 +453,7 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
   return Ok{};
 }
 
-Status ImageFileWriter::commit() {
+Result<AtomicFile> ImageFileWriter::finish() {
   State& s = *state_;
   s.join();
   if (s.failed) return s.writeFailure();
@@ -467,7 +467,14 @@ Status ImageFileWriter::commit() {
     return fileError(ErrorCode::kInternal, s.path,
                      "cannot write image (" + oneLineReason(s.out->error()) + ")");
   }
-  return s.file.commit();  // on failure the temporary is removed and the target untouched
+  if (Status finished = s.file.finish(); !finished) return finished.error();
+  return std::move(s.file);
+}
+
+Status ImageFileWriter::commit() {
+  Result<AtomicFile> file = finish();
+  if (!file) return file.error();
+  return file->commit();  // on failure the temporary is removed and the target untouched
 }
 
 double ImageFileWriter::fileSeconds() const {

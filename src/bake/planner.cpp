@@ -616,11 +616,14 @@ using plan_detail::ProgressReporter;
 /// and the whole image never exists. Extend padding of a strip, done in the ring
 /// (extendMarginRowsInPlace; a copy for signed maps, whose remapped values must not reach the
 /// next strip), needs `margin` rows below it and above it: the rows above are kept in the ring,
-/// and the last `margin` rows of each band wait for the next one. Push-pull needs the whole image, which is then baked,
-/// padded and written in one piece. Masks are not padded (padding would overwrite the coverage
-/// they show).
-Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const SceneOutput& output,
-                     const fs::path& file, ExecuteReport& report) {
+/// and the last `margin` rows of each band wait for the next one. Push-pull needs the whole image,
+/// which is then baked, padded and written in one piece. Masks are not padded (padding would
+/// overwrite the coverage they show). Bakes one tile of @p output into a complete temporary file of
+/// @p file, appended to
+/// @p pending (renamed over @p file once every output of the run is written).
+Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
+                     const SceneOutput& output, const fs::path& file, ExecuteReport& report,
+                     std::vector<AtomicFile>& pending) {
   using Clock = std::chrono::steady_clock;
   const int threads = settings.threads;
   ImageWriteOptions writeOptions;
@@ -703,7 +706,9 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings, const
   }
   const double queueWaits = writer->waitSeconds();  // inside writeRows: the queue was full
   const Clock::time_point commitStart = Clock::now();
-  if (Status ok = writer->commit(); !ok) return ok;
+  Result<AtomicFile> written = writer->finish();
+  if (!written) return written.error();
+  pending.push_back(std::move(*written));
   const double finalWait = writer->waitSeconds() - queueWaits;  // commit waiting for the queue
   const double closeSeconds = secondsSince(commitStart) - finalWait;
   report.padSeconds += padSeconds;
@@ -838,7 +843,11 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     }
   }
 
-  // 3. Bake, pad and write each output; record it in the manifest.
+  // 3. Bake, pad and write each output into a temporary file; they replace the outputs only
+  // once all are written (a run that fails or is interrupted changes no output), then the
+  // manifests record them.
+  std::vector<AtomicFile> pending;
+  std::vector<std::pair<fs::path, json>> manifestEntries;
   for (std::size_t o = 0; o < plan.outputs.size(); ++o) {
     const PlannedOutput& planned = plan.outputs[o];
     if (planned.upToDate) continue;
@@ -862,12 +871,16 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         const std::string table = formatCornerTable(*corners);
         report.bakeSeconds += secondsSince(start);
         start = Clock::now();
-        if (Status ok = writeFileAtomically(file, table); !ok) return ok.error();
+        Result<AtomicFile> csv = AtomicFile::create(file);
+        if (!csv) return csv.error();
+        if (Status ok = csv->write(table); !ok) return ok.error();
+        if (Status ok = csv->finish(); !ok) return ok.error();
+        pending.push_back(std::move(*csv));
         report.writeSeconds += secondsSince(start);
       } else {
         const BakeInput input = plan_detail::bakeInputFor(loaded, layers);
         const BakeSettings settings = plan_detail::bakeSettingsFor(output, tile, options.threads);
-        if (Status ok = bakeImageTile(input, settings, output, file, report); !ok) {
+        if (Status ok = bakeImageTile(input, settings, output, file, report, pending); !ok) {
           return ok.error();
         }
       }
@@ -875,7 +888,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       ++report.tilesBaked;
       start = Clock::now();
       if (plan.options.useManifest) {
-        Result<std::string> hash = hashFile(file);
+        Result<std::string> hash = hashFile(pending.back().tempPath());
         if (!hash) return Error::internal(hash.error().message);
         files[file.filename().string()] = *hash;
       }
@@ -888,13 +901,23 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       start = Clock::now();
       json inputs = json::object();
       for (const auto& [path, hash] : planned.inputHashes) inputs[path] = hash;
-      const json entry = {{"parameters", json::parse(planned.parameters)},
-                          {"inputs", std::move(inputs)},
-                          {"files", std::move(files)}};
-      if (Status ok = recordInManifest(output.file, entry); !ok) return ok.error();
+      manifestEntries.emplace_back(output.file,
+                                   json{{"parameters", json::parse(planned.parameters)},
+                                        {"inputs", std::move(inputs)},
+                                        {"files", std::move(files)}});
       report.writeSeconds += secondsSince(start);
     }
   }
+
+  // 4. Every output is written: replace the files, then record them.
+  start = Clock::now();
+  for (AtomicFile& file : pending) {
+    if (Status ok = file.commit(); !ok) return ok.error();
+  }
+  for (const auto& [file, entry] : manifestEntries) {
+    if (Status ok = recordInManifest(file, entry); !ok) return ok.error();
+  }
+  report.writeSeconds += secondsSince(start);
   progress.finishAll();
   return report;
 }

@@ -157,6 +157,7 @@ AtomicFile::AtomicFile(AtomicFile&& other) noexcept
     : target_(std::move(other.target_)),
       temp_(std::move(other.temp_)),
       fd_(std::exchange(other.fd_, -1)),
+      finished_(std::exchange(other.finished_, false)),
       durable_(other.durable_),
       slot_(std::exchange(other.slot_, -1)) {}
 
@@ -166,6 +167,7 @@ AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
     target_ = std::move(other.target_);
     temp_ = std::move(other.temp_);
     fd_ = std::exchange(other.fd_, -1);
+    finished_ = std::exchange(other.finished_, false);
     durable_ = other.durable_;
     slot_ = std::exchange(other.slot_, -1);
   }
@@ -175,9 +177,10 @@ AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
 AtomicFile::~AtomicFile() { discard(); }
 
 void AtomicFile::discard() noexcept {
-  if (fd_ < 0) return;
-  ::close(fd_);
+  if (fd_ < 0 && !finished_) return;
+  if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
+  finished_ = false;
   ::unlink(temp_.c_str());
   forgetTemporary();
 }
@@ -197,8 +200,9 @@ Status AtomicFile::write(std::string_view bytes) {
   return Ok{};
 }
 
-Status AtomicFile::commit() {
-  if (fd_ < 0) return Error::internal(target_.string() + ": commit after the file was closed");
+Status AtomicFile::finish() {
+  if (finished_) return Ok{};
+  if (fd_ < 0) return Error::internal(target_.string() + ": finish after the file was closed");
   if (durable_ && ::fsync(fd_) != 0) {
     const int err = errno;
     discard();
@@ -212,6 +216,16 @@ Status AtomicFile::commit() {
     forgetTemporary();
     return ioError(ErrorCode::kInternal, target_, "cannot write", err);
   }
+  finished_ = true;
+  return Ok{};
+}
+
+Status AtomicFile::commit() {
+  if (fd_ < 0 && !finished_) {
+    return Error::internal(target_.string() + ": commit after the file was closed");
+  }
+  if (Status finished = finish(); !finished) return finished;
+  finished_ = false;
   const int renamed = ::rename(temp_.c_str(), target_.c_str());
   const int renameError = errno;
   if (renamed != 0) ::unlink(temp_.c_str());

@@ -198,6 +198,31 @@ TEST_F(BakeCliTest, FailedPngWriteIsAnErrorAndLeavesTheExistingOutput) {
   EXPECT_EQ(listDirectory(dir_), before);
 }
 
+TEST_F(BakeCliTest, ARunThatFailsChangesNoOutputEvenThoseItFinished) {
+  // Two outputs: a small mask, then a map too large for the file-size limit. The mask is baked
+  // and written first, but outputs replace their files only once all are written: after the
+  // failure both keep their previous content, and no manifest or temporary appears.
+  writeFile(dir_ / "a.png", "previous a");
+  writeFile(dir_ / "b.png", "previous b");
+  writeFile(dir_ / "scene.json", planeScene(kHeightLayer,
+                                            R"({"map": "mask", "file": "a.png", "size": 8},
+                          {"map": "object-normal", "file": "b.png", "size": 1024, "margin": 0})"));
+  const std::set<std::string> before = listDirectory(dir_);
+  const std::string command = "trap '' XFSZ; ulimit -f 2; exec '" + std::string(SGBAKE_CLI) +
+                              "' bake '" + (dir_ / "scene.json").string() + "'";
+  const ProcessResult r = test::runProcess({"/bin/sh", "-c", command});
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("b.png: cannot write image (File too large"), std::string::npos) << r.err;
+  EXPECT_EQ(readFile(dir_ / "a.png"), "previous a");
+  EXPECT_EQ(readFile(dir_ / "b.png"), "previous b");
+  EXPECT_EQ(listDirectory(dir_), before);
+  // Without the limit both are replaced and recorded.
+  const ProcessResult ok = bakeScene(readFile(dir_ / "scene.json"));
+  EXPECT_EQ(ok.exitCode, 0) << ok.err;
+  EXPECT_NE(readFile(dir_ / "a.png"), "previous a");
+  EXPECT_TRUE(fs::exists(dir_ / ".sgbake-manifest.json"));
+}
+
 TEST_F(BakeCliTest, ManifestThatCannotBeWrittenIsReportedBeforeBaking) {
   // A directory where the manifest goes: one line naming it, exit 2, nothing baked.
   fs::create_directories(dir_ / "out" / ".sgbake-manifest.json");

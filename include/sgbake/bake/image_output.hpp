@@ -20,6 +20,7 @@
 
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/core/result.hpp"
+#include "sgbake/io/atomic_file.hpp"
 
 namespace sgbake {
 
@@ -130,6 +131,11 @@ class ImageFileWriter {
   /// @return kInternal naming the file when a strip failed to write, rows are missing or the
   /// rename fails; the target is then untouched
   Status commit();
+
+  /// @brief commit() without the rename: the complete file, closed, still under its temporary
+  /// name, for the caller to commit() once every file of a run is written.
+  /// @return the errors of commit() before its rename
+  Result<AtomicFile> finish();
 
   /// Seconds the writer's thread (or writeRows, without one) spent inside OpenImageIO
   /// (compressing and writing) so far.

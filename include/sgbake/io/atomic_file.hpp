@@ -55,14 +55,19 @@ class AtomicFile {
   /// @note After a failed write the writer is discarded; later calls fail too.
   Status write(std::string_view bytes);
 
-  /// @brief Closes the temporary file and renames it over the target. After a failure the
-  /// temporary file is removed and the target is untouched.
+  /// @brief Closes the temporary file (syncing it when durable) without renaming it: the file
+  /// is complete, and commit() will only rename it. So several files can all be written before
+  /// any replaces its target. After a failure the temporary is removed. Idempotent.
+  Status finish();
+
+  /// @brief Closes the temporary file (finish(), unless done) and renames it over the target.
+  /// After a failure the temporary file is removed and the target is untouched.
   Status commit();
 
   /// @brief Abandons the file: closes and removes the temporary. Idempotent.
   void discard() noexcept;
 
-  /// @brief True until commit() or discard() (or a failure) ends the writer.
+  /// @brief True until finish(), commit() or discard() (or a failure) ends the writer.
   bool isOpen() const { return fd_ >= 0; }
 
   const std::filesystem::path& target() const { return target_; }
@@ -74,7 +79,8 @@ class AtomicFile {
 
   std::filesystem::path target_;
   std::filesystem::path temp_;
-  int fd_ = -1;  ///< open descriptor of temp_, or -1 once committed or discarded
+  int fd_ = -1;  ///< open descriptor of temp_, or -1 once finished, committed or discarded
+  bool finished_ = false;  ///< temp_ is complete and closed, not yet renamed
   bool durable_ = false;
   int slot_ = -1;  ///< temp_'s entry in the table removeTemporaryFiles reads, or -1
 };
