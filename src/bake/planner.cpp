@@ -618,9 +618,8 @@ using plan_detail::ProgressReporter;
 /// next strip), needs `margin` rows below it and above it: the rows above are kept in the ring,
 /// and the last `margin` rows of each band wait for the next one. Push-pull needs the whole image,
 /// which is then baked, padded and written in one piece. Masks are not padded (padding would
-/// overwrite the coverage they show). Bakes one tile of @p output into a complete temporary file of
-/// @p file, appended to
-/// @p pending (renamed over @p file once every output of the run is written).
+/// overwrite the coverage they show). The complete file is left under its temporary name in
+/// @p pending, renamed over @p file once every output of the run is written.
 Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
                      const SceneOutput& output, const fs::path& file, ExecuteReport& report,
                      std::vector<AtomicFile>& pending) {
