@@ -7,7 +7,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
@@ -23,16 +22,11 @@
 
 #include "bake/raster.hpp"
 #include "io/image_codec.hpp"
+#include "sgbake/core/text.hpp"
 #include "sgbake/io/atomic_file.hpp"
 
 namespace sgbake {
 namespace {
-
-std::string toLower(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
 
 Error fileError(ErrorCode code, const std::filesystem::path& path, std::string_view what) {
   return {code, path.string() + ": " + std::string(what)};
@@ -485,7 +479,7 @@ double ImageFileWriter::fileSeconds() const {
 double ImageFileWriter::waitSeconds() const { return state_->waitSeconds; }
 
 Result<ImageFormat> parseImageFormat(std::string_view name) {
-  const std::string lower = toLower(name);
+  const std::string lower = toLowerAscii(name);
   if (lower == "exr" || lower == "openexr") return ImageFormat::kExr;
   if (lower == "png") return ImageFormat::kPng;
   if (lower == "tif" || lower == "tiff") return ImageFormat::kTiff;
@@ -498,7 +492,7 @@ std::string_view imageFormatName(ImageFormat format) {
 }
 
 Result<ImageFormat> imageFormatFromPath(const std::filesystem::path& path) {
-  const std::string extension = toLower(path.extension().string());
+  const std::string extension = toLowerAscii(path.extension().string());
   if (extension == ".exr") return ImageFormat::kExr;
   if (extension == ".png") return ImageFormat::kPng;
   if (extension == ".tif" || extension == ".tiff") return ImageFormat::kTiff;

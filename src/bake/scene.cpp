@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sgbake/bake/planner.hpp"
+#include "sgbake/core/text.hpp"
 
 namespace sgbake {
 namespace {
@@ -869,13 +870,6 @@ std::string checkLayer(const SceneLayer& layer) {
   return {};
 }
 
-/// The extension of @p path in lower case, with its dot ("" when it has none).
-std::string lowerExtension(const std::filesystem::path& path) {
-  std::string extension = path.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return extension;
-}
-
 std::string checkOutput(const SceneOutput& output, bool inMemory) {
   if (output.file.empty() && !inMemory) return "missing key 'file'";
   if (!inMemory && output.file.filename() == kManifestName) {
@@ -889,7 +883,7 @@ std::string checkOutput(const SceneOutput& output, bool inMemory) {
   }
   if (output.kind == OutputKind::kCorners) {
     if (inMemory) return {};
-    if (lowerExtension(output.file) != ".csv") {
+    if (toLowerAscii(output.file.extension().string()) != ".csv") {
       return "file '" + output.file.string() +
              "': the corners map is a CSV table, its file must end in .csv";
     }

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -21,6 +20,7 @@
 #include <tbb/info.h>
 
 #include "cli.hpp"
+#include "sgbake/core/text.hpp"
 
 namespace sgbake::cli {
 
@@ -142,10 +142,7 @@ CLI::Option* addNamedOption(CLI::App& app, const std::string& name, Enum& target
       ->type_name("NAME")
       ->transform(CLI::Validator(
           [map = nameMap(names), expected](std::string& value) -> std::string {
-            std::string lower = value;
-            for (char& c : lower)
-              c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-            const auto found = map.find(lower);
+            const auto found = map.find(toLowerAscii(value));
             if (found == map.end())
               return "unknown value '" + value + "' (expected " + expected + ")";
             value = std::to_string(static_cast<long long>(found->second));

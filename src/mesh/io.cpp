@@ -34,7 +34,6 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -46,6 +45,7 @@
 
 #include "mesh/validate.hpp"
 #include "sgbake/core/math.hpp"
+#include "sgbake/core/text.hpp"
 #include "sgbake/mesh/normals.hpp"
 
 namespace sgbake {
@@ -61,8 +61,7 @@ enum class Format { kObj, kPly, kOff };
 /// "obj" / ".OBJ" → Format; empty when unknown.
 std::optional<Format> formatOf(std::string_view extension) {
   if (!extension.empty() && extension.front() == '.') extension.remove_prefix(1);
-  std::string lower(extension);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string lower = toLowerAscii(extension);
   if (lower == "obj") return Format::kObj;
   if (lower == "ply") return Format::kPly;
   if (lower == "off") return Format::kOff;
