@@ -81,8 +81,7 @@ class CheckedFileProxy final : public OIIO::Filesystem::IOProxy {
   }
   size_t write(const void* data, size_t size) override {
     if (fd_ < 0) return 0;
-    if (buffer_.empty()) bufferStart_ = m_pos;
-    if (m_pos != bufferStart_ + static_cast<int64_t>(buffer_.size())) {
+    if (m_pos != bufferStart_ + static_cast<int64_t>(buffer_.size())) {  // not where it ends
       flushBuffer();
       bufferStart_ = m_pos;
     }
