@@ -16,6 +16,7 @@
 #include "cli.hpp"
 #include "float_format.hpp"
 #include "sgbake/bake/scene.hpp"
+#include "sgbake/core/text.hpp"
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/io/atomic_file.hpp"
 #include "sgbake/mesh/io.hpp"
@@ -145,7 +146,7 @@ Status runTangents(const TangentsArguments& args, const CLI::App& app) {
     return Error::badInput("tangents: -o " + args.output + " is the mesh it reads");
   }
   if (!args.meshOut.empty()) {
-    if (std::filesystem::path(args.meshOut).extension() != ".obj") {
+    if (toLowerAscii(std::filesystem::path(args.meshOut).extension().string()) != ".obj") {
       return Error::badInput("tangents: --mesh-out " + args.meshOut +
                              ": the mesh is written as OBJ, its file must end in .obj");
     }

@@ -587,6 +587,11 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   const std::string obj = readFile(dir_ / "fine.obj");
   EXPECT_EQ(std::count(obj.begin(), obj.end(), 'f'), 24);  // 24 quads; no other 'f' in it
   EXPECT_EQ(std::count(tangents.out.begin(), tangents.out.end(), '\n'), 1 + 24 * 4);
+  // The extension is compared without regard to case, as the mesh reader compares it.
+  const ProcessResult upper = run({"tangents", mesh, "--subdivide", "1", "--uv-smooth", "none",
+                                   "--mesh-out", (dir_ / "FINE.OBJ").string()});
+  ASSERT_EQ(upper.exitCode, 0) << upper.err;
+  EXPECT_EQ(readFile(dir_ / "FINE.OBJ"), obj);
 
   const std::set<std::string> before = listDirectory(dir_);
   for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
