@@ -90,16 +90,32 @@ std::string describeOutput(const SceneOutput& output) {
 
 // ---- Manifest ----------------------------------------------------------------------------------
 
+/// A manifest as read from disk.
+struct ReadManifest {
+  json content = json::object();  ///< the manifest, or an empty object
+  std::string problem;            ///< why a file at the path was not used; empty when it was
+};
+
 /// The manifest at @p path; an empty object when there is none, or when it is not a regular
-/// file, not valid JSON or not of this version (everything then re-bakes, and writing it
-/// reports what is wrong).
-json readManifest(const fs::path& path) {
+/// file, not valid JSON or not of this version (everything then re-bakes and writing it
+/// replaces it; `problem` says which of the last two it was, for a warning).
+ReadManifest readManifest(const fs::path& path) {
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return json::object();
+  const fs::file_status status = fs::status(path, ec);
+  // Something else at the path is an error before baking (executePlan probes it), not a warning.
+  if (ec || !fs::is_regular_file(status)) return {};
   std::ifstream in(path, std::ios::binary);
   json parsed = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (parsed.is_object() && parsed.value("sgbake_manifest", 0) == kManifestVersion) return parsed;
-  return json::object();
+  if (parsed.is_discarded()) return {json::object(), "not valid JSON"};
+  if (!parsed.is_object()) return {json::object(), "not a JSON object"};
+  const auto version = parsed.find("sgbake_manifest");
+  if (version == parsed.end() || *version != kManifestVersion) {
+    return {json::object(),
+            "not a version " + std::to_string(kManifestVersion) +
+                " sgbake manifest (its \"sgbake_manifest\" is " +
+                (version == parsed.end() ? std::string("missing") : version->dump()) + ")"};
+  }
+  return {std::move(parsed), {}};
 }
 
 /// The manifests of the output directories, read once per plan.
@@ -114,20 +130,32 @@ class ManifestCache {
     return found == outputs->end() ? nullptr : &*found;
   }
 
+  /// One line for each manifest read that could not be used.
+  std::vector<std::string> warnings() const {
+    std::vector<std::string> lines;
+    for (const auto& [dir, manifest] : manifests_) {
+      if (manifest.problem.empty()) continue;
+      lines.push_back((fs::path(dir) / kManifestName).string() + ": " + manifest.problem +
+                      "; its outputs count as changed, and the file is replaced when they are "
+                      "written");
+    }
+    return lines;
+  }
+
  private:
   const json& load(const fs::path& dir) {
     const std::string key = dir.string();
-    if (const auto it = manifests_.find(key); it != manifests_.end()) return it->second;
-    return manifests_.emplace(key, readManifest(dir / kManifestName)).first->second;
+    if (const auto it = manifests_.find(key); it != manifests_.end()) return it->second.content;
+    return manifests_.emplace(key, readManifest(dir / kManifestName)).first->second.content;
   }
 
-  std::map<std::string, json> manifests_;
+  std::map<std::string, ReadManifest> manifests_;
 };
 
 /// Records @p entry for @p file in its directory's manifest (read, modify, write atomically).
 Status recordInManifest(const fs::path& file, const json& entry) {
   const fs::path path = directoryOf(file) / kManifestName;
-  json manifest = readManifest(path);
+  json manifest = readManifest(path).content;
   manifest["sgbake_manifest"] = kManifestVersion;
   if (!manifest.contains("outputs") || !manifest["outputs"].is_object()) {
     manifest["outputs"] = json::object();
@@ -525,12 +553,12 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
       std::sort(planned.inputHashes.begin(), planned.inputHashes.end());
       planned.inputHashes.erase(std::unique(planned.inputHashes.begin(), planned.inputHashes.end()),
                                 planned.inputHashes.end());
-      if (!options.force) {
-        planned.upToDate = isUpToDate(manifests.entry(output.file), planned, output.file);
-      }
+      const json* entry = manifests.entry(output.file);  // read with --force too, for warnings
+      if (!options.force) planned.upToDate = isUpToDate(entry, planned, output.file);
     }
     plan.outputs.push_back(std::move(planned));
   }
+  plan.warnings = manifests.warnings();
 
   // The layers, images and textures of the outputs to bake.
   std::set<std::size_t> used;

@@ -364,6 +364,9 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   planOptions.useManifest = !args.noManifest;
   Result<Plan> plan = makePlan(std::move(*scene), planOptions);
   if (!plan) return plan.error();
+  for (const std::string& warning : plan->warnings) {
+    std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
+  }
   if (args.explain) {
     const std::string text = explainPlan(*plan);
     std::fputs(text.c_str(), stdout);

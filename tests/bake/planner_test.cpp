@@ -446,10 +446,24 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   writeFile(dir_ / "plane.obj", std::string(kPlaneObj) + "# edited\n");
   EXPECT_EQ(plan(json).outputsToBake(), 2u);
 
-  // A corrupt manifest counts as empty.
+  // A corrupt manifest counts as empty, with a warning naming it; the next bake replaces it.
   bake(json);
-  writeFile(dir_ / kManifestName, "{ not json");
-  EXPECT_EQ(plan(json).outputsToBake(), 2u);
+  EXPECT_TRUE(plan(json).warnings.empty());
+  for (const auto& [text, problem] :
+       {std::pair{"{ not json", "not valid JSON"},
+        {"[1, 2]", "not a JSON object"},
+        {R"({"sgbake_manifest": 99, "outputs": {}})", "its \"sgbake_manifest\" is 99"},
+        {R"({"outputs": {}})", "its \"sgbake_manifest\" is missing"}}) {
+    writeFile(dir_ / kManifestName, text);
+    const Plan corrupt = plan(json);
+    EXPECT_EQ(corrupt.outputsToBake(), 2u) << text;
+    ASSERT_EQ(corrupt.warnings.size(), 1u) << text;
+    EXPECT_NE(corrupt.warnings[0].find(kManifestName), std::string::npos) << corrupt.warnings[0];
+    EXPECT_NE(corrupt.warnings[0].find(problem), std::string::npos) << corrupt.warnings[0];
+  }
+  bake(json);
+  EXPECT_TRUE(plan(json).warnings.empty());
+  EXPECT_EQ(plan(json).outputsToBake(), 0u);
 }
 
 TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {

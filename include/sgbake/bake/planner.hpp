@@ -124,6 +124,9 @@ struct Plan {
   std::vector<PlannedOutput> outputs;  ///< one per scene output, in scene order
   std::vector<PlanStep> steps;         ///< in execution order
   std::vector<PlanStep> skipped;       ///< work left out, and why
+  /// What the user may not expect, one line each (e.g. a manifest that is not valid JSON and
+  /// will be replaced)
+  std::vector<std::string> warnings;
   double planSeconds = 0;              ///< time makePlan took (mostly hashing files)
 
   /// @brief Number of outputs that will be baked.
