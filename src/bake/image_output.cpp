@@ -7,11 +7,14 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -113,23 +116,48 @@ FileLayout fileLayout(int imageChannels, ImageFormat format, bool alpha) {
   return layout;
 }
 
+/// Whether @p value is stored as it is in an integer file of codes 0 to @p maxCode: inside
+/// [0, 1] to within half a code (quantize's clamp then changes no code). False for NaN.
+inline bool fitsCodes(float value, double maxCode) {
+  const double v = static_cast<double>(value), halfCode = 0.5 / maxCode;
+  return v >= -halfCode && v <= 1.0 + halfCode;
+}
+
+/// @p value clamped to [−limit, limit], NaN → 0 (for float and half files).
+inline float clampFloat(float value, float limit) {
+  const float clamped = value > limit ? limit : (value < -limit ? -limit : value);
+  return clamped == clamped ? clamped : 0.0f;
+}
+
+/// Converts one value to the file's type T; counts in @p clipped a value the file cannot store
+/// as it is (see ImageFileWriter::clippedValues).
+template <class T>
+inline T convertValue(float value, double maxCode, float floatLimit, std::uint64_t& clipped) {
+  if constexpr (std::is_same_v<T, float>) {
+    clipped += std::fabs(value) <= floatLimit ? 0 : 1;  // NaN too
+    return clampFloat(value, floatLimit);
+  } else {
+    clipped += fitsCodes(value, maxCode) ? 0 : 1;
+    return quantize<T>(value, maxCode);
+  }
+}
+
 /// Converts @p texels texels (image channels in @p pixels, alpha from @p coverage) to the file's
 /// layout and pixel type T at @p out. Integer types are quantized here (clamp, round, NaN → 0)
-/// rather than by the codec, so the rule is ours and documented.
+/// rather than by the codec, so the rule is ours and documented; float types (float and half
+/// files) are clamped to ±@p floatLimit, NaN → 0. @return the number of values the file cannot
+/// store as they are.
 template <class T>
-void convertTexels(const float* pixels, const float* coverage, std::size_t texels,
-                   const FileLayout& layout, double maxCode, T* out) {
+std::uint64_t convertTexels(const float* pixels, const float* coverage, std::size_t texels,
+                            const FileLayout& layout, double maxCode, float floatLimit, T* out) {
+  std::uint64_t clipped = 0;
   const std::size_t in = static_cast<std::size_t>(layout.imageChannels);
   if (layout.fileChannels == layout.imageChannels) {  // no alpha, no padding channel: value by value
     const std::size_t values = texels * in;
     for (std::size_t i = 0; i < values; ++i) {
-      if constexpr (std::is_same_v<T, float>) {
-        out[i] = pixels[i];
-      } else {
-        out[i] = quantize<T>(pixels[i], maxCode);
-      }
+      out[i] = convertValue<T>(pixels[i], maxCode, floatLimit, clipped);
     }
-    return;
+    return clipped;
   }
   for (std::size_t t = 0; t < texels; ++t) {
     for (int c = 0; c < layout.fileChannels; ++c) {
@@ -139,13 +167,10 @@ void convertTexels(const float* pixels, const float* coverage, std::size_t texel
       } else if (c >= layout.colourChannels) {
         v = coverage[t];  // alpha
       }
-      if constexpr (std::is_same_v<T, float>) {
-        *out++ = v;
-      } else {
-        *out++ = quantize<T>(v, maxCode);
-      }
+      *out++ = convertValue<T>(v, maxCode, floatLimit, clipped);
     }
   }
+  return clipped;
 }
 
 /// Checks the image's shape before anything touches the disk.
@@ -216,6 +241,9 @@ struct ImageFileWriter::State {
   std::string failure;    ///< the codec's reason, one line
   double fileSeconds = 0; ///< time inside the codec (guarded by mutex)
   double waitSeconds = 0; ///< caller's time waiting for the thread
+  /// Largest magnitude a float strip value keeps: ±65504 (the largest half) or FLT_MAX
+  float floatLimit = std::numeric_limits<float>::max();
+  std::uint64_t clipped = 0;  ///< values the file cannot store as they are (see clippedValues)
   std::thread thread;
 
   explicit State(AtomicFile f) : file(std::move(f)) {}
@@ -317,6 +345,7 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
   state->layout = fileLayout(channels, format, options.alpha);
   const PixelType fileType = pixelType(format, bitDepth);
   state->stripType = fileType == PixelType::kHalf ? PixelType::kFloat : fileType;
+  if (fileType == PixelType::kHalf) state->floatLimit = 65504.0f;
   const FileLayout& layout = state->layout;
 
   io_detail::ImageWriteSpec spec;
@@ -410,24 +439,32 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
   // Convert row by row in parallel (the file's thread meanwhile compresses earlier strips).
   const std::size_t fileRowValues = rowTexels * static_cast<std::size_t>(layout.fileChannels);
   const std::size_t imageRowValues = rowTexels * static_cast<std::size_t>(layout.imageChannels);
-  auto convertRow = [&](std::size_t r) {
+  auto convertRow = [&](std::size_t r) -> std::uint64_t {
     const float* in = pixels.data() + r * imageRowValues;
     const float* cov = alpha ? coverage.data() + r * rowTexels : nullptr;
     std::byte* to = strip.data.data() + r * fileRowValues * io_detail::pixelTypeSize(stripType);
     if (stripType == PixelType::kUint8) {
-      convertTexels(in, cov, rowTexels, layout, 255.0, reinterpret_cast<std::uint8_t*>(to));
-    } else if (stripType == PixelType::kUint16) {
-      convertTexels(in, cov, rowTexels, layout, 65535.0, reinterpret_cast<std::uint16_t*>(to));
-    } else {
-      convertTexels(in, cov, rowTexels, layout, 1.0, reinterpret_cast<float*>(to));
+      return convertTexels(in, cov, rowTexels, layout, 255.0, 0.0f,
+                           reinterpret_cast<std::uint8_t*>(to));
     }
+    if (stripType == PixelType::kUint16) {
+      return convertTexels(in, cov, rowTexels, layout, 65535.0, 0.0f,
+                           reinterpret_cast<std::uint16_t*>(to));
+    }
+    return convertTexels(in, cov, rowTexels, layout, 1.0, floatLimit, reinterpret_cast<float*>(to));
   };
+  std::atomic<std::uint64_t> stripClipped{0};
   bake_detail::runWithThreads(threads, [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, static_cast<std::size_t>(rows), 4),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t r = range.begin(); r != range.end(); ++r) convertRow(r);
+                        std::uint64_t count = 0;
+                        for (std::size_t r = range.begin(); r != range.end(); ++r) {
+                          count += convertRow(r);
+                        }
+                        if (count != 0) stripClipped.fetch_add(count, std::memory_order_relaxed);
                       });
   });
+  clipped += stripClipped.load(std::memory_order_relaxed);
   if (!thread.joinable()) {  // no writer thread (threads == 1): write the strip here
     const Clock::time_point start = Clock::now();
     std::unique_lock lock(mutex, std::defer_lock);
@@ -463,6 +500,31 @@ Result<AtomicFile> ImageFileWriter::finish() {
   }
   if (Status finished = s.file.finish(); !finished) return finished.error();
   return std::move(s.file);
+}
+
+std::uint64_t ImageFileWriter::clippedValues() const { return state_->clipped; }
+
+std::string describeClippedValues(const std::filesystem::path& file, std::uint64_t clipped,
+                                  std::uint64_t values, ImageFormat format, int bitDepth,
+                                  std::string_view integerWhat) {
+  const int depth = bitDepth == 0 ? 16 : bitDepth;  // as ImageFileWriter::open resolves it
+  const bool floatFile = format == ImageFormat::kExr || depth == 32;
+  std::string what;
+  if (floatFile && depth != 32) {
+    what =
+        "were beyond ±65504, the largest half float, and were clamped to it: a 32-bit EXR "
+        "(\"bit_depth\": 32, --bit-depth 32) keeps them";
+  } else if (floatFile) {
+    what = "were infinite or NaN (a layer's scale or strength too large?) and were clamped";
+  } else if (!integerWhat.empty()) {
+    what = integerWhat;
+  } else {
+    what =
+        "were outside [0, 1], all an integer file stores, and were clamped to it: an EXR or "
+        "a 32-bit TIFF keeps them";
+  }
+  return file.string() + ": " + std::to_string(clipped) + " of " + std::to_string(values) +
+         " values " + what;
 }
 
 Status ImageFileWriter::commit() {

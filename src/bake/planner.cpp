@@ -736,6 +736,18 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
   Result<AtomicFile> written = writer->finish();
   if (!written) return written.error();
   pending.push_back(std::move(*written));
+  if (const std::uint64_t clipped = writer->clippedValues(); clipped != 0) {
+    const std::uint64_t values = static_cast<std::uint64_t>(settings.width) *
+                                 static_cast<std::uint64_t>(settings.height) *
+                                 static_cast<std::uint64_t>(mapChannels(settings.map));
+    const std::string range =
+        output.storesSignedRange()
+            ? "were beyond the stored range ±" + formatNumber(output.range) +
+                  " and were clamped to it: a larger \"range\" (--range) or an EXR keeps them"
+            : std::string();
+    report.warnings.push_back(describeClippedValues(file, clipped, values, writeOptions.format,
+                                                    writeOptions.bitDepth, range));
+  }
   const double finalWait = writer->waitSeconds() - queueWaits;  // commit waiting for the queue
   const double closeSeconds = secondsSince(commitStart) - finalWait;
   report.padSeconds += padSeconds;

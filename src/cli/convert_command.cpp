@@ -1,6 +1,7 @@
 /// @file convert_command.cpp
 /// @brief `sgbake convert IN --mesh M.obj --from object --to tangent -o OUT`: re-expresses a
 /// normal map between object and tangent space with Blender's per-texel frame.
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -210,6 +211,13 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   const double queueWaits = writer->waitSeconds();
   if (Status ok = writer->commit(); !ok) return ok;
   const double commitSeconds = step.lap();
+  if (const std::uint64_t clipped = writer->clippedValues(); clipped != 0) {
+    const std::string warning = describeClippedValues(
+        args.output, clipped,
+        static_cast<std::uint64_t>(input.width) * input.height * (hasAlpha ? 4 : 3), *format,
+        bitDepth);
+    std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
+  }
 
   if (args.stats) {
     const nlohmann::json stats = {

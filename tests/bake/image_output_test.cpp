@@ -138,6 +138,58 @@ TEST_F(ImageOutputTest, IntegerFormatsClampAndWriteNanAsZero) {
   EXPECT_EQ(back.at(2, 0, 0), 0.0f);
 }
 
+/// Writes @p values as a one-row, one-channel image through an ImageFileWriter and returns the
+/// values it says it clamped (the file is read back by the caller).
+std::uint64_t writeAndCountClipped(const std::vector<float>& values, const fs::path& path,
+                                   int bitDepth) {
+  ImageWriteOptions options;
+  options.bitDepth = bitDepth;
+  Result<ImageFileWriter> writer =
+      ImageFileWriter::open(path, static_cast<int>(values.size()), 1, 1, options);
+  if (!writer) {
+    ADD_FAILURE() << writer.error().message;
+    return 0;
+  }
+  EXPECT_TRUE(writer->writeRows(0, 1, values, {}));
+  EXPECT_TRUE(writer->commit());
+  return writer->clippedValues();
+}
+
+TEST_F(ImageOutputTest, ValuesTheFileCannotStoreAreClampedAndCounted) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // Integer files: outside [0, 1] by more than half a code, and NaN. Within half a code of the
+  // ends (rounding noise of an encoded unit normal) is stored as it is: not counted.
+  const std::vector<float> codes = {
+      0.0f, 1.0f, 1.0f + 0.4f / 65535, -0.4f / 65535, 1.0f + 0.6f / 65535, -0.6f / 65535,
+      2.0f, nan};
+  EXPECT_EQ(writeAndCountClipped(codes, dir_ / "c16.png", 16), 4u);
+  const ReadBack png = readBack(dir_ / "c16.png");
+  EXPECT_EQ(png.at(4, 0, 0), 1.0f);
+  EXPECT_EQ(png.at(5, 0, 0), 0.0f);
+  EXPECT_EQ(writeAndCountClipped(codes, dir_ / "c8.png", 8), 2u);  // ±0.6/65535 fit 8 bits
+
+  // Half: beyond ±65504 is clamped to it instead of becoming an infinity.
+  const std::vector<float> halves = {65504.0f, -65504.0f, 1e5f, -1e30f, inf, nan, 3.0f};
+  EXPECT_EQ(writeAndCountClipped(halves, dir_ / "h.exr", 16), 4u);
+  const ReadBack half = readBack(dir_ / "h.exr");
+  const std::vector<float> expectedHalf = {65504.0f, -65504.0f, 65504.0f, -65504.0f,
+                                           65504.0f, 0.0f,      3.0f};
+  for (std::size_t i = 0; i < halves.size(); ++i) {
+    EXPECT_EQ(half.at(static_cast<int>(i), 0, 0), expectedHalf[i]) << i;
+  }
+
+  // Float: only infinities and NaN.
+  const std::vector<float> floats = {1e30f, -1e38f, inf, -inf, nan, 0.5f};
+  EXPECT_EQ(writeAndCountClipped(floats, dir_ / "f.exr", 32), 3u);
+  const ReadBack full = readBack(dir_ / "f.exr");
+  const float max = std::numeric_limits<float>::max();
+  const std::vector<float> expectedFloat = {1e30f, -1e38f, max, -max, 0.0f, 0.5f};
+  for (std::size_t i = 0; i < floats.size(); ++i) {
+    EXPECT_EQ(full.at(static_cast<int>(i), 0, 0), expectedFloat[i]) << i;
+  }
+}
+
 TEST_F(ImageOutputTest, PngAlphaIsUnassociatedCoverage) {
   FloatImage image = rampImage(2, 2, 3);
   image.coverage = {0.5f, 1.0f, 0.25f, 0.0f};

@@ -466,6 +466,29 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   EXPECT_EQ(plan(json).outputsToBake(), 0u);
 }
 
+TEST_F(PlannerTest, ValuesAFileCannotStoreAreAWarningNamingTheFileAndTheRemedy) {
+  // h.png rises by 0.5 across the plane: with scale 4, ∂h/∂u = 2 and heights reach 2.
+  const std::string layer = R"({"type": "height", "image": "h.png", "scale": 4})";
+  const ExecuteReport clipped =
+      bake(planeScene(layer, R"({"map": "derivative", "file": "d.png", "size": 16, "margin": 0},
+                {"map": "height", "file": "h_out.png", "size": 16, "margin": 0},
+                {"map": "tangent-normal", "file": "n_out.png", "size": 16, "margin": 0})"));
+  ASSERT_EQ(clipped.warnings.size(), 2u);
+  EXPECT_NE(clipped.warnings[0].find("d.png: "), std::string::npos) << clipped.warnings[0];
+  EXPECT_NE(clipped.warnings[0].find("range"), std::string::npos) << clipped.warnings[0];
+  EXPECT_NE(clipped.warnings[1].find("h_out.png: "), std::string::npos) << clipped.warnings[1];
+  EXPECT_NE(clipped.warnings[1].find("outside [0, 1]"), std::string::npos) << clipped.warnings[1];
+  // Every ∂h/∂u texel of the plane is clipped; the normal map (always in range) is not named.
+  EXPECT_NE(clipped.warnings[0].find(" values were beyond the stored range ±1"), std::string::npos);
+
+  // A range that holds the derivatives (−32 where the repeating ramp drops back from 0.5 to 0
+  // within a texel of the 16² height map), and a float file for the heights: no warning.
+  const ExecuteReport kept = bake(planeScene(
+      layer, R"({"map": "derivative", "file": "d.png", "size": 16, "margin": 0, "range": 64},
+                {"map": "height", "file": "h_out.exr", "size": 16, "margin": 0})"));
+  EXPECT_TRUE(kept.warnings.empty()) << kept.warnings.front();
+}
+
 TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
   writeFile(dir_ / "n_out.png", "previous output");
   const std::set<std::string> before = listDirectory(dir_);

@@ -829,6 +829,17 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
            "object", (dir_ / "ts.exr").string(), "-o", (dir_ / "os2.png").string()});
   ASSERT_EQ(back.exitCode, 0) << back.err;
   EXPECT_TRUE(fs::exists(dir_ / "os2.png"));
+  EXPECT_EQ(back.err, "") << "encoded normals fit the PNG: no warning";
+
+  // An alpha of 2 (kept as it is) does not fit a PNG: clamped, with a warning counting it.
+  writeTestImage(dir_ / "os_alpha.exr", 8, {0.5f, 0.5f, 1.0f, 2.0f}, false);
+  const ProcessResult alpha =
+      run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "object", "--to",
+           "tangent", (dir_ / "os_alpha.exr").string(), "-o", (dir_ / "ts_alpha.png").string()});
+  ASSERT_EQ(alpha.exitCode, 0) << alpha.err;
+  EXPECT_EQ(alpha.err, "sgbake: warning: " + (dir_ / "ts_alpha.png").string() +
+                           ": 64 of 256 values were outside [0, 1], all an integer file stores, "
+                           "and were clamped to it: an EXR or a 32-bit TIFF keeps them\n");
 }
 
 TEST_F(BakeCliTest, ConvertErrors) {

@@ -12,6 +12,7 @@
 /// no colour transform); integer formats clamp to [0, 1] and round to the nearest code.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <span>
@@ -78,8 +79,10 @@ struct ImageWriteOptions {
 /// Channels: 1 → grey ("Y"), 2 → R, G (plus a zero B channel in PNG and TIFF, which have no
 /// two-channel colour layout: two channels would be read as grey + alpha), 3 → R, G, B; plus A
 /// when options.alpha. Integer formats: each value is clamped to [0, 1] and rounded to the
-/// nearest of 2^bits − 1 codes; NaN is written as 0. EXR keeps values as they are (half rounds
-/// to nearest even; values beyond ±65504 become ±infinity in half).
+/// nearest of 2^bits − 1 codes; NaN is written as 0. Float formats keep values as they are,
+/// except that half (16-bit EXR) rounds to nearest even and clamps to ±65504, the largest half
+/// (rather than turning larger values into infinities), float clamps infinities to ±FLT_MAX,
+/// and NaN is written as 0. ImageFileWriter::clippedValues counts the values so changed.
 ///
 /// Errors name the file, in one line: an extension writeImage does not know
 /// (`out/n.jpg: unknown image format '.jpg' (use .exr, .png, .tif or .tiff)`), a bit depth the
@@ -137,6 +140,11 @@ class ImageFileWriter {
   /// @return the errors of commit() before its rename
   Result<AtomicFile> finish();
 
+  /// Values given to writeRows so far that the file cannot store as they are, and that were
+  /// clamped into its range (see writeImage): in integer files, values outside [0, 1] by more
+  /// than half a code; in half files, beyond ±65504; in float files, infinities; in all, NaN.
+  std::uint64_t clippedValues() const;
+
   /// Seconds the writer's thread (or writeRows, without one) spent inside OpenImageIO
   /// (compressing and writing) so far.
   double fileSeconds() const;
@@ -149,6 +157,15 @@ class ImageFileWriter {
   explicit ImageFileWriter(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
 };
+
+/// @brief One line (without "warning:") saying that @p clipped of the @p values values written
+/// to @p file were clamped (ImageFileWriter::clippedValues) and what would keep them, for the
+/// file's @p format (not kAuto) and @p bitDepth (0 = the format's default). @p integerWhat
+/// replaces the words after "values" for integer files (e.g. a signed map's range); empty: the
+/// [0, 1] clamp.
+std::string describeClippedValues(const std::filesystem::path& file, std::uint64_t clipped,
+                                  std::uint64_t values, ImageFormat format, int bitDepth,
+                                  std::string_view integerWhat = {});
 
 /// The token an output file name carries to be baked once per UDIM tile.
 inline constexpr std::string_view kUdimToken = "<UDIM>";
