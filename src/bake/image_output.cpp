@@ -116,11 +116,13 @@ FileLayout fileLayout(int imageChannels, ImageFormat format, bool alpha) {
   return layout;
 }
 
-/// Whether @p value is stored as it is in an integer file of codes 0 to @p maxCode: inside
-/// [0, 1] to within half a code (quantize's clamp then changes no code). False for NaN.
-inline bool fitsCodes(float value, double maxCode) {
-  const double v = static_cast<double>(value), halfCode = 0.5 / maxCode;
-  return v >= -halfCode && v <= 1.0 + halfCode;
+/// 1 unless @p value is stored as it is in an integer file of codes 0 to @p maxCode: inside
+/// [0, 1] to within half a code (quantize's clamp then changes no code). 1 for NaN. Compares
+/// floats without branches (`|`, not `||`), so that conversion loops vectorize.
+inline unsigned outsideCodes(float value, double maxCode) {
+  const float low = static_cast<float>(-0.5 / maxCode),
+              high = static_cast<float>(1 + 0.5 / maxCode);
+  return static_cast<unsigned>(!(value >= low)) | static_cast<unsigned>(!(value <= high));
 }
 
 /// @p value clamped to [−limit, limit], NaN → 0 (for float and half files).
@@ -129,16 +131,23 @@ inline float clampFloat(float value, float limit) {
   return clamped == clamped ? clamped : 0.0f;
 }
 
-/// Converts one value to the file's type T; counts in @p clipped a value the file cannot store
-/// as it is (see ImageFileWriter::clippedValues).
+/// @p value in the file's type T (a float type: float or half files, clamped to ±@p floatLimit).
 template <class T>
-inline T convertValue(float value, double maxCode, float floatLimit, std::uint64_t& clipped) {
+inline T fileValue(float value, double maxCode, float floatLimit) {
   if constexpr (std::is_same_v<T, float>) {
-    clipped += std::fabs(value) <= floatLimit ? 0 : 1;  // NaN too
     return clampFloat(value, floatLimit);
   } else {
-    clipped += fitsCodes(value, maxCode) ? 0 : 1;
     return quantize<T>(value, maxCode);
+  }
+}
+
+/// 1 when fileValue changes @p value beyond rounding (see ImageFileWriter::clippedValues), else 0.
+template <class T>
+inline unsigned isClipped(float value, double maxCode, float floatLimit) {
+  if constexpr (std::is_same_v<T, float>) {
+    return static_cast<unsigned>(!(std::fabs(value) <= floatLimit));  // NaN too
+  } else {
+    return outsideCodes(value, maxCode);
   }
 }
 
@@ -150,12 +159,15 @@ inline T convertValue(float value, double maxCode, float floatLimit, std::uint64
 template <class T>
 std::uint64_t convertTexels(const float* pixels, const float* coverage, std::size_t texels,
                             const FileLayout& layout, double maxCode, float floatLimit, T* out) {
-  std::uint64_t clipped = 0;
+  unsigned clipped = 0;  // per row of a strip: fewer than 2^32 values
   const std::size_t in = static_cast<std::size_t>(layout.imageChannels);
   if (layout.fileChannels == layout.imageChannels) {  // no alpha, no padding channel: value by value
     const std::size_t values = texels * in;
+    // The count is a local of the loop: a reference could alias out (uint8_t aliases anything)
+    // and would be stored and reloaded for every value, which stops the loop vectorizing.
     for (std::size_t i = 0; i < values; ++i) {
-      out[i] = convertValue<T>(pixels[i], maxCode, floatLimit, clipped);
+      clipped += isClipped<T>(pixels[i], maxCode, floatLimit);
+      out[i] = fileValue<T>(pixels[i], maxCode, floatLimit);
     }
     return clipped;
   }
@@ -167,7 +179,8 @@ std::uint64_t convertTexels(const float* pixels, const float* coverage, std::siz
       } else if (c >= layout.colourChannels) {
         v = coverage[t];  // alpha
       }
-      *out++ = convertValue<T>(v, maxCode, floatLimit, clipped);
+      clipped += isClipped<T>(v, maxCode, floatLimit);
+      *out++ = fileValue<T>(v, maxCode, floatLimit);
     }
   }
   return clipped;
