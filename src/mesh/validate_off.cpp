@@ -102,7 +102,12 @@ Status OffChecker::header(OffFlags& flags, std::uint64_t& numVertices, std::uint
   }
   const std::size_t numCounts = tokens_.size() - first;
   if (numCounts < 2 || numCounts > 3) {
-    return errorAt(name_, line(), "OFF counts line needs vertex, face and edge counts");
+    return errorAt(name_, line(),
+                   std::string(first == 1 ? "OFF header has " : "OFF counts line has ") +
+                       std::to_string(numCounts) + " value" + (numCounts == 1 ? "" : "s") +
+                       (first == 1 ? " after the keyword" : "") +
+                       "; it needs the vertex, face and edge counts alone (the vertices start "
+                       "on the next line)");
   }
   std::uint64_t counts[3] = {};
   for (std::size_t i = 0; i < numCounts; ++i) {

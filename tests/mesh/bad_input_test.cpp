@@ -61,7 +61,13 @@ const std::map<std::string, std::string>& expectedProblems() {
       {"off_extra_data.off", ":7: unexpected data after the last face"},
       {"off_index_out_of_range.off",
        ":8: face corner refers to vertex 4 but only 4 vertices are defined"},
+      {"off_long_counts.off",
+       ":2: OFF counts line has 6 values; it needs the vertex, face and edge counts alone (the "
+       "vertices start on the next line)"},
       {"off_nan.off", ":4: coordinate 'NaN' is not a finite number"},
+      {"off_one_line.off",
+       ":1: OFF header has 23 values after the keyword; it needs the vertex, face and edge counts "
+       "alone (the vertices start on the next line)"},
       {"off_no_faces.off", "off_no_faces.off: mesh has no faces"},
       {"off_short_vertex.off", ":5: OFF vertex needs 3 numbers, found 2"},
       {"off_truncated.off", ":8: file is truncated: it ends after 2 of 3 faces"},
