@@ -377,6 +377,7 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
     spec.pngFilters = kPngFilters;
   }
   spec.software = "sgbake";
+  spec.attributes = options.attributes;
 
   Result<const io_detail::ImageCodec*> codec = io_detail::imageCodec();
   if (!codec) return codec.error();

@@ -638,6 +638,34 @@ namespace {
 using plan_detail::Loaded;
 using plan_detail::ProgressReporter;
 
+/// What a baked image file says about itself (ImageWriteOptions::attributes), so that a tool
+/// reading it knows how to decode it: the map, how its values are stored, the range of a
+/// signed map in an integer file, the green convention, the UV set and the UDIM tile.
+std::vector<std::pair<std::string, std::string>> bakedFileAttributes(const SceneOutput& output,
+                                                                     const BakeSettings& settings) {
+  const MapKind map = settings.map;
+  std::string encoding = "value";
+  if (map == MapKind::kTangentNormal || map == MapKind::kObjectNormal || map == MapKind::kTangent ||
+      map == MapKind::kBitangent) {
+    encoding = "n/2+0.5";
+  } else if (output.storesSignedRange()) {
+    encoding = "value/(2*range)+0.5";
+  }
+  std::vector<std::pair<std::string, std::string>> attributes = {
+      {"sgbake:map", std::string(mapKindName(map))},
+      {"sgbake:encoding", encoding},
+      {"sgbake:uv", std::to_string(settings.uvSet)},
+      {"sgbake:udim_tile", std::to_string(settings.udimTile)},
+      {"sgbake:version", sgbake_version()}};
+  if (output.storesSignedRange())
+    attributes.emplace_back("sgbake:range", formatNumber(output.range));
+  if (map == MapKind::kTangentNormal) {
+    attributes.emplace_back("sgbake:green",
+                            settings.green == NormalMapGreen::kDirectX ? "directx" : "opengl");
+  }
+  return attributes;
+}
+
 /// Bakes one image tile into @p file and adds its timings to @p report. The image is baked band
 /// by band into a small ring of rows (bakeMapRows), and each band's final rows are padded and
 /// handed to an ImageFileWriter, so the file is compressed and written while the rest is baked
@@ -658,6 +686,7 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
   writeOptions.bitDepth = output.resolvedBitDepth();
   writeOptions.alpha = output.alpha;
   writeOptions.threads = threads;
+  writeOptions.attributes = bakedFileAttributes(output, settings);
   Result<ImageFileWriter> writer = ImageFileWriter::open(file, settings.width, settings.height,
                                                         mapChannels(settings.map), writeOptions);
   if (!writer) return writer.error();

@@ -19,6 +19,7 @@
 #include "sgbake/io/atomic_file.hpp"
 #include "sgbake/io/image_io.hpp"
 #include "sgbake/mesh/io.hpp"
+#include "sgbake/sgbake.h"
 #include "sgbake/subdiv/limit_surface.hpp"
 
 namespace sgbake::cli {
@@ -175,6 +176,14 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   writeOptions.bitDepth = bitDepth;
   writeOptions.alpha = hasAlpha;
   writeOptions.threads = args.threads;
+  // The output says what it holds, as a baked map does (texels outside the UV islands are the
+  // input's, whatever they were).
+  const bool toTangent = *to == NormalSpace::kTangent;
+  writeOptions.attributes = {{"sgbake:map", toTangent ? "tangent-normal" : "object-normal"},
+                             {"sgbake:encoding", "n/2+0.5"},
+                             {"sgbake:uv", std::to_string(args.uvSet)},
+                             {"sgbake:version", sgbake_version()}};
+  if (toTangent) writeOptions.attributes.emplace_back("sgbake:green", args.green);
   Result<ImageFileWriter> writer =
       ImageFileWriter::open(args.output, input.width, input.height, 3, writeOptions);
   if (!writer) return writer.error();

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sgbake/core/result.hpp"
@@ -78,6 +79,8 @@ struct ImageWriteSpec {
   int pngCompressionLevel = -1;  ///< zlib level of PNG files (−1: the codec's default)
   int pngFilters = -1;           ///< libpng filter mask of PNG files (−1: the codec's default)
   std::string software;
+  /// Further string attributes (name, value): EXR header attributes, PNG text chunks
+  std::vector<std::pair<std::string, std::string>> attributes;
 };
 
 /// An image file being written, rows top first.

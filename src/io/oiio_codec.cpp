@@ -200,6 +200,7 @@ class OiioCodec final : public ImageCodec {
     }
     if (spec.pngFilters >= 0) oiioSpec.attribute("png:filter", spec.pngFilters);
     if (!spec.software.empty()) oiioSpec.attribute("Software", spec.software);
+    for (const auto& [name, value] : spec.attributes) oiioSpec.attribute(name, value);
 
     std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(spec.format);
     if (!out) {

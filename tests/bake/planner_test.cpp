@@ -10,16 +10,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
 
-#include "support/files.hpp"
-#include "support/plane_scene.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/bake/planner.hpp"
 #include "sgbake/bake/scene.hpp"
 #include "sgbake/gradient/corners.hpp"
+#include "sgbake/sgbake.h"
+#include "support/files.hpp"
+#include "support/plane_scene.hpp"
 
 namespace sgbake {
 namespace {
@@ -487,6 +489,47 @@ TEST_F(PlannerTest, ValuesAFileCannotStoreAreAWarningNamingTheFileAndTheRemedy) 
       layer, R"({"map": "derivative", "file": "d.png", "size": 16, "margin": 0, "range": 64},
                 {"map": "height", "file": "h_out.exr", "size": 16, "margin": 0})"));
   EXPECT_TRUE(kept.warnings.empty()) << kept.warnings.front();
+}
+
+TEST_F(PlannerTest, BakedFilesSayHowTheyAreEncoded) {
+  bake(planeScene(kHeightLayer,
+                  R"({"map": "derivative", "file": "d.png", "size": 8, "range": 2.5},
+                     {"map": "derivative", "file": "d.exr", "size": 8},
+                     {"map": "tangent-normal", "file": "n_<UDIM>.exr", "size": 8,
+                      "green": "directx"},
+                     {"map": "height", "file": "h_out.png", "size": 8, "uv": 0})"));
+  // What OpenImageIO reads back: PNG text chunks and EXR header attributes.
+  auto attributes = [&](const std::string& name) {
+    std::map<std::string, std::string> found;
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open((dir_ / name).string());
+    EXPECT_TRUE(in) << name;
+    if (!in) return found;
+    for (const OIIO::ParamValue& p : in->spec().extra_attribs) {
+      const std::string key = p.name().string();
+      if (key.starts_with("sgbake:")) found[key] = p.get_string();
+    }
+    return found;
+  };
+  using Attributes = std::map<std::string, std::string>;
+  const std::string version = sgbake_version();
+  EXPECT_EQ(attributes("d.png"), (Attributes{{"sgbake:map", "derivative"},
+                                             {"sgbake:encoding", "value/(2*range)+0.5"},
+                                             {"sgbake:range", "2.5"},
+                                             {"sgbake:uv", "0"},
+                                             {"sgbake:udim_tile", "1001"},
+                                             {"sgbake:version", version}}));
+  EXPECT_EQ(attributes("d.exr"), (Attributes{{"sgbake:map", "derivative"},
+                                             {"sgbake:encoding", "value"},
+                                             {"sgbake:uv", "0"},
+                                             {"sgbake:udim_tile", "1001"},
+                                             {"sgbake:version", version}}));
+  EXPECT_EQ(attributes("n_1001.exr"), (Attributes{{"sgbake:map", "tangent-normal"},
+                                                  {"sgbake:encoding", "n/2+0.5"},
+                                                  {"sgbake:green", "directx"},
+                                                  {"sgbake:uv", "0"},
+                                                  {"sgbake:udim_tile", "1001"},
+                                                  {"sgbake:version", version}}));
+  EXPECT_EQ(attributes("h_out.png").at("sgbake:encoding"), "value");
 }
 
 TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {

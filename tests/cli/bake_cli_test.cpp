@@ -823,6 +823,8 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 0], 0.5f, 2e-3);
   EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 1], 0.5f, 2e-3);
   EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 2], 1.0f, 2e-3);
+  EXPECT_EQ(in->spec().get_string_attribute("sgbake:map"), "tangent-normal");
+  EXPECT_EQ(in->spec().get_string_attribute("sgbake:green"), "opengl");
 
   const ProcessResult back =
       run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "tangent", "--to",

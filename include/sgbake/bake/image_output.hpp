@@ -18,6 +18,8 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/core/result.hpp"
@@ -68,6 +70,9 @@ struct ImageWriteOptions {
   /// Append FloatImage::coverage as an alpha channel (unassociated: colour is not divided or
   /// multiplied by it; PNG gets `oiio:UnassociatedAlpha = 1`).
   bool alpha = false;
+  /// String attributes stored in the file (name, value): header attributes in EXR, text
+  /// chunks in PNG (TIFF has no place for them). Names are conventionally "sgbake:...".
+  std::vector<std::pair<std::string, std::string>> attributes = {};
   /// Most threads converting pixels to the file's type (0 = all cores). The file itself is
   /// written by one thread of its own (see ImageFileWriter), except with 1: then writeRows
   /// writes each strip itself, so that one thread means one busy thread.
