@@ -12,6 +12,7 @@
 #include <fstream>
 #include <future>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <new>
@@ -207,6 +208,18 @@ Status checkInputFile(const Scene& scene, const std::string& user, std::string_v
 }
 
 /// Builds the plan's image, texture and layer lists for the layers in @p used.
+/// The tile files of a UDIM image name (`<UDIM>` in its file name) that exist: tile → file.
+std::map<int, fs::path> existingUdimTiles(const fs::path& pattern) {
+  std::map<int, fs::path> tiles;
+  const std::string text = pattern.string();
+  for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+    fs::path file = expandUdimToken(text, tile);
+    std::error_code ec;
+    if (fs::is_regular_file(file, ec)) tiles.emplace(tile, std::move(file));
+  }
+  return tiles;
+}
+
 void planLayers(Plan& plan, const std::set<std::size_t>& used) {
   std::map<std::pair<std::string, int>, std::size_t> imageIndex;
   std::map<std::tuple<std::size_t, bool, int, int>, std::size_t> textureIndex;
@@ -221,20 +234,43 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used) {
     const auto textureKey =
         std::make_tuple(image->second, vector, static_cast<int>(filter), static_cast<int>(wrap));
     auto [texture, newTexture] = textureIndex.emplace(textureKey, plan.textures.size());
-    if (newTexture) plan.textures.push_back({image->second, vector, filter, wrap});
+    if (newTexture) plan.textures.push_back({image->second, vector, filter, wrap, {}, {}});
     return texture->second;
+  };
+  // A UDIM image: a texture per tile file, and one that picks among them by UV.
+  std::map<std::tuple<std::string, bool, int, int>, std::size_t> udimIndex;
+  const auto addImageTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
+                                   const std::string& user) {
+    if (plan.scene.inMemory || !hasUdimToken(path.string())) {
+      return addTexture(path, vector, filter, wrap, user);
+    }
+    const auto key = std::make_tuple(canonicalPath(path).string(), vector, static_cast<int>(filter),
+                                     static_cast<int>(wrap));
+    if (const auto it = udimIndex.find(key); it != udimIndex.end()) {
+      for (const auto& [tile, t] : plan.textures[it->second].udimTiles) {
+        plan.images[plan.textures[t].image].users.push_back(user);
+      }
+      return it->second;
+    }
+    PlannedTexture udim{std::numeric_limits<std::size_t>::max(), vector, filter, wrap, {}, path};
+    for (const auto& [tile, file] : existingUdimTiles(path)) {  // not empty: makePlan checked
+      udim.udimTiles.emplace(tile, addTexture(file, vector, filter, wrap, user));
+    }
+    plan.textures.push_back(std::move(udim));
+    udimIndex.emplace(key, plan.textures.size() - 1);
+    return plan.textures.size() - 1;
   };
   for (const std::size_t i : used) {
     const SceneLayer& layer = plan.scene.layers[i];
     PlannedLayer planned;
     planned.sceneLayer = i;
     if (layer.hasImage()) {
-      planned.texture =
-          addTexture(layer.image, layer.readsNormals(), layer.filter, layer.wrap, layerLabel(i));
+      planned.texture = addImageTexture(layer.image, layer.readsNormals(), layer.filter, layer.wrap,
+                                        layerLabel(i));
     }
     if (layer.mask) {
-      planned.mask = addTexture(layer.mask->image, false, layer.mask->filter, Wrap::kRepeat,
-                                layerLabel(i) + ".mask");
+      planned.mask = addImageTexture(layer.mask->image, false, layer.mask->filter, Wrap::kRepeat,
+                                     layerLabel(i) + ".mask");
     }
     plan.layers.push_back(planned);
   }
@@ -293,6 +329,12 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
         {"load image " + image.path.string() + " as " + channelsName(image.channels),
          "read by " + joinLabels(image.users)});
   }
+  std::map<std::size_t, std::string> tileOf;  // a UDIM tile's texture → what samples it
+  for (const PlannedTexture& texture : plan.textures) {
+    for (const auto& [tile, t] : texture.udimTiles) {
+      tileOf[t] = "tile " + std::to_string(tile) + " of " + texture.udimImage.string();
+    }
+  }
   for (std::size_t t = 0; t < plan.textures.size(); ++t) {
     const PlannedTexture& texture = plan.textures[t];
     std::vector<std::string> users;
@@ -300,11 +342,22 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       if (layer.texture == t) users.push_back(layerLabel(layer.sceneLayer));
       if (layer.mask == t) users.push_back(layerLabel(layer.sceneLayer) + ".mask");
     }
-    plan.steps.push_back({"make " + std::string(texture.vector ? "vector" : "scalar") +
-                              " texture " + plan.images[texture.image].path.string() + ", " +
-                              std::string(filterName(texture.filter)) + ", " +
-                              (texture.wrap == Wrap::kRepeat ? "repeat" : "clamp"),
-                          "sampled by " + joinLabels(users)});
+    const std::string kind = texture.vector ? "vector" : "scalar";
+    if (!texture.udimTiles.empty()) {
+      std::vector<std::string> tiles;
+      for (const auto& entry : texture.udimTiles) tiles.push_back(std::to_string(entry.first));
+      plan.steps.push_back({"make UDIM " + kind + " texture " + texture.udimImage.string() +
+                                " of tiles " + joinLabels(tiles) +
+                                " (no bump where the UVs reach no tile)",
+                            "sampled by " + joinLabels(users)});
+      continue;
+    }
+    const auto tile = tileOf.find(t);
+    plan.steps.push_back(
+        {"make " + kind + " texture " + plan.images[texture.image].path.string() + ", " +
+             std::string(filterName(texture.filter)) + ", " +
+             (texture.wrap == Wrap::kRepeat ? "repeat" : "clamp"),
+         tile != tileOf.end() && users.empty() ? tile->second : "sampled by " + joinLabels(users)});
   }
   for (const PlannedLayer& layer : plan.layers) {
     if (scene.layers[layer.sceneLayer].type == SceneLayerType::kVolume) {
@@ -530,13 +583,32 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
       if (!whyNotRead(output, layer).empty()) continue;
       planned.layers.push_back(l);  // scene index for now; remapped below
       layersJson += (layersJson.empty() ? "" : ",") + layerParametersJson(layer);
+      // A UDIM image's inputs are its tile files; it needs one at least.
+      const auto addInput = [&](const fs::path& image, const std::string& user) -> Status {
+        if (s.inMemory || !hasUdimToken(image.string())) {
+          inputs.push_back(image);
+          users.push_back(user);
+          return Ok{};
+        }
+        const std::map<int, fs::path> tiles = existingUdimTiles(image);
+        if (tiles.empty()) {
+          return Error::badInput(prefix + user + ": no tile of the UDIM image " + image.string() +
+                                 " exists (" + expandUdimToken(image.string(), kFirstUdimTile) +
+                                 " to " + expandUdimToken(image.string(), kLastUdimTile) + ")");
+        }
+        for (const auto& [tile, file] : tiles) {
+          inputs.push_back(file);
+          users.push_back(user);
+        }
+        return Ok{};
+      };
       if (layer.hasImage()) {
-        inputs.push_back(layer.image);
-        users.push_back(layerLabel(l));
+        if (Status ok = addInput(layer.image, layerLabel(l)); !ok) return ok.error();
       }
       if (layer.mask) {
-        inputs.push_back(layer.mask->image);
-        users.push_back(layerLabel(l) + ".mask");
+        if (Status ok = addInput(layer.mask->image, layerLabel(l) + ".mask"); !ok) {
+          return ok.error();
+        }
       }
     }
     planned.parameters = common + ",\"output\":" + outputParametersJson(output) + ",\"layers\":[" +

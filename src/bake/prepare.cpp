@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <utility>
 
 #include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/udim.hpp"
 
 namespace sgbake::plan_detail {
 
@@ -123,6 +125,25 @@ Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
       ++report.texturesCreated;
     }
     progress.finishOne();  // the Image itself is released here: textures keep their own copy
+  }
+  // UDIM textures take over their tiles' textures.
+  for (std::size_t t = 0; t < plan.textures.size(); ++t) {
+    const PlannedTexture& texture = plan.textures[t];
+    if (texture.udimTiles.empty()) continue;
+    if (texture.vector) {
+      std::map<int, std::unique_ptr<VectorTexture>> tiles;
+      for (const auto& [tile, index] : texture.udimTiles) {
+        tiles.emplace(tile, std::move(loaded.vector[index]));
+      }
+      loaded.vector[t] = std::make_unique<UdimVectorTexture>(std::move(tiles));
+    } else {
+      std::map<int, std::unique_ptr<ScalarTexture>> tiles;
+      for (const auto& [tile, index] : texture.udimTiles) {
+        tiles.emplace(tile, std::move(loaded.scalar[index]));
+      }
+      loaded.scalar[t] = std::make_unique<UdimScalarTexture>(std::move(tiles));
+    }
+    ++report.texturesCreated;
   }
   return Ok{};
 }

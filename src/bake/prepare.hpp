@@ -54,8 +54,9 @@ struct Loaded {
   Mesh mesh;  ///< as read, subdivided, or the tessellation of the limit surface
   std::optional<LimitSurface> limit;  ///< "level": "limit": the surface the samples are shaded on
   SurfaceParameters limitParameters;  ///< where mesh's corners lie on it
-  std::vector<std::unique_ptr<ImageScalarTexture>> scalar;  ///< per plan texture (or null)
-  std::vector<std::unique_ptr<ImageVectorTexture>> vector;  ///< per plan texture (or null)
+  /// Per plan texture (or null: the other kind, or a UDIM tile's, owned by its UDIM texture)
+  std::vector<std::unique_ptr<ScalarTexture>> scalar;
+  std::vector<std::unique_ptr<VectorTexture>> vector;  ///< per plan texture, as scalar
   std::vector<std::unique_ptr<HeightVolume>> volumes;
   std::vector<Layer> layers;  ///< per plan layer
   std::optional<CornerTangents> tangents;

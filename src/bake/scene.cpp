@@ -838,7 +838,7 @@ std::string checkFinite(std::string_view name, double value) {
   return std::isfinite(value) ? std::string() : std::string(name) + " must be a finite number";
 }
 
-std::string checkLayer(const SceneLayer& layer) {
+std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   for (const auto& [name, value] : {std::pair<const char*, double>{"weight", layer.weight},
                                     {"scale", layer.scale},
                                     {"tiling", layer.tiling.x},
@@ -867,6 +867,41 @@ std::string checkLayer(const SceneLayer& layer) {
     }
   }
   if (layer.mask && layer.mask->image.empty()) return "mask has no image";
+  // UDIM images: tile 1001 + u + 10·v is read where the layer's UV set lies in [u, u+1)×[v, v+1).
+  const auto udimProblem = [&](const std::filesystem::path& image, const char* what, Vec2d tiling,
+                               Vec2d offset) -> std::string {
+    if (!hasUdimToken(image.string())) return {};
+    const std::string name = std::string(what) + " '" + image.string() + "'";
+    if (inMemory) return name + ": " + std::string(kUdimToken) + " images are read from files";
+    if (hasUdimToken(image.parent_path().string())) {
+      return name + ": " + std::string(kUdimToken) + " must be in the file name, not a directory";
+    }
+    if (tiling != Vec2d{1, 1} || offset != Vec2d{0, 0}) {
+      return name +
+             " is a UDIM image: its tiles lie where the UVs do, so tiling and offset "
+             "cannot apply";
+    }
+    return {};
+  };
+  if (layer.hasImage()) {
+    const bool uvLayer =
+        layer.type == SceneLayerType::kHeight || layer.type == SceneLayerType::kNormal;
+    if (!uvLayer && hasUdimToken(layer.image.string())) {
+      return "image '" + layer.image.string() + "': " + std::string(kUdimToken) +
+             " images are for UV layers (height, normal), not projections";
+    }
+    if (std::string why = udimProblem(layer.image, "image", layer.tiling, layer.offset);
+        !why.empty()) {
+      return why;
+    }
+  }
+  if (layer.mask) {
+    if (std::string why =
+            udimProblem(layer.mask->image, "mask", layer.mask->tiling, layer.mask->offset);
+        !why.empty()) {
+      return why;
+    }
+  }
   return {};
 }
 
@@ -1262,7 +1297,7 @@ Status validateScene(const Scene& scene) {
     return Error::badInput(rangeMessage("uv", scene.uvSet, 0, kMaxUvSets - 1));
   }
   for (std::size_t i = 0; i < scene.layers.size(); ++i) {
-    if (std::string why = checkLayer(scene.layers[i]); !why.empty()) {
+    if (std::string why = checkLayer(scene.layers[i], scene.inMemory); !why.empty()) {
       return Error::badInput(where("layers", i) + why);
     }
   }

@@ -532,6 +532,86 @@ TEST_F(PlannerTest, BakedFilesSayHowTheyAreEncoded) {
   EXPECT_EQ(attributes("h_out.png").at("sgbake:encoding"), "value");
 }
 
+/// The pixels of an image file as floats (rows top first), read by OpenImageIO.
+std::vector<float> readPixels(const fs::path& path) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
+  EXPECT_TRUE(in) << path;
+  if (!in) return {};
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+  return pixels;
+}
+
+TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
+  // The same square in tile 1001 (UVs 0.25–0.75) and in tile 1002 (1.25–1.75).
+  writeFile(dir_ / "quarter.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+            "vt 0.25 0.25\nvt 0.75 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
+            "f 1/1 2/2 3/3 4/4\n");
+  const std::string output =
+      R"({"map": "surface-gradient", "file": "g.exr", "size": 16, "bit_depth": 32})";
+  bake(planeScene(kHeightLayer, output, "quarter.obj"));
+  const std::vector<float> single = readPixels(dir_ / "g.exr");
+
+  // h_1002.png is h.png: tile 1002 of the UDIM image read in tile 1002 is h.png read in 1001.
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");
+  const std::string udimLayer = R"({"type": "height", "image": "h_<UDIM>.png", "scale": 0.1})";
+  const ExecuteReport report = bake(planeScene(
+      udimLayer,
+      R"({"map": "surface-gradient", "file": "g_<UDIM>.exr", "size": 16, "bit_depth": 32})",
+      "tile1002.obj"));
+  EXPECT_EQ(report.imagesLoaded, 1u);
+  const std::vector<float> tiled = readPixels(dir_ / "g_1002.exr");
+  ASSERT_EQ(tiled.size(), single.size());
+  double largest = 0;
+  for (std::size_t i = 0; i < single.size(); ++i) {
+    largest = std::max(largest, std::abs(static_cast<double>(single[i])));
+    EXPECT_NEAR(tiled[i], single[i], 1e-5) << i;
+  }
+  EXPECT_GT(largest, 0.01) << "the height map bumps the square";
+
+  // Only tile 1001 given: the square in tile 1002 reads no tile, so it is not bumped.
+  fs::remove(dir_ / "h_1002.png");
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1001.png");
+  bake(planeScene(
+      udimLayer,
+      R"({"map": "surface-gradient", "file": "g_<UDIM>.exr", "size": 16, "bit_depth": 32})",
+      "tile1002.obj"));
+  for (const float v : readPixels(dir_ / "g_1002.exr")) ASSERT_EQ(v, 0.0f);
+
+  // The manifest hashes every tile: a changed tile re-bakes.
+  const std::string udimOutput = R"({"map": "height", "file": "u.exr", "size": 8})";
+  bake(planeScene(udimLayer, udimOutput, "quarter.obj"));
+  EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "quarter.obj")).outputsToBake(), 0u);
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1005.png");
+  EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "quarter.obj")).outputsToBake(), 1u);
+}
+
+TEST_F(PlannerTest, UdimImagesThatCannotWorkAreBadInput) {
+  const std::string out = R"({"map": "height", "file": "u.exr", "size": 8})";
+  for (const auto& [layer, message] : {
+           std::pair{R"({"type": "height", "image": "none_<UDIM>.png"})",
+                     "layers[0]: no tile of the UDIM image " + (dir_ / "none_<UDIM>.png").string() +
+                         " exists (" + (dir_ / "none_1001.png").string() + " to " +
+                         (dir_ / "none_2000.png").string() + ")"},
+           {R"({"type": "height", "image": "h_<UDIM>.png", "tiling": 2})",
+            "is a UDIM image: its tiles lie where the UVs do, so tiling and offset cannot apply"},
+           {R"({"type": "triplanar", "image": "h_<UDIM>.png"})",
+            "images are for UV layers (height, normal), not projections"},
+           {R"({"type": "height", "image": "<UDIM>/h.png"})",
+            "<UDIM> must be in the file name, not a directory"},
+       }) {
+    fs::copy_file(dir_ / "h.png", dir_ / "h_1001.png", fs::copy_options::overwrite_existing);
+    writeFile(dir_ / "scene.json", planeScene(layer, out));
+    Result<Scene> parsed = loadScene(dir_ / "scene.json");
+    Result<Plan> planned = parsed ? makePlan(std::move(*parsed)) : Result<Plan>(parsed.error());
+    ASSERT_FALSE(planned) << layer;
+    EXPECT_EQ(planned.error().code, ErrorCode::kBadInput);
+    EXPECT_NE(planned.error().message.find(message), std::string::npos) << planned.error().message;
+  }
+}
+
 TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
   writeFile(dir_ / "n_out.png", "previous output");
   const std::set<std::string> before = listDirectory(dir_);

@@ -43,6 +43,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -80,6 +81,10 @@ struct PlannedTexture {
   bool vector = false;    ///< ImageVectorTexture (normal maps) or ImageScalarTexture
   Filter filter = Filter::kBilinear;
   Wrap wrap = Wrap::kRepeat;
+  /// A UDIM image (`<UDIM>` in its name): tile number → index into Plan::textures of the tile's
+  /// own texture; `image` is then unused. Empty for a single image.
+  std::map<int, std::size_t> udimTiles;
+  std::filesystem::path udimImage;  ///< the UDIM image's name, `<UDIM>` in it (for messages)
 };
 
 /// @brief A scene layer some output to bake reads.

@@ -1,0 +1,46 @@
+/// @file udim.hpp
+/// @brief UDIM textures: one texture per tile of texture space, each tile one unit square.
+#pragma once
+
+#include <map>
+#include <memory>
+
+#include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/texture.hpp"
+
+namespace sgbake {
+
+/// @brief The UDIM tile number of texture coordinates (s, t): 1001 + u + 10·v for the unit
+/// square [u, u+1) × [v, v+1) with 0 ≤ u < 10 and v ≥ 0; 0 outside those columns (s < 0,
+/// s ≥ 10, t < 0), where no tile lies. Also returns the coordinates within the tile, in [0, 1).
+int udimTileOf(Vec2d st, Vec2d& within);
+
+/// @brief A scalar texture made of UDIM tiles (Blender's tiled images, Mari's UDIMs): where
+/// (s, t) lies in tile k, the tile's texture is sampled at the coordinates within the tile,
+/// so derivatives are those of the tile's texture (one tile spans one unit, as one image does).
+/// Where no tile is given the value and derivatives are 0: no bump.
+class UdimScalarTexture : public ScalarTexture {
+ public:
+  /// @p tiles: tile number (1001 …) → texture; none may be null.
+  explicit UdimScalarTexture(std::map<int, std::unique_ptr<ScalarTexture>> tiles)
+      : tiles_(std::move(tiles)) {}
+  ScalarSample sample(Vec2d st) const override;
+
+ private:
+  std::map<int, std::unique_ptr<ScalarTexture>> tiles_;
+};
+
+/// @brief A three-channel texture made of UDIM tiles, as UdimScalarTexture. Where no tile is
+/// given the sample is (0.5, 0.5, 1): an encoded tangent-space normal map's "no bump" (an
+/// object-space map reads it as the +Z direction).
+class UdimVectorTexture : public VectorTexture {
+ public:
+  explicit UdimVectorTexture(std::map<int, std::unique_ptr<VectorTexture>> tiles)
+      : tiles_(std::move(tiles)) {}
+  Vec3d sample(Vec2d st) const override;
+
+ private:
+  std::map<int, std::unique_ptr<VectorTexture>> tiles_;
+};
+
+}  // namespace sgbake
