@@ -207,7 +207,6 @@ Status checkInputFile(const Scene& scene, const std::string& user, std::string_v
   return Ok{};
 }
 
-/// Builds the plan's image, texture and layer lists for the layers in @p used.
 /// The tile files of a UDIM image name (`<UDIM>` in its file name) that exist: tile → file.
 std::map<int, fs::path> existingUdimTiles(const fs::path& pattern) {
   std::map<int, fs::path> tiles;
@@ -220,6 +219,7 @@ std::map<int, fs::path> existingUdimTiles(const fs::path& pattern) {
   return tiles;
 }
 
+/// Builds the plan's image, texture and layer lists for the layers in @p used.
 void planLayers(Plan& plan, const std::set<std::size_t>& used) {
   std::map<std::pair<std::string, int>, std::size_t> imageIndex;
   std::map<std::tuple<std::size_t, bool, int, int>, std::size_t> textureIndex;
