@@ -207,20 +207,29 @@ Status checkInputFile(const Scene& scene, const std::string& user, std::string_v
   return Ok{};
 }
 
-/// The tile files of a UDIM image name (`<UDIM>` in its file name) that exist: tile → file.
-std::map<int, fs::path> existingUdimTiles(const fs::path& pattern) {
-  std::map<int, fs::path> tiles;
-  const std::string text = pattern.string();
-  for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
-    fs::path file = expandUdimToken(text, tile);
-    std::error_code ec;
-    if (fs::is_regular_file(file, ec)) tiles.emplace(tile, std::move(file));
+/// The tile files of UDIM image names (`<UDIM>` in the file name) that exist, looked for once
+/// per name and plan (a name means 1,000 candidate files).
+class UdimTileFinder {
+ public:
+  /// Tile → file, for the tiles of @p pattern that exist.
+  const std::map<int, fs::path>& tiles(const fs::path& pattern) {
+    const std::string text = pattern.string();
+    if (const auto it = found_.find(text); it != found_.end()) return it->second;
+    std::map<int, fs::path> tiles;
+    for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+      fs::path file = expandUdimToken(text, tile);
+      std::error_code ec;
+      if (fs::is_regular_file(file, ec)) tiles.emplace(tile, std::move(file));
+    }
+    return found_.emplace(text, std::move(tiles)).first->second;
   }
-  return tiles;
-}
+
+ private:
+  std::map<std::string, std::map<int, fs::path>> found_;
+};
 
 /// Builds the plan's image, texture and layer lists for the layers in @p used.
-void planLayers(Plan& plan, const std::set<std::size_t>& used) {
+void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& udimTiles) {
   std::map<std::pair<std::string, int>, std::size_t> imageIndex;
   std::map<std::tuple<std::size_t, bool, int, int>, std::size_t> textureIndex;
   const auto addTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
@@ -253,7 +262,7 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used) {
       return it->second;
     }
     PlannedTexture udim{std::numeric_limits<std::size_t>::max(), vector, filter, wrap, {}, path};
-    for (const auto& [tile, file] : existingUdimTiles(path)) {  // not empty: makePlan checked
+    for (const auto& [tile, file] : udimTiles.tiles(path)) {  // not empty: makePlan checked
       udim.udimTiles.emplace(tile, addTexture(file, vector, filter, wrap, user));
     }
     plan.textures.push_back(std::move(udim));
@@ -567,6 +576,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   };
 
   ManifestCache manifests;
+  UdimTileFinder udimTiles;
   const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
                              "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
                              ",\"mesh\":" +
@@ -590,7 +600,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
           users.push_back(user);
           return Ok{};
         }
-        const std::map<int, fs::path> tiles = existingUdimTiles(image);
+        const std::map<int, fs::path>& tiles = udimTiles.tiles(image);
         if (tiles.empty()) {
           return Error::badInput(prefix + user + ": no tile of the UDIM image " + image.string() +
                                  " exists (" + expandUdimToken(image.string(), kFirstUdimTile) +
@@ -653,7 +663,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     }
   }
   plan.computeTangents = !tangentReasons.empty();
-  planLayers(plan, used);
+  planLayers(plan, used, udimTiles);
   // Output layer lists: scene indices → indices into plan.layers (up-to-date outputs: none).
   for (PlannedOutput& output : plan.outputs) {
     std::vector<std::size_t> mapped;
