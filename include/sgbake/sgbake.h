@@ -140,7 +140,10 @@ typedef struct sgbake_progress {
 ///                        tile, 1001 by default) — e.g.
 ///                        `{"layers": [{"type": "height", "image": "Bumps", "scale": 0.1}],
 ///                          "outputs": [{"map": "tangent-normal", "size": 1024, "margin": 16}]}`.
-///                        "image" keys name entries of @p images instead of files. The planner
+///                        "image" keys name entries of @p images instead of files; a name
+///                        with `<UDIM>` in it ("Bumps.<UDIM>") is a UDIM image whose tiles are
+///                        the entries named with a tile number in its place ("Bumps.1001",
+///                        "Bumps.1002", …), each read where the UVs lie in its tile. The planner
 ///                        runs as for a scene file: only what the output needs is computed.
 ///                        "subdivision" subdivides @p mesh first, as Blender's modifier would.
 /// @param[in]  mesh        the mesh (see sgbake_mesh).
@@ -164,7 +167,8 @@ typedef struct sgbake_progress {
 ///                         be NULL. Untouched on success.
 /// @param[in]  error_buf_size size of error_buf in bytes; may be 0.
 ///
-/// @return SGBAKE_OK, SGBAKE_CANCELLED, SGBAKE_ERROR_BAD_INPUT (bad scene text — the message names the key as
+/// @return SGBAKE_OK, SGBAKE_CANCELLED, SGBAKE_ERROR_BAD_INPUT (bad scene text — the message names
+/// the key as
 ///         for a scene file —, a bad mesh array as in sgbake_compute_tangents, an image a layer
 ///         names that is not among @p images, a UV set the mesh lacks, a wrong out_floats) or
 ///         SGBAKE_ERROR_INTERNAL. Everything is validated before anything is baked; on failure

@@ -211,20 +211,28 @@ Status checkInputFile(const Scene& scene, const std::string& user, std::string_v
 /// per name and plan (a name means 1,000 candidate files).
 class UdimTileFinder {
  public:
-  /// Tile → file, for the tiles of @p pattern that exist.
+  /// In memory (@p inMemory), tiles are among @p imageNames instead of files.
+  UdimTileFinder(bool inMemory, const std::set<std::string>& imageNames)
+      : inMemory_(inMemory), imageNames_(imageNames) {}
+
+  /// Tile → file (or image name), for the tiles of @p pattern that exist.
   const std::map<int, fs::path>& tiles(const fs::path& pattern) {
     const std::string text = pattern.string();
     if (const auto it = found_.find(text); it != found_.end()) return it->second;
     std::map<int, fs::path> tiles;
     for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
-      fs::path file = expandUdimToken(text, tile);
+      std::string name = expandUdimToken(text, tile);
       std::error_code ec;
-      if (fs::is_regular_file(file, ec)) tiles.emplace(tile, std::move(file));
+      if (inMemory_ ? imageNames_.contains(name) : fs::is_regular_file(name, ec)) {
+        tiles.emplace(tile, std::move(name));
+      }
     }
     return found_.emplace(text, std::move(tiles)).first->second;
   }
 
  private:
+  bool inMemory_;
+  const std::set<std::string>& imageNames_;
   std::map<std::string, std::map<int, fs::path>> found_;
 };
 
@@ -250,11 +258,9 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& u
   std::map<std::tuple<std::string, bool, int, int>, std::size_t> udimIndex;
   const auto addImageTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
                                    const std::string& user) {
-    if (plan.scene.inMemory || !hasUdimToken(path.string())) {
-      return addTexture(path, vector, filter, wrap, user);
-    }
-    const auto key = std::make_tuple(canonicalPath(path).string(), vector, static_cast<int>(filter),
-                                     static_cast<int>(wrap));
+    if (!hasUdimToken(path.string())) return addTexture(path, vector, filter, wrap, user);
+    const auto key = std::make_tuple((plan.scene.inMemory ? path : canonicalPath(path)).string(),
+                                     vector, static_cast<int>(filter), static_cast<int>(wrap));
     if (const auto it = udimIndex.find(key); it != udimIndex.end()) {
       for (const auto& [tile, t] : plan.textures[it->second].udimTiles) {
         plan.images[plan.textures[t].image].users.push_back(user);
@@ -576,7 +582,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   };
 
   ManifestCache manifests;
-  UdimTileFinder udimTiles;
+  UdimTileFinder udimTiles(s.inMemory, options.imageNames);
   const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
                              "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
                              ",\"mesh\":" +
@@ -595,7 +601,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
       layersJson += (layersJson.empty() ? "" : ",") + layerParametersJson(layer);
       // A UDIM image's inputs are its tile files; it needs one at least.
       const auto addInput = [&](const fs::path& image, const std::string& user) -> Status {
-        if (s.inMemory || !hasUdimToken(image.string())) {
+        if (!hasUdimToken(image.string())) {
           inputs.push_back(image);
           users.push_back(user);
           return Ok{};
@@ -603,8 +609,9 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
         const std::map<int, fs::path>& tiles = udimTiles.tiles(image);
         if (tiles.empty()) {
           return Error::badInput(prefix + user + ": no tile of the UDIM image " + image.string() +
-                                 " exists (" + expandUdimToken(image.string(), kFirstUdimTile) +
-                                 " to " + expandUdimToken(image.string(), kLastUdimTile) + ")");
+                                 (s.inMemory ? " is among the images given (names " : " exists (") +
+                                 expandUdimToken(image.string(), kFirstUdimTile) + " to " +
+                                 expandUdimToken(image.string(), kLastUdimTile) + ")");
         }
         for (const auto& [tile, file] : tiles) {
           inputs.push_back(file);

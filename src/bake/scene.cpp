@@ -872,8 +872,7 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
                                Vec2d offset) -> std::string {
     if (!hasUdimToken(image.string())) return {};
     const std::string name = std::string(what) + " '" + image.string() + "'";
-    if (inMemory) return name + ": " + std::string(kUdimToken) + " images are read from files";
-    if (hasUdimToken(image.parent_path().string())) {
+    if (!inMemory && hasUdimToken(image.parent_path().string())) {
       return name + ": " + std::string(kUdimToken) + " must be in the file name, not a directory";
     }
     if (tiling != Vec2d{1, 1} || offset != Vec2d{0, 0}) {

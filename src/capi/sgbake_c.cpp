@@ -345,7 +345,9 @@ Status bakeMapFromArrays(const BakeArguments& a) {
   if (m.num_faces == 0) return Error::badInput(where + "the mesh has no faces");
   if (Status valid = validateImages(where, a.images, a.numImages); !valid) return valid;
 
-  Result<Plan> plan = makePlan(std::move(*scene), PlanOptions{.force = true, .useManifest = false});
+  PlanOptions planOptions{.force = true, .useManifest = false};
+  for (std::size_t i = 0; i < a.numImages; ++i) planOptions.imageNames.insert(a.images[i].name);
+  Result<Plan> plan = makePlan(std::move(*scene), planOptions);
   if (!plan) return plan.error();
   const Mesh mesh = toMesh(arrays);
   MemoryInputs inputs;

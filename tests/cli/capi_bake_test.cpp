@@ -130,14 +130,16 @@ class CApiBake : public ::testing::Test {
     return image ? *image : Image{};
   }
 
-  /// The same output through sgbake_bake_map: status, message and the RGBA buffer.
+  /// The same output through sgbake_bake_map: status, message and the RGBA buffer. The bump
+  /// image is given as @p bumpsImage and the height layer names it @p bumpsKey.
   int memoryBake(const std::string& output, int size, std::vector<float>& rgba,
-                 std::string& message) {
-    const MemoryImage bumps("Bumps", bumpTexture()), normals("Normal Map.001", normalTexture());
+                 std::string& message, const std::string& bumpsImage = "Bumps",
+                 const std::string& bumpsKey = "Bumps") {
+    const MemoryImage bumps(bumpsImage, bumpTexture()), normals("Normal Map.001", normalTexture());
     const sgbake_image images[] = {bumps.view(), normals.view()};
     const std::string scene =
         R"({"layers": )" +
-        replaceAll(replaceAll(kLayers, "%BUMPS%", "Bumps"), "%NORMALS%", "Normal Map.001") +
+        replaceAll(replaceAll(kLayers, "%BUMPS%", bumpsKey), "%NORMALS%", "Normal Map.001") +
         R"(, "outputs": [)" + output + "]}";
     std::vector<float> positions, normalsArray, uvs;
     for (const Vec3f& p : mesh_.positions) positions.insert(positions.end(), {p.x, p.y, p.z});
@@ -189,6 +191,29 @@ class CApiBake : public ::testing::Test {
   fs::path dir_;
   Mesh mesh_;
 };
+
+TEST_F(CApiBake, UdimImagesAreTheImagesNamedWithATileNumber) {
+  // Suzanne's UVs lie in tile 1001: "Bumps.<UDIM>" reading the image "Bumps.1001" is "Bumps".
+  const std::string output = R"({"map": "tangent-normal", "size": 64})";
+  std::vector<float> single, tiled;
+  std::string message;
+  ASSERT_EQ(memoryBake(output, 64, single, message), SGBAKE_OK) << message;
+  ASSERT_EQ(memoryBake(output, 64, tiled, message, "Bumps.1001", "Bumps.<UDIM>"), SGBAKE_OK)
+      << message;
+  EXPECT_EQ(tiled, single);
+  // Only tile 1002 given: the UVs reach no tile, so the bump layer changes nothing there.
+  std::vector<float> elsewhere;
+  ASSERT_EQ(memoryBake(output, 64, elsewhere, message, "Bumps.1002", "Bumps.<UDIM>"), SGBAKE_OK)
+      << message;
+  EXPECT_NE(elsewhere, single);
+  // No image with a tile number in place of <UDIM>: bad input naming the layer and the names.
+  std::vector<float> none;
+  EXPECT_EQ(memoryBake(output, 64, none, message, "Bumps", "Bumps.<UDIM>"), SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_NE(message.find("layers[0]: no tile of the UDIM image Bumps.<UDIM> is among the images "
+                         "given (names Bumps.1001 to Bumps.2000)"),
+            std::string::npos)
+      << message;
+}
 
 TEST_F(CApiBake, TangentNormalWithExtendMarginIsTheFileBake) {
   expectSameAsFile(R"({"map": "tangent-normal", "size": 96, "margin": 3})", 96, 3, false);

@@ -45,6 +45,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -115,6 +116,9 @@ struct PlanStep {
 struct PlanOptions {
   bool force = false;       ///< bake every output, up to date or not
   bool useManifest = true;  ///< read and write the manifest (false: always bake, write none)
+  /// An in-memory scene's image names (the C ABI's sgbake_image::name): where a layer's
+  /// "image" holds `<UDIM>`, the names with a tile number (1001 …) in its place are its tiles.
+  std::set<std::string> imageNames = {};
 };
 
 /// @brief The work a scene needs, decided before any of it is done.
