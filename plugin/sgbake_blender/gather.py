@@ -140,10 +140,11 @@ def _srgb_to_linear(values):
 def image_pixels(image):
     """(pixels, width, height, channels) of a Blender image, rows bottom first, the values
     an Image Texture node gives the shader: byte images in the sRGB colour space are
-    converted to linear as Blender does; float images and Non-Color data are used as stored."""
+    converted to linear as Blender does; float images and Non-Color data are used as stored.
+    A UDIM (tiled) image goes through tile_pixels."""
     if image.source == "TILED":
-        raise BakeInputError(f"image '{image.name}' is a UDIM (tiled) image: layers and masks "
-                             "read single images (bake into UDIM images, not from them)")
+        raise BakeInputError(f"image '{image.name}' is a UDIM (tiled) image: read it with "
+                             "tile_pixels")
     width, height = image.size
     channels = image.channels
     if width * height == 0 or len(image.pixels) == 0:
@@ -157,10 +158,43 @@ def image_pixels(image):
     return pixels, width, height, channels
 
 
+def tile_pixels(image):
+    """{tile number: image_pixels of the tile} of a UDIM (tiled) image, read from its tile
+    files: Blender 3.4's Image.pixels reaches only a tiled image's first tile. Each file is
+    loaded as a temporary image with the tiled image's colour space (so byte tiles in sRGB
+    are made linear as the image's would be) and removed again. A tiled image whose tiles are
+    not files (generated, packed) or that has unsaved changes is refused: its files would not
+    be what the image shows."""
+    template = image.filepath_raw
+    if "<UDIM>" not in template and "<UVTILE>" not in template:
+        raise BakeInputError(f"image '{image.name}' is a UDIM image whose tiles are not files "
+                             "(save it with a <UDIM> file name first)")
+    if image.packed_file is not None or len(image.packed_files) > 0:
+        raise BakeInputError(f"image '{image.name}' is a packed UDIM image (unpack it to files "
+                             "first)")
+    if image.is_dirty:
+        raise BakeInputError(f"image '{image.name}' has unsaved changes (save it first: the "
+                             "bake reads its tile files)")
+    tiles = {}
+    for tile in image.tiles:
+        path = bpy.path.abspath(_tile_path(template, tile.number), library=image.library)
+        if not os.path.isfile(path):
+            raise BakeInputError(f"image '{image.name}': tile {tile.number} has no file "
+                                 f"({path})")
+        loaded = bpy.data.images.load(path, check_existing=False)
+        try:
+            loaded.colorspace_settings.name = image.colorspace_settings.name
+            tiles[tile.number] = image_pixels(loaded)
+        finally:
+            bpy.data.images.remove(loaded)
+    return tiles
+
+
 def layer_images(layers):
-    """{Image.name: image_pixels(image)} of every image the layers read (their images and
-    masks). Layers are named layers[i], counted from 0 as in libsgbake's messages about the
-    same list."""
+    """{name: image_pixels(image)} of every image the layers read (their images and masks),
+    named as scene.image_key names them: a UDIM image's tiles as NAME.1001, NAME.1002, ...
+    Layers are named layers[i], counted from 0 as in libsgbake's messages about the same
+    list."""
     images = {}
     for index, layer in enumerate(layers):
         used = [layer.mask_image] if layer.mask_image is not None else []
@@ -170,11 +204,15 @@ def layer_images(layers):
                                      "image")
             used.insert(0, layer.image)
         for image in used:
-            if image.name not in images:
-                try:
-                    images[image.name] = image_pixels(image)
-                except BakeInputError as exc:
-                    raise BakeInputError(f"layers[{index}] '{layer.name}': {exc}") from None
+            try:
+                if image.source != "TILED":
+                    if image.name not in images:
+                        images[image.name] = image_pixels(image)
+                    continue
+                for tile, pixels in tile_pixels(image).items():
+                    images[f"{image.name}.{tile}"] = pixels
+            except BakeInputError as exc:
+                raise BakeInputError(f"layers[{index}] '{layer.name}': {exc}") from None
     return images
 
 

@@ -66,10 +66,16 @@ def _pair(values):
     return [_number(values[0]), _number(values[1])]
 
 
+def image_key(image):
+    """The name a layer's "image" gives a Blender image: its name, or for a UDIM (tiled) image
+    NAME.<UDIM>, whose tiles gather.layer_images sends as NAME.1001, NAME.1002, ..."""
+    return f"{image.name}.<UDIM>" if image.source == "TILED" else image.name
+
+
 def mask_json(layer, uv_index):
     """A layer's "mask" (it has a mask_image): the image, its lookup and, when the layer names
     a mask UV map, that UV set (otherwise the mask is read on the layer's UV set)."""
-    mask = {"image": layer.mask_image.name, "tiling": _pair(layer.mask_tiling),
+    mask = {"image": image_key(layer.mask_image), "tiling": _pair(layer.mask_tiling),
             "offset": _pair(layer.mask_offset), "filter": layer.mask_filter}
     if layer.mask_uv_map:
         mask["uv"] = uv_index(layer.mask_uv_map)
@@ -90,7 +96,7 @@ def layer_json(layer, uv_index):
     UV map, when it names one, for height and normal layers)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
     if layer.type in IMAGE_LAYER_TYPES:
-        entry.update(image=layer.image.name, filter=layer.filter, wrap=layer.wrap,
+        entry.update(image=image_key(layer.image), filter=layer.filter, wrap=layer.wrap,
                      tiling=_pair(layer.tiling), offset=_pair(layer.offset))
     if layer.mask_image is not None:
         entry["mask"] = mask_json(layer, uv_index)

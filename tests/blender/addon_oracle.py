@@ -20,8 +20,8 @@
    becomes an error report,
    not a traceback: a layer without an image, an object without a UV map, no active object,
    a library path that does not exist, a scene libsgbake refuses (a normal layer with the
-   hermite filter: its message must come through), a mask on a missing UV map, and a UDIM
-   image as a layer's image or mask.
+   hermite filter: its message must come through), a mask on a missing UV map, and a generated
+   UDIM image (its tiles are no files) as a layer's image or mask.
    UDIM (udim_case): a copy of Suzanne whose faces with x < 0 have u + 1 (tile 1002; the rest
    in 1001; mesh_udim.obj) is baked (UDIM_MAP, margin UDIM_MARGIN) into a tiled image with
    tiles 1001, 1002 and 1011 (no UV there) created at 64^2, twice (height first, so that the
@@ -29,7 +29,9 @@
    at 256^2, packed as //udim_target.<UDIM>.exr, Non-Color, with no image or temporary
    folder left behind; the job must name the tiles the UVs lie in, note 1011, and a single
    target must warn about 1002. Blender's own Image.save() then writes the tiles as
-   addon_udim.<UDIM>.exr.
+   addon_udim.<UDIM>.exr. Then a tiled height image (height_tiles.<UDIM>.exr: tiles 1001 and
+   1002 of two different fields, loaded from files) becomes the layer's image and the add-on
+   bakes into a new tiled target (addon_udim_in.<UDIM>.exr), leaving no image behind.
    Layer options (options_case): a height layer with an offset and a mask (own tiling, offset,
    bicubic filter, named UV map), a noise volume with central differences and a step, a
    triplanar layer with an offset and a minimum weight: the add-on's scene JSON must carry
@@ -62,7 +64,9 @@
    derivatives and the mask, which read no normal, come out bit-identical.
    Each UDIM tile must equal the CLI's file of that tile within UDIM_TOLERANCE (1e-6: the
    tiles pass through files, and a 16-bit one would be 7.6e-6 off), and the add-on's tile
-   1002 must differ from the CLI's 1001 by more than 1e-5 (negative control). The layer
+   1002 must differ from the CLI's 1001 by more than 1e-5 (negative control); the tiled height
+   image's bake must equal the CLI's scene reading "height_tiles.<UDIM>.exr" within
+   UDIM_TOLERANCE per tile, and differ from the scene reading the tile files swapped. The layer
    options bake must equal options.json's within 1e-5 and differ from every
    options_no_*.json by more than that. The limit surface bake must equal the CLI's within
    1e-5 (it comes out bit-identical), and differ by more than that from the CLI's negative
@@ -231,11 +235,11 @@ def error_reports(settings, prefs, height, work, library_path):
     layer.mask_uv_map = ""
     tiled = bpy.data.images.new("tiled_input", 8, 8, float_buffer=True, tiled=True)
     layer.mask_image = tiled
-    checks.append(expect_error("UDIM image as a mask", "'tiled_input' is a UDIM (tiled) image",
-                               bake))
+    checks.append(expect_error("generated UDIM image as a mask",
+                               "'tiled_input' is a UDIM image whose tiles are not files", bake))
     layer.mask_image, layer.image = None, tiled
-    checks.append(expect_error("UDIM image as a layer", "'tiled_input' is a UDIM (tiled) image",
-                               bake))
+    checks.append(expect_error("generated UDIM image as a layer",
+                               "'tiled_input' is a UDIM image whose tiles are not files", bake))
     settings.layers.remove(len(settings.layers) - 1)
 
     prefs.library_path = os.path.join(work, "missing", "libsgbake.so")
@@ -395,6 +399,7 @@ def udim_case(settings, ob, work, sabotage):
     image.filepath_raw = os.path.join(work, "addon_udim.<UDIM>.exr")
     image.file_format = "OPEN_EXR"
     image.save()
+    input_cli = udim_input_case(settings, work, checks)
     settings.target_image = None
     bpy.context.view_layer.objects.active = ob
     # The CLI: '<UDIM>' bakes the tiles the UVs touch (1001, 1002); a scene with "tile" bakes
@@ -405,7 +410,7 @@ def udim_case(settings, ob, work, sabotage):
          repr(scale), "--filter", "bilinear", "--map", UDIM_MAP, "--size", str(SIZE),
          "--margin", str(UDIM_MARGIN), "--green", "opengl", "--bit-depth", "32",
          "--no-manifest", "-o", "cli_udim.<UDIM>.exr"],
-        ["bake", "udim_1011.json", "--no-manifest"]]
+        ["bake", "udim_1011.json", "--no-manifest"]] + input_cli
     with open(os.path.join(work, "udim_1011.json"), "w", encoding="ascii") as out:
         json.dump({"mesh": "mesh_udim.obj",
                    "layers": [{"type": "height", "image": "height.exr", "scale": scale,
@@ -414,6 +419,72 @@ def udim_case(settings, ob, work, sabotage):
                                 "green": "opengl", "tile": 1011, "file": "cli_udim.1011.exr",
                                 "format": "exr", "bit_depth": 32}]}, out, indent=1)
     return entry
+
+
+def load_tiled(first_tile_path, template):
+    """The tile files of `template` (<UDIM> in it) as one tiled Non-Color image."""
+    import bpy
+    img = bpy.data.images.load(first_tile_path)
+    img.source = "TILED"
+    img.filepath = template
+    img.reload()
+    img.colorspace_settings.name = "Non-Color"
+    return img
+
+
+def udim_input_case(settings, work, checks):
+    """A UDIM image as the height layer's image: tiles 1001 and 1002 of two different height
+    fields (height_tiles.<UDIM>.exr), baked by the add-on (the UV-shifted Suzanne is active)
+    into a tiled target saved as addon_udim_in.<UDIM>.exr. Appends its check; returns the CLI
+    commands: the scene reading height_tiles.<UDIM>.exr, and the negative control reading the
+    two tile files swapped."""
+    import bpy
+    import numpy as np
+    import bake_scene
+    side = 128
+    first = bake_scene.height_field(side)
+    fields = {1001: first, 1002: np.roll(first[::-1], side // 3, axis=1) * 0.8 + 0.1}
+    for tile, field in fields.items():
+        img = bc.new_float_image(f"height tile {tile}", side, side, field)
+        bc.save_exr(img, os.path.join(work, f"height_tiles.{tile}.exr"))
+        bc.save_exr(img, os.path.join(work, f"height_swapped.{2003 - tile}.exr"))
+        bpy.data.images.remove(img)
+    heights = load_tiled(os.path.join(work, "height_tiles.1001.exr"),
+                         os.path.join(work, "height_tiles.<UDIM>.exr"))
+    target = bpy.data.images.new("udim_in_target", 64, 64, alpha=True, float_buffer=True,
+                                 tiled=True)
+    target.tiles.new(1002)
+    layer = settings.layers[0]
+    single = layer.image
+    layer.image = heights
+    settings.target_image = target
+    settings.map = UDIM_MAP
+    images_before = set(bpy.data.images.keys())
+    try:
+        result = sorted(bpy.ops.object.sgbake_bake())
+    except RuntimeError as exc:
+        result = ["ERROR", str(exc).strip()]
+    stray = set(bpy.data.images.keys()) - images_before  # the tiles' temporary images
+    layer.image = single
+    checks.append({"name": "UDIM: a tiled height image as the layer's image",
+                   "ok": result == ["FINISHED"] and not stray,
+                   "expected": "FINISHED, no image left behind",
+                   "message": f"{result}, new images {sorted(stray)}"})
+    target.filepath_raw = os.path.join(work, "addon_udim_in.<UDIM>.exr")
+    target.file_format = "OPEN_EXR"
+    target.save()
+    scale = float(layer.scale)
+    commands = []
+    for name, heights_file in (("udim_in", "height_tiles"), ("udim_in_swapped", "height_swapped")):
+        with open(os.path.join(work, f"{name}.json"), "w", encoding="ascii") as out:
+            json.dump({"mesh": "mesh_udim.obj",
+                       "layers": [{"type": "height", "image": f"{heights_file}.<UDIM>.exr",
+                                   "scale": scale, "filter": "bilinear"}],
+                       "outputs": [{"map": UDIM_MAP, "size": SIZE, "margin": UDIM_MARGIN,
+                                    "green": "opengl", "file": f"cli_{name}.<UDIM>.exr",
+                                    "bit_depth": 32}]}, out, indent=1)
+        commands.append(["bake", f"{name}.json", "--no-manifest"])
+    return commands
 
 
 def mask_field(side):
@@ -671,6 +742,12 @@ def extra_comparisons(work, manifest):
               UDIM_TOLERANCE) for t in manifest["udim"]["tiles"]]
     pairs.append(("UDIM negative control: add-on tile 1002 vs CLI tile 1001",
                   "addon_udim.1002.exr", "cli_udim.1001.exr", "differ", TOLERANCE))
+    for t in (1001, 1002):
+        pairs.append((f"UDIM height image, tile {t}", f"addon_udim_in.{t}.exr",
+                      f"cli_udim_in.{t}.exr", "equal", UDIM_TOLERANCE))
+        pairs.append((f"UDIM height image negative control: tile {t} vs the swapped tiles",
+                      f"addon_udim_in.{t}.exr", f"cli_udim_in_swapped.{t}.exr", "differ",
+                      TOLERANCE))
     pairs.append(("exact limit surface vs CLI --subdivide limit", "addon_limit.npy",
                   "cli_limit.exr", "equal", TOLERANCE))
     pairs.append(("limit negative control: Blender's level-1 mesh vs CLI --subdivide limit",
