@@ -1060,10 +1060,12 @@ std::string_view filterName(Filter filter) {
 
 std::filesystem::path canonicalPath(const std::filesystem::path& path) {
   std::error_code ec;
-  std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
-  if (!ec) return canonical;
-  canonical = std::filesystem::absolute(path, ec);
-  return (ec ? path : canonical).lexically_normal();
+  // Absolute first: weakly_canonical leaves a relative path relative when none of it exists
+  // (a bare "h_<UDIM>.png"), and it would then not compare equal to its tiles' paths.
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  if (ec) return path.lexically_normal();
+  std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  return ec ? absolute.lexically_normal() : canonical;
 }
 
 bool mayBeSameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
@@ -1072,10 +1074,11 @@ bool mayBeSameFile(const std::filesystem::path& a, const std::filesystem::path& 
   if (aTiles && bTiles) return canonicalPath(a) == canonicalPath(b);
   if (aTiles || bTiles) {
     const std::filesystem::path single = canonicalPath(aTiles ? b : a);
-    const std::filesystem::path pattern = aTiles ? a : b;
+    // Canonical first: a bare file name has an empty parent, which is the current directory.
+    const std::filesystem::path pattern = canonicalPath(aTiles ? a : b);
     const std::string name = pattern.filename().string();
     const bool tokenInName = !hasUdimToken(pattern.parent_path().string());
-    if (tokenInName && canonicalPath(pattern.parent_path()) != single.parent_path()) return false;
+    if (tokenInName && pattern.parent_path() != single.parent_path()) return false;
     for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
       if (tokenInName ? expandUdimToken(name, tile) == single.filename().string()
                       : canonicalPath(expandUdimToken(pattern.string(), tile)) == single) {

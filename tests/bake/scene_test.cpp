@@ -314,6 +314,16 @@ TEST(Scene, NumbersBeyondADoubleAreInvalidJson) {
             "scene.json: invalid JSON: number overflow parsing '1e400'");
 }
 
+TEST(Scene, MayBeSameFileExpandsUdimNamesInTheCurrentDirectory) {
+  // A bare file name's directory is the current one (its parent path is empty).
+  EXPECT_TRUE(mayBeSameFile("h_<UDIM>.png", "h_1001.png"));
+  EXPECT_TRUE(mayBeSameFile("./h_1002.png", "h_<UDIM>.png"));
+  EXPECT_TRUE(mayBeSameFile("h_<UDIM>.png", "h_<UDIM>.png"));
+  EXPECT_FALSE(mayBeSameFile("h_<UDIM>.png", "h_1001.exr"));
+  EXPECT_FALSE(mayBeSameFile("elsewhere/h_<UDIM>.png", "h_1001.png"));
+  EXPECT_FALSE(mayBeSameFile("h_<UDIM>.png", "h_999.png"));
+}
+
 TEST(Scene, OutputsThatWouldOverwriteSomethingAreRefused) {
   // Inputs, the manifest, a format contradicting the extension, a corners table in an image's
   // name, and a UDIM output whose tile another output writes.
