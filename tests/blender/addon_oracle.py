@@ -421,17 +421,6 @@ def udim_case(settings, ob, work, sabotage):
     return entry
 
 
-def load_tiled(first_tile_path, template):
-    """The tile files of `template` (<UDIM> in it) as one tiled Non-Color image."""
-    import bpy
-    img = bpy.data.images.load(first_tile_path)
-    img.source = "TILED"
-    img.filepath = template
-    img.reload()
-    img.colorspace_settings.name = "Non-Color"
-    return img
-
-
 def udim_input_case(settings, work, checks):
     """A UDIM image as the height layer's image: tiles 1001 and 1002 of two different height
     fields (height_tiles.<UDIM>.exr), baked by the add-on (the UV-shifted Suzanne is active)
@@ -449,8 +438,7 @@ def udim_input_case(settings, work, checks):
         bc.save_exr(img, os.path.join(work, f"height_tiles.{tile}.exr"))
         bc.save_exr(img, os.path.join(work, f"height_swapped.{2003 - tile}.exr"))
         bpy.data.images.remove(img)
-    heights = load_tiled(os.path.join(work, "height_tiles.1001.exr"),
-                         os.path.join(work, "height_tiles.<UDIM>.exr"))
+    heights = bc.load_tiled(os.path.join(work, "height_tiles.<UDIM>.exr"), list(fields))
     target = bpy.data.images.new("udim_in_target", 64, 64, alpha=True, float_buffer=True,
                                  tiled=True)
     target.tiles.new(1002)

@@ -241,6 +241,22 @@ def new_float_image(name, width, height, array=None, colour=(0.0, 0.0, 0.0, 1.0)
     return img
 
 
+def load_tiled(template, tiles):
+    """The tile files of `template` (<UDIM> in its name) as one tiled Non-Color image, which
+    must come out with exactly the tiles `tiles`, each with pixels (RuntimeError otherwise).
+    Blender finds the tiles from the first one's file name once the source is TILED."""
+    import bpy
+    img = bpy.data.images.load(template.replace("<UDIM>", str(min(tiles))))
+    img.source = "TILED"
+    img.filepath = template
+    img.reload()
+    img.colorspace_settings.name = "Non-Color"
+    sizes = {tile.number: tuple(tile.size) for tile in img.tiles}
+    if sorted(sizes) != sorted(tiles) or any(s == (0, 0) for s in sizes.values()):
+        raise RuntimeError(f"{template}: tiles {sizes} did not load")
+    return img
+
+
 def image_array(img):
     """The raw pixels of a Blender image as (H, W, 4) float32, rows top first."""
     import numpy as np

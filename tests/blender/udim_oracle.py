@@ -49,20 +49,6 @@ RESULT_TAG = "UDIM_ORACLE_RESULT "
 
 # ---- Inside Blender ------------------------------------------------------------------------
 
-def load_tiled(path_1001, template):
-    """Loads the tile files of `template` (<UDIM> in it) as one tiled Non-Color image."""
-    import bpy
-    img = bpy.data.images.load(path_1001)
-    img.source = "TILED"
-    img.filepath = template
-    img.reload()
-    img.colorspace_settings.name = "Non-Color"
-    sizes = {tile.number: tuple(tile.size) for tile in img.tiles}
-    if sorted(sizes) != list(TILES) or any(s == (0, 0) for s in sizes.values()):
-        raise RuntimeError(f"{template}: tiles {sizes} did not load")
-    return img
-
-
 def build(out_dir):
     """Step 1 of the docstring."""
     import bpy
@@ -93,10 +79,8 @@ def build(out_dir):
         blank = bc.new_float_image(f"target {tile}", SIZE, SIZE)
         bc.save_exr(blank, os.path.join(out_dir, f"target.{tile}.exr"), verify=False)
         bpy.data.images.remove(blank)
-    height = load_tiled(os.path.join(out_dir, "height.1001.exr"),
-                        os.path.join(out_dir, "height.<UDIM>.exr"))
-    target = load_tiled(os.path.join(out_dir, "target.1001.exr"),
-                        os.path.join(out_dir, "target.<UDIM>.exr"))
+    height = bc.load_tiled(os.path.join(out_dir, "height.<UDIM>.exr"), TILES)
+    target = bc.load_tiled(os.path.join(out_dir, "target.<UDIM>.exr"), TILES)
     mat, node = bake_scene.make_material(height, SCALE)
     me.materials.clear()
     me.materials.append(mat)
