@@ -1068,26 +1068,69 @@ std::filesystem::path canonicalPath(const std::filesystem::path& path) {
   return ec ? absolute.lexically_normal() : canonical;
 }
 
-bool mayBeSameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
-  const std::string as = a.string(), bs = b.string();
-  const bool aTiles = hasUdimToken(as), bTiles = hasUdimToken(bs);
-  if (aTiles && bTiles) return canonicalPath(a) == canonicalPath(b);
-  if (aTiles || bTiles) {
-    const std::filesystem::path single = canonicalPath(aTiles ? b : a);
-    // Canonical first: a bare file name has an empty parent, which is the current directory.
-    const std::filesystem::path pattern = canonicalPath(aTiles ? a : b);
-    const std::string name = pattern.filename().string();
-    const bool tokenInName = !hasUdimToken(pattern.parent_path().string());
-    if (tokenInName && pattern.parent_path() != single.parent_path()) return false;
-    for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
-      if (tokenInName ? expandUdimToken(name, tile) == single.filename().string()
-                      : canonicalPath(expandUdimToken(pattern.string(), tile)) == single) {
-        return true;
+namespace {
+
+/// The canonical paths of the files a path names (itself, or each of its UDIM tiles), sorted;
+/// each path's list is made once.
+class NamedFiles {
+ public:
+  const std::vector<std::filesystem::path>& of(const std::filesystem::path& path) {
+    const std::string text = path.string();
+    if (const auto it = named_.find(text); it != named_.end()) return it->second;
+    std::vector<std::filesystem::path> files;
+    if (!hasUdimToken(text)) {
+      files.push_back(canonicalPath(path));
+    } else if (!hasUdimToken(path.parent_path().string())) {
+      // The token in the name: the directory is made canonical once, and only the tiles that
+      // are links need resolving (one lstat each, not a canonicalPath per tile).
+      const std::filesystem::path dir = canonicalPath(path).parent_path();
+      const std::string name = path.filename().string();
+      for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+        std::filesystem::path file = dir / expandUdimToken(name, tile);
+        // A link, even one to a file not there yet (an output's): where it points.
+        std::error_code ec;
+        for (int hops = 0; hops < 8 && std::filesystem::is_symlink(file, ec); ++hops) {
+          const std::filesystem::path target = std::filesystem::read_symlink(file, ec);
+          if (ec) break;
+          file = canonicalPath(file.parent_path() / target);
+        }
+        files.push_back(std::move(file));
+      }
+    } else {
+      for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+        files.push_back(canonicalPath(expandUdimToken(text, tile)));
+      }
+    }
+    std::sort(files.begin(), files.end());
+    return named_.emplace(text, std::move(files)).first->second;
+  }
+
+  /// Whether @p a and @p b name a file in common.
+  bool share(const std::filesystem::path& a, const std::filesystem::path& b) {
+    const std::vector<std::filesystem::path>& as = of(a);
+    const std::vector<std::filesystem::path>& bs = of(b);
+    for (auto i = as.begin(), j = bs.begin(); i != as.end() && j != bs.end();) {
+      if (*i == *j) return true;
+      if (*i < *j) {
+        ++i;
+      } else {
+        ++j;
       }
     }
     return false;
   }
-  return canonicalPath(a) == canonicalPath(b);
+
+ private:
+  std::map<std::string, std::vector<std::filesystem::path>> named_;
+};
+
+}  // namespace
+
+bool mayBeSameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+  // Every file each names, canonical (links resolved as far as they exist): two UDIM names
+  // may share a file under different tile numbers (x<UDIM>1.png and x1<UDIM>.png both name
+  // x11001.png), and a tile may be a link to the other's file.
+  return NamedFiles().share(a, b);
 }
 
 std::string describeLayer(const SceneLayer& layer) {
@@ -1304,6 +1347,7 @@ Status validateScene(const Scene& scene) {
     }
   }
   if (scene.outputs.empty()) return Error::badInput("'outputs' is empty: nothing to bake");
+  NamedFiles named;  // each path's files found once
   for (std::size_t i = 0; i < scene.outputs.size(); ++i) {
     if (std::string why = checkOutput(scene.outputs[i], scene.inMemory); !why.empty()) {
       return Error::badInput(where("outputs", i) + why);
@@ -1311,13 +1355,13 @@ Status validateScene(const Scene& scene) {
     if (scene.inMemory) continue;
     const std::filesystem::path& file = scene.outputs[i].file;
     for (std::size_t j = 0; j < i; ++j) {
-      if (mayBeSameFile(scene.outputs[j].file, file)) {
+      if (named.share(scene.outputs[j].file, file)) {
         return Error::badInput(where("outputs", i) + "file '" + file.string() +
                                "' is also written by outputs[" + std::to_string(j) + "]");
       }
     }
     for (const auto& [input, what] : sceneInputs(scene)) {
-      if (mayBeSameFile(file, input)) {
+      if (named.share(file, input)) {
         return Error::badInput(where("outputs", i) + "file '" + file.string() + "' is " + what +
                                ", which the bake reads (write it elsewhere)");
       }

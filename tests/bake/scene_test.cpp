@@ -2,7 +2,10 @@
 /// @brief The scene parser: the example, defaults, paths, and one-line errors that name
 /// the key, its place and a suggestion.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -322,6 +325,26 @@ TEST(Scene, MayBeSameFileExpandsUdimNamesInTheCurrentDirectory) {
   EXPECT_FALSE(mayBeSameFile("h_<UDIM>.png", "h_1001.exr"));
   EXPECT_FALSE(mayBeSameFile("elsewhere/h_<UDIM>.png", "h_1001.png"));
   EXPECT_FALSE(mayBeSameFile("h_<UDIM>.png", "h_999.png"));
+  // Two UDIM names sharing a file under different tile numbers: tile 1100 of x<UDIM>1.png and
+  // tile 1001 of x1<UDIM>.png are both x11001.png.
+  EXPECT_TRUE(mayBeSameFile("x<UDIM>1.png", "x1<UDIM>.png"));
+  EXPECT_FALSE(mayBeSameFile("y<UDIM>.png", "x1<UDIM>.png"));
+}
+
+TEST(Scene, MayBeSameFileFollowsLinkedUdimTiles) {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("sgbake_scene_links_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "links");
+  std::ofstream(dir / "h_1001.png") << "tile";
+  fs::create_symlink("../h_1001.png", dir / "links" / "h_1001.png");   // a tile that is a link
+  fs::create_symlink("../o_1002.png", dir / "links" / "in_1002.png");  // a link to an output
+  EXPECT_TRUE(mayBeSameFile(dir / "links" / "h_<UDIM>.png", dir / "h_1001.png"));
+  EXPECT_TRUE(mayBeSameFile(dir / "links" / "h_<UDIM>.png", dir / "h_<UDIM>.png"));
+  EXPECT_TRUE(mayBeSameFile(dir / "o_<UDIM>.png", dir / "links" / "in_<UDIM>.png"));
+  EXPECT_FALSE(mayBeSameFile(dir / "links" / "h_<UDIM>.png", dir / "o_<UDIM>.png"));
+  fs::remove_all(dir);
 }
 
 TEST(Scene, OutputsThatWouldOverwriteSomethingAreRefused) {
