@@ -97,9 +97,42 @@ struct ReadManifest {
   std::string problem;            ///< why a file at the path was not used; empty when it was
 };
 
+/// Whether @p value nests arrays and objects more than @p limit deep (iteratively: a value
+/// too deep for recursion is what this guards against).
+bool nestsDeeperThan(const json& value, int limit) {
+  std::vector<std::pair<const json*, int>> pending{{&value, 0}};
+  while (!pending.empty()) {
+    const auto [node, depth] = pending.back();
+    pending.pop_back();
+    if (!node->is_structured()) continue;
+    if (depth >= limit) return true;
+    for (const json& child : *node) pending.emplace_back(&child, depth + 1);
+  }
+  return false;
+}
+
+/// Whether @p entry is an output's entry as recordInManifest writes it: "parameters" (an
+/// object, a few levels deep), "inputs" and "files" (objects of strings).
+bool isManifestEntry(const json& entry) {
+  if (!entry.is_object()) return false;
+  const auto parameters = entry.find("parameters");
+  if (parameters == entry.end() || !parameters->is_object() || nestsDeeperThan(*parameters, 16)) {
+    return false;
+  }
+  for (const char* key : {"inputs", "files"}) {
+    const auto strings = entry.find(key);
+    if (strings == entry.end() || !strings->is_object()) return false;
+    for (const json& value : *strings) {
+      if (!value.is_string()) return false;
+    }
+  }
+  return true;
+}
+
 /// The manifest at @p path; an empty object when there is none, or when it is not a regular
 /// file, not valid JSON or not of this version (everything then re-bakes and writing it
-/// replaces it; `problem` says which of the last two it was, for a warning).
+/// replaces it), without the entries that are not what recordInManifest writes (those
+/// outputs re-bake); `problem` says what was wrong, for a warning.
 ReadManifest readManifest(const fs::path& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
@@ -116,7 +149,24 @@ ReadManifest readManifest(const fs::path& path) {
                 " sgbake manifest (its \"sgbake_manifest\" is " +
                 (version == parsed.end() ? std::string("missing") : version->dump()) + ")"};
   }
-  return {std::move(parsed), {}};
+  // Entries as recordInManifest writes them; anything else (hand-edited, or a foreign value
+  // nested deep enough to exhaust the stack when written back) is dropped with a warning.
+  const auto outputs = parsed.find("outputs");
+  if (outputs == parsed.end()) return {std::move(parsed), {}};
+  if (!outputs->is_object()) return {json::object(), "its \"outputs\" is not an object"};
+  std::vector<std::string> malformed;
+  for (auto entry = outputs->begin(); entry != outputs->end();) {
+    if (isManifestEntry(*entry)) {
+      ++entry;
+    } else {
+      malformed.push_back("'" + entry.key() + "'");
+      entry = outputs->erase(entry);
+    }
+  }
+  if (malformed.empty()) return {std::move(parsed), {}};
+  std::string names;
+  for (const std::string& name : malformed) names += (names.empty() ? "" : ", ") + name;
+  return {std::move(parsed), "its entries for " + names + " are not what sgbake writes"};
 }
 
 /// The manifests of the output directories, read once per plan.
@@ -137,8 +187,8 @@ class ManifestCache {
     for (const auto& [dir, manifest] : manifests_) {
       if (manifest.problem.empty()) continue;
       lines.push_back((fs::path(dir) / kManifestName).string() + ": " + manifest.problem +
-                      "; its outputs count as changed, and the file is replaced when they are "
-                      "written");
+                      "; outputs without a valid record there count as changed, and the file "
+                      "is rewritten when outputs are written");
     }
     return lines;
   }

@@ -452,10 +452,18 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   bake(json);
   EXPECT_TRUE(plan(json).warnings.empty());
   for (const auto& [text, problem] :
-       {std::pair{"{ not json", "not valid JSON"},
+       {std::pair<std::string, std::string>{"{ not json", "not valid JSON"},
         {"[1, 2]", "not a JSON object"},
         {R"({"sgbake_manifest": 99, "outputs": {}})", "its \"sgbake_manifest\" is 99"},
-        {R"({"outputs": {}})", "its \"sgbake_manifest\" is missing"}}) {
+        {R"({"outputs": {}})", "its \"sgbake_manifest\" is missing"},
+        {R"({"sgbake_manifest": 1, "outputs": 5})", "its \"outputs\" is not an object"},
+        {R"({"sgbake_manifest": 1, "outputs": {"n_out.png": {"files": "x"}}})",
+         "its entries for 'n_out.png' are not what sgbake writes"},
+        // Last, so that the bake below writes over it: a value nested 100,000 deep, which
+        // crashed the manifest's writing (stack overflow) before entries were checked.
+        {R"({"sgbake_manifest": 1, "outputs": {"y": )" + std::string(100000, '[') +
+             std::string(100000, ']') + "}}",
+         "its entries for 'y' are not what sgbake writes"}}) {
     writeFile(dir_ / kManifestName, text);
     const Plan corrupt = plan(json);
     EXPECT_EQ(corrupt.outputsToBake(), 2u) << text;
