@@ -266,24 +266,46 @@ class UdimTileFinder {
       : inMemory_(inMemory), imageNames_(imageNames) {}
 
   /// Tile → file (or image name), for the tiles of @p pattern that exist.
-  const std::map<int, fs::path>& tiles(const fs::path& pattern) {
-    const std::string text = pattern.string();
-    if (const auto it = found_.find(text); it != found_.end()) return it->second;
-    std::map<int, fs::path> tiles;
-    for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
-      std::string name = expandUdimToken(text, tile);
-      std::error_code ec;
-      if (inMemory_ ? imageNames_.contains(name) : fs::is_regular_file(name, ec)) {
-        tiles.emplace(tile, std::move(name));
-      }
-    }
-    return found_.emplace(text, std::move(tiles)).first->second;
-  }
+  const std::map<int, fs::path>& tiles(const fs::path& pattern) { return find(pattern).tiles; }
+
+  /// Why a tile of @p pattern cannot be read: something at a tile's name that is not a
+  /// regular file (a directory, a link to nothing, a pipe); empty when there is none.
+  const std::string& problem(const fs::path& pattern) { return find(pattern).problem; }
 
  private:
+  struct Found {
+    std::map<int, fs::path> tiles;
+    std::string problem;
+  };
+
+  const Found& find(const fs::path& pattern) {
+    const std::string text = pattern.string();
+    if (const auto it = found_.find(text); it != found_.end()) return it->second;
+    Found found;
+    for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+      std::string name = expandUdimToken(text, tile);
+      if (inMemory_) {
+        if (imageNames_.contains(name)) found.tiles.emplace(tile, std::move(name));
+        continue;
+      }
+      std::error_code ec;
+      const fs::file_status link = fs::symlink_status(name, ec);
+      if (ec || !fs::exists(link)) continue;  // no tile
+      if (fs::is_regular_file(fs::status(name, ec)) && !ec) {
+        found.tiles.emplace(tile, std::move(name));
+      } else if (found.problem.empty()) {
+        found.problem = "tile file " + name + " is not a regular file" +
+                        (fs::is_directory(fs::status(name, ec)) ? " (a directory)"
+                         : fs::is_symlink(link)                 ? " (a link to nothing?)"
+                                                                : "");
+      }
+    }
+    return found_.emplace(text, std::move(found)).first->second;
+  }
+
   bool inMemory_;
   const std::set<std::string>& imageNames_;
-  std::map<std::string, std::map<int, fs::path>> found_;
+  std::map<std::string, Found> found_;
 };
 
 /// Builds the plan's image, texture and layer lists for the layers in @p used.
@@ -413,7 +435,8 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       for (const auto& entry : texture.udimTiles) tiles.push_back(std::to_string(entry.first));
       plan.steps.push_back({"make UDIM " + kind + " texture " + texture.udimImage.string() +
                                 " of tiles " + joinLabels(tiles) +
-                                " (no bump where the UVs reach no tile)",
+                                (texture.vector ? " ((0, 0, 1) where the UVs reach no tile)"
+                                                : " (0 where the UVs reach no tile)"),
                             "sampled by " + joinLabels(users)});
       continue;
     }
@@ -655,6 +678,9 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
           inputs.push_back(image);
           users.push_back(user);
           return Ok{};
+        }
+        if (const std::string& problem = udimTiles.problem(image); !problem.empty()) {
+          return Error::badInput(prefix + user + ": UDIM image " + image.string() + ": " + problem);
         }
         const std::map<int, fs::path>& tiles = udimTiles.tiles(image);
         if (tiles.empty()) {

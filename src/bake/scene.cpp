@@ -949,6 +949,10 @@ std::string checkOutput(const SceneOutput& output, bool inMemory) {
   if (output.uvSet < 0 || output.uvSet >= kMaxUvSets) {
     return rangeMessage("uv", output.uvSet, 0, kMaxUvSets - 1);
   }
+  if (!inMemory && hasUdimToken(output.file.string()) && output.tile != kFirstUdimTile) {
+    return "key 'tile' applies only to a file without " + std::string(kUdimToken) +
+           " (which bakes every tile the UV set touches)";
+  }
   if (output.tile < kFirstUdimTile || output.tile > kLastUdimTile) {
     return rangeMessage("tile", output.tile, kFirstUdimTile, kLastUdimTile);
   }

@@ -618,6 +618,25 @@ TEST_F(PlannerTest, UdimImagesThatCannotWorkAreBadInput) {
     EXPECT_EQ(planned.error().code, ErrorCode::kBadInput);
     EXPECT_NE(planned.error().message.find(message), std::string::npos) << planned.error().message;
   }
+  // A tile name taken by something that is not a file is named, not taken for a missing tile.
+  fs::create_directory(dir_ / "h_1002.png");
+  writeFile(dir_ / "scene.json", planeScene(R"({"type": "height", "image": "h_<UDIM>.png"})", out));
+  Result<Scene> parsed = loadScene(dir_ / "scene.json");
+  ASSERT_TRUE(parsed) << parsed.error().message;
+  Result<Plan> planned = makePlan(std::move(*parsed));
+  ASSERT_FALSE(planned);
+  EXPECT_NE(planned.error().message.find("tile file " + (dir_ / "h_1002.png").string() +
+                                         " is not a regular file (a directory)"),
+            std::string::npos)
+      << planned.error().message;
+  // "tile" picks the tile of a file without <UDIM>; with it, every tile is baked.
+  writeFile(dir_ / "scene.json",
+            planeScene("", R"({"map": "mask", "file": "m_<UDIM>.png", "tile": 1002})"));
+  Result<Scene> tiled = loadScene(dir_ / "scene.json");
+  ASSERT_FALSE(tiled);
+  EXPECT_NE(tiled.error().message.find("key 'tile' applies only to a file without <UDIM>"),
+            std::string::npos)
+      << tiled.error().message;
 }
 
 TEST_F(PlannerTest, FailingBakeLeavesExistingOutputsUntouched) {
