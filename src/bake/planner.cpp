@@ -1015,8 +1015,20 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     imageOptions.channels = image.channels;
     return loadImage(image.path, imageOptions);
   };
-  const Status textures = plan_detail::loadTextures(plan, imageFiles, loaded, progress, report);
-  if (Status mesh = meshLoad.get(); !mesh) return mesh.error();
+  // With UDIM images the mesh comes first: only the tiles its UVs reach are loaded.
+  const bool udim = std::any_of(plan.textures.begin(), plan.textures.end(),
+                                [](const PlannedTexture& t) { return !t.udimTiles.empty(); });
+  std::optional<Status> mesh;
+  std::vector<bool> load;
+  if (udim) {
+    mesh = meshLoad.get();
+    if (!*mesh) return mesh->error();
+    load = plan_detail::imagesToLoad(plan, loaded.mesh);
+  }
+  const Status textures =
+      plan_detail::loadTextures(plan, imageFiles, loaded, progress, report, load);
+  if (!mesh) mesh = meshLoad.get();
+  if (!*mesh) return mesh->error();
   progress.finishOne();
   if (!textures) return textures.error();
   // Layers, and tangent frames if the plan needs them (timed apart from the loading).

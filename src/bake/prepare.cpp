@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include "sgbake/gradient/filters.hpp"
@@ -92,12 +93,51 @@ Status checkUvSets(const Plan& plan, const Mesh& mesh) {
 
 }  // namespace
 
+std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh) {
+  // The tiles any layer or mask can sample, on any UV set: those a triangle overlaps, and
+  // those a corner lies in (a corner on a tile's left or bottom edge samples that tile, as the
+  // corner table does).
+  std::set<int> reached;
+  for (std::size_t uv = 0; uv < mesh.uvSets.size(); ++uv) {
+    for (const int tile : udimTiles(mesh, static_cast<int>(uv))) reached.insert(tile);
+    for (const Vec2f& corner : mesh.uvSets[uv].uvs) {
+      Vec2d within;
+      reached.insert(udimTileOf({corner.x, corner.y}, within));
+    }
+  }
+  std::vector<bool> tileOnly(plan.textures.size(), false), load(plan.images.size(), false);
+  for (const PlannedTexture& texture : plan.textures) {
+    for (const auto& [tile, t] : texture.udimTiles) tileOnly[t] = true;
+  }
+  for (const PlannedLayer& layer : plan.layers) {  // used directly: needed whatever the tiles
+    for (const std::optional<std::size_t>& t : {layer.texture, layer.mask}) {
+      if (t) tileOnly[*t] = false;
+    }
+  }
+  for (std::size_t t = 0; t < plan.textures.size(); ++t) {
+    const PlannedTexture& texture = plan.textures[t];
+    if (!texture.udimTiles.empty()) {
+      for (const auto& [tile, tileTexture] : texture.udimTiles) {
+        if (reached.contains(tile)) load[plan.textures[tileTexture].image] = true;
+      }
+    } else if (!tileOnly[t]) {
+      load[texture.image] = true;
+    }
+  }
+  return load;
+}
+
 Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
-                    ProgressReporter& progress, ExecuteReport& report) {
+                    ProgressReporter& progress, ExecuteReport& report,
+                    const std::vector<bool>& load) {
   loaded.scalar.resize(plan.textures.size());
   loaded.vector.resize(plan.textures.size());
   for (std::size_t i = 0; i < plan.images.size(); ++i) {
     const PlannedImage& planned = plan.images[i];
+    if (!load.empty() && !load[i]) {  // a UDIM tile no UV reaches
+      progress.finishOne();
+      continue;
+    }
     progress.start("loading " + planned.path.string());
     Result<Image> image = source(planned);
     if (!image) return image.error();
@@ -132,14 +172,14 @@ Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
     if (texture.udimTiles.empty()) continue;
     if (texture.vector) {
       std::map<int, std::unique_ptr<VectorTexture>> tiles;
-      for (const auto& [tile, index] : texture.udimTiles) {
-        tiles.emplace(tile, std::move(loaded.vector[index]));
+      for (const auto& [tile, index] : texture.udimTiles) {  // the tiles loaded
+        if (loaded.vector[index]) tiles.emplace(tile, std::move(loaded.vector[index]));
       }
       loaded.vector[t] = std::make_unique<UdimVectorTexture>(std::move(tiles));
     } else {
       std::map<int, std::unique_ptr<ScalarTexture>> tiles;
-      for (const auto& [tile, index] : texture.udimTiles) {
-        tiles.emplace(tile, std::move(loaded.scalar[index]));
+      for (const auto& [tile, index] : texture.udimTiles) {  // the tiles loaded
+        if (loaded.scalar[index]) tiles.emplace(tile, std::move(loaded.scalar[index]));
       }
       loaded.scalar[t] = std::make_unique<UdimScalarTexture>(std::move(tiles));
     }

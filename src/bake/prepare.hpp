@@ -90,9 +90,15 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded);
 /// Where the images of a plan come from: the image of a PlannedImage, with its channels.
 using ImageSource = std::function<Result<Image>(const PlannedImage&)>;
 
-/// @brief Gets every image of the plan from @p source and makes the plan's textures of it.
+/// @brief Which images of the plan a bake of @p mesh reads: all but the UDIM tiles no UV set
+/// of the mesh reaches (and no layer reads directly).
+std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh);
+
+/// @brief Gets the images of the plan from @p source (those @p load marks; all when it is
+/// empty) and makes the plan's textures of them; a UDIM texture gets the tiles loaded.
 Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
-                    ProgressReporter& progress, ExecuteReport& report);
+                    ProgressReporter& progress, ExecuteReport& report,
+                    const std::vector<bool>& load = {});
 
 /// @brief With the surface and textures loaded: checks the UV sets the outputs and layers use,
 /// makes the layers (and their volumes) and, if the plan needs them, the tangent frames.

@@ -596,6 +596,27 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
   EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "quarter.obj")).outputsToBake(), 1u);
 }
 
+TEST_F(PlannerTest, UdimTilesNoUvReachesAreNotLoaded) {
+  // The square lies in tile 1002: tile 1001 is read, 1005 (not even an image) is not.
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");
+  writeFile(dir_ / "h_1005.png", "not an image");
+  const std::string layer = R"({"type": "height", "image": "h_<UDIM>.png", "scale": 0.1})";
+  const ExecuteReport report = bake(
+      planeScene(layer, R"({"map": "height", "file": "u_<UDIM>.exr", "size": 8})", "tile1002.obj"));
+  EXPECT_EQ(report.imagesLoaded, 1u);
+  EXPECT_TRUE(fs::exists(dir_ / "u_1002.exr"));
+  // A mesh that reaches tile 1005 reads it, and its bad file is then an error.
+  writeFile(dir_ / "tile1005.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+            "vt 4.25 0.25\nvt 4.75 0.25\nvt 4.75 0.75\nvt 4.25 0.75\nf 1/1 2/2 3/3 4/4\n");
+  Result<Plan> planned = makePlan(scene(planeScene(
+      layer, R"({"map": "height", "file": "v_<UDIM>.exr", "size": 8})", "tile1005.obj")));
+  ASSERT_TRUE(planned) << planned.error().message;
+  Result<ExecuteReport> failed = executePlan(*planned);
+  ASSERT_FALSE(failed);
+  EXPECT_NE(failed.error().message.find("h_1005.png"), std::string::npos) << failed.error().message;
+}
+
 TEST_F(PlannerTest, UdimImagesThatCannotWorkAreBadInput) {
   const std::string out = R"({"map": "height", "file": "u.exr", "size": 8})";
   for (const auto& [layer, message] : {
