@@ -1057,6 +1057,21 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
                                     " lies in a UDIM tile (1001 to 2000); tile 1001 holds "
                                     "only the background");
         }
+        // Tiles of an earlier bake the UVs no longer reach stay as they were: said, so that
+        // a tool loading the whole set does not mix old tiles with new ones unawares.
+        std::vector<std::string> stale;
+        for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+          std::error_code ec;
+          if (!std::binary_search(tiles[o].begin(), tiles[o].end(), tile) &&
+              fs::exists(tileFile(output, tile), ec)) {
+            stale.push_back(std::to_string(tile));
+          }
+        }
+        if (!stale.empty()) {
+          report.warnings.push_back(output.file.string() + ": tile(s) " + joinLabels(stale) +
+                                    " of an earlier bake are left as they were (no triangle of " +
+                                    uvSet + " lies there now)");
+        }
       } else {
         tiles[o] = {output.tile};
         if (std::find(touched.begin(), touched.end(), output.tile) == touched.end()) {

@@ -597,14 +597,21 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
 }
 
 TEST_F(PlannerTest, UdimTilesNoUvReachesAreNotLoaded) {
-  // The square lies in tile 1002: tile 1001 is read, 1005 (not even an image) is not.
+  // The square lies in tile 1002: tile 1002 is read, 1005 (not even an image) is not.
   fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");
   writeFile(dir_ / "h_1005.png", "not an image");
+  writeFile(dir_ / "u_1001.exr", "an earlier bake's tile");
   const std::string layer = R"({"type": "height", "image": "h_<UDIM>.png", "scale": 0.1})";
   const ExecuteReport report = bake(
       planeScene(layer, R"({"map": "height", "file": "u_<UDIM>.exr", "size": 8})", "tile1002.obj"));
   EXPECT_EQ(report.imagesLoaded, 1u);
   EXPECT_TRUE(fs::exists(dir_ / "u_1002.exr"));
+  // The output tile the UVs no longer reach is left, with a warning.
+  EXPECT_EQ(readFile(dir_ / "u_1001.exr"), "an earlier bake's tile");
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("tile(s) 1001 of an earlier bake are left as they were"),
+            std::string::npos)
+      << report.warnings[0];
   // A mesh that reaches tile 1005 reads it, and its bad file is then an error.
   writeFile(dir_ / "tile1005.obj",
             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
