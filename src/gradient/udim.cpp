@@ -16,16 +16,14 @@ int udimTileOf(Vec2d st, Vec2d& within) {
 
 ScalarSample UdimScalarTexture::sample(Vec2d st) const {
   Vec2d within;
-  const auto tile = tiles_.find(udimTileOf(st, within));
-  if (tile == tiles_.end()) return {};
-  return tile->second->sample(within);
+  const ScalarTexture* tile = tiles_.at(st, within);
+  return tile != nullptr ? tile->sample(within) : ScalarSample{};
 }
 
 Vec3d UdimVectorTexture::sample(Vec2d st) const {
   Vec2d within;
-  const auto tile = tiles_.find(udimTileOf(st, within));
-  if (tile == tiles_.end()) return {0.5, 0.5, 1.0};
-  return tile->second->sample(within);
+  const VectorTexture* tile = tiles_.at(st, within);
+  return tile != nullptr ? tile->sample(within) : Vec3d{0.5, 0.5, 1.0};
 }
 
 }  // namespace sgbake
