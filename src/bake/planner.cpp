@@ -291,13 +291,14 @@ class UdimTileFinder {
       std::error_code ec;
       const fs::file_status link = fs::symlink_status(name, ec);
       if (ec || !fs::exists(link)) continue;  // no tile
-      if (fs::is_regular_file(fs::status(name, ec)) && !ec) {
+      const fs::file_status target = fs::status(name, ec);  // of the file a link points to
+      if (!ec && fs::is_regular_file(target)) {
         found.tiles.emplace(tile, std::move(name));
       } else if (found.problem.empty()) {
         found.problem = "tile file " + name + " is not a regular file" +
-                        (fs::is_directory(fs::status(name, ec)) ? " (a directory)"
-                         : fs::is_symlink(link)                 ? " (a link to nothing?)"
-                                                                : "");
+                        (fs::is_directory(target) ? " (a directory)"
+                         : fs::is_symlink(link)   ? " (a link to nothing?)"
+                                                  : "");
       }
     }
     return found_.emplace(text, std::move(found)).first->second;
