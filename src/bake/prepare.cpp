@@ -6,7 +6,6 @@
 #include <cmath>
 #include <map>
 #include <optional>
-#include <set>
 #include <utility>
 
 #include "sgbake/gradient/filters.hpp"
@@ -97,12 +96,16 @@ std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh) {
   // The tiles any layer or mask can sample, on any UV set: those a triangle overlaps, and
   // those a corner lies in (a corner on a tile's left or bottom edge samples that tile, as the
   // corner table does).
-  std::set<int> reached;
+  // One flag per tile number (0: outside the tiles), not a tree insertion per corner.
+  std::vector<bool> reached(static_cast<std::size_t>(kLastUdimTile) + 1, false);
+  const auto reach = [&reached](int tile) {
+    if (tile <= kLastUdimTile) reached[static_cast<std::size_t>(tile)] = true;
+  };
   for (std::size_t uv = 0; uv < mesh.uvSets.size(); ++uv) {
-    for (const int tile : udimTiles(mesh, static_cast<int>(uv))) reached.insert(tile);
+    for (const int tile : udimTiles(mesh, static_cast<int>(uv))) reach(tile);
     for (const Vec2f& corner : mesh.uvSets[uv].uvs) {
       Vec2d within;
-      reached.insert(udimTileOf({corner.x, corner.y}, within));
+      reach(udimTileOf({corner.x, corner.y}, within));
     }
   }
   std::vector<bool> tileOnly(plan.textures.size(), false), load(plan.images.size(), false);
@@ -118,7 +121,7 @@ std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh) {
     const PlannedTexture& texture = plan.textures[t];
     if (!texture.udimTiles.empty()) {
       for (const auto& [tile, tileTexture] : texture.udimTiles) {
-        if (reached.contains(tile)) load[plan.textures[tileTexture].image] = true;
+        if (reached[static_cast<std::size_t>(tile)]) load[plan.textures[tileTexture].image] = true;
       }
     } else if (!tileOnly[t]) {
       load[texture.image] = true;
