@@ -9,6 +9,7 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <future>
 #include <iterator>
@@ -17,6 +18,7 @@
 #include <memory>
 #include <new>
 #include <set>
+#include <span>
 #include <string>
 #include <system_error>
 #include <tuple>
@@ -487,6 +489,12 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
         pushPull ? "; the whole image in memory for push-pull (" + std::string(megabytes) + ")"
                  : "; in bands of " + std::to_string(kBakeBandRows) + " rows, " +
                        std::to_string(rowsHeld) + " rows (" + megabytes + ") in memory at a time";
+    if (output.rangeAuto && output.storesSignedRange()) {
+      plan.steps.push_back({"find the range of " + output.file.string() +
+                                ": bake it once for its largest |value|" +
+                                (udim ? " over every tile" : ""),
+                            "\"range\": \"auto\" (a second bake of the map)"});
+    }
     plan.steps.push_back(
         {"bake " + output.file.string() + ": " + std::string(mapKindName(output.map)) + " " +
              std::to_string(output.width) + "x" + std::to_string(output.height) + ", " +
@@ -590,6 +598,15 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
 }
 
 }  // namespace
+
+double roundRangeUp(double largest) {
+  if (!(largest > 0) || !std::isfinite(largest)) return 1;
+  const double step = std::pow(10.0, std::floor(std::log10(largest)) - 2);  // 3 digits
+  double range = std::ceil(largest / step) * step;
+  range = std::strtod(formatNumber(range).c_str(), nullptr);  // exactly the number recorded
+  if (range < largest) range = std::strtod(formatNumber(range + step).c_str(), nullptr);
+  return range;
+}
 
 // ---- Hashing -----------------------------------------------------------------------------------
 
@@ -832,6 +849,33 @@ std::vector<std::pair<std::string, std::string>> bakedFileAttributes(const Scene
   return attributes;
 }
 
+/// The largest finite |v| of the texels covered in the tiles @p tiles of a signed map: the first
+/// pass of a `"range": "auto"` output, band by band as the bake itself (bakeMapRows, no halo).
+Result<double> largestMagnitude(const BakeInput& input, const SceneOutput& output,
+                                std::span<const int> tiles, int threads) {
+  float largest = 0;
+  for (const int tile : tiles) {
+    const BakeSettings settings = plan_detail::bakeSettingsFor(output, tile, threads);
+    const Status baked = bakeMapRows(input, settings, 0, [&](const MutableImageRows& rows) {
+      const auto channels = static_cast<std::size_t>(rows.channels);
+      for (int row = rows.begin; row < rows.end; ++row) {
+        const float* pixels = rows.pixelRow(row);
+        const float* coverage = rows.coverageRow(row);
+        for (std::size_t x = 0; x < static_cast<std::size_t>(rows.width); ++x) {
+          if (coverage[x] == 0) continue;
+          for (std::size_t c = 0; c < channels; ++c) {
+            const float magnitude = std::fabs(pixels[x * channels + c]);
+            if (magnitude > largest && std::isfinite(magnitude)) largest = magnitude;
+          }
+        }
+      }
+      return Status{Ok{}};
+    });
+    if (!baked) return baked.error();
+  }
+  return static_cast<double>(largest);
+}
+
 /// Bakes one image tile into @p file and adds its timings to @p report. The image is baked band
 /// by band into a small ring of rows (bakeMapRows), and each band's final rows are padded and
 /// handed to an ImageFileWriter, so the file is compressed and written while the rest is baked
@@ -938,7 +982,8 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
     const std::string range =
         output.storesSignedRange()
             ? "were beyond the stored range ±" + formatNumber(output.range) +
-                  " and were clamped to it: a larger \"range\" (--range) or an EXR keeps them"
+                  " and were clamped to it: a larger \"range\" (--range), \"range\": \"auto\" "
+                  "(--range auto) or an EXR keeps them"
             : std::string();
     report.warnings.push_back(describeClippedValues(file, clipped, values, writeOptions.format,
                                                     writeOptions.bitDepth, range));
@@ -1116,6 +1161,19 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     const std::vector<Layer> layers = plan_detail::outputLayers(planned, loaded);
     OutputReport& outputReport = report.outputs[o];
     json files = json::object();
+    // A "range": "auto" output is stored with one range for all its tiles, found first.
+    SceneOutput stored = output;
+    if (output.rangeAuto && output.storesSignedRange()) {
+      start = Clock::now();
+      progress.start("finding the range of " + output.file.string());
+      Result<double> largest = largestMagnitude(plan_detail::bakeInputFor(loaded, layers), output,
+                                                tiles[o], options.threads);
+      if (!largest)
+        return Error{largest.error().code, output.file.string() + ": " + largest.error().message};
+      stored.range = roundRangeUp(*largest);
+      outputReport.autoRange = stored.range;
+      report.bakeSeconds += secondsSince(start);
+    }
 
     for (const int tile : tiles[o]) {
       const fs::path file = tileFile(output, tile);
@@ -1141,7 +1199,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       } else {
         const BakeInput input = plan_detail::bakeInputFor(loaded, layers);
         const BakeSettings settings = plan_detail::bakeSettingsFor(output, tile, options.threads);
-        if (Status ok = bakeImageTile(input, settings, output, file, report, pending); !ok) {
+        if (Status ok = bakeImageTile(input, settings, stored, file, report, pending); !ok) {
           return ok.error();
         }
       }

@@ -740,7 +740,16 @@ SceneOutput parseOutput(const json& value, const std::string& where,
     }
   }
   if (reader.has("alpha")) output.alpha = reader.boolean("alpha");
-  if (reader.has("range")) output.range = reader.numberAtLeast("range", 0, true);
+  if (reader.has("range")) {
+    const json& range = reader.at("range");
+    if (range == "auto") {
+      output.rangeAuto = true;
+    } else if (range.is_string()) {
+      fail(where, "range " + range.dump() + " must be a positive number or \"auto\"");
+    } else {
+      output.range = reader.numberAtLeast("range", 0, true);
+    }
+  }
   if (reader.has("green") && output.map != MapKind::kTangentNormal) {
     fail(where, "key 'green' applies only to tangent-normal maps");
   }
@@ -1236,7 +1245,9 @@ std::string outputParametersJson(const SceneOutput& output) {
   j["format"] = imageFormatName(output.resolvedFormat());
   j["bit_depth"] = output.resolvedBitDepth();
   j["alpha"] = output.alpha;
-  if (output.storesSignedRange()) j["range"] = output.range;
+  if (output.storesSignedRange()) {
+    j["range"] = output.rangeAuto ? json("auto") : json(output.range);
+  }
   return j.dump();
 }
 

@@ -6,8 +6,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -54,7 +56,7 @@ struct BakeArguments {
   std::string normalGreen = "opengl";
   int bitDepth = 0;
   bool alpha = false;
-  std::optional<double> range;
+  std::optional<std::string> range;  ///< a number, or "auto"
   SubdivisionOptions subdivision;  ///< level 0: none
   bool limitSurface = false;       ///< --subdivide limit
 };
@@ -104,7 +106,8 @@ constexpr const char* kFooter =
     "    samples = 1 (N x N per texel), uv, green = opengl|directx, tile = 1001,\n"
     "    format = png|exr|tiff, bit_depth = 8|16|32 (default 16; 8 for masks in PNG/TIFF),\n"
     "    alpha = false (coverage as alpha), range = 1 (derivative and surface-gradient maps\n"
-    "    in PNG/TIFF integers store v / (2 range) + 0.5; EXR and float TIFF store v).\n"
+    "    in PNG/TIFF integers store v / (2 range) + 0.5; EXR and float TIFF store v;\n"
+    "    \"auto\": the largest |v| of the map, rounded up, found by a first pass).\n"
     "  Unknown keys are errors; keys starting with '_' are comments.\n"
     "\n"
     "Incremental:\n"
@@ -299,7 +302,17 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     if (!isSignedMap(output.map)) {
       return Error::badInput("bake: --range applies only to derivative and surface-gradient maps");
     }
-    output.range = *args.range;
+    if (*args.range == "auto") {
+      output.rangeAuto = true;
+    } else {
+      char* end = nullptr;
+      output.range = std::strtod(args.range->c_str(), &end);
+      if (args.range->empty() || *end != '\0' || !(output.range > 0) ||
+          !std::isfinite(output.range)) {
+        return Error::badInput("bake: --range " + *args.range +
+                               " must be a positive number or 'auto'");
+      }
+    }
   }
   scene.outputs.push_back(output);
   if (Status valid = validateScene(scene); !valid) {
@@ -316,7 +329,16 @@ void printOutcome(const ExecuteReport& report) {
       text += "up to date: " + output.file.string() + "\n";
       continue;
     }
-    for (const std::filesystem::path& file : output.files) text += "wrote " + file.string() + "\n";
+    // The range "range": "auto" chose: what a shader decoding the files needs.
+    std::string range;
+    if (output.autoRange > 0) {
+      char number[32];
+      std::snprintf(number, sizeof number, "%g", output.autoRange);
+      range = std::string(" (range ±") + number + ")";
+    }
+    for (const std::filesystem::path& file : output.files) {
+      text += "wrote " + file.string() + range + "\n";
+    }
   }
   std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
@@ -514,7 +536,8 @@ CommandAction defineBakeCommand(CLI::App& app) {
       ->group(oneMap);
   app.add_flag("--alpha", args->alpha, "Write the coverage as an alpha channel")->group(oneMap);
   app.add_option("--range", args->range,
-                 "Derivative/surface-gradient maps in PNG/TIFF store v / (2 R) + 0.5 (default 1)")
+                 "Derivative/surface-gradient maps in PNG/TIFF store v / (2 R) + 0.5 (default 1; "
+                 "auto: the map's largest |v|, rounded up)")
       ->type_name("R")
       ->group(oneMap);
 

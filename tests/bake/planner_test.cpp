@@ -7,9 +7,11 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
@@ -622,6 +624,95 @@ TEST_F(PlannerTest, UdimTilesNoUvReachesAreNotLoaded) {
   Result<ExecuteReport> failed = executePlan(*planned);
   ASSERT_FALSE(failed);
   EXPECT_NE(failed.error().message.find("h_1005.png"), std::string::npos) << failed.error().message;
+}
+
+TEST_F(PlannerTest, AutoRangeHoldsEveryValueOfEveryTileInOneRange) {
+  // Two squares, one per UDIM tile, UVs 0.5 wide: a unit square in tile 1001 and a 4-unit one
+  // in tile 1002. The ramp's ∂h/∂u = 0.05 gives an object-space gradient of 0.025 in the first
+  // and 0.00625 in the second; one range serves both files.
+  writeFile(dir_ / "two.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 10 0 0\nv 14 0 0\nv 14 4 0\nv 10 4 0\n"
+            "vt 0.25 0.25\nvt 0.75 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
+            "vt 1.25 0.25\nvt 1.75 0.25\nvt 1.75 0.75\nvt 1.25 0.75\n"
+            "f 1/1 2/2 3/3 4/4\nf 5/5 6/6 7/7 8/8\n");
+  const std::string both = planeScene(
+      kHeightLayer,
+      R"({"map": "surface-gradient", "file": "g_<UDIM>.png", "size": 32, "range": "auto"},
+         {"map": "surface-gradient", "file": "g_<UDIM>.exr", "size": 32, "bit_depth": 32,
+          "range": "auto"})",
+      "two.obj");
+  const std::string text = explainPlan(plan(both));
+  EXPECT_NE(text.find("find the range of " + (dir_ / "g_<UDIM>.png").string() +
+                      ": bake it once for its largest |value| over every tile"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("find the range of " + (dir_ / "g_<UDIM>.exr").string()), std::string::npos)
+      << text;
+  const ExecuteReport report = bake(both);
+  ASSERT_EQ(report.outputs.size(), 2u);
+  const double range = report.outputs[0].autoRange;
+  EXPECT_EQ(report.outputs[1].autoRange, 0.0) << "a float file stores the values";
+  EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
+
+  double largest = 0;
+  for (const char* tile : {"1001", "1002"}) {
+    const fs::path png = dir_ / ("g_" + std::string(tile) + ".png");
+    const std::vector<float> codes = readPixels(png);
+    const std::vector<float> values = readPixels(dir_ / ("g_" + std::string(tile) + ".exr"));
+    ASSERT_EQ(codes.size(), values.size()) << tile;
+    double tileLargest = 0;
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      tileLargest = std::max(tileLargest, std::abs(static_cast<double>(values[i])));
+      // Decoded as the file says: v = (code − 0.5) · 2 · range, within half a 16-bit step.
+      EXPECT_NEAR((codes[i] - 0.5) * 2 * range, values[i], 1.01 * range / 65535)
+          << tile << " " << i;
+    }
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(png.string());
+    ASSERT_TRUE(in);
+    // The number the file records is exactly the range its codes were made with.
+    EXPECT_EQ(std::stod(in->spec().get_string_attribute("sgbake:range", "0")), range) << tile;
+    largest = std::max(largest, tileLargest);
+    EXPECT_GT(tileLargest, 0.005) << tile << ": the height map bumps the square";
+  }
+  // The range is the largest value rounded up: nothing clipped, under 1 % of the codes unused.
+  EXPECT_EQ(range, roundRangeUp(largest));
+  EXPECT_GE(range, largest);
+  EXPECT_LE(range, largest * 1.01);
+
+  // "auto" is a parameter like any other: unchanged, the second run is up to date.
+  EXPECT_EQ(plan(planeScene(kHeightLayer,
+                            R"({"map": "surface-gradient", "file": "g_<UDIM>.png", "size": 32,
+                                "range": "auto"})",
+                            "two.obj"))
+                .outputsToBake(),
+            0u);
+}
+
+TEST(AutoRange, RoundsUpToThreeSignificantDigits) {
+  EXPECT_EQ(roundRangeUp(0), 1.0);
+  EXPECT_EQ(roundRangeUp(-2), 1.0);
+  EXPECT_EQ(roundRangeUp(std::numeric_limits<double>::infinity()), 1.0);
+  EXPECT_EQ(roundRangeUp(2), 2.0);
+  EXPECT_EQ(roundRangeUp(3.14159), 3.15);
+  EXPECT_EQ(roundRangeUp(123456), 124000.0);
+  EXPECT_EQ(roundRangeUp(0.0012345), 0.00124);
+  // Invariants over many magnitudes: never below the value, at most 1 % above, and the
+  // shortest form of the number (what files record) has at most 3 significant digits.
+  double x = 1.234567e-9;
+  for (int i = 0; i < 400; ++i, x *= 1.1373) {
+    const double range = roundRangeUp(x);
+    EXPECT_GE(range, x) << x;
+    EXPECT_LE(range, x * 1.01) << x;
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", range);  // the shortest form, as files record it
+    std::string digits;
+    for (const char c : std::string(text).substr(0, std::string(text).find('e'))) {
+      if (c >= '0' && c <= '9' && !(digits.empty() && c == '0')) digits += c;
+    }
+    while (!digits.empty() && digits.back() == '0') digits.pop_back();
+    const std::size_t significant = digits.size();
+    EXPECT_LE(significant, 3u) << text;
+  }
 }
 
 TEST_F(PlannerTest, UdimImagesThatCannotWorkAreBadInput) {

@@ -410,6 +410,16 @@ TEST(Scene, SignedMapsTakeARangeForIntegerFiles) {
             "maps");
   EXPECT_EQ(parseError(withOutput(R"({"map": "derivative", "file": "d.png", "range": 0})")),
             "scene.json: outputs[0]: range 0 must be greater than 0");
+  Result<Scene> automatic = parseScene(
+      withOutput(R"({"map": "derivative", "file": "d.png", "range": "auto"})"), options());
+  ASSERT_TRUE(automatic) << automatic.error().message;
+  EXPECT_TRUE(automatic->outputs[0].rangeAuto);
+  EXPECT_FALSE(scene->outputs[0].rangeAuto);
+  EXPECT_EQ(parseError(withOutput(R"({"map": "derivative", "file": "d.png", "range": "max"})")),
+            "scene.json: outputs[0]: range \"max\" must be a positive number or \"auto\"");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "height", "file": "h.png", "range": "auto"})")),
+            "scene.json: outputs[0]: key 'range' applies only to derivative and surface-gradient "
+            "maps");
 }
 
 TEST(Scene, InvalidCombinations) {

@@ -412,6 +412,20 @@ TEST_F(BakeCliTest, OneMapShorthand) {
            "push-pull", "-o", (dir_ / "os.exr").string()});
   ASSERT_EQ(normal.exitCode, 0) << normal.err;
   EXPECT_TRUE(fs::exists(dir_ / "os.exr"));
+
+  // --range auto: the range chosen is said beside the file, and recorded in it.
+  const ProcessResult autoRange = run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--height",
+                                       (dir_ / "h.png").string(), "--map", "derivative", "--size",
+                                       "8", "--range", "auto", "-o", (dir_ / "d.png").string()});
+  ASSERT_EQ(autoRange.exitCode, 0) << autoRange.err;
+  const std::size_t said = autoRange.out.find("wrote " + (dir_ / "d.png").string() + " (range ±");
+  ASSERT_NE(said, std::string::npos) << autoRange.out;
+  const std::string number = autoRange.out.substr(said).substr(
+      autoRange.out.substr(said).find("±") + std::string("±").size());
+  std::unique_ptr<OIIO::ImageInput> derivative = OIIO::ImageInput::open((dir_ / "d.png").string());
+  ASSERT_TRUE(derivative);
+  EXPECT_EQ(std::stod(number), std::stod(derivative->spec().get_string_attribute("sgbake:range")))
+      << autoRange.out;
 }
 
 TEST_F(BakeCliTest, OneMapShorthandErrors) {
@@ -429,6 +443,10 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
            {"bake", (dir_ / "scene.json").string(), "--mesh", mesh},
            {"bake"},
            {"bake", "--mesh", mesh, "--padding", "extnd", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "derivative", "--range", "0", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "derivative", "--range", "automatic", "-o",
+            (dir_ / "o.png").string()},
            // Options that would change nothing: no layer for them, another map, no subdivision.
            {"bake", "--mesh", mesh, "--height-scale", "2", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--filter", "bicubic", "-o", (dir_ / "o.png").string()},

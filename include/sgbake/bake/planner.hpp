@@ -174,7 +174,15 @@ struct OutputReport {
   std::filesystem::path file;                ///< the scene's file name (may contain `<UDIM>`)
   bool baked = false;                        ///< false: up to date, not touched
   std::vector<std::filesystem::path> files;  ///< files written (one per UDIM tile)
+  /// The range a `"range": "auto"` output was stored with (0: none was chosen)
+  double autoRange = 0;
 };
+
+/// @brief The range a `"range": "auto"` output is stored with when the largest |v| of its
+/// covered texels is @p largest: @p largest rounded up to 3 significant digits, so that the
+/// number a file records ("sgbake:range") is short and every value fits; 1 when @p largest is 0
+/// (or not a positive finite number).
+double roundRangeUp(double largest);
 
 /// @brief Timings (seconds) and counts of an execution.
 struct ExecuteReport {

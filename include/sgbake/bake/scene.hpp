@@ -197,6 +197,9 @@ struct SceneOutput {
   /// "range": signed maps (derivative, surface-gradient) in integer files (PNG, TIFF 8/16)
   /// store v / (2·range) + 0.5, so [−range, range] fills the codes; float files store v.
   double range = 1;
+  /// "range": "auto": the range is the largest |v| of the covered texels of all the output's
+  /// tiles, rounded up to 3 significant digits (autoRange), found by a first pass over the map.
+  bool rangeAuto = false;
 
   /// @brief Whether the file stores this output's values remapped by range (see above).
   bool storesSignedRange() const;
