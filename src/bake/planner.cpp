@@ -436,11 +436,12 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     if (!texture.udimTiles.empty()) {
       std::vector<std::string> tiles;
       for (const auto& entry : texture.udimTiles) tiles.push_back(std::to_string(entry.first));
-      plan.steps.push_back({"make UDIM " + kind + " texture " + texture.udimImage.string() +
-                                " of tiles " + joinLabels(tiles) +
-                                (texture.vector ? " ((0, 0, 1) where the UVs reach no tile)"
-                                                : " (0 where the UVs reach no tile)"),
-                            "sampled by " + joinLabels(users)});
+      plan.steps.push_back(
+          {"make UDIM " + kind + " texture " + texture.udimImage.string() + " of tiles " +
+               joinLabels(tiles) +
+               (texture.vector ? " (the zero normal, no bump, where the UVs reach no tile)"
+                               : " (0 where the UVs reach no tile)"),
+           "sampled by " + joinLabels(users)});
       continue;
     }
     const auto tile = tileOf.find(t);

@@ -23,7 +23,7 @@ ScalarSample UdimScalarTexture::sample(Vec2d st) const {
 Vec3d UdimVectorTexture::sample(Vec2d st) const {
   Vec2d within;
   const VectorTexture* tile = tiles_.at(st, within);
-  return tile != nullptr ? tile->sample(within) : Vec3d{0.5, 0.5, 1.0};
+  return tile != nullptr ? tile->sample(within) : Vec3d{0.5, 0.5, 0.5};  // the zero normal
 }
 
 }  // namespace sgbake

@@ -598,6 +598,35 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
   EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "quarter.obj")).outputsToBake(), 1u);
 }
 
+TEST_F(PlannerTest, UdimNormalMapsAreFlatWhereNoTileIs) {
+  // A square tilted 36.87° about x (normal (0, −0.6, 0.8)), its UVs in tile 1002; the normal
+  // maps have only tile 1001, which holds +Z: unread, so both spaces leave the normal as it is.
+  writeFile(dir_ / "tilted.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 0.8 0.6\nv 0 0.8 0.6\n"
+            "vt 1.25 0.25\nvt 1.75 0.25\nvt 1.75 0.75\nvt 1.25 0.75\n"
+            "f 1/1 2/2 3/3 4/4\n");
+  fs::copy_file(dir_ / "n.png", dir_ / "n_1001.png");
+  for (const char* space : {"object", "tangent"}) {
+    const std::string layer =
+        R"({"type": "normal", "image": "n_<UDIM>.png", "space": ")" + std::string(space) + "\"}";
+    bake(planeScene(layer,
+                    R"({"map": "object-normal", "file": "o_<UDIM>.exr", "size": 8,
+                        "bit_depth": 32, "margin": 0, "alpha": true})",
+                    "tilted.obj"));
+    const std::vector<float> pixels = readPixels(dir_ / "o_1002.exr");
+    ASSERT_EQ(pixels.size(), std::size_t{8 * 8 * 4}) << space;
+    int covered = 0;
+    for (std::size_t t = 0; t < 64; ++t) {
+      if (pixels[t * 4 + 3] < 1) continue;
+      ++covered;
+      EXPECT_NEAR(pixels[t * 4 + 0], 0.5, 1e-6) << space << " texel " << t;
+      EXPECT_NEAR(pixels[t * 4 + 1], 0.5 * -0.6 + 0.5, 1e-6) << space << " texel " << t;
+      EXPECT_NEAR(pixels[t * 4 + 2], 0.5 * 0.8 + 0.5, 1e-6) << space << " texel " << t;
+    }
+    EXPECT_GE(covered, 9) << space;
+  }
+}
+
 TEST_F(PlannerTest, UdimTilesNoUvReachesAreNotLoaded) {
   // The square lies in tile 1002: tile 1002 is read, 1005 (not even an image) is not.
   fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");

@@ -65,7 +65,7 @@ TEST(Udim, SamplesTheTileAtCoordinatesWithinIt) {
   normals.emplace(1002, std::make_unique<ConstantVector>(Vec3d{0.1, 0.2, 0.3}));
   const UdimVectorTexture normalUdim(std::move(normals));
   EXPECT_EQ(normalUdim.sample({1.5, 0.5}), (Vec3d{0.1, 0.2, 0.3}));
-  EXPECT_EQ(normalUdim.sample({0.5, 0.5}), (Vec3d{0.5, 0.5, 1.0}));  // encoded (0, 0, 1)
+  EXPECT_EQ(normalUdim.sample({0.5, 0.5}), (Vec3d{0.5, 0.5, 0.5}));  // encoded (0, 0, 0)
 }
 
 }  // namespace

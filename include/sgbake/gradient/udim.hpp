@@ -48,8 +48,10 @@ class UdimScalarTexture : public ScalarTexture {
 };
 
 /// @brief A three-channel texture made of UDIM tiles, as UdimScalarTexture. Where no tile is
-/// given the sample is (0.5, 0.5, 1): an encoded tangent-space normal map's "no bump" (an
-/// object-space map reads it as the +Z direction).
+/// given the sample is (0.5, 0.5, 0.5), the encoded zero normal, which tangent-space
+/// (slopesFromTangentNormal) and object-space (gradientFromObjectNormal) layers both read as
+/// no bump. (0.5, 0.5, 1) would be "no bump" only in tangent space: an object-space layer
+/// reads it as +Z and turns every surface there towards +Z.
 class UdimVectorTexture : public VectorTexture {
  public:
   explicit UdimVectorTexture(std::map<int, std::unique_ptr<VectorTexture>> tiles)
