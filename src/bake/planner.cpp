@@ -1095,9 +1095,16 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     } else {
       // A map no UV triangle reaches holds only its background: said, not an error (a UV
       // set still being laid out, say).
-      const std::vector<int> touched = udimTiles(loaded.mesh, output.uvSet);
+      std::size_t outside = 0;
+      const std::vector<int> touched = udimTiles(loaded.mesh, output.uvSet, &outside);
       const std::string uvSet = "UV set " + std::to_string(output.uvSet);
       if (hasUdimToken(output.file.string())) {
+        if (outside > 0 && !touched.empty()) {  // (none in a tile: said below)
+          report.warnings.push_back(
+              output.file.string() + ": " + std::to_string(outside) + " triangle(s) of " + uvSet +
+              " lie outside UDIM tiles 1001 to 2000 (negative u or v, u ≥ 10 or v ≥ 100) and are "
+              "not baked");
+        }
         tiles[o] = touched.empty() ? std::vector<int>{kFirstUdimTile} : touched;
         if (touched.empty()) {
           report.warnings.push_back(output.file.string() + ": no triangle of " + uvSet +

@@ -248,7 +248,8 @@ bool overlapsOpenSquare(const std::array<Vec2d, 3>& p, Vec2d origin) {
 
 }  // namespace
 
-std::vector<int> udimTiles(const Mesh& mesh, int uvSet) {
+std::vector<int> udimTiles(const Mesh& mesh, int uvSet, std::size_t* trianglesOutside) {
+  if (trianglesOutside != nullptr) *trianglesOutside = 0;
   if (uvSet < 0 || !mesh.hasUvSet(static_cast<std::size_t>(uvSet))) return {};
   const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
   constexpr int kTilesU = 10, kTilesV = (kLastUdimTile - kFirstUdimTile) / 10 + 1;
@@ -265,9 +266,14 @@ std::vector<int> udimTiles(const Mesh& mesh, int uvSet) {
     const int u1 = std::min(kTilesU - 1, static_cast<int>(std::floor(std::min(maxU, double(kTilesU)))));
     const int v0 = std::max(0, static_cast<int>(std::floor(std::max(minV, -1.0))));
     const int v1 = std::min(kTilesV - 1, static_cast<int>(std::floor(std::min(maxV, double(kTilesV)))));
+    bool inAnyTile = false;
     for (int tv = v0; tv <= v1; ++tv)
       for (int tu = u0; tu <= u1; ++tu)
-        if (overlapsOpenSquare(p, {double(tu), double(tv)})) tiles.insert(kFirstUdimTile + tv * 10 + tu);
+        if (overlapsOpenSquare(p, {double(tu), double(tv)})) {
+          tiles.insert(kFirstUdimTile + tv * 10 + tu);
+          inAnyTile = true;
+        }
+    if (!inAnyTile && trianglesOutside != nullptr) ++*trianglesOutside;
   }
   return {tiles.begin(), tiles.end()};
 }

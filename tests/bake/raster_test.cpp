@@ -261,14 +261,17 @@ TEST(Udim, RowsOfTilesBordersAndOutOfRange) {
   const Mesh mesh = test::uvPlaneMesh({{{0.1f, 1.1f}, {0.9f, 1.1f}, {0.9f, 1.9f}, {0.1f, 1.9f}},
                                        {{2.2f, 0.2f}, {3.0f, 0.5f}, {2.2f, 0.8f}},
                                        {{-0.5f, 0.2f}, {-0.1f, 0.2f}, {-0.1f, 0.6f}}});
-  EXPECT_EQ(udimTiles(mesh, 0), (std::vector<int>{1003, 1011}));
+  std::size_t outside = 99;
+  EXPECT_EQ(udimTiles(mesh, 0, &outside), (std::vector<int>{1003, 1011}));
+  EXPECT_EQ(outside, 1u) << "the triangle at negative u";
   const Result<FloatImage> t = bakeMask(mesh, 10, 10, 1, 1011);
   ASSERT_TRUE(t.ok());
   EXPECT_EQ(test::coverageUp(*t, 5, 5), 1.0f);
   EXPECT_EQ(test::coverageUp(*t, 0, 0), 0.0f);
   // A triangle spanning two tiles is baked, clipped, into both.
   const Mesh spanning = test::uvPlaneMesh({{{0.5f, 0.1f}, {1.5f, 0.1f}, {1.0f, 0.9f}}});
-  EXPECT_EQ(udimTiles(spanning, 0), (std::vector<int>{1001, 1002}));
+  EXPECT_EQ(udimTiles(spanning, 0, &outside), (std::vector<int>{1001, 1002}));
+  EXPECT_EQ(outside, 0u);
   const Result<FloatImage> a = bakeMask(spanning, 16, 16, 1, 1001), b = bakeMask(spanning, 16, 16, 1, 1002);
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_EQ(test::coverageUp(*a, 15, 4), 1.0f);

@@ -259,6 +259,18 @@ TEST_F(BakeCliTest, MapsNoTriangleReachesAreBakedWithAWarning) {
             std::string::npos)
       << tiles.err;
   EXPECT_TRUE(fs::exists(dir_ / "m_1001.png"));
+  // Some triangles in tiles, two at negative u: baked, and the two counted.
+  writeFile(dir_ / "partly.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\n"
+            "vt 0.1 0.9\nvt -0.9 -0.9\nvt -0.1 -0.9\nvt -0.1 -0.1\nvt -0.9 -0.1\n"
+            "f 1/1 2/2 3/3 4/4\nf 1/5 2/6 3/7 4/8\n");
+  const ProcessResult partly =
+      run({"bake", "--mesh", (dir_ / "partly.obj").string(), "--map", "mask", "--size", "8",
+           "--no-manifest", "-o", (dir_ / "q_<UDIM>.png").string()});
+  EXPECT_EQ(partly.exitCode, 0) << partly.err;
+  EXPECT_EQ(partly.err, "sgbake: warning: " + (dir_ / "q_<UDIM>.png").string() +
+                            ": 2 triangle(s) of UV set 0 lie outside UDIM tiles 1001 to 2000 "
+                            "(negative u or v, u ≥ 10 or v ≥ 100) and are not baked\n");
   // A mesh in the square: no warning.
   const ProcessResult plane =
       run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "mask", "--size", "8",

@@ -241,8 +241,10 @@ std::vector<std::array<std::uint32_t, 3>> loopTriangles(const Mesh& mesh);
 ///
 /// A tile is touched when a triangle with nonzero UV area overlaps the tile's open square
 /// (touching its border only does not count). Parts of the UV layout outside tiles
-/// 1001 … 2000 (negative u or v, u ≥ 10, v ≥ 100) are ignored. Empty when the set does not exist.
-std::vector<int> udimTiles(const Mesh& mesh, int uvSet);
+/// 1001 … 2000 (negative u or v, u ≥ 10, v ≥ 100) are ignored; @p trianglesOutside (when not
+/// null) is set to how many triangles with nonzero UV area lie wholly there, in no tile. Empty
+/// when the set does not exist.
+std::vector<int> udimTiles(const Mesh& mesh, int uvSet, std::size_t* trianglesOutside = nullptr);
 
 /// @brief Edge padding as Blender's "Extend" margin (IMB_filter_extend, what Blender 3.4 runs for
 /// margin type Extend): @p margin passes, each filling every not-yet-filled texel that has a
