@@ -114,7 +114,8 @@ bool nestsDeeperThan(const json& value, int limit) {
 }
 
 /// Whether @p entry is an output's entry as recordInManifest writes it: "parameters" (an
-/// object, a few levels deep), "inputs" and "files" (objects of strings).
+/// object, a few levels deep), "inputs" and "files" (objects of strings), and "udim_reached"
+/// (tile numbers) when the output reads a UDIM image.
 bool isManifestEntry(const json& entry) {
   if (!entry.is_object()) return false;
   const auto parameters = entry.find("parameters");
@@ -126,6 +127,12 @@ bool isManifestEntry(const json& entry) {
     if (strings == entry.end() || !strings->is_object()) return false;
     for (const json& value : *strings) {
       if (!value.is_string()) return false;
+    }
+  }
+  if (const auto reached = entry.find("udim_reached"); reached != entry.end()) {
+    if (!reached->is_array()) return false;
+    for (const json& tile : *reached) {
+      if (!tile.is_number_integer()) return false;
     }
   }
   return true;
@@ -224,14 +231,24 @@ bool isUpToDate(const json* entry, const PlannedOutput& planned, const fs::path&
   const auto parameters = entry->find("parameters");
   if (parameters == entry->end() || parameters->dump() != planned.parameters) return false;
   const auto inputs = entry->find("inputs");
-  if (inputs == entry->end() || !inputs->is_object() ||
-      inputs->size() != planned.inputHashes.size()) {
-    return false;
-  }
+  if (inputs == entry->end() || !inputs->is_object()) return false;
+  // The UDIM tiles the mesh's UVs reached when it was baked: the same mesh (its hash is an
+  // input) reaches the same tiles, and tiles it does not reach do not count.
+  const auto reached = entry->find("udim_reached");
+  std::set<int> reachedTiles;
+  if (reached != entry->end()) reachedTiles = reached->get<std::set<int>>();
+  std::size_t compared = 0;
   for (const auto& [path, hash] : planned.inputHashes) {
+    const auto tile = planned.udimTileInputs.find(path);
+    if (reached != entry->end() && tile != planned.udimTileInputs.end() &&
+        !reachedTiles.contains(tile->second)) {
+      continue;
+    }
+    ++compared;
     const auto recorded = inputs->find(path);
     if (recorded == inputs->end() || *recorded != hash) return false;
   }
+  if (compared != inputs->size()) return false;
   const auto files = entry->find("files");
   if (files == entry->end() || !files->is_object() || files->empty()) return false;
   for (const auto& [name, hash] : files->items()) {
@@ -686,6 +703,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     std::string layersJson;
     std::vector<fs::path> inputs{s.mesh};
     std::vector<std::string> users{"mesh"};
+    std::set<std::string> directInputs;  // images read as they are (not as a UDIM tile)
     for (std::size_t l = 0; l < s.layers.size(); ++l) {
       const SceneLayer& layer = s.layers[l];
       if (!whyNotRead(output, layer).empty()) continue;
@@ -696,6 +714,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
         if (!hasUdimToken(image.string())) {
           inputs.push_back(image);
           users.push_back(user);
+          directInputs.insert(canonicalPath(image).string());
           return Ok{};
         }
         if (const std::string& problem = udimTiles.problem(image); !problem.empty()) {
@@ -711,6 +730,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
         for (const auto& [tile, file] : tiles) {
           inputs.push_back(file);
           users.push_back(user);
+          planned.udimTileInputs[canonicalPath(file).string()] = tile;
         }
         return Ok{};
       };
@@ -723,6 +743,8 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
         }
       }
     }
+    // A file read directly too is an input whatever the UVs reach.
+    for (const std::string& path : directInputs) planned.udimTileInputs.erase(path);
     planned.parameters = common + ",\"output\":" + outputParametersJson(output) + ",\"layers\":[" +
                          layersJson + "]}";
     planned.parameters = json::parse(planned.parameters).dump();  // canonical key order
@@ -1066,11 +1088,16 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   const bool udim = std::any_of(plan.textures.begin(), plan.textures.end(),
                                 [](const PlannedTexture& t) { return !t.udimTiles.empty(); });
   std::optional<Status> mesh;
-  std::vector<bool> load;
+  std::vector<bool> load, reached;  // reached: flags by tile number
   if (udim) {
     mesh = meshLoad.get();
     if (!*mesh) return mesh->error();
-    load = plan_detail::imagesToLoad(plan, loaded.mesh);
+    reached = plan_detail::reachedUdimTiles(loaded.mesh);
+    load = plan_detail::imagesToLoad(plan, reached);
+  }
+  std::set<int> reachedTiles;  // for the manifest
+  for (int tile = kFirstUdimTile; tile < static_cast<int>(reached.size()); ++tile) {
+    if (reached[static_cast<std::size_t>(tile)]) reachedTiles.insert(tile);
   }
   const Status textures =
       plan_detail::loadTextures(plan, imageFiles, loaded, progress, report, load);
@@ -1226,12 +1253,19 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
 
     if (plan.options.useManifest) {
       start = Clock::now();
+      // UDIM tiles no UV reaches are left out (isUpToDate): changing them changes no texel.
       json inputs = json::object();
-      for (const auto& [path, hash] : planned.inputHashes) inputs[path] = hash;
-      manifestEntries.emplace_back(output.file,
-                                   json{{"parameters", json::parse(planned.parameters)},
-                                        {"inputs", std::move(inputs)},
-                                        {"files", std::move(files)}});
+      for (const auto& [path, hash] : planned.inputHashes) {
+        const auto tile = planned.udimTileInputs.find(path);
+        if (tile == planned.udimTileInputs.end() || reachedTiles.contains(tile->second)) {
+          inputs[path] = hash;
+        }
+      }
+      json entry = {{"parameters", json::parse(planned.parameters)},
+                    {"inputs", std::move(inputs)},
+                    {"files", std::move(files)}};
+      if (!planned.udimTileInputs.empty()) entry["udim_reached"] = reachedTiles;
+      manifestEntries.emplace_back(output.file, std::move(entry));
       report.writeSeconds += secondsSince(start);
     }
   }

@@ -92,10 +92,8 @@ Status checkUvSets(const Plan& plan, const Mesh& mesh) {
 
 }  // namespace
 
-std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh) {
-  // The tiles any layer or mask can sample, on any UV set: those a triangle overlaps, and
-  // those a corner lies in (a corner on a tile's left or bottom edge samples that tile, as the
-  // corner table does).
+std::vector<bool> reachedUdimTiles(const Mesh& mesh) {
+  // A corner on a tile's left or bottom edge samples that tile, as the corner table does.
   // One flag per tile number (0: outside the tiles), not a tree insertion per corner.
   std::vector<bool> reached(static_cast<std::size_t>(kLastUdimTile) + 1, false);
   const auto reach = [&reached](int tile) {
@@ -108,6 +106,10 @@ std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh) {
       reach(udimTileOf({corner.x, corner.y}, within));
     }
   }
+  return reached;
+}
+
+std::vector<bool> imagesToLoad(const Plan& plan, const std::vector<bool>& reached) {
   std::vector<bool> tileOnly(plan.textures.size(), false), load(plan.images.size(), false);
   for (const PlannedTexture& texture : plan.textures) {
     for (const auto& [tile, t] : texture.udimTiles) tileOnly[t] = true;

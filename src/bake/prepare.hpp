@@ -90,9 +90,13 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded);
 /// Where the images of a plan come from: the image of a PlannedImage, with its channels.
 using ImageSource = std::function<Result<Image>(const PlannedImage&)>;
 
-/// @brief Which images of the plan a bake of @p mesh reads: all but the UDIM tiles no UV set
-/// of the mesh reaches (and no layer reads directly).
-std::vector<bool> imagesToLoad(const Plan& plan, const Mesh& mesh);
+/// @brief The UDIM tiles any layer or mask of a bake of @p mesh can sample, on any UV set: those
+/// a triangle overlaps, and those a corner lies in. One flag per tile number, 0 … kLastUdimTile.
+std::vector<bool> reachedUdimTiles(const Mesh& mesh);
+
+/// @brief Which images of the plan a bake reads: all but the UDIM tiles not in @p reached
+/// (reachedUdimTiles) that no layer reads directly.
+std::vector<bool> imagesToLoad(const Plan& plan, const std::vector<bool>& reached);
 
 /// @brief Gets the images of the plan from @p source (those @p load marks; all when it is
 /// empty) and makes the plan's textures of them; a UDIM texture gets the tiles loaded.

@@ -590,12 +590,33 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
       "tile1002.obj"));
   for (const float v : readPixels(dir_ / "g_1002.exr")) ASSERT_EQ(v, 0.0f);
 
-  // The manifest hashes every tile: a changed tile re-bakes.
+  // The manifest hashes the tiles the UVs reach: one added, changed or removed there re-bakes;
+  // tiles elsewhere (another object's, sharing the set) do not.
   const std::string udimOutput = R"({"map": "height", "file": "u.exr", "size": 8})";
-  bake(planeScene(udimLayer, udimOutput, "quarter.obj"));
-  EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "quarter.obj")).outputsToBake(), 0u);
+  const auto toBake = [&](const char* mesh) {
+    return plan(planeScene(udimLayer, udimOutput, mesh)).outputsToBake();
+  };
+  bake(planeScene(udimLayer, udimOutput, "quarter.obj"));  // tile 1001 only
+  EXPECT_EQ(toBake("quarter.obj"), 0u);
   fs::copy_file(dir_ / "h.png", dir_ / "h_1005.png");
-  EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "quarter.obj")).outputsToBake(), 1u);
+  EXPECT_EQ(toBake("quarter.obj"), 0u) << "no UV reaches tile 1005";
+  writeImage(heightImage(16, 0.25f), dir_ / "h_1005.png");
+  EXPECT_EQ(toBake("quarter.obj"), 0u) << "no UV reaches tile 1005";
+  writeImage(heightImage(16, 0.25f), dir_ / "h_1001.png");
+  EXPECT_EQ(toBake("quarter.obj"), 1u) << "tile 1001 changed";
+  bake(planeScene(udimLayer, udimOutput, "quarter.obj"));
+  EXPECT_EQ(toBake("quarter.obj"), 0u);
+  fs::remove(dir_ / "h_1005.png");
+  EXPECT_EQ(toBake("quarter.obj"), 0u) << "no UV reaches tile 1005";
+  // The square in tile 1002, which had no file: adding one re-bakes, removing it again too.
+  bake(planeScene(udimLayer, udimOutput, "tile1002.obj"));
+  EXPECT_EQ(toBake("tile1002.obj"), 0u);
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");
+  EXPECT_EQ(toBake("tile1002.obj"), 1u) << "tile 1002 added where the UVs are";
+  bake(planeScene(udimLayer, udimOutput, "tile1002.obj"));
+  EXPECT_EQ(toBake("tile1002.obj"), 0u);
+  fs::remove(dir_ / "h_1002.png");
+  EXPECT_EQ(toBake("tile1002.obj"), 1u) << "tile 1002 removed where the UVs are";
 }
 
 TEST_F(PlannerTest, UdimNormalMapsAreFlatWhereNoTileIs) {

@@ -104,6 +104,10 @@ struct PlannedOutput {
   /// The files it depends on (canonical path → hash): the mesh and its layers' images. Empty
   /// when the manifest is off.
   std::vector<std::pair<std::string, std::string>> inputHashes;
+  /// Inputs that are tiles of UDIM images only (canonical path → tile number): the manifest
+  /// records, and compares, only the tiles the mesh's UVs reach ("udim_reached"), so that a
+  /// tile no UV reaches can be added, changed or removed without a re-bake.
+  std::map<std::string, int> udimTileInputs;
 };
 
 /// @brief One line of the plan: what is done and why.
