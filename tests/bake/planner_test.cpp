@@ -600,9 +600,9 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
   EXPECT_EQ(toBake("quarter.obj"), 0u);
   fs::copy_file(dir_ / "h.png", dir_ / "h_1005.png");
   EXPECT_EQ(toBake("quarter.obj"), 0u) << "no UV reaches tile 1005";
-  writeImage(heightImage(16, 0.25f), dir_ / "h_1005.png");
+  ASSERT_TRUE(writeImage(heightImage(16, 0.25f), dir_ / "h_1005.png"));
   EXPECT_EQ(toBake("quarter.obj"), 0u) << "no UV reaches tile 1005";
-  writeImage(heightImage(16, 0.25f), dir_ / "h_1001.png");
+  ASSERT_TRUE(writeImage(heightImage(16, 0.25f), dir_ / "h_1001.png"));
   EXPECT_EQ(toBake("quarter.obj"), 1u) << "tile 1001 changed";
   bake(planeScene(udimLayer, udimOutput, "quarter.obj"));
   EXPECT_EQ(toBake("quarter.obj"), 0u);
