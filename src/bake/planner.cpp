@@ -225,37 +225,67 @@ Status recordInManifest(const fs::path& file, const json& entry) {
   return writeFileAtomically(path, text);
 }
 
-/// Whether the manifest entry says @p planned needs no baking.
-bool isUpToDate(const json* entry, const PlannedOutput& planned, const fs::path& file) {
-  if (entry == nullptr || !entry->is_object()) return false;
+std::string joinLabels(const std::vector<std::string>& labels) {
+  std::string text;
+  for (const std::string& label : labels) {
+    if (!text.empty()) text += ", ";
+    text += label;
+  }
+  return text;
+}
+
+/// Why @p planned must be baked, as the manifest entry @p entry of its @p file says (one
+/// phrase for explainPlan: the first difference found); empty when nothing changed.
+std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::path& file) {
+  const std::string manifest = (directoryOf(file) / kManifestName).string();
+  if (entry == nullptr || !entry->is_object()) return "it is not in " + manifest + " yet";
   const auto parameters = entry->find("parameters");
-  if (parameters == entry->end() || parameters->dump() != planned.parameters) return false;
+  if (parameters == entry->end() || parameters->dump() != planned.parameters) {
+    // Name the parts that differ: "output", "layers", "mesh", "subdivision", "sgbake".
+    const json now = json::parse(planned.parameters);
+    std::vector<std::string> changed;
+    for (const auto& [key, value] : now.items()) {
+      if (parameters == entry->end() || !parameters->contains(key) || (*parameters)[key] != value) {
+        changed.push_back("\"" + key + "\"");
+      }
+    }
+    return "its parameters changed" + (changed.empty() ? "" : ": " + joinLabels(changed));
+  }
   const auto inputs = entry->find("inputs");
-  if (inputs == entry->end() || !inputs->is_object()) return false;
+  if (inputs == entry->end() || !inputs->is_object()) return "its inputs are not in " + manifest;
   // The UDIM tiles the mesh's UVs reached when it was baked: the same mesh (its hash is an
   // input) reaches the same tiles, and tiles it does not reach do not count.
   const auto reached = entry->find("udim_reached");
   std::set<int> reachedTiles;
   if (reached != entry->end()) reachedTiles = reached->get<std::set<int>>();
-  std::size_t compared = 0;
+  std::set<std::string> compared;
   for (const auto& [path, hash] : planned.inputHashes) {
     const auto tile = planned.udimTileInputs.find(path);
     if (reached != entry->end() && tile != planned.udimTileInputs.end() &&
         !reachedTiles.contains(tile->second)) {
       continue;
     }
-    ++compared;
+    compared.insert(path);
     const auto recorded = inputs->find(path);
-    if (recorded == inputs->end() || *recorded != hash) return false;
+    if (recorded == inputs->end()) return path + " is new";
+    if (*recorded != hash) return path + " changed";
   }
-  if (compared != inputs->size()) return false;
+  for (const auto& [path, hash] : inputs->items()) {
+    if (!compared.contains(path)) return path + " is gone";
+  }
   const auto files = entry->find("files");
-  if (files == entry->end() || !files->is_object() || files->empty()) return false;
-  for (const auto& [name, hash] : files->items()) {
-    Result<std::string> now = hashFile(directoryOf(file) / name);
-    if (!now || !hash.is_string() || *now != hash.get<std::string>()) return false;
+  if (files == entry->end() || !files->is_object() || files->empty()) {
+    return "its files are not in " + manifest;
   }
-  return true;
+  for (const auto& [name, hash] : files->items()) {
+    const fs::path path = directoryOf(file) / name;
+    Result<std::string> now = hashFile(path);
+    if (!now) return path.string() + " is missing";
+    if (!hash.is_string() || *now != hash.get<std::string>()) {
+      return path.string() + " was changed since it was baked";
+    }
+  }
+  return {};
 }
 
 // ---- Planning ----------------------------------------------------------------------------------
@@ -383,15 +413,6 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& u
   }
 }
 
-std::string joinLabels(const std::vector<std::string>& labels) {
-  std::string text;
-  for (const std::string& label : labels) {
-    if (!text.empty()) text += ", ";
-    text += label;
-  }
-  return text;
-}
-
 /// A number in its shortest "%g" form (0.001, not 0.001000).
 std::string formatNumber(double value) {
   char text[32];
@@ -490,7 +511,8 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     const std::string reads = read.empty() ? "reads no layers" : "reads " + joinLabels(read);
     if (output.kind == OutputKind::kCorners) {
       plan.steps.push_back({"evaluate the corner table " + output.file.string(),
-                            reads + "; MikkTSpace frames of UV set 0 computed with it"});
+                            "because " + planned.whyBake + "; " + reads +
+                                "; MikkTSpace frames of UV set 0 computed with it"});
       plan.steps.push_back({"write " + output.file.string() + " as CSV", "all or nothing"});
       continue;
     }
@@ -520,7 +542,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
              " samples per texel, UV set " + std::to_string(output.uvSet) + ", " +
              (udim ? "every UDIM tile the UV set touches"
                    : "UDIM tile " + std::to_string(output.tile)),
-         reads + memory});
+         "because " + planned.whyBake + "; " + reads + memory});
     if (pushPull) {  // (masks are never padded: outputPadding)
       plan.steps.push_back({"pad " + output.file.string() + " by push-pull",
                             "fills every texel outside the UV islands"});
@@ -760,7 +782,11 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
       planned.inputHashes.erase(std::unique(planned.inputHashes.begin(), planned.inputHashes.end()),
                                 planned.inputHashes.end());
       const json* entry = manifests.entry(output.file);  // read with --force too, for warnings
-      if (!options.force) planned.upToDate = isUpToDate(entry, planned, output.file);
+      planned.whyBake = options.force ? "of --force" : whyBake(entry, planned, output.file);
+      planned.upToDate = planned.whyBake.empty();
+    } else {
+      planned.whyBake =
+          s.inMemory ? "it is baked in memory" : "the manifest is off (--no-manifest)";
     }
     plan.outputs.push_back(std::move(planned));
   }
@@ -1253,7 +1279,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
 
     if (plan.options.useManifest) {
       start = Clock::now();
-      // UDIM tiles no UV reaches are left out (isUpToDate): changing them changes no texel.
+      // UDIM tiles no UV reaches are left out (whyBake): changing them changes no texel.
       json inputs = json::object();
       for (const auto& [path, hash] : planned.inputHashes) {
         const auto tile = planned.udimTileInputs.find(path);

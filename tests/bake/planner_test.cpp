@@ -427,7 +427,12 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   ASSERT_TRUE(writeImage(heightImage(16, 0.25f), dir_ / "h.png"));
   Plan touched = plan(json);
   EXPECT_FALSE(touched.outputs[0].upToDate);
+  EXPECT_EQ(touched.outputs[0].whyBake, fs::canonical(dir_ / "h.png").string() + " changed");
   EXPECT_TRUE(touched.outputs[1].upToDate);
+  EXPECT_EQ(touched.outputs[1].whyBake, "");
+  EXPECT_NE(explainPlan(touched).find("(because " + touched.outputs[0].whyBake + "; reads "),
+            std::string::npos)
+      << explainPlan(touched);
   ASSERT_TRUE(executePlan(touched));
   EXPECT_EQ(plan(json).outputsToBake(), 0u);
 
@@ -436,19 +441,30 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
       planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8, "margin": 2},
                        {"map": "mask", "file": "m.png", "size": 8})");
   EXPECT_EQ(plan(wider).outputsToBake(), 1u);
+  EXPECT_EQ(plan(wider).outputs[0].whyBake, "its parameters changed: \"output\"");
 
   // A deleted output, and an output changed by someone else.
   fs::remove(dir_ / "m.png");
   EXPECT_FALSE(plan(json).outputs[1].upToDate);
+  EXPECT_EQ(plan(json).outputs[1].whyBake, (dir_ / "m.png").string() + " is missing");
   bake(json);
   writeFile(dir_ / "h.exr", "edited");
   EXPECT_FALSE(plan(json).outputs[0].upToDate);
+  EXPECT_EQ(plan(json).outputs[0].whyBake,
+            (dir_ / "h.exr").string() + " was changed since it was baked");
   EXPECT_TRUE(plan(json).outputs[1].upToDate);
 
   // A changed mesh re-bakes everything.
   bake(json);
   writeFile(dir_ / "plane.obj", std::string(kPlaneObj) + "# edited\n");
   EXPECT_EQ(plan(json).outputsToBake(), 2u);
+  EXPECT_EQ(plan(json).outputs[1].whyBake, fs::canonical(dir_ / "plane.obj").string() + " changed");
+  PlanOptions force;
+  force.force = true;
+  EXPECT_EQ(plan(json, force).outputs[1].whyBake, "of --force");
+  fs::remove(dir_ / kManifestName);
+  EXPECT_EQ(plan(json).outputs[1].whyBake,
+            "it is not in " + (dir_ / kManifestName).string() + " yet");
 
   // A corrupt manifest counts as empty, with a warning naming it; the next bake replaces it.
   bake(json);
@@ -613,10 +629,14 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
   EXPECT_EQ(toBake("tile1002.obj"), 0u);
   fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");
   EXPECT_EQ(toBake("tile1002.obj"), 1u) << "tile 1002 added where the UVs are";
+  EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "tile1002.obj")).outputs[0].whyBake,
+            fs::canonical(dir_ / "h_1002.png").string() + " is new");
   bake(planeScene(udimLayer, udimOutput, "tile1002.obj"));
   EXPECT_EQ(toBake("tile1002.obj"), 0u);
   fs::remove(dir_ / "h_1002.png");
   EXPECT_EQ(toBake("tile1002.obj"), 1u) << "tile 1002 removed where the UVs are";
+  EXPECT_EQ(plan(planeScene(udimLayer, udimOutput, "tile1002.obj")).outputs[0].whyBake,
+            (dir_ / "h_1002.png").string() + " is gone");
 }
 
 TEST_F(PlannerTest, UdimNormalMapsAreFlatWhereNoTileIs) {

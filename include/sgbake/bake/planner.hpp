@@ -99,6 +99,10 @@ struct PlannedLayer {
 struct PlannedOutput {
   std::size_t sceneOutput = 0;      ///< index into Scene::outputs
   bool upToDate = false;            ///< the manifest says nothing changed: not baked
+  /// Why it is baked, for explainPlan, as a clause after "because" ("of --force", "/d/h_1001.png
+  /// changed", "its parameters changed: \"layers\"", "it is not in /d/.sgbake-manifest.json
+  /// yet", …); empty when up to date.
+  std::string whyBake;
   std::vector<std::size_t> layers;  ///< indices into Plan::layers it reads, in scene order
   std::string parameters;           ///< canonical JSON of its parameters (manifest)
   /// The files it depends on (canonical path → hash): the mesh and its layers' images. Empty
