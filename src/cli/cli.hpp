@@ -115,9 +115,11 @@ class ThreadLimit {
   std::optional<tbb::global_control> control_;
 };
 
-/// @brief Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGQUIT that remove the temporary
-/// files of every unfinished AtomicFile (Outputs and the images the library writes) before the
-/// process dies. Call once, early in main.
+/// @brief Installs handlers for SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGUSR1/2, SIGALRM,
+/// SIGVTALRM, SIGPROF and SIGXCPU that remove the temporary files of every unfinished AtomicFile
+/// (Outputs and the images the library writes) before the process dies of the signal, and
+/// ignores SIGXFSZ, so that a write past a file-size limit is an error like a full disk. Call
+/// once, early in main.
 void installSignalCleanup();
 
 /// @brief Where a command writes its main result: standard output, or a file that appears

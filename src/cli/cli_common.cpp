@@ -381,9 +381,15 @@ void installSignalCleanup() {
   action.sa_handler = removeTemporariesAndDie;
   sigemptyset(&action.sa_mask);
   action.sa_flags = SA_RESETHAND;
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+  // Every signal whose default action ends the process and that a user, a shell or a job
+  // scheduler sends to a running job (the crash signals, SEGV and the like, are left alone).
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGUSR1, SIGUSR2, SIGALRM,
+                           SIGVTALRM, SIGPROF, SIGXCPU}) {
     ::sigaction(signal, &action, nullptr);
   }
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG instead of killing the
+  // process: the error names the file, and the temporaries are removed as for any failure.
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 // ---- Output -----------------------------------------------------------------------------------

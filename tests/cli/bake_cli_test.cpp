@@ -180,12 +180,12 @@ TEST_F(BakeCliTest, FailingBakeLeavesTheExistingOutputByteIdentical) {
 
 TEST_F(BakeCliTest, FailedPngWriteIsAnErrorAndLeavesTheExistingOutput) {
   // A file-size limit (as a full disk would) stops the PNG partway: OpenImageIO's PNG writer
-  // does not notice, so sgbake writes PNGs through a file that does. SIGXFSZ ignored, the
-  // write fails with EFBIG.
+  // does not notice, so sgbake writes PNGs through a file that does. sgbake ignores SIGXFSZ
+  // (which would kill it, leaving its temporaries), so the write fails with EFBIG.
   writeFile(dir_ / "out.png", "the previous bake");
   const std::set<std::string> before = listDirectory(dir_);
   const std::string command =
-      "trap '' XFSZ; ulimit -f 2; exec '" + std::string(SGBAKE_CLI) + "' bake --mesh '" +
+      "ulimit -f 2; exec '" + std::string(SGBAKE_CLI) + "' bake --mesh '" +
       (dir_ / "plane.obj").string() + "' --height '" + (dir_ / "h.png").string() +
       "' --height-scale 0.3 --map object-normal --size 1024 --margin 0 --no-manifest -o '" +
       (dir_ / "out.png").string() + "'";
@@ -208,8 +208,8 @@ TEST_F(BakeCliTest, ARunThatFailsChangesNoOutputEvenThoseItFinished) {
                                             R"({"map": "mask", "file": "a.png", "size": 8},
                           {"map": "object-normal", "file": "b.png", "size": 1024, "margin": 0})"));
   const std::set<std::string> before = listDirectory(dir_);
-  const std::string command = "trap '' XFSZ; ulimit -f 2; exec '" + std::string(SGBAKE_CLI) +
-                              "' bake '" + (dir_ / "scene.json").string() + "'";
+  const std::string command = "ulimit -f 2; exec '" + std::string(SGBAKE_CLI) + "' bake '" +
+                              (dir_ / "scene.json").string() + "'";
   const ProcessResult r = test::runProcess({"/bin/sh", "-c", command});
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_NE(r.err.find("b.png: cannot write image (File too large"), std::string::npos) << r.err;
@@ -279,39 +279,52 @@ TEST_F(BakeCliTest, MapsNoTriangleReachesAreBakedWithAWarning) {
 }
 
 TEST_F(BakeCliTest, InterruptedBakeLeavesNoTemporaryAndNoOutput) {
-  // A long bake (8192², 4×4 samples) is interrupted with SIGINT once its image's temporary
-  // exists: the process dies of the signal and removes the temporary the library was writing.
-  const fs::path out = dir_ / "out";
-  fs::create_directories(out);
-  const std::vector<std::string> args = {SGBAKE_CLI, "bake", "--mesh", (dir_ / "plane.obj").string(),
-                                         "--map", "object-normal", "--size", "8192", "--samples",
-                                         "4", "--no-manifest", "-o", (out / "n.exr").string()};
-  std::vector<char*> argv;
-  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
-  ASSERT_EQ(::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
+  // A long bake (8192², 4×4 samples) is interrupted once its image's temporary exists: the
+  // process dies of the signal and removes the temporary the library was writing. Ctrl-C, a
+  // reader that went away (SIGPIPE), and a signal a job scheduler may send.
+  for (const int signal : {SIGINT, SIGPIPE, SIGUSR1}) {
+    const fs::path out = dir_ / ("out" + std::to_string(signal));
+    fs::create_directories(out);
+    const std::vector<std::string> args = {SGBAKE_CLI,
+                                           "bake",
+                                           "--mesh",
+                                           (dir_ / "plane.obj").string(),
+                                           "--map",
+                                           "object-normal",
+                                           "--size",
+                                           "8192",
+                                           "--samples",
+                                           "4",
+                                           "--no-manifest",
+                                           "-o",
+                                           (out / "n.exr").string()};
+    std::vector<char*> argv;
+    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    pid_t pid = 0;
+    ASSERT_EQ(::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
 
-  // Wait (up to 30 s) for the image's temporary, then a little longer: well inside the bake.
-  bool sawTemporary = false;
-  for (int i = 0; i < 3000 && !sawTemporary; ++i) {
-    for (const std::string& name : listDirectory(out))
-      sawTemporary = sawTemporary || name.find(".tmp-") != std::string::npos;
-    if (!sawTemporary) ::usleep(10000);
+    // Wait (up to 30 s) for the image's temporary, then a little longer: well inside the bake.
+    bool sawTemporary = false;
+    for (int i = 0; i < 3000 && !sawTemporary; ++i) {
+      for (const std::string& name : listDirectory(out))
+        sawTemporary = sawTemporary || name.find(".tmp-") != std::string::npos;
+      if (!sawTemporary) ::usleep(10000);
+    }
+    ::usleep(300000);
+    ::kill(pid, signal);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(sawTemporary) << signal;
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the bake finished before signal " << signal;
+    EXPECT_EQ(WTERMSIG(status), signal);
+    EXPECT_EQ(listDirectory(out), std::set<std::string>{}) << signal;  // no temporary, no output
   }
-  ::usleep(300000);
-  ::kill(pid, SIGINT);
-  int status = 0;
-  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(sawTemporary);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the bake finished before the signal";
-  EXPECT_EQ(WTERMSIG(status), SIGINT);
-  EXPECT_EQ(listDirectory(out), std::set<std::string>{});  // no temporary, no output
 }
 
 TEST_F(BakeCliTest, BakesAScene) {
