@@ -380,6 +380,20 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
       return Error::badInput(std::string("bake: ") + option + " applies only with " + needs);
     }
   }
+  if (args.map == "corners") {  // a CSV table of the mesh's corners: no image options
+    for (const char* option :
+         {"--size", "--margin", "--samples", "--padding", "--bit-depth", "--alpha", "--range"}) {
+      if (app.count(option) > 0) {
+        return Error::badInput(std::string("bake: ") + option +
+                               " applies to images, not to --map corners (a CSV table)");
+      }
+    }
+  }
+  if (normal && args.filter == "hermite") {  // Hermite interpolates heights
+    return Error::badInput(
+        "bake: --filter hermite applies only to height images; --normal takes bilinear or "
+        "bicubic");
+  }
 
   Result<Scene> scene = oneMap ? oneMapScene(args) : loadScene(args.scene, args.outDir);
   if (!scene) return scene.error();

@@ -470,6 +470,11 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
            {"bake", "--mesh", mesh, "--padding", "extnd", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--map", "derivative", "--range", "0", "-o",
             (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "corners", "--size", "64", "-o",
+            (dir_ / "o.csv").string()},
+           {"bake", "--mesh", mesh, "--map", "corners", "--alpha", "-o", (dir_ / "o.csv").string()},
+           {"bake", "--mesh", mesh, "--normal", (dir_ / "n.png").string(), "--filter", "hermite",
+            "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--map", "derivative", "--range", "automatic", "-o",
             (dir_ / "o.png").string()},
            // Options that would change nothing: no layer for them, another map, no subdivision.
