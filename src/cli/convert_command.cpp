@@ -1,16 +1,19 @@
 /// @file convert_command.cpp
 /// @brief `sgbake convert IN --mesh M.obj --from object --to tangent -o OUT`: re-expresses a
 /// normal map between object and tangent space with Blender's per-texel frame.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "sgbake/bake/bake.hpp"
 #include "sgbake/bake/convert.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/bake/scene.hpp"
@@ -96,6 +99,10 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   if (!from) return Error::badInput("convert: --from: " + from.error().message);
   Result<NormalSpace> to = parseNormalSpace(args.to);
   if (!to) return Error::badInput("convert: --to: " + to.error().message);
+  if (*from == *to) {
+    return Error::badInput("convert: --from and --to are both " + args.from +
+                           ": there is nothing to convert");
+  }
   if (args.green != "opengl" && args.green != "directx") {
     return Error::badInput("convert: --green: unknown value '" + args.green +
                            "' (expected opengl or directx)");
@@ -182,6 +189,7 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   writeOptions.attributes = {{"sgbake:map", toTangent ? "tangent-normal" : "object-normal"},
                              {"sgbake:encoding", "n/2+0.5"},
                              {"sgbake:uv", std::to_string(args.uvSet)},
+                             {"sgbake:udim_tile", std::to_string(args.tile)},
                              {"sgbake:version", sgbake_version()}};
   if (toTangent) writeOptions.attributes.emplace_back("sgbake:green", args.green);
   Result<ImageFileWriter> writer =
@@ -220,6 +228,16 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   const double queueWaits = writer->waitSeconds();
   if (Status ok = writer->commit(); !ok) return ok;
   const double commitSeconds = step.lap();
+  // A tile no UV triangle reaches converts nothing: said, as `bake` says it of its maps.
+  const std::vector<int> touched = udimTiles(*mesh, args.uvSet);
+  if (std::find(touched.begin(), touched.end(), args.tile) == touched.end()) {
+    std::fprintf(stderr,
+                 "sgbake: warning: %s: no triangle of UV set %d lies in %s; every texel keeps "
+                 "the input's value\n",
+                 args.output.c_str(), args.uvSet,
+                 args.tile == kFirstUdimTile ? "the 0-1 UV square"
+                                             : ("UDIM tile " + std::to_string(args.tile)).c_str());
+  }
   if (const std::uint64_t clipped = writer->clippedValues(); clipped != 0) {
     const std::string warning = describeClippedValues(
         args.output, clipped,

@@ -873,6 +873,7 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   EXPECT_NEAR(pixels[(3 * 8 + 4) * 3 + 2], 1.0f, 2e-3);
   EXPECT_EQ(in->spec().get_string_attribute("sgbake:map"), "tangent-normal");
   EXPECT_EQ(in->spec().get_string_attribute("sgbake:green"), "opengl");
+  EXPECT_EQ(in->spec().get_string_attribute("sgbake:udim_tile"), "1001");
 
   const ProcessResult back =
       run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "tangent", "--to",
@@ -880,6 +881,15 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   ASSERT_EQ(back.exitCode, 0) << back.err;
   EXPECT_TRUE(fs::exists(dir_ / "os2.png"));
   EXPECT_EQ(back.err, "") << "encoded normals fit the PNG: no warning";
+
+  // A tile the plane's UVs do not reach: the image is copied, and the run says so.
+  const ProcessResult away = run(
+      {"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "object", "--to", "tangent",
+       "--tile", "1002", (dir_ / "os.png").string(), "-o", (dir_ / "ts1002.exr").string()});
+  ASSERT_EQ(away.exitCode, 0) << away.err;
+  EXPECT_EQ(away.err, "sgbake: warning: " + (dir_ / "ts1002.exr").string() +
+                          ": no triangle of UV set 0 lies in UDIM tile 1002; every texel keeps "
+                          "the input's value\n");
 
   // An alpha of 2 (kept as it is) does not fit a PNG: clamped, with a warning counting it.
   writeTestImage(dir_ / "os_alpha.exr", 8, {0.5f, 0.5f, 1.0f, 2.0f}, false);
@@ -899,6 +909,8 @@ TEST_F(BakeCliTest, ConvertErrors) {
            {"convert", "--mesh", mesh, "--from", "object", (dir_ / "n.png").string(), "-o",
             (dir_ / "o.png").string()},
            {"convert", "--mesh", mesh, "--from", "objekt", "--to", "tangent",
+            (dir_ / "n.png").string(), "-o", (dir_ / "o.png").string()},
+           {"convert", "--mesh", mesh, "--from", "object", "--to", "object",
             (dir_ / "n.png").string(), "-o", (dir_ / "o.png").string()},
            {"convert", "--mesh", mesh, "--from", "object", "--to", "tangent",
             (dir_ / "none.png").string(), "-o", (dir_ / "o.png").string()},
