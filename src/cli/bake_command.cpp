@@ -322,7 +322,7 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
 }
 
 /// Prints what happened to each output on standard output.
-void printOutcome(const ExecuteReport& report) {
+Status printOutcome(const ExecuteReport& report) {
   std::string text;
   for (const OutputReport& output : report.outputs) {
     if (!output.baked) {
@@ -340,8 +340,7 @@ void printOutcome(const ExecuteReport& report) {
       text += "wrote " + file.string() + range + "\n";
     }
   }
-  std::fputs(text.c_str(), stdout);
-  std::fflush(stdout);
+  return writeStandardOutput(text);
 }
 
 Status runBake(const BakeArguments& args, const CLI::App& app) {
@@ -408,8 +407,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   }
   if (args.explain) {
     const std::string text = explainPlan(*plan);
-    std::fputs(text.c_str(), stdout);
-    return Ok{};
+    return writeStandardOutput(text);
   }
 
   ProgressBar bar;
@@ -422,7 +420,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   for (const std::string& warning : report->warnings) {
     std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
   }
-  printOutcome(*report);
+  if (Status ok = printOutcome(*report); !ok) return ok;
 
   if (args.stats) {
     std::size_t baked = 0;

@@ -122,6 +122,11 @@ class ThreadLimit {
 /// once, early in main.
 void installSignalCleanup();
 
+/// @brief Writes @p bytes to standard output (unbuffered, after whatever stdio holds).
+/// @return kInternal "cannot write to standard output: ..." when it fails (a closed pipe with
+/// SIGPIPE ignored, a full disk, /dev/full)
+Status writeStandardOutput(std::string_view bytes);
+
 /// @brief Where a command writes its main result: standard output, or a file that appears
 /// complete on finish() or not at all (AtomicFile), even when the command fails or is
 /// interrupted.

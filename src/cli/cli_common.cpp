@@ -413,6 +413,11 @@ std::string Output::name() const { return file_ ? file_->target().string() : "-"
 
 Status Output::write(std::string_view bytes) {
   if (file_) return file_->write(bytes);
+  return writeStandardOutput(bytes);
+}
+
+Status writeStandardOutput(std::string_view bytes) {
+  std::fflush(stdout);  // whatever stdio holds goes first
   while (!bytes.empty()) {
     const ssize_t n = ::write(STDOUT_FILENO, bytes.data(), bytes.size());
     if (n < 0) {

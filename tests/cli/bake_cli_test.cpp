@@ -390,6 +390,17 @@ TEST_F(BakeCliTest, ExplainPrintsThePlanAndBakesNothing) {
   EXPECT_NE(r.out.find("mask maps read no layers"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir_ / "h.exr"));
   EXPECT_FALSE(fs::exists(dir_ / ".sgbake-manifest.json"));
+
+  // A plan, or the list of files written, that cannot be written is an error, not exit 0.
+  for (const char* extra : {" --explain", ""}) {
+    const ProcessResult full =
+        test::runProcess({"/bin/sh", "-c",
+                          "exec '" + std::string(SGBAKE_CLI) + "' bake '" +
+                              (dir_ / "scene.json").string() + "'" + extra + " > /dev/full"});
+    EXPECT_EQ(full.exitCode, 1) << extra << ": " << full.err;
+    EXPECT_NE(full.err.find("sgbake: error: cannot write to standard output"), std::string::npos)
+        << full.err;
+  }
 }
 
 TEST_F(BakeCliTest, OutDirMovesRelativeOutputs) {
