@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -260,7 +261,17 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
              "not) are split where its faces meet at more than this, replacing any the file "
              "gives (default: Auto Smooth off)")
           ->type_name("DEG")
-          ->check(CLI::Range(0.0, 180.0).description(""));
+          // (Range lets NaN through: every comparison with it is false.)
+          ->check(CLI::Validator(
+              [](std::string& text) {
+                char* end = nullptr;
+                const double degrees = std::strtod(text.c_str(), &end);
+                return degrees >= 0.0 && degrees <= 180.0 ? std::string()
+                                                          : "'" + text +
+                                                                "' is not an angle "
+                                                                "from 0 to 180 degrees";
+              },
+              "", ""));
   options.sharpEdges.clear();
   CLI::Option* const sharpEdge = addCreaseOption(
       app, "--sharp-edge", options.sharpEdges, parseSharpEdge,
