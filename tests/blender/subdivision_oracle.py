@@ -31,6 +31,8 @@
      faces      every Blender face is an sgbake face with the same vertex cycle, its first
                 corner the same or the opposite one (the same diagonal: Blender splits a quad
                 0-1-2 / 0-2-3), and no face is left over;
+     order      sgbake's face f is Blender's face f, from the same first corner (so row k of
+                `tangents` is Blender's loop k);
      normals    per matched corner, the angle between sgbake's `vn` and Blender's split normal
                 <= 0.05 deg (0.0017 deg measured; flat-shaded faces included);
      uvs        per matched corner, max |du|, |dv| <= 2.5e-7, and the corners whose UV is not
@@ -381,7 +383,7 @@ def compare(case, ref, obj, csv):
     mapped = index[corner_vertex]
     used = np.zeros(len(b_size), dtype=bool)
     ours_corners, blender_corners = [], []
-    unmatched = diagonal = 0
+    unmatched = diagonal = misordered = 0
     for f in range(len(face_size)):
         n = int(face_size[f])
         cycle = mapped[start[f]:start[f + 1]].tolist()
@@ -401,12 +403,17 @@ def compare(case, ref, obj, csv):
             continue
         bf, shift = hit
         used[bf] = True
+        if bf != f or shift != 0:  # not Blender's face f, starting at its first corner
+            misordered += 1
         if n == 4 and shift % 2:
             diagonal += 1
         ours_corners += range(start[f], start[f + 1])
         blender_corners += [b_start[bf] + (j + shift) % n for j in range(n)]
     unmatched = max(unmatched, int((~used).sum()))
-    fig.update(unmatched=unmatched, diagonal=diagonal)
+    fig.update(unmatched=unmatched, diagonal=diagonal, misordered=misordered)
+    if misordered:
+        failures.append(("order", f"{misordered} sgbake faces are not Blender's face of the same "
+                                  "index, or start at another corner"))
     if unmatched:
         failures.append(("faces", f"{unmatched} Blender faces have no sgbake face with the "
                                   "same vertex cycle"))
