@@ -348,7 +348,7 @@ Status bakeMapFromArrays(const BakeArguments& a) {
   PlanOptions planOptions{.force = true, .useManifest = false};
   for (std::size_t i = 0; i < a.numImages; ++i) planOptions.imageNames.insert(a.images[i].name);
   Result<Plan> plan = makePlan(std::move(*scene), planOptions);
-  if (!plan) return plan.error();
+  if (!plan) return Error{plan.error().code, where + plan.error().message};
   const Mesh mesh = toMesh(arrays);
   MemoryInputs inputs;
   inputs.mesh = &mesh;

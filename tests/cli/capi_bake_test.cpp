@@ -209,8 +209,8 @@ TEST_F(CApiBake, UdimImagesAreTheImagesNamedWithATileNumber) {
   // No image with a tile number in place of <UDIM>: bad input naming the layer and the names.
   std::vector<float> none;
   EXPECT_EQ(memoryBake(output, 64, none, message, "Bumps", "Bumps.<UDIM>"), SGBAKE_ERROR_BAD_INPUT);
-  EXPECT_NE(message.find("layers[0]: no tile of the UDIM image Bumps.<UDIM> is among the images "
-                         "given (names Bumps.1001 to Bumps.2000)"),
+  EXPECT_NE(message.find("sgbake_bake_map: layers[0]: no tile of the UDIM image Bumps.<UDIM> is "
+                         "among the images given (names Bumps.1001 to Bumps.2000)"),
             std::string::npos)
       << message;
 }
