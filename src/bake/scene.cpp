@@ -1285,7 +1285,9 @@ std::string describeSubdivision(const SceneSubdivision& subdivision) {
 }
 
 std::string subdivisionParametersJson(const SceneSubdivision& subdivision) {
-  if (!subdivision.present) return "null";
+  // A block that changes nothing ("level": 0 alone, a script's copy of an unused modifier) is
+  // the same bake as no block: the manifest must not re-bake for it.
+  if (!subdivision.requested()) return "null";
   json j;
   j["level"] = subdivision.limit ? json("limit") : json(subdivision.level);
   j["uv_smooth"] = nameIn(kUvSmooths, subdivision.uvSmooth);

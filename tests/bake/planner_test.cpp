@@ -494,6 +494,19 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   EXPECT_EQ(plan(json).outputsToBake(), 0u);
 }
 
+TEST_F(PlannerTest, ASubdivisionBlockThatChangesNothingIsNoChange) {
+  const std::string plain =
+      planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8})");
+  bake(plain);
+  std::string levelZero = plain;
+  levelZero.insert(1, R"("subdivision": {"level": 0, "uv_smooth": "all"}, )");
+  EXPECT_EQ(plan(levelZero).outputsToBake(), 0u) << explainPlan(plan(levelZero));
+  std::string levelOne = plain;
+  levelOne.insert(1, R"("subdivision": {"level": 1}, )");
+  EXPECT_EQ(plan(levelOne).outputsToBake(), 1u);
+  EXPECT_EQ(plan(levelOne).outputs[0].whyBake, "its parameters changed: \"subdivision\"");
+}
+
 TEST_F(PlannerTest, ValuesAFileCannotStoreAreAWarningNamingTheFileAndTheRemedy) {
   // h.png rises by 0.5 across the plane: with scale 4, ∂h/∂u = 2 and heights reach 2.
   const std::string layer = R"({"type": "height", "image": "h.png", "scale": 4})";
