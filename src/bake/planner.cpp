@@ -234,10 +234,24 @@ std::string joinLabels(const std::vector<std::string>& labels) {
   return text;
 }
 
+/// How the manifest in @p dir (canonical) names @p path: relative to @p dir, in generic form
+/// ("h.png", "../textures/h.png"), or absolute where no relative path leads there (another
+/// root).
+std::string manifestName(const fs::path& path, const fs::path& dir) {
+  const fs::path canonical = canonicalPath(path);
+  const fs::path relative = canonical.lexically_relative(dir);
+  return relative.empty() ? canonical.generic_string() : relative.generic_string();
+}
+
 /// Why @p planned must be baked, as the manifest entry @p entry of its @p file says (one
 /// phrase for explainPlan: the first difference found); empty when nothing changed.
 std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::path& file) {
   const std::string manifest = (directoryOf(file) / kManifestName).string();
+  // Inputs are named relative to the manifest's directory: said as full paths.
+  const fs::path dir = canonicalPath(directoryOf(file));
+  const auto full = [&dir](const std::string& name) {
+    return (dir / name).lexically_normal().string();
+  };
   if (entry == nullptr || !entry->is_object()) return "it is not in " + manifest + " yet";
   const auto parameters = entry->find("parameters");
   if (parameters == entry->end() || parameters->dump() != planned.parameters) {
@@ -267,11 +281,11 @@ std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::p
     }
     compared.insert(path);
     const auto recorded = inputs->find(path);
-    if (recorded == inputs->end()) return path + " is new";
-    if (*recorded != hash) return path + " changed";
+    if (recorded == inputs->end()) return full(path) + " is new";
+    if (*recorded != hash) return full(path) + " changed";
   }
   for (const auto& [path, hash] : inputs->items()) {
-    if (!compared.contains(path)) return path + " is gone";
+    if (!compared.contains(path)) return full(path) + " is gone";
   }
   const auto files = entry->find("files");
   if (files == entry->end() || !files->is_object() || files->empty()) {
@@ -714,14 +728,19 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
 
   ManifestCache manifests;
   UdimTileFinder udimTiles(s.inMemory, options.imageNames);
-  const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
-                             "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
-                             ",\"mesh\":" +
-                             json(s.inMemory ? s.mesh.string() : canonicalPath(s.mesh).string()).dump();
   for (std::size_t o = 0; o < s.outputs.size(); ++o) {
     const SceneOutput& output = s.outputs[o];
     PlannedOutput planned;
     planned.sceneOutput = o;
+    // Files are named relative to the manifest's directory (manifestName), so that a project
+    // moved or checked out elsewhere as a whole is still up to date.
+    const fs::path manifestDir = canonicalPath(directoryOf(output.file));
+    const PathNamer name = [&](const fs::path& path) {
+      return s.inMemory ? path.string() : manifestName(path, manifestDir);
+    };
+    const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
+                               "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
+                               ",\"mesh\":" + json(name(s.mesh)).dump();
     std::string layersJson;
     std::vector<fs::path> inputs{s.mesh};
     std::vector<std::string> users{"mesh"};
@@ -730,13 +749,13 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
       const SceneLayer& layer = s.layers[l];
       if (!whyNotRead(output, layer).empty()) continue;
       planned.layers.push_back(l);  // scene index for now; remapped below
-      layersJson += (layersJson.empty() ? "" : ",") + layerParametersJson(layer);
+      layersJson += (layersJson.empty() ? "" : ",") + layerParametersJson(layer, name);
       // A UDIM image's inputs are its tile files; it needs one at least.
       const auto addInput = [&](const fs::path& image, const std::string& user) -> Status {
         if (!hasUdimToken(image.string())) {
           inputs.push_back(image);
           users.push_back(user);
-          directInputs.insert(canonicalPath(image).string());
+          directInputs.insert(name(image));
           return Ok{};
         }
         if (const std::string& problem = udimTiles.problem(image); !problem.empty()) {
@@ -752,7 +771,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
         for (const auto& [tile, file] : tiles) {
           inputs.push_back(file);
           users.push_back(user);
-          planned.udimTileInputs[canonicalPath(file).string()] = tile;
+          planned.udimTileInputs[name(file)] = tile;
         }
         return Ok{};
       };
@@ -776,7 +795,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
             hashOf(inputs[i], users[i],
                    i == 0 ? "file" : (users[i].ends_with(".mask") ? "mask image" : "image"));
         if (!hash) return hash.error();
-        planned.inputHashes.emplace_back(canonicalPath(inputs[i]).string(), *hash);
+        planned.inputHashes.emplace_back(name(inputs[i]), *hash);
       }
       std::sort(planned.inputHashes.begin(), planned.inputHashes.end());
       planned.inputHashes.erase(std::unique(planned.inputHashes.begin(), planned.inputHashes.end()),

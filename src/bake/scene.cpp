@@ -1168,19 +1168,22 @@ std::string describeLayer(const SceneLayer& layer) {
   return layer.name.empty() ? text : "'" + layer.name + "', " + text;
 }
 
-std::string layerParametersJson(const SceneLayer& layer) {
+std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer) {
+  const auto name = [&namer](const std::filesystem::path& path) {
+    return namer ? namer(path) : canonicalPath(path).string();
+  };
   json j;
   j["type"] = sceneLayerTypeName(layer.type);
   j["weight"] = layer.weight;
   if (layer.mask) {
-    j["mask"] = {{"image", canonicalPath(layer.mask->image).string()},
+    j["mask"] = {{"image", name(layer.mask->image)},
                  {"uv", layer.mask->uvSet},
                  {"tiling", {layer.mask->tiling.x, layer.mask->tiling.y}},
                  {"offset", {layer.mask->offset.x, layer.mask->offset.y}},
                  {"filter", filterName(layer.mask->filter)}};
   }
   if (layer.hasImage()) {
-    j["image"] = canonicalPath(layer.image).string();
+    j["image"] = name(layer.image);
     j["filter"] = filterName(layer.filter);
     j["wrap"] = nameIn(kWraps, layer.wrap);
     j["tiling"] = {layer.tiling.x, layer.tiling.y};

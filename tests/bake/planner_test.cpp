@@ -494,6 +494,27 @@ TEST_F(PlannerTest, ChangedInputsParametersAndOutputsAreRebaked) {
   EXPECT_EQ(plan(json).outputsToBake(), 0u);
 }
 
+TEST_F(PlannerTest, AProjectMovedAsAWholeIsUpToDate) {
+  // The manifest names files relative to its directory: a project renamed, moved or checked
+  // out elsewhere as a whole needs no re-bake; a changed input there still does.
+  fs::create_directories(dir_ / "masks");
+  ASSERT_TRUE(writeImage(heightImage(16), dir_ / "masks" / "m.png"));
+  const std::string json =
+      planeScene(R"({"type": "height", "image": "h.png", "scale": 0.1, "mask": "masks/m.png"})",
+                 R"({"map": "height", "file": "out/h.exr", "size": 8},
+         {"map": "mask", "file": "m.png", "size": 8})");
+  bake(json);
+  ASSERT_EQ(plan(json).outputsToBake(), 0u);
+  const fs::path moved = dir_.string() + "_moved";
+  fs::remove_all(moved);
+  fs::rename(dir_, moved);
+  dir_ = moved;                   // (TearDown removes it)
+  const Plan there = plan(json);  // (the old build: every output re-baked here)
+  EXPECT_EQ(there.outputsToBake(), 0u) << explainPlan(there);
+  writeFile(dir_ / "plane.obj", std::string(kPlaneObj) + "# edited\n");
+  EXPECT_EQ(plan(json).outputs[1].whyBake, (dir_ / "plane.obj").string() + " changed");
+}
+
 TEST_F(PlannerTest, ASubdivisionBlockThatChangesNothingIsNoChange) {
   const std::string plain =
       planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8})");

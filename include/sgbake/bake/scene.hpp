@@ -31,6 +31,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -265,10 +266,14 @@ std::string_view filterName(Filter filter);
 /// `triplanar height t.png`; prefixed with the layer's "name" when it has one.
 std::string describeLayer(const SceneLayer& layer);
 
+/// How the parameters name a file (layerParametersJson).
+using PathNamer = std::function<std::string(const std::filesystem::path&)>;
+
 /// @brief The parameters of @p layer as canonical JSON text: sorted keys, every default filled
-/// in, image paths made canonical (absolute, symbolic links resolved) — equal text means an
-/// equal layer. For the manifest.
-std::string layerParametersJson(const SceneLayer& layer);
+/// in, image paths as @p name gives them (default: canonical, i.e. absolute with symbolic links
+/// resolved; the manifest names them relative to its directory) — equal text means an equal
+/// layer. For the manifest.
+std::string layerParametersJson(const SceneLayer& layer, const PathNamer& name = {});
 
 /// @brief The parameters of @p output as canonical JSON text (like layerParametersJson; the
 /// file itself is not included, the resolved format and bit depth are).
