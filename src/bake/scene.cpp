@@ -502,6 +502,13 @@ void checkSubdivisionConflict(const ObjectReader& reader, const SceneSubdivision
                              " applies to a subdivided mesh; set \"level\" to 1 or more (at "
                              "\"level\": 0 nothing is subdivided)");
   };
+  // Quality is how closely Use Limit Surface approximates the limit: unused without it, and by
+  // the exact limit surface.
+  if (reader.has("quality") && (subdivision.limit || !subdivision.useLimitSurface)) {
+    fail(reader.where(), std::string("\"quality\" applies with Use Limit Surface, not with ") +
+                             (subdivision.limit ? "\"level\": \"limit\" (the exact surface)"
+                                                : "\"use_limit_surface\": false"));
+  }
   switch (findSubdivisionConflict(subdivision.options(), subdivision.limit)) {
     case SubdivisionConflict::kNone:
       return;
@@ -515,8 +522,8 @@ void checkSubdivisionConflict(const ObjectReader& reader, const SceneSubdivision
       return unsubdivided("\"type\": \"simple\"");
     case SubdivisionConflict::kSharpEdgesWithoutAutoSmooth:
       fail(reader.where(),
-           "\"sharp_edges\" at \"level\": 0 need \"auto_smooth\" (edges "
-           "marked sharp split the normals only with Auto Smooth)");
+           "\"sharp_edges\" need \"auto_smooth\" (edges marked sharp split the normals only "
+           "with Auto Smooth)");
     case SubdivisionConflict::kLimitWithoutLimitSurface:
       fail(reader.where(),
            "\"level\": \"limit\" shades the limit surface itself; it cannot be "
@@ -529,6 +536,10 @@ void checkSubdivisionConflict(const ObjectReader& reader, const SceneSubdivision
       fail(reader.where(),
            "\"level\": \"limit\" shades the exact surface's own normals; it "
            "cannot be combined with \"auto_smooth\"");
+    case SubdivisionConflict::kLimitSharpEdges:
+      fail(reader.where(),
+           "\"level\": \"limit\" shades the exact surface's own normals; it "
+           "cannot be combined with \"sharp_edges\"");
   }
 }
 

@@ -307,6 +307,15 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
       if (app.count(option) > 0) return unsubdivided(option);
     }
   }
+  // Quality is how closely Use Limit Surface approximates the limit: unused without it, and by
+  // the exact limit surface.
+  if (app.count("--subdivision-quality") > 0 && (limit || !options.useLimitSurface)) {
+    return Error::badInput(
+        command +
+        ": --subdivision-quality applies with Use Limit Surface, "
+        "not with " +
+        (limit ? "--subdivide limit (the exact surface)" : "--no-limit-surface"));
+  }
   switch (findSubdivisionConflict(options, limit)) {
     case SubdivisionConflict::kNone:
       return Ok{};
@@ -320,8 +329,8 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
       return unsubdivided("--subdivision-type simple");
     case SubdivisionConflict::kSharpEdgesWithoutAutoSmooth:
       return Error::badInput(command +
-                             ": --sharp-edge without --subdivide needs --auto-smooth DEG (edges "
-                             "marked sharp split the normals only with Auto Smooth)");
+                             ": --sharp-edge needs --auto-smooth DEG (edges marked sharp split "
+                             "the normals only with Auto Smooth)");
     case SubdivisionConflict::kLimitWithoutLimitSurface:
       return Error::badInput(command +
                              ": --no-limit-surface cannot be combined with --subdivide limit, "
@@ -333,6 +342,10 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
     case SubdivisionConflict::kLimitAutoSmooth:
       return Error::badInput(command +
                              ": --auto-smooth cannot be combined with --subdivide limit, which "
+                             "shades the exact surface's own normals");
+    case SubdivisionConflict::kLimitSharpEdges:
+      return Error::badInput(command +
+                             ": --sharp-edge cannot be combined with --subdivide limit, which "
                              "shades the exact surface's own normals");
   }
   return Ok{};

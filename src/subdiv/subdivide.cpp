@@ -349,16 +349,17 @@ SubdivisionConflict findSubdivisionConflict(const SubdivisionOptions& options, b
     if (!options.useLimitSurface) return C::kLimitWithoutLimitSurface;
     if (options.type == SubdivisionType::kSimple) return C::kLimitSimple;
     if (options.autoSmoothDegrees) return C::kLimitAutoSmooth;
+    if (!options.sharpEdges.empty()) return C::kLimitSharpEdges;
     return C::kNone;
+  }
+  if (!options.sharpEdges.empty() && !options.autoSmoothDegrees) {
+    return C::kSharpEdgesWithoutAutoSmooth;  // at any level: they split nothing
   }
   if (options.level != 0) return C::kNone;
   if (!options.edgeCreases.empty()) return C::kEdgeCreasesUnsubdivided;
   if (!options.vertexCreases.empty()) return C::kVertexCreasesUnsubdivided;
   if (!options.useLimitSurface) return C::kNoLimitSurfaceUnsubdivided;
   if (options.type == SubdivisionType::kSimple) return C::kSimpleUnsubdivided;
-  if (!options.sharpEdges.empty() && !options.autoSmoothDegrees) {
-    return C::kSharpEdgesWithoutAutoSmooth;
-  }
   return C::kNone;
 }
 

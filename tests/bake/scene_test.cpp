@@ -650,8 +650,28 @@ TEST(Scene, SettingsThatDoNothingWithoutSubdivisionAreRefused) {
             where + "\"type\": \"simple\"" + fix);
   EXPECT_EQ(parseError(withSubdivision(R"({"level": 0, "sharp_edges": [[0, 1]]})")),
             where +
-                "\"sharp_edges\" at \"level\": 0 need \"auto_smooth\" (edges marked "
-                "sharp split the normals only with Auto Smooth)");
+                "\"sharp_edges\" need \"auto_smooth\" (edges marked sharp split the normals "
+                "only with Auto Smooth)");
+  // Nor at a level: without Auto Smooth marks split nothing, as in Blender.
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": 2, "sharp_edges": [[0, 1]]})")),
+            where +
+                "\"sharp_edges\" need \"auto_smooth\" (edges marked sharp split the normals "
+                "only with Auto Smooth)");
+  // The exact limit surface shades its own normals; Quality shapes the approximation of
+  // Use Limit Surface only.
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": "limit", "sharp_edges": [[0, 1]]})")),
+            where +
+                "\"level\": \"limit\" shades the exact surface's own normals; it cannot be "
+                "combined with \"sharp_edges\"");
+  EXPECT_EQ(parseError(withSubdivision(R"({"level": "limit", "quality": 4})")),
+            where +
+                "\"quality\" applies with Use Limit Surface, not with \"level\": \"limit\" "
+                "(the exact surface)");
+  EXPECT_EQ(
+      parseError(withSubdivision(R"({"level": 2, "use_limit_surface": false, "quality": 4})")),
+      where +
+          "\"quality\" applies with Use Limit Surface, not with "
+          "\"use_limit_surface\": false");
   // What does something at level 0 stays accepted: Auto Smooth, with or without sharp edges,
   // and the settings whose defaults cannot be told from their absence.
   for (const char* accepted :
@@ -663,8 +683,8 @@ TEST(Scene, SettingsThatDoNothingWithoutSubdivisionAreRefused) {
   }
   // A subdivided mesh takes every one of them.
   EXPECT_TRUE(parseScene(withSubdivision(R"({"level": 1, "edge_creases": [[0, 1, 0.5]],
-      "vertex_creases": [[0, 1]], "sharp_edges": [[0, 1]], "use_limit_surface": false,
-      "type": "simple"})"),
+      "vertex_creases": [[0, 1]], "sharp_edges": [[0, 1]], "auto_smooth": 30,
+      "use_limit_surface": false, "type": "simple"})"),
                          options()));
 }
 

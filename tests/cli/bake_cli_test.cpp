@@ -681,11 +681,20 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
            // Subdivision shaping without --subdivide: a forgotten level, not silently ignored.
            {"bake", "--mesh", mesh, "--edge-crease", "0,1,1", "-o", (dir_ / "o.png").string()},
            {"tangents", mesh, "--sharp-edge", "0,1", "-o", (dir_ / "t.csv").string()},
-           {"convert", "--mesh", mesh, "--sharp-edge", "0,1", "--from", "object", "--to",
-            "tangent", (dir_ / "l0.exr").string(), "-o", (dir_ / "c.exr").string()},
+           {"convert", "--mesh", mesh, "--sharp-edge", "0,1", "--from", "object", "--to", "tangent",
+            (dir_ / "l0.exr").string(), "-o", (dir_ / "c.exr").string()},
            {"convert", "--mesh", mesh, "--subdivide", "limit", "--auto-smooth", "30", "--from",
             "object", "--to", "tangent", (dir_ / "l0.exr").string(), "-o",
             (dir_ / "c.exr").string()},
+           // Settings that would change nothing at a level either.
+           {"tangents", mesh, "--subdivide", "1", "--sharp-edge", "0,1", "-o",
+            (dir_ / "t.csv").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "limit", "--sharp-edge", "0,1", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--subdivide", "limit", "--subdivision-quality", "1", "-o",
+            (dir_ / "o.png").string()},
+           {"tangents", mesh, "--subdivide", "1", "--no-limit-surface", "--subdivision-quality",
+            "1", "-o", (dir_ / "t.csv").string()},
        }) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args[2] << ": " << r.err;
@@ -694,9 +703,8 @@ TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   EXPECT_EQ(listDirectory(dir_), before);
   const ProcessResult forgotten =
       run({"tangents", mesh, "--sharp-edge", "0,1", "-o", (dir_ / "t.csv").string()});
-  EXPECT_NE(forgotten.err.find("tangents: --sharp-edge without --subdivide needs --auto-smooth "
-                               "DEG (edges marked sharp split the normals only with Auto "
-                               "Smooth)"),
+  EXPECT_NE(forgotten.err.find("tangents: --sharp-edge needs --auto-smooth DEG (edges marked "
+                               "sharp split the normals only with Auto Smooth)"),
             std::string::npos)
       << forgotten.err;
   // --auto-smooth alone shades the mesh as it is: the cube's faces meet at 90 degrees, so at

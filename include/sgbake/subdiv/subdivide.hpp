@@ -153,11 +153,12 @@ enum class SubdivisionConflict {
   kVertexCreasesUnsubdivided,    ///< vertex creases at level 0
   kNoLimitSurfaceUnsubdivided,   ///< Use Limit Surface off at level 0
   kSimpleUnsubdivided,           ///< type Simple at level 0
-  kSharpEdgesWithoutAutoSmooth,  ///< sharp edges at level 0 without Auto Smooth: they split nothing
+  kSharpEdgesWithoutAutoSmooth,  ///< sharp edges without Auto Smooth: they split nothing
   kLimitWithoutLimitSurface,     ///< the exact limit surface with Use Limit Surface off
   kLimitSimple,                  ///< the exact limit surface (Catmull-Clark's) with type Simple
   kLimitAutoSmooth,              ///< the exact limit surface, which shades its own normals, with
                                  ///< Auto Smooth
+  kLimitSharpEdges,              ///< the exact limit surface with edges marked sharp
 };
 
 /// @brief The first conflict of @p options, shaded as a subdivision to options.level or, when
