@@ -209,7 +209,8 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
                            std::to_string(input.tangents->tangent.size()) + " for " +
                            std::to_string(mesh.numCorners()) + " corners)");
   }
-  if (mapNeedsTangents(s.map) && input.tangents == nullptr) {
+  // (A limit surface gives every sample its own frame: LimitShader.)
+  if (mapNeedsTangents(s.map) && input.tangents == nullptr && input.limit == nullptr) {
     return Error::badInput(where + ": the " + std::string(mapKindName(s.map)) +
                            " map needs tangent frames (none given)");
   }

@@ -95,7 +95,10 @@ Status validateConvert(const Mesh& mesh, const CornerTangents& tangents, const F
     return Error::badInput(where + ": the mesh has no UV set " + std::to_string(settings.uvSet) +
                            " (it has " + std::to_string(mesh.uvSets.size()) + ")");
   }
-  if (tangents.tangent.size() != mesh.numCorners() || tangents.sign.size() != mesh.numCorners()) {
+  // On a limit surface no frames may be given: every sample has the surface's own (LimitShader).
+  const bool none = tangents.tangent.empty() && tangents.sign.empty() && settings.limit != nullptr;
+  if (!none &&
+      (tangents.tangent.size() != mesh.numCorners() || tangents.sign.size() != mesh.numCorners())) {
     return Error::badInput(where + ": tangent frames do not match the mesh (" +
                            std::to_string(tangents.tangent.size()) + " for " +
                            std::to_string(mesh.numCorners()) + " corners)");
@@ -124,7 +127,7 @@ bake_detail::ConvertShader convertShader(const Mesh& mesh, const CornerTangents&
                                          const ConvertSettings& settings) {
   bake_detail::ConvertShader shader;
   shader.mesh = &mesh;
-  shader.tangents = &tangents;
+  shader.tangents = tangents.tangent.empty() ? nullptr : &tangents;  // none: the limit's frames
   shader.input = &input;
   shader.from = from;
   shader.to = to;

@@ -37,6 +37,15 @@ inline void limitUvDerivatives(const Vec3d& dPds, const Vec3d& dPdt, const Vec2d
   dPdv = (-b.x / det) * dPds + (a.x / det) * dPdt;
 }
 
+/// The tangent frame of UV set 0 on a limit surface (and of a tessellation triangle without
+/// MikkTSpace frames): T = ∂P/∂u made orthogonal to the unit normal @p n (0 where ∂P/∂u is
+/// along n or 0), the bitangent sign −1 where ∂P/∂v points against n × T.
+inline void frameFromUvDerivatives(const Vec3d& n, const Vec3d& dPdu, const Vec3d& dPdv,
+                                   Vec3d& tangent, double& sign) {
+  tangent = normalizeOr(dPdu - dot(dPdu, n) * n, Vec3d{0, 0, 0});
+  sign = dot(cross(n, tangent), dPdv) < 0 ? -1.0 : 1.0;
+}
+
 template <class Inner>
 struct LimitShader {
   static constexpr int kChannels = Inner::kChannels;
@@ -58,6 +67,14 @@ struct LimitShader {
     corners = c;
     inner.beginTriangle(c);  // the tessellation's triangle: the fallback where Bfr has nothing
     meshTriangle = inner.tri;
+    if (!meshTriangle.hasTangents) {  // no MikkTSpace frames (the planner skips them): the
+      // triangle's own, as the limit surface's are made (T = ∂P/∂u made orthogonal to N)
+      for (std::size_t i = 0; i < 3; ++i) {
+        frameFromUvDerivatives(meshTriangle.normal[i], meshTriangle.dPdu[0], meshTriangle.dPdv[0],
+                               meshTriangle.tangent[i], meshTriangle.sign[i]);
+      }
+      meshTriangle.hasTangents = true;
+    }
   }
 
   void shade(const Vec3d& b, int x, int y, double* out) {
@@ -92,10 +109,7 @@ struct LimitShader {
       const std::size_t k = static_cast<std::size_t>(s);
       limitUvDerivatives(p.dPds, p.dPdt, p.dUVds[k], p.dUVdt[k], t.dPdu[k], t.dPdv[k]);
       t.uv[k] = {p.uv[k], p.uv[k], p.uv[k]};
-      if (s == 0) {
-        tangent = normalizeOr(t.dPdu[k] - dot(t.dPdu[k], n) * n, Vec3d{0, 0, 0});
-        sign = dot(cross(n, tangent), t.dPdv[k]) < 0 ? -1.0 : 1.0;
-      }
+      if (s == 0) frameFromUvDerivatives(n, t.dPdu[k], t.dPdv[k], tangent, sign);
     }
     const std::size_t bake = static_cast<std::size_t>(inner.uvSet);
     if (bake < static_cast<std::size_t>(t.numUvSets)) {
@@ -105,10 +119,8 @@ struct LimitShader {
     t.position = {p.position, p.position, p.position};
     t.normal = {n, n, n};
     t.faceNormal = n;
-    if (t.hasTangents) {
-      t.tangent = {tangent, tangent, tangent};
-      t.sign = {sign, sign, sign};
-    }
+    t.tangent = {tangent, tangent, tangent};
+    t.sign = {sign, sign, sign};
   }
 };
 

@@ -624,9 +624,13 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     }
   }
   if (!plan.computeTangents && plan.loadMesh) {
-    plan.skipped.push_back({"tangent frames (MikkTSpace)",
-                            "no map to bake is tangent-normal, tangent or bitangent, and no layer "
-                            "it reads is a tangent-space normal map on UV set 0"});
+    plan.skipped.push_back(
+        {"tangent frames (MikkTSpace)",
+         scene.subdivision.limitSurface()
+             ? "the exact limit surface gives every sample its own frame (T = dP/du made "
+               "orthogonal to N, the sign from dP/dv)"
+             : "no map to bake is tangent-normal, tangent or bitangent, and no layer it reads "
+               "is a tangent-space normal map on UV set 0"});
   }
   bool images = false;
   for (const PlannedOutput& output : plan.outputs) {
@@ -814,16 +818,18 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   // The layers, images and textures of the outputs to bake.
   std::set<std::size_t> used;
   std::vector<std::string> tangentReasons;
+  // On the exact limit surface every sample gets the surface's own frame (LimitShader).
+  const bool limitFrames = s.subdivision.limitSurface();
   for (const PlannedOutput& output : plan.outputs) {
     if (output.upToDate) continue;
     const SceneOutput& out = s.outputs[output.sceneOutput];
     plan.loadMesh = true;
-    if (out.kind == OutputKind::kMap && mapNeedsTangents(out.map)) {
+    if (out.kind == OutputKind::kMap && mapNeedsTangents(out.map) && !limitFrames) {
       tangentReasons.push_back(describeOutput(out) + " is expressed in them");
     }
     for (const std::size_t l : output.layers) {
       used.insert(l);
-      if (out.kind == OutputKind::kMap && layerNeedsTangents(s.layers[l])) {
+      if (out.kind == OutputKind::kMap && layerNeedsTangents(s.layers[l]) && !limitFrames) {
         tangentReasons.push_back(layerLabel(l) +
                                  ", a tangent-space normal map on UV set 0, is "
                                  "decoded in them for " +

@@ -157,9 +157,13 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   { const Image decoded = std::move(*image); }  // freed now: the conversion reads `input`
   const double loadSeconds = step.lap();
 
-  TangentOptions tangentOptions;
-  tangentOptions.threads = args.threads;
-  Result<CornerTangents> tangents = computeTangents(mesh->view(0), tangentOptions);
+  // MikkTSpace frames of the mesh; none on the exact limit surface, which has its own.
+  Result<CornerTangents> tangents = CornerTangents{};
+  if (!limit) {
+    TangentOptions tangentOptions;
+    tangentOptions.threads = args.threads;
+    tangents = computeTangents(mesh->view(0), tangentOptions);
+  }
   if (!tangents) {
     return Error{tangents.error().code, args.mesh + ": " + tangents.error().message};
   }

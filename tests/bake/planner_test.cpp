@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -73,6 +74,17 @@ FloatImage flatNormalImage(int size) {
   }
   image.coverage.assign(static_cast<std::size_t>(size * size), 1.0f);
   return image;
+}
+
+/// The pixels of an image file as floats, channels interleaved.
+std::vector<float> readPixels(const fs::path& path) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
+  EXPECT_TRUE(in) << path;
+  if (!in) return {};
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+  return pixels;
 }
 
 /// A directory with a plane mesh, a height map and a normal map; scenes are written into it.
@@ -281,6 +293,38 @@ TEST_F(PlannerTest, ExplainSaysTheMeshIsSubdivided) {
                            "boundary all): every sample is shaded on the exact surface"),
             std::string::npos)
       << limitText;
+
+  // A tangent-space map and layer on the exact surface: its own frames, no MikkTSpace pass.
+  // The unit square's limit surface (all boundaries sharp) is the square itself, whose
+  // MikkTSpace frame is the UV derivatives': a tilted normal map gives the same map either way.
+  FloatImage tilted = flatNormalImage(4);
+  for (std::size_t i = 0; i < tilted.pixels.size(); i += 3) {
+    tilted.pixels[i] = 0.75f;
+    tilted.pixels[i + 1] = 0.4f;
+    tilted.pixels[i + 2] = 0.9f;
+  }
+  ASSERT_TRUE(writeImage(tilted, dir_ / "tilted.exr"));
+  const auto tangentSpace = [](const std::string& subdivision, const std::string& file) {
+    return R"({"mesh": "plane.obj", )" + subdivision +
+           R"("layers": [{"type": "normal", "image": "tilted.exr"}],
+               "outputs": [{"map": "tangent-normal", "file": ")" +
+           file + R"(", "size": 8, "bit_depth": 32}]})";
+  };
+  const Plan frames = plan(tangentSpace(R"("subdivision": {"level": "limit"}, )", "t.exr"));
+  EXPECT_FALSE(frames.computeTangents);
+  EXPECT_NE(explainPlan(frames).find("tangent frames (MikkTSpace): the exact limit surface gives "
+                                     "every sample its own frame"),
+            std::string::npos)
+      << explainPlan(frames);
+  EXPECT_FALSE(
+      bake(tangentSpace(R"("subdivision": {"level": "limit"}, )", "t.exr")).tangentsComputed);
+  EXPECT_TRUE(bake(tangentSpace("", "mesh.exr")).tangentsComputed);
+  const std::vector<float> exact = readPixels(dir_ / "t.exr"), mesh = readPixels(dir_ / "mesh.exr");
+  ASSERT_EQ(exact.size(), std::size_t{8 * 8 * 3});
+  ASSERT_EQ(mesh.size(), exact.size());
+  for (std::size_t i = 0; i < exact.size(); ++i) EXPECT_NEAR(exact[i], mesh[i], 1e-5) << i;
+  EXPECT_NEAR(exact[0], 0.5 + 0.5 * (0.5 / std::sqrt(0.25 + 0.04 + 0.64)), 1e-4)
+      << "the normal map's tilt, decoded in the plane's frame";
 }
 
 TEST_F(PlannerTest, MissingInputsAreNamed) {
@@ -590,17 +634,6 @@ TEST_F(PlannerTest, BakedFilesSayHowTheyAreEncoded) {
                                                   {"sgbake:udim_tile", "1001"},
                                                   {"sgbake:version", version}}));
   EXPECT_EQ(attributes("h_out.png").at("sgbake:encoding"), "value");
-}
-
-/// The pixels of an image file as floats (rows top first), read by OpenImageIO.
-std::vector<float> readPixels(const fs::path& path) {
-  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path.string());
-  EXPECT_TRUE(in) << path;
-  if (!in) return {};
-  const OIIO::ImageSpec& spec = in->spec();
-  std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
-  EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
-  return pixels;
 }
 
 TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {

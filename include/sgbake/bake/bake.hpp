@@ -172,7 +172,7 @@ struct BakeInput {
   /// They define the tangent space of kTangentNormal/kTangent/kBitangent whatever uvSet places
   /// the texels (Blender: the tangents of the active UV map), and are the SurfacePoint's tangent
   /// frame for tangent-space layers.
-  const CornerTangents* tangents = nullptr;
+  const CornerTangents* tangents = nullptr;  ///< may be null with `limit` (its own frames)
   std::span<const Layer> layers;  ///< composited in order; textures must outlive the bake
   /// With a limit surface, `mesh` is its tessellation (subdivideMesh of the same coarse mesh and
   /// options, with `limitParameters`): the raster walks the tessellation, and every sample is

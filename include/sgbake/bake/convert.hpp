@@ -58,7 +58,8 @@ struct ConvertSettings {
 /// values; channels after the first three are copied unchanged. The output's coverage is the
 /// raster's (the input's coverage is not read).
 ///
-/// @param[in] tangents MikkTSpace frames per corner of UV set 0 (see BakeInput::tangents)
+/// @param[in] tangents MikkTSpace frames per corner of UV set 0 (see BakeInput::tangents); empty
+///            with settings.limit: the limit surface's own frames
 /// @param[in] input    W×H image with ≥ 3 channels, rows top first; it defines the output size
 /// @return W×H image with input.channels channels; kBadInput when the input is empty or has fewer
 ///         than 3 channels, pixel storage does not match its size, the mesh has no UV set
