@@ -222,6 +222,41 @@ class ProgressBar {
 // ---- The command -------------------------------------------------------------------------------
 
 /// The scene of the one-map form: one output and the layers its options name.
+/// @p message (about the scene oneMapScene builds) in the words of the one-map flags: the scene's
+/// "outputs[0]: bit_depth 8 …" is "--bit-depth 8 …", "layers[0]: scale …" is
+/// "--height-scale …", and the layers and the output are named by their flags.
+std::string inFlagWords(std::string message, const BakeArguments& args) {
+  const auto replaceAll = [&message](const std::string& from, const std::string& to) {
+    for (std::size_t at = message.find(from); at != std::string::npos;
+         at = message.find(from, at + to.size())) {
+      message.replace(at, from.size(), to);
+    }
+  };
+  // The layers in the order oneMapScene adds them.
+  std::vector<std::pair<std::string, std::string>> layers;  // flag, the flag of its scale
+  if (!args.heightImage.empty()) layers.emplace_back("--height", "--height-scale");
+  if (!args.normalImage.empty()) layers.emplace_back("--normal", "--normal");
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    const std::string label = "layers[" + std::to_string(l) + "]";
+    replaceAll(label + ": scale ", layers[l].second + " ");
+    replaceAll(label + ": filter ", "--filter ");
+    replaceAll(label + ": ", layers[l].first + ": ");
+    replaceAll(label, "the " + layers[l].first + " image");
+  }
+  for (const auto& [key, flag] : {std::pair<const char*, const char*>{"bit_depth", "--bit-depth"},
+                                  {"size", "--size"},
+                                  {"margin", "--margin"},
+                                  {"samples", "--samples"},
+                                  {"uv", "--uv"},
+                                  {"range", "--range"},
+                                  {"file", "-o"}}) {
+    replaceAll(std::string("outputs[0]: ") + key + " ", std::string(flag) + " ");
+  }
+  replaceAll("outputs[0]: ", "-o " + args.output + ": ");
+  replaceAll("outputs[0]", "the map (-o " + args.output + ")");
+  return message;
+}
+
 Result<Scene> oneMapScene(const BakeArguments& args) {
   if (args.mesh.empty()) return Error::badInput("bake: --mesh is required without a SCENE file");
   if (args.output.empty()) return Error::badInput("bake: -o/--output is required with --mesh");
@@ -394,14 +429,19 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
         "bicubic");
   }
 
+  // The one-map flags build a scene: its messages are said in the flags' words.
+  const auto inWords = [&](Error error) {
+    if (oneMap) error.message = inFlagWords(error.message, args);
+    return error;
+  };
   Result<Scene> scene = oneMap ? oneMapScene(args) : loadScene(args.scene, args.outDir);
-  if (!scene) return scene.error();
+  if (!scene) return inWords(scene.error());
 
   PlanOptions planOptions;
   planOptions.force = args.force;
   planOptions.useManifest = !args.noManifest;
   Result<Plan> plan = makePlan(std::move(*scene), planOptions);
-  if (!plan) return plan.error();
+  if (!plan) return inWords(plan.error());
   for (const std::string& warning : plan->warnings) {
     std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
   }
@@ -416,7 +456,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   executeOptions.progress = [&bar](const BakeProgress& progress) { bar.update(progress); };
   Result<ExecuteReport> report = executePlan(*plan, executeOptions);
   bar.stop();
-  if (!report) return report.error();
+  if (!report) return inWords(report.error());
   for (const std::string& warning : report->warnings) {
     std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
   }

@@ -503,6 +503,18 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
     expectOneErrorLine(r);
   }
   EXPECT_EQ(listDirectory(dir_), before);
+  // Messages about the scene the flags build are said in the flags' words.
+  const ProcessResult depth = run({"bake", "--mesh", mesh, "--map", "tangent-normal", "--bit-depth",
+                                   "8", "-o", (dir_ / "o.exr").string()});
+  EXPECT_EQ(depth.err,
+            "sgbake: error: bake: --bit-depth 8 is not available in EXR (16 = half or 32 = "
+            "float)\n");
+  const ProcessResult self = run({"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(),
+                                  "-o", (dir_ / "h.png").string()});
+  EXPECT_NE(self.err.find("is the image of the --height image, which the bake reads"),
+            std::string::npos)
+      << self.err;
+  EXPECT_EQ(self.err.find("layers[0]"), std::string::npos) << self.err;
   const ProcessResult green = run({"bake", "--mesh", mesh, "--map", "mask", "--green", "directx",
                                    "-o", (dir_ / "o.png").string()});
   EXPECT_NE(green.err.find("bake: --green applies only with --map tangent-normal"),
