@@ -307,8 +307,14 @@ class ObjectReader {
 /// Resolves a scene path: absolute as is, relative against @p base; lexically normalized.
 std::filesystem::path resolvePath(const std::filesystem::path& base, const std::string& text) {
   const std::filesystem::path path(text);
-  if (path.is_absolute() || base.empty()) return path.lexically_normal();
-  return (base / path).lexically_normal();
+  const std::filesystem::path joined = path.is_absolute() || base.empty() ? path : base / path;
+  // ".." after a symbolic link to a directory leads where the link's target is, not back
+  // where the text says: such paths are resolved as the system resolves them (their existing
+  // part, links included; the result is absolute). Others only lose "." and doubled slashes.
+  if (std::any_of(joined.begin(), joined.end(), [](const auto& part) { return part == ".."; })) {
+    return canonicalPath(joined);
+  }
+  return joined.lexically_normal();
 }
 
 /// How a scene's input paths are read: resolved against a directory, or, for a scene of an

@@ -198,6 +198,29 @@ TEST(Scene, OutputDirectoryMovesOnlyOutputs) {
   EXPECT_EQ(scene->mesh, std::filesystem::path("scenes/m.obj"));
 }
 
+TEST(Scene, DotDotAfterALinkedDirectoryIsWhereTheSystemGoes) {
+  // real/dir/s.json reached as proj/link/s.json (link → ../real/dir): "../m.obj" is
+  // real/m.obj, as the system resolves it, not proj/m.obj, as the text would say.
+  namespace fs = std::filesystem;
+  const fs::path root =
+      fs::temp_directory_path() / ("sgbake_scene_dotdot_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root / "real" / "dir");
+  fs::create_directories(root / "proj");
+  fs::create_directory_symlink("../real/dir", root / "proj" / "link");
+  SceneParseOptions o;
+  o.baseDir = root / "proj" / "link";  // the scene file's directory
+  Result<Scene> scene = parseScene(
+      R"({"mesh": "../m.obj", "layers": [{"type": "height", "image": "./h.png"}],
+          "outputs": [{"map": "mask", "file": "../out/m.png"}]})",
+      o);
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->mesh, fs::canonical(root / "real") / "m.obj");
+  EXPECT_EQ(scene->outputs[0].file, fs::canonical(root / "real") / "out" / "m.png");
+  EXPECT_EQ(scene->layers[0].image, root / "proj" / "link" / "h.png") << "no .., kept as given";
+  fs::remove_all(root);
+}
+
 TEST(Scene, TypoedKeyNamesItsPlaceAndTheClosestKey) {
   EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "m.png", "sise": 4})")),
             "scene.json: outputs[0]: unknown key 'sise' (did you mean 'size'?)");
