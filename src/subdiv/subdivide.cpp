@@ -586,6 +586,12 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionO
     }
   });
   if (failed) throw EvaluationFailed{};
+  // Vertices no face uses keep their index and their place, as in Blender (no grid has them).
+  std::vector<std::uint8_t> used(coarse.numVertices(), 0);
+  for (const std::uint32_t v : coarse.cornerVertex) used[v] = 1;
+  for (std::size_t v = 0; v < coarse.numVertices(); ++v) {
+    if (!used[v]) fine.positions[v] = coarse.positions[v];
+  }
 
   // Normals as Blender 3.4 computes them on the modified mesh (Auto Smooth off): each new face
   // keeps its coarse face's flat/smooth flag; corners of smooth faces get the vertex normal

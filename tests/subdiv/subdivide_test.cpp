@@ -105,6 +105,28 @@ TEST(Subdivide, CountsAreThoseOfBlendersModifier) {
   }
 }
 
+TEST(Subdivide, VerticesNoFaceUsesKeepTheirIndexAndPlace) {
+  // The cube with two loose vertices among its own (indices 3 and 9), as Blender keeps them.
+  Mesh mesh =
+      meshOf({{-1, -1, -1},
+              {1, -1, -1},
+              {1, 1, -1},
+              {5, 5, 5},
+              {-1, 1, -1},
+              {-1, -1, 1},
+              {1, -1, 1},
+              {1, 1, 1},
+              {-1, 1, 1},
+              {-3, 2, 1}},
+             {{0, 4, 2, 1}, {5, 6, 7, 8}, {0, 1, 6, 5}, {1, 2, 7, 6}, {2, 4, 8, 7}, {4, 0, 5, 8}});
+  for (int level = 1; level <= 2; ++level) {
+    Result<Mesh> fine = subdivideMesh(mesh, {level});
+    ASSERT_TRUE(fine) << fine.error().message;
+    EXPECT_EQ(fine->positions[3], (Vec3f{5, 5, 5})) << level;
+    EXPECT_EQ(fine->positions[9], (Vec3f{-3, 2, 1})) << level;
+  }
+}
+
 TEST(Subdivide, ResultIsClosedAndConsistentlyOrientedOutward) {
   for (const Mesh& coarse : {cube(), prism(3), prism(5), prism(8)}) {
     for (int level = 1; level <= 3; ++level) {
