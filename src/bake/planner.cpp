@@ -1143,7 +1143,11 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   if (udim) {
     mesh = meshLoad.get();
     if (!*mesh) return mesh->error();
-    reached = plan_detail::reachedUdimTiles(loaded.mesh);
+    const bool cornerTable =
+        std::any_of(plan.outputs.begin(), plan.outputs.end(), [&](const PlannedOutput& o) {
+          return !o.upToDate && s.outputs[o.sceneOutput].kind == OutputKind::kCorners;
+        });
+    reached = plan_detail::reachedUdimTiles(loaded.mesh, cornerTable);
     load = plan_detail::imagesToLoad(plan, reached);
   }
   std::set<int> reachedTiles;  // for the manifest

@@ -91,8 +91,9 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded);
 using ImageSource = std::function<Result<Image>(const PlannedImage&)>;
 
 /// @brief The UDIM tiles any layer or mask of a bake of @p mesh can sample, on any UV set: those
-/// a triangle overlaps, and those a corner lies in. One flag per tile number, 0 … kLastUdimTile.
-std::vector<bool> reachedUdimTiles(const Mesh& mesh);
+/// a triangle overlaps, and with @p cornerTable (a corners output is baked) those a corner lies
+/// in. One flag per tile number, 0 … kLastUdimTile.
+std::vector<bool> reachedUdimTiles(const Mesh& mesh, bool cornerTable);
 
 /// @brief Which images of the plan a bake reads: all but the UDIM tiles not in @p reached
 /// (reachedUdimTiles) that no layer reads directly.

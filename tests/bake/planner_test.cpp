@@ -761,6 +761,21 @@ TEST_F(PlannerTest, UdimTilesNoUvReachesAreNotLoaded) {
   Result<ExecuteReport> failed = executePlan(*planned);
   ASSERT_FALSE(failed);
   EXPECT_NE(failed.error().message.find("h_1005.png"), std::string::npos) << failed.error().message;
+
+  // The unit square's UVs end exactly at 1: its texels sample tile 1001 only, but its corner
+  // table samples the corners at u = 1 in tile 1002 (and 1011, 1012), so only the table reads it.
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1001.png");
+  const ExecuteReport map =
+      bake(planeScene(layer, R"({"map": "height", "file": "w.exr", "size": 8})"));
+  EXPECT_EQ(map.imagesLoaded, 1u) << "tile 1001";
+  const ExecuteReport table = bake(planeScene(layer, R"({"map": "corners", "file": "c.csv"})"));
+  EXPECT_EQ(table.imagesLoaded, 2u) << "tiles 1001 and 1002 (1011, 1012 have no file)";
+  // Tile 1002 changed: the map is up to date, the table is not.
+  ASSERT_TRUE(writeImage(heightImage(16, 0.25f), dir_ / "h_1002.png"));
+  EXPECT_EQ(
+      plan(planeScene(layer, R"({"map": "height", "file": "w.exr", "size": 8})")).outputsToBake(),
+      0u);
+  EXPECT_EQ(plan(planeScene(layer, R"({"map": "corners", "file": "c.csv"})")).outputsToBake(), 1u);
 }
 
 TEST_F(PlannerTest, AutoRangeHoldsEveryValueOfEveryTileInOneRange) {
