@@ -1053,8 +1053,13 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
     const std::uint64_t values = static_cast<std::uint64_t>(settings.width) *
                                  static_cast<std::uint64_t>(settings.height) *
                                  static_cast<std::uint64_t>(mapChannels(settings.map));
+    // With "range": "auto" only infinities and NaN lie beyond the range found.
     const std::string range =
-        output.storesSignedRange()
+        output.storesSignedRange() && output.rangeAuto
+            ? "were infinite or NaN (a layer's scale or strength too large?) and were clamped "
+              "to the range ±" +
+                  formatNumber(output.range) + " (NaN to 0)"
+        : output.storesSignedRange()
             ? "were beyond the stored range ±" + formatNumber(output.range) +
                   " and were clamped to it: a larger \"range\" (--range), \"range\": \"auto\" "
                   "(--range auto) or an EXR keeps them"

@@ -773,6 +773,12 @@ SceneOutput parseOutput(const json& value, const std::string& where,
   if (reader.has("range") && !isSignedMap(output.map)) {
     fail(where, "key 'range' applies only to derivative and surface-gradient maps");
   }
+  if (reader.has("range") && !inMemory && !output.storesSignedRange()) {
+    fail(where,
+         "key 'range' applies to integer files (PNG, 8- and 16-bit TIFF); this " +
+             std::string(output.resolvedFormat() == ImageFormat::kExr ? "EXR" : "float TIFF") +
+             " stores the values themselves");
+  }
   return output;
 }
 

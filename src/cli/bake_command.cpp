@@ -337,6 +337,11 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     if (!isSignedMap(output.map)) {
       return Error::badInput("bake: --range applies only to derivative and surface-gradient maps");
     }
+    if (!output.storesSignedRange()) {
+      return Error::badInput(
+          "bake: --range applies to integer files (PNG, 8- and 16-bit TIFF); -o " + args.output +
+          " stores the values themselves");
+    }
     if (*args.range == "auto") {
       output.rangeAuto = true;
     } else {

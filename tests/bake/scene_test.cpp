@@ -438,6 +438,13 @@ TEST(Scene, SignedMapsTakeARangeForIntegerFiles) {
   ASSERT_TRUE(automatic) << automatic.error().message;
   EXPECT_TRUE(automatic->outputs[0].rangeAuto);
   EXPECT_FALSE(scene->outputs[0].rangeAuto);
+  EXPECT_EQ(parseError(withOutput(R"({"map": "derivative", "file": "d.exr", "range": 2})")),
+            "scene.json: outputs[0]: key 'range' applies to integer files (PNG, 8- and 16-bit "
+            "TIFF); this EXR stores the values themselves");
+  EXPECT_EQ(parseError(withOutput(
+                R"({"map": "derivative", "file": "d.tif", "bit_depth": 32, "range": "auto"})")),
+            "scene.json: outputs[0]: key 'range' applies to integer files (PNG, 8- and 16-bit "
+            "TIFF); this float TIFF stores the values themselves");
   EXPECT_EQ(parseError(withOutput(R"({"map": "derivative", "file": "d.png", "range": "max"})")),
             "scene.json: outputs[0]: range \"max\" must be a positive number or \"auto\"");
   EXPECT_EQ(parseError(withOutput(R"({"map": "height", "file": "h.png", "range": "auto"})")),

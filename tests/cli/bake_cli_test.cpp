@@ -488,6 +488,8 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
             "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--map", "derivative", "--range", "automatic", "-o",
             (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "derivative", "--range", "auto", "-o",
+            (dir_ / "o.exr").string()},
            // Options that would change nothing: no layer for them, another map, no subdivision.
            {"bake", "--mesh", mesh, "--height-scale", "2", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--filter", "bicubic", "-o", (dir_ / "o.png").string()},
