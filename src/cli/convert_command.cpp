@@ -146,8 +146,47 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
                            " UV set(s); --uv " + std::to_string(args.uvSet) +
                            " does not exist (UV sets are numbered from 0)");
   }
-  Result<Image> image = loadImage(args.input);
+  std::vector<std::pair<std::string, std::string>> said;  // the input's sgbake:… attributes
+  LoadImageOptions imageOptions;
+  imageOptions.attributes = &said;
+  Result<Image> image = loadImage(args.input, imageOptions);
   if (!image) return image.error();
+  // A map sgbake wrote says what it holds: its space must be --from, and its UDIM tile and
+  // green convention are what --tile and --green default to.
+  const auto saidOf = [&said](std::string_view key) {
+    for (const auto& [name, value] : said) {
+      if (name == key) return value;
+    }
+    return std::string();
+  };
+  const std::string map = saidOf("sgbake:map");
+  if ((map == "object-normal" || map == "tangent-normal") &&
+      map != std::string(normalSpaceName(*from)) + "-normal") {
+    return Error::badInput(args.input + ": the file says it is a " + map +
+                           " map (sgbake:map); --from " + std::string(normalSpaceName(*from)) +
+                           " would misread it");
+  }
+  int tile = args.tile;
+  const std::string saidTile = saidOf("sgbake:udim_tile");
+  if (!saidTile.empty() && saidTile != std::to_string(args.tile)) {
+    char* end = nullptr;
+    const long number = std::strtol(saidTile.c_str(), &end, 10);
+    const bool valid = *end == '\0' && number >= kFirstUdimTile && number <= kLastUdimTile;
+    if (valid && app.count("--tile") == 0) {
+      tile = static_cast<int>(number);
+    } else if (valid) {
+      std::fprintf(stderr,
+                   "sgbake: warning: %s: the file says it is UDIM tile %s (sgbake:udim_tile); "
+                   "converted as tile %d, as --tile says\n",
+                   args.input.c_str(), saidTile.c_str(), args.tile);
+    }
+  }
+  std::string green = args.green;
+  const std::string saidGreen = saidOf("sgbake:green");
+  if (*from == NormalSpace::kTangent && app.count("--green") == 0 &&
+      (saidGreen == "opengl" || saidGreen == "directx")) {
+    green = saidGreen;
+  }
   if (image->channels() < 3) {
     return Error::badInput(args.input + ": image has " + std::to_string(image->channels()) +
                            " channel(s) but a normal map needs 3 (RGB)");
@@ -171,8 +210,8 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
 
   ConvertSettings settings;
   settings.uvSet = args.uvSet;
-  settings.udimTile = args.tile;
-  settings.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
+  settings.udimTile = tile;
+  settings.green = green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
   settings.samples = args.samples;
   settings.threads = args.threads;
   if (limit) {
@@ -193,9 +232,9 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   writeOptions.attributes = {{"sgbake:map", toTangent ? "tangent-normal" : "object-normal"},
                              {"sgbake:encoding", "n/2+0.5"},
                              {"sgbake:uv", std::to_string(args.uvSet)},
-                             {"sgbake:udim_tile", std::to_string(args.tile)},
+                             {"sgbake:udim_tile", std::to_string(tile)},
                              {"sgbake:version", sgbake_version()}};
-  if (toTangent) writeOptions.attributes.emplace_back("sgbake:green", args.green);
+  if (toTangent) writeOptions.attributes.emplace_back("sgbake:green", green);
   Result<ImageFileWriter> writer =
       ImageFileWriter::open(args.output, input.width, input.height, 3, writeOptions);
   if (!writer) return writer.error();
@@ -234,13 +273,13 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   const double commitSeconds = step.lap();
   // A tile no UV triangle reaches converts nothing: said, as `bake` says it of its maps.
   const std::vector<int> touched = udimTiles(*mesh, args.uvSet);
-  if (std::find(touched.begin(), touched.end(), args.tile) == touched.end()) {
+  if (std::find(touched.begin(), touched.end(), tile) == touched.end()) {
     std::fprintf(stderr,
                  "sgbake: warning: %s: no triangle of UV set %d lies in %s; every texel keeps "
                  "the input's value\n",
                  args.output.c_str(), args.uvSet,
-                 args.tile == kFirstUdimTile ? "the 0-1 UV square"
-                                             : ("UDIM tile " + std::to_string(args.tile)).c_str());
+                 tile == kFirstUdimTile ? "the 0-1 UV square"
+                                        : ("UDIM tile " + std::to_string(tile)).c_str());
   }
   if (const std::uint64_t clipped = writer->clippedValues(); clipped != 0) {
     const std::string warning = describeClippedValues(

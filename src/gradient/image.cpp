@@ -105,6 +105,7 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
   std::unique_ptr<io_detail::ImageReader> in = (*codec)->openReader(path, reason);
   if (!in) return fileError(path, "cannot read image (" + io_detail::oneLineReason(reason) + ")");
   const io_detail::ImageHeader spec = in->header();
+  if (options.attributes != nullptr) *options.attributes = spec.attributes;
   if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0) {
     return fileError(path, "image has zero size (" + std::to_string(spec.width) + "x" +
                                std::to_string(spec.height) + ", " + channelsText(spec.channels) +

@@ -28,7 +28,7 @@
 namespace sgbake::io_detail {
 
 /// Bumped whenever anything in this header changes.
-inline constexpr int kImageCodecVersion = 1;
+inline constexpr int kImageCodecVersion = 2;
 /// The module's entry point: `const ImageCodec* sgbake_image_codec(int version)`, nullptr when
 /// @p version is not the module's.
 inline constexpr const char* kImageCodecEntryPoint = "sgbake_image_codec";
@@ -53,6 +53,8 @@ constexpr std::size_t pixelTypeSize(PixelType type) {
 /// What an image file holds (its first subimage at full resolution).
 struct ImageHeader {
   int width = 0, height = 0, depth = 1, channels = 0;
+  /// The file's string attributes named "sgbake:…" (name, value), as baked files carry them
+  std::vector<std::pair<std::string, std::string>> attributes;
 };
 
 /// An image file opened for reading.

@@ -40,7 +40,14 @@ class OiioReader final : public ImageReader {
 
   ImageHeader header() const override {
     const OIIO::ImageSpec& spec = in_->spec();
-    return {spec.width, spec.height, spec.depth, spec.nchannels};
+    ImageHeader header{spec.width, spec.height, spec.depth, spec.nchannels, {}};
+    for (const OIIO::ParamValue& p : spec.extra_attribs) {
+      const std::string name = p.name().string();
+      if (name.starts_with("sgbake:") && p.type() == OIIO::TypeDesc::STRING) {
+        header.attributes.emplace_back(name, p.get_string());
+      }
+    }
+    return header;
   }
   bool readFloat(int channels, float* first, std::ptrdiff_t pixelStride,
                  std::ptrdiff_t rowStride) override {

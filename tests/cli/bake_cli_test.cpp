@@ -924,6 +924,41 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
                           ": no triangle of UV set 0 lies in UDIM tile 1002; every texel keeps "
                           "the input's value\n");
 
+  // The converted file says what it holds: read with the wrong --from it is refused.
+  const ProcessResult wrongSpace =
+      run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "object", "--to",
+           "tangent", (dir_ / "ts.exr").string(), "-o", (dir_ / "again.exr").string()});
+  EXPECT_EQ(wrongSpace.exitCode, 2);
+  EXPECT_EQ(wrongSpace.err, "sgbake: error: " + (dir_ / "ts.exr").string() +
+                                ": the file says it is a tangent-normal map (sgbake:map); --from "
+                                "object would misread it\n");
+  // Its tile is the default of --tile: a map of tile 1002 converts back as tile 1002.
+  writeFile(dir_ / "plane1002.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 2 0\nvt 2 1\nvt 1 1\n"
+            "f 1/1 2/2 3/3 4/4\n");
+  const std::string mesh1002 = (dir_ / "plane1002.obj").string();
+  ASSERT_EQ(run({"convert", "--mesh", mesh1002, "--from", "object", "--to", "tangent", "--tile",
+                 "1002", (dir_ / "os.png").string(), "-o", (dir_ / "ts1002b.exr").string()})
+                .exitCode,
+            0);
+  const ProcessResult tileBack =
+      run({"convert", "--mesh", mesh1002, "--from", "tangent", "--to", "object",
+           (dir_ / "ts1002b.exr").string(), "-o", (dir_ / "os1002.exr").string()});
+  ASSERT_EQ(tileBack.exitCode, 0) << tileBack.err;
+  EXPECT_EQ(tileBack.err, "") << "tile 1002, which the UVs reach";
+  std::unique_ptr<OIIO::ImageInput> back1002 =
+      OIIO::ImageInput::open((dir_ / "os1002.exr").string());
+  ASSERT_TRUE(back1002);
+  EXPECT_EQ(back1002->spec().get_string_attribute("sgbake:udim_tile"), "1002");
+  // An explicit --tile wins, with a warning.
+  const ProcessResult overridden =
+      run({"convert", "--mesh", mesh1002, "--from", "tangent", "--to", "object", "--tile", "1001",
+           (dir_ / "ts1002b.exr").string(), "-o", (dir_ / "os1001.exr").string()});
+  EXPECT_NE(overridden.err.find("the file says it is UDIM tile 1002 (sgbake:udim_tile); "
+                                "converted as tile 1001, as --tile says"),
+            std::string::npos)
+      << overridden.err;
+
   // An alpha of 2 (kept as it is) does not fit a PNG: clamped, with a warning counting it.
   writeTestImage(dir_ / "os_alpha.exr", 8, {0.5f, 0.5f, 1.0f, 2.0f}, false);
   const ProcessResult alpha =

@@ -13,6 +13,8 @@
 #include <cstddef>
 #include <filesystem>
 #include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sgbake/core/result.hpp"
@@ -92,6 +94,9 @@ enum class ImageChannels {
 /// @brief Options for loadImage.
 struct LoadImageOptions {
   ImageChannels channels = ImageChannels::kAll;
+  /// When not null, set to the file's "sgbake:…" string attributes (name, value): how a file
+  /// sgbake wrote says it is encoded (sgbake:map, sgbake:udim_tile, sgbake:green, …).
+  std::vector<std::pair<std::string, std::string>>* attributes = nullptr;
 };
 
 /// @brief Reads the first subimage (full resolution) of an image file through OpenImageIO (in
