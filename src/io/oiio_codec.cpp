@@ -164,8 +164,10 @@ class OiioWriter final : public ImageWriter {
     return closed && !proxyFailed();
   }
   std::string error() override {
-    std::string error = out_->geterror();
-    if (proxyFailed()) error = proxy_->failure() + (error.empty() ? "" : "; " + error);
+    std::string error = out_->geterror();  // (read either way: it clears OpenImageIO's text)
+    // The file's own failure says it all; OpenImageIO then adds one "Write error at position
+    // …" per later write that went nowhere.
+    if (proxyFailed()) return proxy_->failure();
     return error;
   }
 
