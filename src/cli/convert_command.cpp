@@ -48,7 +48,9 @@ struct ConvertArguments {
 
 constexpr const char* kFooter =
     "What it does:\n"
-    "  Every texel the mesh covers (in the UV set, tile 1001 unless --tile) is decoded as\n"
+    "  Every texel the mesh covers (in the UV set; tile 1001 unless --tile, or the tile a map\n"
+    "  sgbake wrote says it is, sgbake:udim_tile; its sgbake:green is --green's default, and\n"
+    "  its sgbake:map must agree with --from) is decoded as\n"
     "  n = 2c - 1 and re-expressed in the per-texel MikkTSpace frame Blender's baker uses:\n"
     "  object -> tangent applies inverse([T B N]); tangent -> object applies x T + y B + z N.\n"
     "  Texels outside the UV islands keep their input values. The output has the input's size;\n"
