@@ -4,10 +4,12 @@
 #include <malloc.h>
 
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <exception>
 #include <new>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -75,7 +77,15 @@ std::string sentenceCase(std::string message) {
 /// Reports a command-line error as one line and returns the exit code; help and version
 /// requests (which CLI11 also raises as exceptions) print to stdout and succeed.
 int handleParseError(const CLI::App& app, const CLI::ParseError& e) {
-  if (dynamic_cast<const CLI::Success*>(&e) != nullptr) return app.exit(e);
+  if (dynamic_cast<const CLI::Success*>(&e) != nullptr) {
+    const int code = app.exit(e);
+    // Help or a version nobody could read (a full disk, a closed pipe) is not a success.
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
+      printError("cannot write to standard output: " + std::generic_category().message(errno));
+      return kExitInternal;
+    }
+    return code;
+  }
 
   const std::vector<CLI::App*> chosen = app.get_subcommands();
   if (!chosen.empty()) {

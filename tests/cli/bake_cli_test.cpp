@@ -393,7 +393,15 @@ TEST_F(BakeCliTest, ExplainPrintsThePlanAndBakesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "h.exr"));
   EXPECT_FALSE(fs::exists(dir_ / ".sgbake-manifest.json"));
 
-  // A plan, or the list of files written, that cannot be written is an error, not exit 0.
+  // A plan, the list of files written, help or the version that cannot be written is an
+  // error, not exit 0.
+  for (const char* words : {" --help", " --version", " bake --help"}) {
+    const ProcessResult full = test::runProcess(
+        {"/bin/sh", "-c", "exec '" + std::string(SGBAKE_CLI) + "'" + words + " > /dev/full"});
+    EXPECT_EQ(full.exitCode, 1) << words << ": " << full.err;
+    EXPECT_NE(full.err.find("sgbake: error: cannot write to standard output"), std::string::npos)
+        << full.err;
+  }
   for (const char* extra : {" --explain", ""}) {
     const ProcessResult full =
         test::runProcess({"/bin/sh", "-c",
