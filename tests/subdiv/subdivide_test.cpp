@@ -105,6 +105,41 @@ TEST(Subdivide, CountsAreThoseOfBlendersModifier) {
   }
 }
 
+TEST(Subdivide, LevelOneIsBlendersMeshIndexForIndex) {
+  // A quad, two triangles, a pentagon and a hexagon with an open boundary, as an OBJ Blender
+  // 3.4 imports (edges numbered by its hash tables), subdivided once by its modifier: the
+  // faces below are the vertex indices Blender's evaluated mesh gave (BlenderSubdivisionOrder
+  // compares with Blender itself, at more levels and on Suzanne).
+  const Mesh mesh =
+      meshOf({{1, 1, 0.1f},
+              {0, 0, 0},
+              {2, 0, 0.2f},
+              {1, 0, 0},
+              {0, 1, 0},
+              {2, 1, 0},
+              {3, 0.5f, 0.3f},
+              {1.5f, 2, 0},
+              {0.5f, 1.8f, 0.2f},
+              {-0.5f, 1.5f, 0},
+              {2.6f, 1.6f, 0.1f},
+              {-0.7f, 0.5f, 0}},
+             {{1, 3, 0, 4}, {3, 2, 5, 0}, {2, 6, 5}, {0, 5, 10, 7, 8}, {4, 0, 8, 9, 11, 1}});
+  const std::vector<std::vector<std::uint32_t>> blender = {
+      {1, 14, 28, 15},  {14, 3, 23, 28}, {28, 23, 0, 25}, {15, 28, 25, 4},  {3, 12, 29, 23},
+      {12, 2, 16, 29},  {29, 16, 5, 26}, {23, 29, 26, 0}, {2, 17, 30, 16},  {6, 18, 30, 17},
+      {5, 16, 30, 18},  {0, 26, 31, 19}, {5, 21, 31, 26}, {10, 22, 31, 21}, {7, 13, 31, 22},
+      {8, 19, 31, 13},  {4, 25, 32, 15}, {0, 19, 32, 25}, {8, 20, 32, 19},  {9, 24, 32, 20},
+      {11, 27, 32, 24}, {1, 15, 32, 27}};
+  Result<Mesh> fine = subdivideMesh(mesh, {1});
+  ASSERT_TRUE(fine) << fine.error().message;
+  ASSERT_EQ(fine->numFaces(), blender.size());
+  for (std::size_t f = 0; f < blender.size(); ++f) {
+    const std::vector<std::uint32_t> face(fine->cornerVertex.begin() + fine->faceStart[f],
+                                          fine->cornerVertex.begin() + fine->faceStart[f + 1]);
+    EXPECT_EQ(face, blender[f]) << "face " << f;
+  }
+}
+
 TEST(Subdivide, VerticesNoFaceUsesKeepTheirIndexAndPlace) {
   // The cube with two loose vertices among its own (indices 3 and 9), as Blender keeps them.
   Mesh mesh =
