@@ -192,10 +192,19 @@ def tile_pixels(image):
 
 def layer_images(layers):
     """{name: image_pixels(image)} of every image the layers read (their images and masks),
-    named as scene.image_key names them: a UDIM image's tiles as NAME.1001, NAME.1002, ...
+    named as scene.image_key and scene.tile_key name them (a UDIM image's tiles as
+    "NAME (tile 1001)", ...).
     Layers are named layers[i], counted from 0 as in libsgbake's messages about the same
     list."""
     images = {}
+    owners = {}  # key -> the Blender image sent under it
+
+    def add(key, image, pixels):
+        if owners.setdefault(key, image.name) != image.name:
+            raise BakeInputError(f"images '{owners[key]}' and '{image.name}' would both be sent "
+                                 f"as '{key}' (rename one)")
+        images[key] = pixels
+
     for index, layer in enumerate(layers):
         used = [layer.mask_image] if layer.mask_image is not None else []
         if layer.type in scene.IMAGE_LAYER_TYPES:
@@ -204,13 +213,14 @@ def layer_images(layers):
                                      "image")
             used.insert(0, layer.image)
         for image in used:
+            if image.name in owners.values():  # read once, however many layers use it
+                continue
             try:
                 if image.source != "TILED":
-                    if image.name not in images:
-                        images[image.name] = image_pixels(image)
+                    add(scene.image_key(image), image, image_pixels(image))
                     continue
                 for tile, pixels in tile_pixels(image).items():
-                    images[f"{image.name}.{tile}"] = pixels
+                    add(scene.tile_key(image, tile), image, pixels)
             except BakeInputError as exc:
                 raise BakeInputError(f"layers[{index}] '{layer.name}': {exc}") from None
     return images
@@ -236,6 +246,38 @@ def image_tiles(image):
     if image is not None and image.source == "TILED":
         return [tile.number for tile in image.tiles]
     return [1001]
+
+
+def blender_name(name):
+    """`name` as Blender stores an ID name: at most 63 bytes of UTF-8, cut at a character
+    boundary (so that an image made under `name` is found again under it)."""
+    return name.encode("utf-8")[:63].decode("utf-8", errors="ignore")
+
+
+def check_target(image):
+    """Raises BakeInputError when the single image `image` cannot be baked into: Blender's
+    render or compositing result, or an image without pixels (its file is missing)."""
+    if image.type in {"RENDER_RESULT", "COMPOSITING"}:
+        raise BakeInputError(f"image '{image.name}' is Blender's render result: bake into "
+                             "another image")
+    if image.size[0] == 0 or image.size[1] == 0:
+        raise BakeInputError(f"target image '{image.name}' has no pixels (is its file "
+                             "missing? reload it or pick another image)")
+
+
+def check_memory(width, height):
+    """Raises BakeInputError when a width x height bake cannot fit in this machine's memory:
+    the library holds ~6 floats per texel (the map, its coverage, a copy for padding) and the
+    add-on 4 more (the RGBA pixels it gets back)."""
+    needed = width * height * 10 * 4
+    try:
+        memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError):
+        return
+    if needed > memory:
+        raise BakeInputError(f"a {width} x {height} bake needs about {needed / 2**30:.0f} GiB, "
+                             f"more than this machine's {memory / 2**30:.0f} GiB (try a "
+                             "smaller size)")
 
 
 def target_image(target, name, width, height):

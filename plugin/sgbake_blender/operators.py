@@ -66,11 +66,17 @@ class BakeJob:
         self.threads = settings.threads
         # What finish() needs, fixed now: the settings may change while the bake runs.
         self.map, self.width, self.height = settings.map, settings.width, settings.height
-        self.target = settings.target_image.name if settings.target_image else None
-        self.default_name = f"{ob.name}_{settings.map}"
+        # The target is found again by its identity, not its name: it may be renamed meanwhile.
+        target = settings.target_image
+        self.target = target.name if target else None
+        self.target_pointer = target.as_pointer() if target else None
+        self.default_name = gather.blender_name(f"{ob.name}_{settings.map}")
         # A tiled (UDIM) target gets every one of its tiles, each baked by its own call.
-        image = bpy.data.images.get(self.target or self.default_name)
+        image = target if target else bpy.data.images.get(self.default_name)
         self.tiled = image is not None and image.source == "TILED"
+        if image is not None and not self.tiled:
+            gather.check_target(image)
+        gather.check_memory(self.width, self.height)
         self.tiles = gather.image_tiles(image)
         self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
                                               subdivision)
@@ -104,12 +110,23 @@ class BakeJob:
             self.rgba = rgba
         except capi.SgbakeError as exc:
             self.error = exc
+        except MemoryError:
+            self.error = capi.SgbakeError(f"not enough memory for a {self.width} x "
+                                          f"{self.height} bake (try a smaller size)")
+        except Exception as exc:  # on the worker thread: reported, not lost with the thread
+            self.error = capi.SgbakeError(f"the bake failed: {type(exc).__name__}: {exc}")
         self.seconds = time.perf_counter() - start
 
     def finish(self):
         """Writes the pixels into the target image (after a successful run); returns the image
         and notes for the report. Raises BakeInputError when the target changed meanwhile."""
-        target = bpy.data.images.get(self.target) if self.target else None
+        target = None
+        if self.target_pointer is not None:
+            target = next((image for image in bpy.data.images
+                           if image.as_pointer() == self.target_pointer), None)
+            if target is None:
+                raise gather.BakeInputError(f"the target image '{self.target}' was removed "
+                                            "during the bake; nothing was written")
         if self.tiled:
             image = target if self.target else bpy.data.images.get(self.default_name)
             if image is None or image.source != "TILED":
@@ -117,7 +134,11 @@ class BakeJob:
                                             "longer a UDIM image; bake again")
             return image, gather.write_tiles(image, self.rgba, self.width, self.height)
         image = gather.target_image(target, self.default_name, self.width, self.height)
-        gather.write_pixels(image, self.rgba[1001])
+        try:
+            gather.write_pixels(image, self.rgba[1001])
+        except RuntimeError as exc:  # an image Blender cannot hold pixels in after all
+            raise gather.BakeInputError(f"image '{image.name}' cannot take the pixels: "
+                                        f"{exc}") from None
         return image, []
 
     def tile_notes(self, image_name):

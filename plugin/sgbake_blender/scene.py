@@ -67,9 +67,18 @@ def _pair(values):
 
 
 def image_key(image):
-    """The name a layer's "image" gives a Blender image: its name, or for a UDIM (tiled) image
-    NAME.<UDIM>, whose tiles gather.layer_images sends as NAME.1001, NAME.1002, ..."""
-    return f"{image.name}.<UDIM>" if image.source == "TILED" else image.name
+    """The name a layer's "image" gives a Blender image in the library's scene: its name, or
+    for a UDIM (tiled) image "NAME (tile <UDIM>)", whose tiles gather.layer_images sends as
+    "NAME (tile 1001)", "NAME (tile 1002)", ... (not NAME.1001: a single image may be called
+    that). '<' and '>' in a name become '‹' and '›', so that no name reads as a <UDIM> token
+    (Blender names a UDIM image opened from h.<UDIM>.png "h.<UDIM>.png")."""
+    name = image.name.replace("<", "\u2039").replace(">", "\u203a")
+    return f"{name} (tile <UDIM>)" if image.source == "TILED" else name
+
+
+def tile_key(image, tile):
+    """The name tile `tile` of the UDIM image `image` is sent under (see image_key)."""
+    return image_key(image).replace("<UDIM>", str(tile))
 
 
 def mask_json(layer, uv_index):

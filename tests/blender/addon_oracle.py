@@ -242,6 +242,26 @@ def error_reports(settings, prefs, height, work, library_path):
                                "'tiled_input' is a UDIM image whose tiles are not files", bake))
     settings.layers.remove(len(settings.layers) - 1)
 
+    # A target whose file went missing, and a size no machine here holds: one-line reports
+    # before the bake, no traceback and no image made.
+    images_before = set(bpy.data.images.keys())
+    gone = bpy.data.images.new("gone_target", 8, 8)
+    gone.filepath_raw = os.path.join(work, "missing", "gone_target.png")
+    gone.source = "FILE"
+    gone.reload()
+    settings.target_image = gone
+    checks.append(expect_error("target image whose file is missing", "has no pixels", bake))
+    settings.target_image = None
+    bpy.data.images.remove(gone)
+    width, height_px = settings.width, settings.height
+    settings.width = settings.height = 65536
+    checks.append(expect_error("a size beyond the machine's memory", "GiB, more than this "
+                               "machine's", bake))
+    settings.width, settings.height = width, height_px
+    stray = set(bpy.data.images.keys()) - images_before
+    checks.append({"name": "refused bakes leave no image", "ok": not stray,
+                   "expected": "no new image", "message": f"new images {sorted(stray)}"})
+
     prefs.library_path = os.path.join(work, "missing", "libsgbake.so")
     checks.append(expect_error("library path that does not exist", "does not exist", bake))
     prefs.library_path = library_path
@@ -439,6 +459,8 @@ def udim_input_case(settings, work, checks):
         bc.save_exr(img, os.path.join(work, f"height_swapped.{2003 - tile}.exr"))
         bpy.data.images.remove(img)
     heights = bc.load_tiled(os.path.join(work, "height_tiles.<UDIM>.exr"), list(fields))
+    # Named as Image > Open names a tiled image it finds by a tile's file: with "<UDIM>" in it.
+    heights.name = "height_tiles.<UDIM>.exr"
     target = bpy.data.images.new("udim_in_target", 64, 64, alpha=True, float_buffer=True,
                                  tiled=True)
     target.tiles.new(1002)
