@@ -253,7 +253,7 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
         if material is None or not material.use_nodes:
             self.report({"ERROR"}, "the active object has no active node material")
             return {"CANCELLED"}
-        found, skipped = material_layers(material.node_tree)
+        found, skipped, ignored = material_layers(material.node_tree)
         if not found:
             self.report({"ERROR"}, f"material '{material.name}' has no Bump or Normal Map node "
                                    "fed by an Image Texture node" + _notes(skipped))
@@ -267,8 +267,12 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
                 setattr(layer, key, value)
         settings.active_layer_index = len(settings.layers) - 1
         added = ", ".join(f"{v['type']} '{v['image'].name}' x {v['scale']:.4g}" for v in found)
-        self.report({"INFO"}, f"added {len(found)} layer(s) from '{material.name}': {added}"
-                              + _notes(skipped))
+        # What the layers could not take over is a warning: the bake will differ from Cycles'.
+        self.report({"WARNING" if ignored else "INFO"},
+                    f"added {len(found)} layer(s) from '{material.name}': {added}"
+                    + _notes(skipped)
+                    + (f" (ignored, the layers read their UV maps as they are: "
+                       f"{'; '.join(ignored)})" if ignored else ""))
         return {"FINISHED"}
 
 
@@ -282,6 +286,35 @@ def _linked_image_node(socket):
         return None
     node = socket.links[0].from_node
     return node if node.type == "TEX_IMAGE" and node.image is not None else None
+
+
+def _not_image(socket):
+    """Why `socket` gave no layer: what is linked into it instead of an Image Texture node."""
+    if socket.is_linked and socket.links[0].from_node.type == "TEX_IMAGE":
+        return f"{socket.name}'s Image Texture node has no image"
+    return f"{socket.name} is not an Image Texture node"
+
+
+def _ignored(node, tex, inputs):
+    """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` a layer cannot
+    take over: a Vector input other than a UV map (a Mapping node, object or generated
+    coordinates), a projection other than Flat, and node-driven `inputs` (of which the layer
+    takes the unconnected value)."""
+    notes = []
+    vector = tex.inputs["Vector"]
+    if vector.is_linked:
+        link = vector.links[0]
+        uv = link.from_node.type == "UVMAP" or (link.from_node.type == "TEX_COORD"
+                                                 and link.from_socket.name == "UV")
+        if not uv:
+            notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
+    if tex.projection != "FLAT":
+        notes.append(f"'{tex.name}' {tex.projection.title()} projection")
+    for name in inputs:
+        if node.inputs[name].is_linked:
+            notes.append(f"'{node.name}' {name} from a node (its own value "
+                         f"{node.inputs[name].default_value:.4g} is used)")
+    return notes
 
 
 def _texture_settings(node):
@@ -303,14 +336,16 @@ def material_layers(node_tree):
 
     Bump: scale = Distance x Strength, negated when Invert is on (Cycles blends the bumped
     normal by Strength; for a Strength of 1 the two are the same). Normal Map: its space
-    (Tangent or Object) and its Strength."""
-    found, skipped = [], []
+    (Tangent or Object) and its Strength. Then notes on what the layers cannot take over
+    (_ignored): the layers are made, and the report says what differs."""
+    found, skipped, ignored = [], [], []
     for node in node_tree.nodes:
         if node.type == "BUMP":
             tex = _linked_image_node(node.inputs["Height"])
             if tex is None:
-                skipped.append(f"'{node.name}': Height is not an Image Texture node")
+                skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
                 continue
+            ignored += _ignored(node, tex, ("Strength", "Distance"))
             scale = node.inputs["Distance"].default_value * node.inputs["Strength"].default_value
             values = _texture_settings(tex)
             values.update(type="height", scale=-scale if node.invert else scale)
@@ -319,16 +354,17 @@ def material_layers(node_tree):
             tex = _linked_image_node(node.inputs["Color"])
             space = NORMAL_MAP_SPACES.get(node.space)
             if tex is None or space is None:
-                why = ("Color is not an Image Texture node" if tex is None
+                why = (_not_image(node.inputs["Color"]) if tex is None
                        else f"space {node.space} is not Tangent or Object")
                 skipped.append(f"'{node.name}': {why}")
                 continue
+            ignored += _ignored(node, tex, ("Strength",))
             values = _texture_settings(tex)
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
             if space == "tangent" and node.uv_map:
                 values["uv_map"] = node.uv_map
             found.append(values)
-    return found, skipped
+    return found, skipped, ignored
 
 
 class SGBAKE_OT_layer_add(bpy.types.Operator):

@@ -148,8 +148,11 @@ def output_json(settings, tile=1001):
 
 
 def baked_layers(settings):
-    """The layers the settings' map reads: all of them, or none for LAYERLESS_MAPS."""
-    return [] if settings.map in LAYERLESS_MAPS else list(settings.layers)
+    """The layers the settings' map reads: all but those of weight 0 (turned off: they need
+    no image either), or none for LAYERLESS_MAPS."""
+    if settings.map in LAYERLESS_MAPS:
+        return []
+    return [layer for layer in settings.layers if layer.weight != 0]
 
 
 def limit_subdivision_json(modifier, edge_creases, vertex_creases):

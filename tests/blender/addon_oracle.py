@@ -188,6 +188,20 @@ def layers_from_material(settings, distance):
     if (len(layers) != 1 or any(layers[0][k] != v for k, v in expected.items())
             or abs(layers[0]["scale"] - distance) > 1e-7):  # float32 0.1 x 1
         entry["error"] = f"expected one {expected} layer with scale {distance}, got {layers}"
+    # A Mapping node before the Image Texture: the layer is still made, and what it cannot
+    # take over is named (the report then warns).
+    from sgbake_blender import operators
+    tree = bpy.context.active_object.active_material.node_tree
+    tex = next(node for node in tree.nodes if node.type == "TEX_IMAGE")
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    found, _, ignored = operators.material_layers(tree)
+    tree.nodes.remove(mapping)
+    _, _, none_ignored = operators.material_layers(tree)
+    if len(found) != 1 or not any("Vector from 'Mapping'" in note for note in ignored) \
+            or none_ignored:
+        entry["error"] = (f"a Mapping node should be named as ignored (and nothing without "
+                          f"it): {ignored}, then {none_ignored}")
     return entry
 
 
@@ -226,6 +240,14 @@ def error_reports(settings, prefs, height, work, library_path):
     layer = settings.layers.add()
     layer.name = "empty"
     checks.append(expect_error("layer without an image", "has no image", bake))
+    layer.weight = 0.0  # turned off: it needs no image
+    try:
+        off = sorted(bake())
+    except RuntimeError as exc:
+        off = ["ERROR", str(exc).strip()]
+    checks.append({"name": "a layer of weight 0 without an image is left out", "ok": off == [
+        "FINISHED"], "expected": "FINISHED", "message": str(off)})
+    layer.weight = 1.0
     layer.type, layer.image, layer.filter = "normal", height, "hermite"
     checks.append(expect_error("scene refused by libsgbake", "filter 'hermite' is only", bake))
     layer.filter = "bilinear"
