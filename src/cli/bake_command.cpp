@@ -221,7 +221,6 @@ class ProgressBar {
 
 // ---- The command -------------------------------------------------------------------------------
 
-/// The scene of the one-map form: one output and the layers its options name.
 /// @p message (about the scene oneMapScene builds) in the words of the one-map flags: the scene's
 /// "outputs[0]: bit_depth 8 …" is "--bit-depth 8 …", "layers[0]: scale …" is
 /// "--height-scale …", and the layers and the output are named by their flags.
@@ -257,6 +256,7 @@ std::string inFlagWords(std::string message, const BakeArguments& args) {
   return message;
 }
 
+/// The scene of the one-map form: one output and the layers its options name.
 Result<Scene> oneMapScene(const BakeArguments& args) {
   if (args.mesh.empty()) return Error::badInput("bake: --mesh is required without a SCENE file");
   if (args.output.empty()) return Error::badInput("bake: -o/--output is required with --mesh");
