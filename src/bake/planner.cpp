@@ -1143,6 +1143,24 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   // With UDIM images the mesh comes first: only the tiles its UVs reach are loaded.
   const bool udim = std::any_of(plan.textures.begin(), plan.textures.end(),
                                 [](const PlannedTexture& t) { return !t.udimTiles.empty(); });
+  // The UDIM tiles each UV set touches, and its triangles in no tile: found once per set (a
+  // pass over every triangle), for the tiles to load and for every output on the set.
+  struct UvSetTiles {
+    std::vector<int> tiles;
+    std::size_t outside = 0;
+  };
+  // Sized once the mesh is loaded; the last entry stands for every set the mesh lacks (none).
+  std::vector<std::optional<UvSetTiles>> tilesBySet;
+  const auto uvSetTiles = [&](int uvSet) -> const UvSetTiles& {
+    if (tilesBySet.empty()) tilesBySet.resize(loaded.mesh.uvSets.size() + 1);
+    std::optional<UvSetTiles>& entry =
+        tilesBySet[std::min(static_cast<std::size_t>(uvSet), tilesBySet.size() - 1)];
+    if (!entry) {
+      entry.emplace();
+      entry->tiles = udimTiles(loaded.mesh, uvSet, &entry->outside);
+    }
+    return *entry;
+  };
   std::optional<Status> mesh;
   std::vector<bool> load, reached;  // reached: flags by tile number
   if (udim) {
@@ -1152,7 +1170,9 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         std::any_of(plan.outputs.begin(), plan.outputs.end(), [&](const PlannedOutput& o) {
           return !o.upToDate && s.outputs[o.sceneOutput].kind == OutputKind::kCorners;
         });
-    reached = plan_detail::reachedUdimTiles(loaded.mesh, cornerTable);
+    reached = plan_detail::reachedUdimTiles(
+        loaded.mesh, [&](int uvSet) -> const std::vector<int>& { return uvSetTiles(uvSet).tiles; },
+        cornerTable);
     load = plan_detail::imagesToLoad(plan, reached);
   }
   std::set<int> reachedTiles;  // for the manifest
@@ -1182,8 +1202,8 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     } else {
       // A map no UV triangle reaches holds only its background: said, not an error (a UV
       // set still being laid out, say).
-      std::size_t outside = 0;
-      const std::vector<int> touched = udimTiles(loaded.mesh, output.uvSet, &outside);
+      const std::vector<int>& touched = uvSetTiles(output.uvSet).tiles;
+      const std::size_t outside = uvSetTiles(output.uvSet).outside;
       const std::string uvSet = "UV set " + std::to_string(output.uvSet);
       if (hasUdimToken(output.file.string())) {
         if (outside > 0 && !touched.empty()) {  // (none in a tile: said below)

@@ -92,7 +92,8 @@ Status checkUvSets(const Plan& plan, const Mesh& mesh) {
 
 }  // namespace
 
-std::vector<bool> reachedUdimTiles(const Mesh& mesh, bool cornerTable) {
+std::vector<bool> reachedUdimTiles(const Mesh& mesh, const TouchedTiles& touched,
+                                   bool cornerTable) {
   // A corner on a tile's left or bottom edge samples that tile in the corner table (a UV of
   // exactly 1 samples the tile to the right); texels sample inside the triangles only.
   // One flag per tile number (0: outside the tiles), not a tree insertion per corner.
@@ -101,7 +102,7 @@ std::vector<bool> reachedUdimTiles(const Mesh& mesh, bool cornerTable) {
     if (tile <= kLastUdimTile) reached[static_cast<std::size_t>(tile)] = true;
   };
   for (std::size_t uv = 0; uv < mesh.uvSets.size(); ++uv) {
-    for (const int tile : udimTiles(mesh, static_cast<int>(uv))) reach(tile);
+    for (const int tile : touched(static_cast<int>(uv))) reach(tile);
     if (!cornerTable) continue;
     for (const Vec2f& corner : mesh.uvSets[uv].uvs) {
       Vec2d within;

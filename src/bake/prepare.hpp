@@ -90,10 +90,13 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded);
 /// Where the images of a plan come from: the image of a PlannedImage, with its channels.
 using ImageSource = std::function<Result<Image>(const PlannedImage&)>;
 
+/// The UDIM tiles UV set `uvSet` of a mesh touches (udimTiles), ascending.
+using TouchedTiles = std::function<const std::vector<int>&(int uvSet)>;
+
 /// @brief The UDIM tiles any layer or mask of a bake of @p mesh can sample, on any UV set: those
-/// a triangle overlaps, and with @p cornerTable (a corners output is baked) those a corner lies
-/// in. One flag per tile number, 0 … kLastUdimTile.
-std::vector<bool> reachedUdimTiles(const Mesh& mesh, bool cornerTable);
+/// a triangle overlaps (@p touched), and with @p cornerTable (a corners output is baked) those
+/// a corner lies in. One flag per tile number, 0 … kLastUdimTile.
+std::vector<bool> reachedUdimTiles(const Mesh& mesh, const TouchedTiles& touched, bool cornerTable);
 
 /// @brief Which images of the plan a bake reads: all but the UDIM tiles not in @p reached
 /// (reachedUdimTiles) that no layer reads directly.
