@@ -1236,11 +1236,9 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       } else {
         tiles[o] = {output.tile};
         if (std::find(touched.begin(), touched.end(), output.tile) == touched.end()) {
-          report.warnings.push_back(
-              output.file.string() + ": no triangle of " + uvSet + " lies in " +
-              (output.tile == kFirstUdimTile ? std::string("the 0-1 UV square")
-                                             : "UDIM tile " + std::to_string(output.tile)) +
-              "; the map holds only the background");
+          report.warnings.push_back(output.file.string() + ": no triangle of " + uvSet +
+                                    " lies in " + describeUdimTile(output.tile) +
+                                    "; the map holds only the background");
         }
       }
     }

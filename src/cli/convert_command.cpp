@@ -281,9 +281,7 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
     std::fprintf(stderr,
                  "sgbake: warning: %s: no triangle of UV set %d lies in %s; every texel keeps "
                  "the input's value\n",
-                 args.output.c_str(), args.uvSet,
-                 tile == kFirstUdimTile ? "the 0-1 UV square"
-                                        : ("UDIM tile " + std::to_string(tile)).c_str());
+                 args.output.c_str(), args.uvSet, describeUdimTile(tile).c_str());
   }
   if (const std::uint64_t clipped = writer->clippedValues(); clipped != 0) {
     const std::string warning = describeClippedValues(

@@ -59,6 +59,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -148,6 +149,10 @@ using MutableImageRows = BasicImageRows<float>;
 inline constexpr int kFirstUdimTile = 1001;
 /// Last UDIM tile number Blender accepts (u tile 9, v tile 99).
 inline constexpr int kLastUdimTile = 2000;
+/// UDIM tile @p tile in words for messages: "the 0-1 UV square" (1001) or "UDIM tile N".
+inline std::string describeUdimTile(int tile) {
+  return tile == kFirstUdimTile ? "the 0-1 UV square" : "UDIM tile " + std::to_string(tile);
+}
 /// Largest N of N×N supersampling.
 inline constexpr int kMaxBakeSamples = 16;
 /// Largest width or height of a bake, texels.
