@@ -234,11 +234,11 @@ std::string joinLabels(const std::vector<std::string>& labels) {
   return text;
 }
 
-/// How the manifest in @p dir (canonical) names @p path: relative to @p dir, in generic form
+/// How the manifest in @p dir names @p canonical (both canonical): relative to @p dir, in generic
+/// form
 /// ("h.png", "../textures/h.png"), or absolute where no relative path leads there (another
 /// root).
-std::string manifestName(const fs::path& path, const fs::path& dir) {
-  const fs::path canonical = canonicalPath(path);
+std::string manifestName(const fs::path& canonical, const fs::path& dir) {
   const fs::path relative = canonical.lexically_relative(dir);
   return relative.empty() ? canonical.generic_string() : relative.generic_string();
 }
@@ -717,11 +717,18 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
   plan.scene = std::move(scene);
   const Scene& s = plan.scene;
 
-  // Which layers each output reads; the files each output depends on.
+  // Which layers each output reads; the files each output depends on. Every output names and
+  // hashes its inputs: each path is made canonical once (a UDIM image has up to 1000 tiles).
+  std::map<std::string, fs::path> canonicalPaths;  // path as given → canonical
+  const auto canonicalOf = [&canonicalPaths](const fs::path& path) -> const fs::path& {
+    auto [it, added] = canonicalPaths.try_emplace(path.string());
+    if (added) it->second = canonicalPath(path);
+    return it->second;
+  };
   std::map<std::string, std::string> hashes;  // canonical path → hash
   const auto hashOf = [&](const fs::path& path, const std::string& user,
                           std::string_view what) -> Result<std::string> {
-    const std::string canonical = canonicalPath(path).string();
+    const std::string canonical = canonicalOf(path).string();
     if (const auto it = hashes.find(canonical); it != hashes.end()) return it->second;
     if (Status ok = checkInputFile(s, user, what, path); !ok) return ok.error();
     Result<std::string> hash = hashFile(path);
@@ -740,7 +747,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     // moved or checked out elsewhere as a whole is still up to date.
     const fs::path manifestDir = canonicalPath(directoryOf(output.file));
     const PathNamer name = [&](const fs::path& path) {
-      return s.inMemory ? path.string() : manifestName(path, manifestDir);
+      return s.inMemory ? path.string() : manifestName(canonicalOf(path), manifestDir);
     };
     const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
                                "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
