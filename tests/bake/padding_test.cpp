@@ -7,8 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <random>
 
+#include "bake_test_util.hpp"
 #include "sgbake/bake/bake.hpp"
 
 namespace sgbake {
@@ -302,6 +304,129 @@ TEST(Padding, InvalidImagesAreIgnored) {
   extendMargin(bad, 3);
   pushPullFill(bad);
   EXPECT_EQ(bad.pixels.size(), 5u);
+}
+
+}  // namespace
+}  // namespace sgbake
+
+namespace sgbake {
+namespace {
+
+// Adjacent Faces margin: two unit squares side by side in 3D (x ∈ [0, 2], y ∈ [0, 1]) whose UV
+// islands lie apart, the second turned by 90° (or mirrored). Each covered texel holds the 3D
+// point (x, y) it shows; a margin texel across the shared edge must hold the point the surface
+// continues to there, which the other island shows.
+struct SeamScene {
+  Mesh mesh;
+  FloatImage image;
+  bool mirrored = false;
+};
+
+constexpr int kSeamSize = 100;  // 0.2 UV = 20 texels: island edges lie between texel centres
+
+Vec2d islandA(Vec2d uv) { return {(uv.x - 0.2) / 0.2, (uv.y - 0.2) / 0.2}; }
+Vec2d islandB(Vec2d uv, bool mirrored) {
+  // Turned: uv = (0.7, 0.6) + 0.2·(−b, a); mirrored: uv = (0.5, 0.6) + 0.2·(b, a); (a, b) = (x − 1,
+  // y).
+  const double a = (uv.y - 0.6) / 0.2;
+  const double b = mirrored ? (uv.x - 0.5) / 0.2 : -(uv.x - 0.7) / 0.2;
+  return {1 + a, b};
+}
+
+SeamScene seamScene(bool mirrored) {
+  SeamScene s;
+  s.mirrored = mirrored;
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0},
+                                     {0, 1, 0}, {2, 0, 0}, {2, 1, 0}};
+  auto uvB = [&](float x, float y) {
+    const float a = x - 1, b = y;
+    return mirrored ? Vec2f{0.5f + 0.2f * b, 0.6f + 0.2f * a}
+                    : Vec2f{0.7f - 0.2f * b, 0.6f + 0.2f * a};
+  };
+  const std::vector<Vec2f> uvs{{0.2f, 0.2f}, {0.4f, 0.2f}, {0.4f, 0.4f}, {0.2f, 0.4f},
+                               uvB(1, 0),    uvB(2, 0),    uvB(2, 1),    uvB(1, 1)};
+  s.mesh = test::polygonMesh(positions, {{0, 1, 2, 3}, {1, 4, 5, 2}}, uvs);
+  s.image = holes(kSeamSize, kSeamSize, 2);
+  for (int row = 0; row < kSeamSize; ++row) {
+    for (int x = 0; x < kSeamSize; ++x) {
+      const Vec2d uv{(x + 0.5) / kSeamSize, 1 - (row + 0.5) / kSeamSize};
+      const bool inA = uv.x > 0.2 && uv.x < 0.4 && uv.y > 0.2 && uv.y < 0.4;
+      const bool inB = uv.x > 0.5 && uv.x < 0.7 && uv.y > 0.6 && uv.y < 0.8;
+      if (!inA && !inB) continue;
+      const Vec2d p = inA ? islandA(uv) : islandB(uv, mirrored);
+      cover(s.image, x, row, {static_cast<float>(p.x), static_cast<float>(p.y)});
+    }
+  }
+  return s;
+}
+
+TEST(AdjacentFacesMargin, ContinuesTheSurfaceAcrossASeam) {
+  for (const bool mirrored : {false, true}) {
+    SeamScene s = seamScene(mirrored);
+    const std::vector<float> before = s.image.pixels;
+    adjacentFacesMargin(s.image, s.mesh, 0, kFirstUdimTile, 1, 4);
+    int checked = 0;
+    for (int row = 0; row < kSeamSize; ++row) {
+      for (int x = 0; x < kSeamSize; ++x) {
+        const Vec2d uv{(x + 0.5) / kSeamSize, 1 - (row + 0.5) / kSeamSize};
+        std::optional<Vec2d> expected;
+        // Right of A, off the edge's ends: the surface continues into B.
+        if (uv.x > 0.4 && uv.x < 0.45 && uv.y > 0.22 && uv.y < 0.38) expected = islandA(uv);
+        // Beyond B's side on the shared edge (its bottom, v = 0.6): back into A.
+        if (uv.y < 0.6 && uv.y > 0.55 && uv.x > 0.52 && uv.x < 0.68)
+          expected = islandB(uv, mirrored);
+        if (!expected) continue;
+        ASSERT_FALSE(isHole(s.image, x, row))
+            << "mirrored " << mirrored << " texel " << x << "," << row;
+        EXPECT_NEAR(s.image.at(x, row, 0), expected->x, 1e-5)
+            << "mirrored " << mirrored << " " << x << "," << row;
+        EXPECT_NEAR(s.image.at(x, row, 1), expected->y, 1e-5)
+            << "mirrored " << mirrored << " " << x << "," << row;
+        ++checked;
+      }
+    }
+    EXPECT_EQ(checked, 2 * 5 * 16);  // 5 columns beyond A (margin 4 reaches 5), 5 rows below B
+    for (std::size_t i = 0; i < before.size(); ++i) {  // covered texels keep their values
+      if (s.image.coverage[i / 2] > 0) {
+        ASSERT_EQ(s.image.pixels[i], before[i]);
+      }
+    }
+  }
+}
+
+TEST(AdjacentFacesMargin, ReachesOneTexelBeyondTheMarginAsBlenderDoes) {
+  // Blender 3.4 writes margin + 1 texel rows beyond a straight island edge with Adjacent Faces
+  // (9 for margin 8), one more than its Extend margin.
+  for (const int margin : {1, 3, 8}) {
+    SeamScene s = seamScene(false);
+    adjacentFacesMargin(s.image, s.mesh, 0, kFirstUdimTile, 1, margin);
+    const int row = kSeamSize - 30;  // v = 0.295: across A's middle
+    int written = 0;
+    for (int x = 40; x < 50; ++x) written += isHole(s.image, x, row) ? 0 : 1;
+    EXPECT_EQ(written, margin + 1) << "margin " << margin;
+  }
+}
+
+TEST(AdjacentFacesMargin, ABoundaryEdgeRepeatsTheNearestPointOfTheFace) {
+  // Left of A the mesh ends: the margin holds the face's value at the edge's nearest point,
+  // which for a texel beside the island is the edge texel of the same row.
+  SeamScene s = seamScene(false);
+  adjacentFacesMargin(s.image, s.mesh, 0, kFirstUdimTile, 1, 4);
+  for (int row = kSeamSize - 38; row < kSeamSize - 22; ++row) {
+    for (int x = 15; x < 20; ++x) {
+      ASSERT_FALSE(isHole(s.image, x, row));
+      EXPECT_FLOAT_EQ(s.image.at(x, row, 0), s.image.at(20, row, 0));
+      EXPECT_FLOAT_EQ(s.image.at(x, row, 1), s.image.at(20, row, 1));
+    }
+  }
+}
+
+TEST(AdjacentFacesMargin, ThreadsGiveIdenticalBits) {
+  SeamScene a = seamScene(true), b = seamScene(true);
+  adjacentFacesMargin(a.image, a.mesh, 0, kFirstUdimTile, 1, 6, 1);
+  adjacentFacesMargin(b.image, b.mesh, 0, kFirstUdimTile, 1, 6, 2);
+  EXPECT_EQ(0, std::memcmp(a.image.pixels.data(), b.image.pixels.data(),
+                           a.image.pixels.size() * sizeof(float)));
 }
 
 }  // namespace

@@ -2,7 +2,8 @@
 
     blender -b --factory-startup --python-exit-code 1 \\
         --python tests/blender/bake_scene.py -- OUT_DIR [--cases NAME,...] [--size N]
-        [--passes object,tangent,mask] [--margin M] [--height-size H] [--samples S]
+        [--passes object,tangent,mask] [--margin M] [--margin-type EXTEND|ADJACENT_FACES]
+        [--height-size H] [--samples S]
 
 Used by bake_oracle.py (the BlenderBakeOracle test) and, as a module, by
 bench/bake_vs_cycles.py. For every case it builds one object at the origin (identity
@@ -12,7 +13,8 @@ transform, so object space = world space), gives it the material
     Bump (Strength 1, Distance = the case's scale S, not inverted) --Normal--> Diffuse BSDF.Normal
     Add Shader(Diffuse BSDF, Emission(white, strength 1)) --> Material Output.Surface
 
-and bakes with Cycles on the CPU (1 sample, denoising off, margin 0 unless --margin):
+and bakes with Cycles on the CPU (1 sample, denoising off, margin 0 unless --margin, of
+--margin-type, default EXTEND):
   blender_object.exr   NORMAL, normal_space OBJECT,  channels POS_X / POS_Y / POS_Z
   blender_tangent.exr  NORMAL, normal_space TANGENT, channels POS_X / POS_Y / POS_Z
   blender_mask.exr     EMIT of the white emission: 1 where a triangle covers the texel centre
@@ -192,7 +194,7 @@ def make_material(height_image, scale):
     return mat, target
 
 
-def bake_pass(ob, mat, target, image, kind, margin):
+def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND"):
     """Bakes one pass of `ob` into `image`; returns the seconds bpy.ops.object.bake took.
     kind: "object" / "tangent" (NORMAL in that space, +X +Y +Z) or "mask" (EMIT)."""
     target.image = image
@@ -200,7 +202,7 @@ def bake_pass(ob, mat, target, image, kind, margin):
     bpy.ops.object.select_all(action="DESELECT")
     ob.select_set(True)
     bpy.context.view_layer.objects.active = ob
-    kwargs = dict(margin=margin, margin_type="EXTEND", use_clear=False, target="IMAGE_TEXTURES",
+    kwargs = dict(margin=margin, margin_type=margin_type, use_clear=False, target="IMAGE_TEXTURES",
                   save_mode="INTERNAL", use_selected_to_active=False)
     if kind == "mask":
         kwargs["type"] = "EMIT"
@@ -216,7 +218,7 @@ def bake_pass(ob, mat, target, image, kind, margin):
 
 
 def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), margin=0,
-               height_size=HEIGHT_SIZE, save_bakes=True, runs=1):
+               height_size=HEIGHT_SIZE, save_bakes=True, runs=1, margin_type="EXTEND"):
     """Builds case `name`, writes mesh.obj and height.exr into out_dir, bakes `passes`
     (saved as blender_PASS.exr when save_bakes); returns the case's manifest entry. With
     runs > 1 every pass is baked that many times and bake_s keeps the fastest run; bake_cpu
@@ -244,13 +246,14 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
 
     entry = {"name": name, "dir": os.path.abspath(out_dir), "size": size, "scale": scale,
              "filter": "bilinear", "height_size": height_size, "margin": margin,
+             "margin_type": margin_type,
              "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {},
              "subdivision": SUBDIVISION[name]}
     for kind in passes:
         img = bake_common.new_float_image(f"blender_{kind}", size, size)
         for _ in range(runs):
             cpu0 = time.process_time()
-            seconds = bake_pass(ob, mat, target, img, kind, margin)
+            seconds = bake_pass(ob, mat, target, img, kind, margin, margin_type)
             cpu = time.process_time() - cpu0
             if kind not in entry["bake_s"] or seconds < entry["bake_s"][kind]:
                 entry["bake_s"][kind] = seconds
@@ -273,6 +276,7 @@ def parse_args(argv):
     parser.add_argument("--size", type=int, help="bake size (default: per case)")
     parser.add_argument("--passes", default="object,tangent,mask")
     parser.add_argument("--margin", type=int, default=0)
+    parser.add_argument("--margin-type", default="EXTEND", choices=("EXTEND", "ADJACENT_FACES"))
     parser.add_argument("--height-size", type=int, default=HEIGHT_SIZE)
     parser.add_argument("--samples", type=int, default=1)
     parser.add_argument("--threads", type=int, help="Cycles threads (default: all cores)")
@@ -290,7 +294,7 @@ def main(argv):
             raise SystemExit(f"unknown case {name!r} (known: {', '.join(CASES)})")
         entry = build_case(name, os.path.join(args.out_dir, name), size=args.size,
                            passes=args.passes.split(","), margin=args.margin,
-                           height_size=args.height_size)
+                           margin_type=args.margin_type, height_size=args.height_size)
         entry["blender_version"] = bpy.app.version_string
         entry["cycles_threads"] = scene.render.threads
         entry["samples"] = args.samples

@@ -287,6 +287,30 @@ void extendMarginRowsInPlace(const MutableImageRows& rows, int margin, int rowBe
 int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowEnd,
                      FloatImage& window, int threads = 0);
 
+/// @brief Edge padding as Blender's "Adjacent Faces" margin (Blender's default margin type):
+/// each uncovered texel near an island takes the value the surface has on the other side of
+/// the UV seam it faces, so mipmaps and filtering across a seam blend the right colours.
+///
+/// The margin is every uncovered texel within `margin + 1.5` texels of a covered one along
+/// 8-connected steps of 1 and √2 (Blender writes margin + 1 rows beyond a straight edge). Each
+/// starts at the face that covers its nearest covered texel and walks: while its point p (the
+/// texel centre, in that face's UV frame) lies outside the face, it crosses the face's edge
+/// nearest p into the face across it in the mesh, carrying p over with the edge — its position
+/// along the edge in proportion, its distance from the edge in texels, on the far side. Where
+/// p lands inside a face its value is the bilinear interpolation of the covered texels there.
+/// At a boundary edge (no face across) it is the face's value at the edge's point nearest p.
+/// A walk that lands outside the image, or crosses more than 8 edges, leaves the texel as it
+/// is. Values are read only from covered texels, so the result does not depend on the order.
+///
+/// Checked against Blender 3.4 (tests/blender/margin_oracle.py): along seams the values agree
+/// to float precision; where Blender's choice is arbitrary they differ — beyond the corner of
+/// an island where three or more faces meet, and around poles of triangle fans.
+/// @param mesh the mesh the image was baked from, with UV set @p uvSet; the image is tile
+///        @p udimTile baked with @p samples² samples per texel (its coverage must be the raster's)
+/// @param[in] threads 0 = all cores; the result does not depend on it
+void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udimTile, int samples,
+                         int margin, int threads = 0);
+
 /// @brief Fills every uncovered texel (coverage 0) by push-pull (Gortler et al. 1996): a
 /// pyramid of 2×2 weighted averages of the covered texels (weights clamped to 1), then, from
 /// the coarsest level down, each texel with weight w < 1 becomes w·own + (1−w)·(bilinear

@@ -1,0 +1,316 @@
+// Edge padding as Blender's "Adjacent Faces" margin: each texel of the margin takes the value
+// the surface has on the other side of the UV seam it faces. See bake.hpp for the rules.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "bake/raster.hpp"
+#include "sgbake/bake/bake.hpp"
+
+namespace sgbake {
+namespace {
+
+using bake_detail::RasterTriangle;
+using bake_detail::runWithThreads;
+using bake_detail::uvToTexel;
+using Point = std::complex<double>;
+
+/// Texels of the margin lie within this many texels, along 8-connected steps of length 1 and
+/// √2, of a covered texel, beyond `margin`: Blender's Adjacent Faces margin reaches one texel
+/// farther than its Extend margin of the same size (9 rows beyond a straight island edge for
+/// margin 8).
+constexpr double kReachBeyondMargin = 1.5;
+/// Seams crossed at most from a margin texel's nearest face to the face it is read from
+/// (a texel near a corner of an island may have to go round the corner's vertex).
+constexpr int kMaxFaceSteps = 8;
+
+/// Per polygon edge (corner k → k+1 of a face, numbered by corner k), the corner on the other
+/// side: the corner of the face across the same two vertices that starts that edge there, or
+/// −1 on a boundary. Non-manifold edges: the next face round the edge.
+std::vector<std::int64_t> oppositeCorners(const Mesh& mesh) {
+  std::vector<std::int64_t> across(mesh.numCorners(), -1);
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edges;
+  edges.reserve(mesh.numCorners());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const std::uint32_t begin = mesh.faceStart[f], n = mesh.faceSize(f);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t a = mesh.cornerVertex[begin + k];
+      const std::uint32_t b = mesh.cornerVertex[begin + (k + 1) % n];
+      if (a == b) continue;
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      edges[key].push_back(begin + k);
+    }
+  }
+  for (const auto& [key, corners] : edges) {
+    if (corners.size() < 2) continue;
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+      across[corners[k]] = corners[(k + 1) % corners.size()];
+    }
+  }
+  return across;
+}
+
+/// The triangle that claims each texel (−1: none), as rasterize() assigns them: the last
+/// triangle covering one of the texel's samples. Rows y up.
+std::vector<std::int32_t> texelOwners(const Mesh& mesh, int uvSet,
+                                      std::span<const std::array<std::uint32_t, 3>> triangles,
+                                      int width, int height, int samples, int udimTile) {
+  std::vector<std::int32_t> owner(static_cast<std::size_t>(width) * height, -1);
+  const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
+  std::vector<double> offsets(static_cast<std::size_t>(samples));
+  for (int i = 0; i < samples; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / samples;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const std::array<Vec2d, 3> texel{uvToTexel(uvs[triangles[t][0]], udimTile, width, height),
+                                     uvToTexel(uvs[triangles[t][1]], udimTile, width, height),
+                                     uvToTexel(uvs[triangles[t][2]], udimTile, width, height)};
+    RasterTriangle tri;
+    if (!bake_detail::setupRasterTriangle(texel, width, height, tri)) continue;
+    for (int y = tri.y0; y <= tri.y1; ++y) {
+      int first = 0, last = -1;
+      bake_detail::rowSpan(tri, y, offsets, first, last);
+      for (int x = first; x <= last; ++x) {
+        bool inside = false;
+        for (std::size_t j = 0; j < offsets.size() && !inside; ++j) {
+          for (std::size_t i = 0; i < offsets.size() && !inside; ++i) {
+            const double px = x + offsets[i], py = y + offsets[j];
+            inside = tri.edge[0].inside(tri.edge[0](px, py)) &&
+                     tri.edge[1].inside(tri.edge[1](px, py)) &&
+                     tri.edge[2].inside(tri.edge[2](px, py));
+          }
+        }
+        if (inside) owner[static_cast<std::size_t>(y) * width + x] = static_cast<std::int32_t>(t);
+      }
+    }
+  }
+  return owner;
+}
+
+/// Distance of @p p from the segment [a, b].
+double segmentDistance(Point p, Point a, Point b) {
+  const Point ab = b - a;
+  const double len2 = std::norm(ab);
+  const double s = len2 > 0 ? ((p - a) * std::conj(ab)).real() / len2 : 0.0;
+  if (s <= 0) return std::abs(p - a);  // the vertices exactly, so ties between edges are exact
+  if (s >= 1) return std::abs(p - b);
+  return std::abs(p - (a + s * ab));
+}
+
+/// Twice the signed area of (a, b, p): positive when p is left of a → b.
+double cross(Point a, Point b, Point p) { return (std::conj(b - a) * (p - a)).imag(); }
+
+}  // namespace
+
+void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udimTile, int samples,
+                         int margin, int threads) {
+  const int W = image.width, H = image.height, C = image.channels;
+  if (margin <= 0 || W <= 0 || H <= 0 || !mesh.hasUvSet(static_cast<std::size_t>(uvSet))) return;
+  const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
+  const std::vector<std::int32_t> owner =
+      texelOwners(mesh, uvSet, triangles, W, H, std::max(samples, 1), udimTile);
+  const std::vector<std::int64_t> across = oppositeCorners(mesh);
+  const std::vector<std::uint32_t> cornerFace = cornerFaces(mesh.faceStart);
+  std::vector<std::uint32_t> faceFirstTriangle(mesh.numFaces() + 1, 0);
+  std::vector<std::uint32_t> triangleFace(triangles.size());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    faceFirstTriangle[f + 1] = faceFirstTriangle[f] + (mesh.faceSize(f) - 2);
+    for (std::uint32_t t = faceFirstTriangle[f]; t < faceFirstTriangle[f + 1]; ++t)
+      triangleFace[t] = static_cast<std::uint32_t>(f);
+  }
+  auto covered = [&](int x, int y) {  // y up
+    return image.coverage[static_cast<std::size_t>(H - 1 - y) * W + x] > 0;
+  };
+
+  // The nearest covered texel of every texel within reach, along 8-connected paths of steps
+  // 1 and √2 (a two-pass chamfer distance transform, exact for this 3 × 3 mask), carried as
+  // the index of that texel; ties go to the first neighbour looked at.
+  const double reach = margin + kReachBeyondMargin;
+  const std::size_t texels = static_cast<std::size_t>(W) * H;
+  std::vector<float> distance(texels, std::numeric_limits<float>::infinity());
+  std::vector<std::int32_t> source(texels, -1);
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      if (covered(x, y) && owner[i] >= 0) {
+        distance[i] = 0;
+        source[i] = static_cast<std::int32_t>(i);
+      }
+    }
+  }
+  const float diagonal = static_cast<float>(std::sqrt(2.0));
+  auto relax = [&](std::size_t i, int nx, int ny, float step) {
+    if (nx < 0 || ny < 0 || nx >= W || ny >= H) return;
+    const std::size_t n = static_cast<std::size_t>(ny) * W + nx;
+    if (source[n] >= 0 && distance[n] + step < distance[i]) {
+      distance[i] = distance[n] + step;
+      source[i] = source[n];
+    }
+  };
+  for (int y = 0; y < H; ++y) {  // forward: from the row below and the texel to the left
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      if (distance[i] == 0) continue;
+      relax(i, x - 1, y - 1, diagonal);
+      relax(i, x, y - 1, 1);
+      relax(i, x + 1, y - 1, diagonal);
+      relax(i, x - 1, y, 1);
+    }
+  }
+  for (int y = H - 1; y >= 0; --y) {  // backward: from the row above and the texel to the right
+    for (int x = W - 1; x >= 0; --x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      if (distance[i] == 0) continue;
+      relax(i, x + 1, y + 1, diagonal);
+      relax(i, x, y + 1, 1);
+      relax(i, x - 1, y + 1, diagonal);
+      relax(i, x + 1, y, 1);
+    }
+  }
+  // The margin: uncovered texels within reach, rows y up.
+  std::vector<std::uint32_t> marginTexels;
+  for (std::size_t i = 0; i < texels; ++i) {
+    if (distance[i] > 0 && distance[i] < reach)
+      marginTexels.push_back(static_cast<std::uint32_t>(i));
+  }
+
+  // Bilinear interpolation of the covered texels around texel-space point q (y up).
+  auto sample = [&](Point q, float* out) {
+    const double fx = q.real() - 0.5, fy = q.imag() - 0.5;
+    const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+    const double ax = fx - x0, ay = fy - y0;
+    double sum[16] = {};
+    double weight = 0;
+    for (int j = 0; j < 2; ++j) {
+      for (int i = 0; i < 2; ++i) {
+        const int x = x0 + i, y = y0 + j;
+        if (x < 0 || y < 0 || x >= W || y >= H || !covered(x, y)) continue;
+        const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
+        if (w <= 0) continue;
+        const float* v = &image.pixels[(static_cast<std::size_t>(H - 1 - y) * W + x) * C];
+        for (int c = 0; c < C && c < 16; ++c) sum[c] += w * v[c];
+        weight += w;
+      }
+    }
+    if (weight <= 0) return false;
+    for (int c = 0; c < C && c < 16; ++c) out[c] = static_cast<float>(sum[c] / weight);
+    return true;
+  };
+  auto texelOf = [&](std::uint32_t corner) {
+    const Vec2d p = uvToTexel(uvs[corner], udimTile, W, H);
+    return Point(p.x, p.y);
+  };
+
+  // Which side of the line a → b face f lies on (+1 left, −1 right, 0 unknown): the sign of
+  // its UV area, taken as seen from that edge.
+  auto faceSide = [&](std::uint32_t f, Point a, Point b) {
+    const std::uint32_t begin = mesh.faceStart[f], n = mesh.faceSize(f);
+    double sum = 0;
+    for (std::uint32_t k = 0; k < n; ++k) sum += cross(a, b, texelOf(begin + k));
+    return sum > 0 ? 1.0 : (sum < 0 ? -1.0 : 0.0);
+  };
+  // Whether p lies in one of face f's triangles (edges included).
+  auto insideFace = [&](std::uint32_t f, Point p) {
+    for (std::uint32_t t = faceFirstTriangle[f]; t < faceFirstTriangle[f + 1]; ++t) {
+      const auto& c = triangles[t];
+      const Point a = texelOf(c[0]), b = texelOf(c[1]), d = texelOf(c[2]);
+      const double area = cross(a, b, d);
+      if (area == 0) continue;
+      const double s0 = cross(b, d, p) * area, s1 = cross(d, a, p) * area,
+                   s2 = cross(a, b, p) * area;
+      if (s0 >= 0 && s1 >= 0 && s2 >= 0) return true;
+    }
+    return false;
+  };
+
+  // Each margin texel, read from the covered image only (so the order does not matter).
+  std::vector<float> values(marginTexels.size() * static_cast<std::size_t>(C));
+  std::vector<std::uint8_t> written(marginTexels.size(), 0);
+  runWithThreads(threads, [&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, marginTexels.size(), 1024),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t m = range.begin(); m != range.end(); ++m) {
+            const std::size_t i = marginTexels[m];
+            const int x = static_cast<int>(i % static_cast<std::size_t>(W));
+            const int y = static_cast<int>(i / static_cast<std::size_t>(W));
+            float* out = &values[m * static_cast<std::size_t>(C)];
+            Point p(x + 0.5, y + 0.5);
+            std::uint32_t f =
+                triangleFace[static_cast<std::size_t>(owner[static_cast<std::size_t>(source[i])])];
+            for (int step = 0; step <= kMaxFaceSteps; ++step) {
+              const std::uint32_t begin = mesh.faceStart[f], n = mesh.faceSize(f);
+              if (insideFace(f, p)) {  // read the image here
+                if (p.real() >= 0 && p.imag() >= 0 && p.real() < W && p.imag() < H &&
+                    sample(p, out)) {
+                  written[m] = 1;
+                }
+                break;
+              }
+              // The face's edge nearest p (the first in corner order on a tie).
+              std::uint32_t edge = 0;
+              double best = std::numeric_limits<double>::infinity();
+              for (std::uint32_t k = 0; k < n; ++k) {
+                const double d =
+                    segmentDistance(p, texelOf(begin + k), texelOf(begin + (k + 1) % n));
+                if (d <= best) {
+                  best = d;
+                  edge = k;
+                }
+              }
+              const std::uint32_t ca = begin + edge, cb = begin + (edge + 1) % n;
+              const std::int64_t other = across[ca];
+              if (other < 0) {  // a boundary: read the face at the point of the edge nearest p
+                const Point a = texelOf(ca), ab = texelOf(cb) - a;
+                const double len2 = std::norm(ab);
+                const double s =
+                    len2 > 0 ? std::clamp(((p - a) * std::conj(ab)).real() / len2, 0.0, 1.0) : 0.0;
+                const Point q = a + s * ab;
+                if (q.real() >= 0 && q.imag() >= 0 && q.real() < W && q.imag() < H &&
+                    sample(q, out)) {
+                  written[m] = 1;
+                }
+                break;
+              }
+              const std::uint32_t g = cornerFace[static_cast<std::size_t>(other)];
+              const std::uint32_t gBegin = mesh.faceStart[g], gn = mesh.faceSize(g);
+              // The corners of g on the edge's two vertices (g runs the edge either way).
+              const std::uint32_t o = static_cast<std::uint32_t>(other);
+              const std::uint32_t oNext = gBegin + (o - gBegin + 1) % gn;
+              const bool sameWay = mesh.cornerVertex[o] == mesh.cornerVertex[ca];
+              const std::uint32_t na = sameWay ? o : oNext, nb = sameWay ? oNext : o;
+              const Point A = texelOf(ca), B = texelOf(cb), A2 = texelOf(na), B2 = texelOf(nb);
+              if (!(A == A2 && B == B2)) {  // a seam: carry p over by the similarity A→A', B→B'
+                if (A == B || A2 == B2) break;
+                // p in the edge's frame: s along A → B (0 at A, 1 at B), r across it in texels.
+                const Point w = (p - A) / (B - A);
+                double r = w.imag() * std::abs(B - A);
+                // f's side of the edge must land on the side g is not on: mirror when they agree.
+                if (faceSide(f, A, B) * faceSide(g, A2, B2) > 0) r = -r;
+                const Point mapped = A2 + Point(w.real(), r / std::abs(B2 - A2)) * (B2 - A2);
+                p = mapped;
+              }
+              f = g;
+            }
+          }
+        });
+  });
+  for (std::size_t m = 0; m < marginTexels.size(); ++m) {
+    if (!written[m]) continue;
+    const std::size_t i = marginTexels[m];
+    const std::size_t x = i % static_cast<std::size_t>(W), y = i / static_cast<std::size_t>(W);
+    std::copy_n(&values[m * static_cast<std::size_t>(C)], C,
+                &image.pixels[((static_cast<std::size_t>(H) - 1 - y) * W + x) *
+                              static_cast<std::size_t>(C)]);
+  }
+}
+
+}  // namespace sgbake
