@@ -45,6 +45,8 @@ GRADIENTS = (
 )
 PADDINGS = (
     ("extend", "Extend", "Extend the islands' edge texels by Margin texels (Blender's Extend)"),
+    ("adjacent-faces", "Adjacent Faces",
+     "Fill Margin texels with the surface across the UV seam each faces (Blender's default)"),
     ("push-pull", "Push-Pull", "Fill every uncovered texel from the islands (Margin unused)"),
 )
 

@@ -45,7 +45,7 @@ class SGBAKE_PT_bake(bpy.types.Panel):
         col.prop(settings, "height", text="Y")
         layout.prop(settings, "padding")
         row = layout.row()
-        row.active = settings.padding == "extend"
+        row.active = settings.padding != "push-pull"
         row.prop(settings, "margin")
         layout.prop(settings, "samples")
         if settings.map == "tangent-normal":

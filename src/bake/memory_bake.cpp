@@ -43,15 +43,11 @@ Result<FloatImage> bakeOutputInMemory(const Plan& plan, std::size_t output,
   }
 
   const std::vector<Layer> layers = plan_detail::outputLayers(planned, loaded);
-  Result<FloatImage> image = bakeMap(plan_detail::bakeInputFor(loaded, layers),
-                                     plan_detail::bakeSettingsFor(out, out.tile, threads), progress);
+  const BakeInput input = plan_detail::bakeInputFor(loaded, layers);
+  const BakeSettings settings = plan_detail::bakeSettingsFor(out, out.tile, threads);
+  Result<FloatImage> image = bakeMap(input, settings, progress);
   if (!image) return image.error();
-  const auto [pushPull, margin] = plan_detail::outputPadding(out);
-  if (pushPull) {
-    pushPullFill(*image, threads);
-  } else if (margin > 0) {
-    extendMargin(*image, margin, threads);
-  }
+  plan_detail::padImage(*image, plan_detail::outputPadding(out), input, settings);
   return image;
 }
 

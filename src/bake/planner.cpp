@@ -532,17 +532,22 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     }
     const bool udim = hasUdimToken(output.file.string());
     // Memory of the pixels (float values and coverage): bakeImageTile's ring of bands, or the
-    // whole image for push-pull.
-    const auto [pushPull, margin] = plan_detail::outputPadding(output);
-    const int rowsHeld = pushPull ? output.height : bakeRingRows(output.height, 2 * margin);
+    // whole image for push-pull and Adjacent Faces.
+    const plan_detail::OutputPadding padding = plan_detail::outputPadding(output);
+    const int rowsHeld =
+        padding.wholeImage() ? output.height : bakeRingRows(output.height, padding.bandHalo());
     const double bytes = static_cast<double>(rowsHeld) * output.width *
                          (mapChannels(output.map) + 1) * sizeof(float);
     char megabytes[32];  // one decimal below 10 MB
     std::snprintf(megabytes, sizeof megabytes, bytes < 1e7 ? "%.1f MB" : "%.0f MB", bytes / 1e6);
     const std::string memory =
-        pushPull ? "; the whole image in memory for push-pull (" + std::string(megabytes) + ")"
-                 : "; in bands of " + std::to_string(kBakeBandRows) + " rows, " +
-                       std::to_string(rowsHeld) + " rows (" + megabytes + ") in memory at a time";
+        padding.wholeImage()
+            ? "; the whole image in memory for " +
+                  std::string(padding.mode == PaddingMode::kPushPull ? "push-pull"
+                                                                     : "adjacent-faces") +
+                  " (" + megabytes + ")"
+            : "; in bands of " + std::to_string(kBakeBandRows) + " rows, " +
+                  std::to_string(rowsHeld) + " rows (" + megabytes + ") in memory at a time";
     if (output.rangeAuto && output.storesSignedRange()) {
       plan.steps.push_back({"find the range of " + output.file.string() +
                                 ": bake it once for its largest |value|" +
@@ -557,12 +562,17 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
              (udim ? "every UDIM tile the UV set touches"
                    : "UDIM tile " + std::to_string(output.tile)),
          "because " + planned.whyBake + "; " + reads + memory});
-    if (pushPull) {  // (masks are never padded: outputPadding)
+    if (padding.mode == PaddingMode::kPushPull) {  // (masks are never padded: outputPadding)
       plan.steps.push_back({"pad " + output.file.string() + " by push-pull",
                             "fills every texel outside the UV islands"});
-    } else if (margin > 0) {
+    } else if (padding.margin > 0 && padding.mode == PaddingMode::kAdjacentFaces) {
+      plan.steps.push_back({"pad " + output.file.string() + ": adjacent faces, " +
+                                std::to_string(padding.margin) + " texels",
+                            "each margin texel takes the surface's value across the UV seam it "
+                            "faces (Blender's default margin)"});
+    } else if (padding.margin > 0) {
       plan.steps.push_back(
-          {"pad " + output.file.string() + ": extend " + std::to_string(margin) + " texels",
+          {"pad " + output.file.string() + ": extend " + std::to_string(padding.margin) + " texels",
            "margin against bleeding at UV seams under filtering and mipmaps"});
     }
     const ImageFormat format = output.resolvedFormat();
@@ -963,9 +973,10 @@ Result<double> largestMagnitude(const BakeInput& input, const SceneOutput& outpu
 /// and the whole image never exists. Extend padding of a strip, done in the ring
 /// (extendMarginRowsInPlace; a copy for signed maps, whose remapped values must not reach the
 /// next strip), needs `margin` rows below it and above it: the rows above are kept in the ring,
-/// and the last `margin` rows of each band wait for the next one. Push-pull needs the whole image,
-/// which is then baked, padded and written in one piece. Masks are not padded (padding would
-/// overwrite the coverage they show). The complete file is left under its temporary name in
+/// and the last `margin` rows of each band wait for the next one. Push-pull and Adjacent Faces need
+/// the whole image, which is then baked, padded and written in one piece. Masks are not padded
+/// (padding would overwrite the coverage they show). The complete file is left under its temporary
+/// name in
 /// @p pending, renamed over @p file once every output of the run is written.
 Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
                      const SceneOutput& output, const fs::path& file, ExecuteReport& report,
@@ -982,7 +993,9 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
                                                         mapChannels(settings.map), writeOptions);
   if (!writer) return writer.error();
 
-  const auto [pushPull, margin] = plan_detail::outputPadding(output);
+  const plan_detail::OutputPadding padding = plan_detail::outputPadding(output);
+  // Extend rings padded band by band here; a whole-image padding is done before.
+  const int margin = padding.wholeImage() ? 0 : padding.margin;
   const bool signedRange = output.storesSignedRange();
   int rowsWritten = 0;
   double padSeconds = 0, convertSeconds = 0;
@@ -1028,12 +1041,12 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
   };
 
   const Clock::time_point start = Clock::now();
-  if (pushPull) {
+  if (padding.wholeImage()) {
     Result<FloatImage> image = bakeMap(input, settings);
     if (!image) return Error{image.error().code, file.string() + ": " + image.error().message};
     report.bakeSeconds += secondsSince(start);
     const Clock::time_point padStart = Clock::now();
-    pushPullFill(*image, threads);
+    plan_detail::padImage(*image, padding, input, settings);
     padSeconds += secondsSince(padStart);
     if (Status ok = writeFinalRows(MutableImageRows::of(*image)); !ok) return ok;
   } else {

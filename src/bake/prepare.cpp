@@ -14,9 +14,25 @@
 namespace sgbake::plan_detail {
 
 OutputPadding outputPadding(const SceneOutput& output) {
-  if (output.map == MapKind::kMask) return {};
-  if (output.padding == PaddingMode::kPushPull) return {true, 0};
-  return {false, std::max(output.margin, 0)};
+  if (output.map == MapKind::kMask) return {PaddingMode::kExtend, 0};
+  if (output.padding == PaddingMode::kPushPull) return {PaddingMode::kPushPull, 0};
+  return {output.padding, std::max(output.margin, 0)};
+}
+
+void padImage(FloatImage& image, const OutputPadding& padding, const BakeInput& input,
+              const BakeSettings& settings) {
+  switch (padding.mode) {
+    case PaddingMode::kPushPull:
+      pushPullFill(image, settings.threads);
+      break;
+    case PaddingMode::kAdjacentFaces:
+      adjacentFacesMargin(image, *input.mesh, settings.uvSet, settings.udimTile, settings.samples,
+                          padding.margin, settings.threads);
+      break;
+    case PaddingMode::kExtend:
+      extendMargin(image, padding.margin, settings.threads);
+      break;
+  }
 }
 
 Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {

@@ -42,12 +42,22 @@ inline std::string layerLabel(std::size_t i) { return "layers[" + std::to_string
 inline std::string outputLabel(std::size_t i) { return "outputs[" + std::to_string(i) + "]"; }
 
 /// How an image output is padded: masks not at all (padding would overwrite the coverage they
-/// show), else push-pull or Extend by `margin` texels.
+/// show), else push-pull, or Extend or Adjacent Faces by `margin` texels.
 struct OutputPadding {
-  bool pushPull = false;
-  int margin = 0;  ///< Extend rings; 0 for push-pull and masks
+  PaddingMode mode = PaddingMode::kExtend;
+  int margin = 0;  ///< texels of Extend or Adjacent Faces; 0 for push-pull and masks
+  /// Whether the padding needs the whole baked image (push-pull, and Adjacent Faces, which
+  /// reads across seams anywhere in it); Extend pads band by band.
+  bool wholeImage() const {
+    return mode == PaddingMode::kPushPull || (mode == PaddingMode::kAdjacentFaces && margin > 0);
+  }
+  /// Rows the banded (Extend) padding keeps above a band: 2·margin.
+  int bandHalo() const { return mode == PaddingMode::kExtend ? 2 * margin : 0; }
 };
 OutputPadding outputPadding(const SceneOutput& output);
+/// Pads @p image, bakeMap's whole image of @p input and @p settings, as @p padding says.
+void padImage(FloatImage& image, const OutputPadding& padding, const BakeInput& input,
+              const BakeSettings& settings);
 
 /// Everything loaded for a run; layers point into the textures and volumes held here.
 struct Loaded {

@@ -98,7 +98,8 @@ constexpr Named<GradientScheme> kSchemes[] = {{"analytic", GradientScheme::kAnal
                                               {"central", GradientScheme::kCentral},
                                               {"tetrahedral", GradientScheme::kTetrahedral}};
 constexpr Named<PaddingMode> kPaddings[] = {{"extend", PaddingMode::kExtend},
-                                            {"push-pull", PaddingMode::kPushPull}};
+                                            {"push-pull", PaddingMode::kPushPull},
+                                            {"adjacent-faces", PaddingMode::kAdjacentFaces}};
 constexpr Named<SceneLayerType> kLayerTypes[] = {{"height", SceneLayerType::kHeight},
                                                  {"normal", SceneLayerType::kNormal},
                                                  {"volume", SceneLayerType::kVolume},

@@ -102,7 +102,8 @@ constexpr const char* kFooter =
     "  Output keys: map (tangent-normal, object-normal, height, derivative, surface-gradient,\n"
     "    tangent, bitangent, mask, or corners for the per-corner CSV table), file (.png, .exr,\n"
     "    .tif; '<UDIM>' in the name bakes every UDIM tile the UV set touches),\n"
-    "    size = 1024 (or width and height), margin = 16, padding = extend|push-pull,\n"
+    "    size = 1024 (or width and height), margin = 16,\n"
+    "    padding = extend|adjacent-faces|push-pull,\n"
     "    samples = 1 (N x N per texel), uv, green = opengl|directx, tile = 1001,\n"
     "    format = png|exr|tiff, bit_depth = 8|16|32 (default 16; 8 for masks in PNG/TIFF),\n"
     "    alpha = false (coverage as alpha), range = 1 (derivative and surface-gradient maps\n"
@@ -321,13 +322,16 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     Result<ImageFormat> format = imageFormatFromPath(output.file);
     if (!format) return Error::badInput("bake: -o: " + format.error().message);
   }
-  if (Status ok = parseName("--padding", args.padding, {"extend", "push-pull"}); !ok) {
+  if (Status ok = parseName("--padding", args.padding, {"extend", "adjacent-faces", "push-pull"});
+      !ok) {
     return ok.error();
   }
   if (Status ok = parseName("--green", args.green, {"opengl", "directx"}); !ok) return ok.error();
   output.width = output.height = args.size;
   output.margin = args.margin;
-  output.padding = args.padding == "push-pull" ? PaddingMode::kPushPull : PaddingMode::kExtend;
+  output.padding = args.padding == "push-pull"        ? PaddingMode::kPushPull
+                   : args.padding == "adjacent-faces" ? PaddingMode::kAdjacentFaces
+                                                      : PaddingMode::kExtend;
   output.samples = args.samples;
   output.uvSet = args.uvSet;
   output.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
@@ -542,7 +546,8 @@ CommandAction defineBakeCommand(CLI::App& app) {
       ->check(integerIn(0, kMaxBakeSide))
       ->capture_default_str()
       ->group(oneMap);
-  app.add_option("--padding", args->padding, "extend (by --margin) or push-pull (fill all)")
+  app.add_option("--padding", args->padding,
+                 "extend or adjacent-faces (by --margin), or push-pull (fill all)")
       ->type_name("MODE")
       ->capture_default_str()
       ->group(oneMap);

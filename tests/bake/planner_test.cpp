@@ -143,17 +143,24 @@ TEST(Hash, Fnv1a64KnownValues) {
 
 TEST_F(PlannerTest, ExplainSaysHowMuchOfTheImageIsInMemory) {
   // Extend padding bakes in bands into a ring of 2·256 + 2·margin rows (capped at the height);
-  // push-pull holds the whole image. Values and coverage are 4-byte floats.
-  const Plan p = plan(planeScene(kHeightLayer,
-                                 R"({"map": "object-normal", "file": "o.png", "size": 1000, "margin": 22},
+  // push-pull and adjacent faces hold the whole image. Values and coverage are 4-byte floats.
+  const Plan p =
+      plan(planeScene(kHeightLayer,
+                      R"({"map": "object-normal", "file": "o.png", "size": 1000, "margin": 22},
                                     {"map": "height", "file": "h.exr", "size": 100},
-                                    {"map": "object-normal", "file": "p.png", "size": 500, "padding": "push-pull"})"));
+                                    {"map": "object-normal", "file": "p.png", "size": 500, "padding": "push-pull"},
+                                    {"map": "object-normal", "file": "a.png", "size": 250, "margin": 5,
+                                     "padding": "adjacent-faces"})"));
   const std::string text = explainPlan(p);
   // 556 rows × 1000 × 4 floats × 4 bytes = 8.9 MB; the 100-row height map fits whole: 100 rows.
   EXPECT_NE(text.find("in bands of 256 rows, 556 rows (8.9 MB) in memory at a time"), std::string::npos) << text;
   EXPECT_NE(text.find("in bands of 256 rows, 100 rows (0.1 MB) in memory at a time"), std::string::npos) << text;
   // 500 × 500 × 4 floats × 4 bytes = 4 MB.
   EXPECT_NE(text.find("the whole image in memory for push-pull (4.0 MB)"), std::string::npos) << text;
+  // 250 × 250 × 4 floats × 4 bytes = 1 MB, padded once the whole image is baked.
+  EXPECT_NE(text.find("the whole image in memory for adjacent-faces (1.0 MB)"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("a.png: adjacent faces, 5 texels"), std::string::npos) << text;
 }
 
 TEST_F(PlannerTest, NoTangentsForHeightAndObjectNormalMaps) {

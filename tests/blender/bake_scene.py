@@ -218,13 +218,16 @@ def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND"):
 
 
 def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), margin=0,
-               height_size=HEIGHT_SIZE, save_bakes=True, runs=1, margin_type="EXTEND"):
+               height_size=HEIGHT_SIZE, save_bakes=True, runs=1, margin_type="EXTEND",
+               scale=None):
     """Builds case `name`, writes mesh.obj and height.exr into out_dir, bakes `passes`
-    (saved as blender_PASS.exr when save_bakes); returns the case's manifest entry. With
+    (saved as blender_PASS.exr when save_bakes); returns the case's manifest entry. scale
+    replaces the case's Bump Distance (0: no bump, the interpolated normal). With
     runs > 1 every pass is baked that many times and bake_s keeps the fastest run; bake_cpu
     is the process CPU time over wall time of that run (how many cores Cycles kept busy)."""
     import numpy as np
-    builder, default_size, scale = CASES[name]
+    builder, default_size, case_scale = CASES[name]
+    scale = case_scale if scale is None else scale
     size = size or default_size
     bake_common.reset_scene()
     os.makedirs(out_dir, exist_ok=True)

@@ -458,6 +458,11 @@ TEST_F(BakeCliTest, OneMapShorthand) {
            "push-pull", "-o", (dir_ / "os.exr").string()});
   ASSERT_EQ(normal.exitCode, 0) << normal.err;
   EXPECT_TRUE(fs::exists(dir_ / "os.exr"));
+  const ProcessResult adjacent =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "object-normal", "--size", "8",
+           "--margin", "2", "--padding", "adjacent-faces", "-o", (dir_ / "adj.exr").string()});
+  ASSERT_EQ(adjacent.exitCode, 0) << adjacent.err;
+  EXPECT_TRUE(fs::exists(dir_ / "adj.exr"));
 
   // --range auto: the range chosen is said beside the file, and recorded in it.
   const ProcessResult autoRange = run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--height",

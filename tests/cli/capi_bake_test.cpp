@@ -226,6 +226,12 @@ TEST_F(CApiBake, DirectXObjectNormalAndPushPullAreTheFileBake) {
                    64, 3, false);
 }
 
+TEST_F(CApiBake, AdjacentFacesMarginIsTheFileBake) {
+  expectSameAsFile(
+      R"({"map": "tangent-normal", "size": 96, "margin": 4, "padding": "adjacent-faces"})", 96, 3,
+      false);
+}
+
 TEST_F(CApiBake, SignedTwoChannelAndOneChannelMapsAreTheFileBake) {
   expectSameAsFile(R"({"map": "derivative", "size": 64, "margin": 2})", 64, 2, false);
   expectSameAsFile(R"({"map": "height", "size": 64, "margin": 2, "alpha": true})", 64, 1, true);

@@ -78,6 +78,9 @@ enum class VolumeFunction {
 enum class PaddingMode {
   kExtend,    ///< "extend": extendMargin by the output's margin (Blender's "Extend")
   kPushPull,  ///< "push-pull": pushPullFill, every uncovered texel (the margin is ignored)
+  /// "adjacent-faces": adjacentFacesMargin by the output's margin (Blender's "Adjacent Faces",
+  /// its default): texels across a UV seam take the surface's values from the other side
+  kAdjacentFaces,
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
