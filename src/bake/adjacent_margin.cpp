@@ -59,13 +59,15 @@ std::vector<std::int64_t> oppositeCorners(const Mesh& mesh) {
   return across;
 }
 
-/// The triangle that claims each texel (−1: none), as rasterize() assigns them: the last
-/// triangle covering one of the texel's samples. Rows y up.
-std::vector<std::int32_t> texelOwners(const Mesh& mesh, int uvSet,
+constexpr std::uint32_t kNoFace = std::numeric_limits<std::uint32_t>::max();
+
+/// The face of the triangle that claims each texel (kNoFace: none), as rasterize() assigns
+/// them: the last triangle covering one of the texel's samples. Rows y up.
+std::vector<std::uint32_t> texelFaces(std::span<const Vec2f> uvs,
                                       std::span<const std::array<std::uint32_t, 3>> triangles,
-                                      int width, int height, int samples, int udimTile) {
-  std::vector<std::int32_t> owner(static_cast<std::size_t>(width) * height, -1);
-  const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
+                                      std::span<const std::uint32_t> triangleFace, int width,
+                                      int height, int samples, int udimTile) {
+  std::vector<std::uint32_t> face(static_cast<std::size_t>(width) * height, kNoFace);
   std::vector<double> offsets(static_cast<std::size_t>(samples));
   for (int i = 0; i < samples; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / samples;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
@@ -87,11 +89,11 @@ std::vector<std::int32_t> texelOwners(const Mesh& mesh, int uvSet,
                      tri.edge[2].inside(tri.edge[2](px, py));
           }
         }
-        if (inside) owner[static_cast<std::size_t>(y) * width + x] = static_cast<std::int32_t>(t);
+        if (inside) face[static_cast<std::size_t>(y) * width + x] = triangleFace[t];
       }
     }
   }
-  return owner;
+  return face;
 }
 
 /// Distance of @p p from the segment [a, b].
@@ -115,8 +117,6 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
   if (margin <= 0 || W <= 0 || H <= 0 || !mesh.hasUvSet(static_cast<std::size_t>(uvSet))) return;
   const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
   const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
-  const std::vector<std::int32_t> owner =
-      texelOwners(mesh, uvSet, triangles, W, H, std::max(samples, 1), udimTile);
   const std::vector<std::int64_t> across = oppositeCorners(mesh);
   const std::vector<std::uint32_t> cornerFace = cornerFaces(mesh.faceStart);
   std::vector<std::uint32_t> faceFirstTriangle(mesh.numFaces() + 1, 0);
@@ -130,19 +130,22 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
     return image.coverage[static_cast<std::size_t>(H - 1 - y) * W + x] > 0;
   };
 
-  // The nearest covered texel of every texel within reach, along 8-connected paths of steps
-  // 1 and √2 (a two-pass chamfer distance transform, exact for this 3 × 3 mask), carried as
-  // the index of that texel; ties go to the first neighbour looked at.
+  // The face of the nearest covered texel of every texel within reach, along 8-connected
+  // paths of steps 1 and √2 (a two-pass chamfer distance transform, exact for this 3 × 3
+  // mask); ties go to the first neighbour looked at.
+  std::vector<std::uint32_t> face =
+      texelFaces(uvs, triangles, triangleFace, W, H, std::max(samples, 1), udimTile);
   const double reach = margin + kReachBeyondMargin;
   const std::size_t texels = static_cast<std::size_t>(W) * H;
   std::vector<float> distance(texels, std::numeric_limits<float>::infinity());
-  std::vector<std::int32_t> source(texels, -1);
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      if (covered(x, y) && owner[i] >= 0) {
+      if (face[i] == kNoFace) continue;
+      if (covered(x, y)) {
         distance[i] = 0;
-        source[i] = static_cast<std::int32_t>(i);
+      } else {
+        face[i] = kNoFace;  // a sample inside, but no coverage: not a source
       }
     }
   }
@@ -150,9 +153,9 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
   auto relax = [&](std::size_t i, int nx, int ny, float step) {
     if (nx < 0 || ny < 0 || nx >= W || ny >= H) return;
     const std::size_t n = static_cast<std::size_t>(ny) * W + nx;
-    if (source[n] >= 0 && distance[n] + step < distance[i]) {
+    if (face[n] != kNoFace && distance[n] + step < distance[i]) {
       distance[i] = distance[n] + step;
-      source[i] = source[n];
+      face[i] = face[n];
     }
   };
   for (int y = 0; y < H; ++y) {  // forward: from the row below and the texel to the left
@@ -176,32 +179,40 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
     }
   }
   // The margin: uncovered texels within reach, rows y up.
-  std::vector<std::uint32_t> marginTexels;
+  std::vector<std::size_t> marginTexels;
   for (std::size_t i = 0; i < texels; ++i) {
-    if (distance[i] > 0 && distance[i] < reach)
-      marginTexels.push_back(static_cast<std::uint32_t>(i));
+    const int x = static_cast<int>(i % static_cast<std::size_t>(W));
+    const int y = static_cast<int>(i / static_cast<std::size_t>(W));
+    if (distance[i] > 0 && distance[i] < reach && !covered(x, y)) marginTexels.push_back(i);
   }
+  distance = {};
 
   // Bilinear interpolation of the covered texels around texel-space point q (y up).
   auto sample = [&](Point q, float* out) {
     const double fx = q.real() - 0.5, fy = q.imag() - 0.5;
     const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
     const double ax = fx - x0, ay = fy - y0;
-    double sum[16] = {};
-    double weight = 0;
-    for (int j = 0; j < 2; ++j) {
-      for (int i = 0; i < 2; ++i) {
-        const int x = x0 + i, y = y0 + j;
-        if (x < 0 || y < 0 || x >= W || y >= H || !covered(x, y)) continue;
-        const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
-        if (w <= 0) continue;
-        const float* v = &image.pixels[(static_cast<std::size_t>(H - 1 - y) * W + x) * C];
-        for (int c = 0; c < C && c < 16; ++c) sum[c] += w * v[c];
-        weight += w;
-      }
+    std::array<const float*, 4> value{};
+    std::array<double, 4> weight{};
+    double total = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const int i = static_cast<int>(k & 1), j = static_cast<int>(k >> 1);
+      const int x = x0 + i, y = y0 + j;
+      if (x < 0 || y < 0 || x >= W || y >= H || !covered(x, y)) continue;
+      const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
+      if (w <= 0) continue;
+      value[k] = &image.pixels[(static_cast<std::size_t>(H - 1 - y) * W + x) * C];
+      weight[k] = w;
+      total += w;
     }
-    if (weight <= 0) return false;
-    for (int c = 0; c < C && c < 16; ++c) out[c] = static_cast<float>(sum[c] / weight);
+    if (total <= 0) return false;
+    for (int c = 0; c < C; ++c) {
+      double sum = 0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        if (value[k] != nullptr) sum += weight[k] * value[k][c];
+      }
+      out[c] = static_cast<float>(sum / total);
+    }
     return true;
   };
   auto texelOf = [&](std::uint32_t corner) {
@@ -244,8 +255,7 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
             const int y = static_cast<int>(i / static_cast<std::size_t>(W));
             float* out = &values[m * static_cast<std::size_t>(C)];
             Point p(x + 0.5, y + 0.5);
-            std::uint32_t f =
-                triangleFace[static_cast<std::size_t>(owner[static_cast<std::size_t>(source[i])])];
+            std::uint32_t f = face[i];
             for (int step = 0; step <= kMaxFaceSteps; ++step) {
               const std::uint32_t begin = mesh.faceStart[f], n = mesh.faceSize(f);
               if (insideFace(f, p)) {  // read the image here
