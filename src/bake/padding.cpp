@@ -373,4 +373,19 @@ void pushPullFill(FloatImage& image, int threads) {
   pull(image.pixels.data(), sourceWeight, image.width, image.height, stride, levels[0], threads);
 }
 
+void padImage(FloatImage& image, PaddingMode mode, int margin, const Mesh& mesh, int uvSet,
+              int udimTile, int samples, int threads) {
+  switch (mode) {
+    case PaddingMode::kPushPull:
+      pushPullFill(image, threads);
+      break;
+    case PaddingMode::kAdjacentFaces:
+      adjacentFacesMargin(image, mesh, uvSet, udimTile, samples, margin, threads);
+      break;
+    case PaddingMode::kExtend:
+      extendMargin(image, margin, threads);
+      break;
+  }
+}
+
 }  // namespace sgbake

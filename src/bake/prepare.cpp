@@ -21,18 +21,8 @@ OutputPadding outputPadding(const SceneOutput& output) {
 
 void padImage(FloatImage& image, const OutputPadding& padding, const BakeInput& input,
               const BakeSettings& settings) {
-  switch (padding.mode) {
-    case PaddingMode::kPushPull:
-      pushPullFill(image, settings.threads);
-      break;
-    case PaddingMode::kAdjacentFaces:
-      adjacentFacesMargin(image, *input.mesh, settings.uvSet, settings.udimTile, settings.samples,
-                          padding.margin, settings.threads);
-      break;
-    case PaddingMode::kExtend:
-      extendMargin(image, padding.margin, settings.threads);
-      break;
-  }
+  sgbake::padImage(image, padding.mode, padding.margin, *input.mesh, settings.uvSet,
+                   settings.udimTile, settings.samples, settings.threads);
 }
 
 Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {

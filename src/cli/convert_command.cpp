@@ -42,6 +42,8 @@ struct ConvertArguments {
   int tile = kFirstUdimTile;
   int samples = 1;
   int bitDepth = 0;
+  std::string padding = "keep";  ///< keep, or a PaddingMode's name
+  int margin = 16;
   int threads = 0;
   bool stats = false;
   SubdivisionOptions subdivision;  ///< level 0: none
@@ -55,7 +57,10 @@ constexpr const char* kFooter =
     "  its sgbake:map must agree with --from) is decoded as\n"
     "  n = 2c - 1 and re-expressed in the per-texel MikkTSpace frame Blender's baker uses:\n"
     "  object -> tangent applies inverse([T B N]); tangent -> object applies x T + y B + z N.\n"
-    "  Texels outside the UV islands keep their input values. The output has the input's size;\n"
+    "  Texels outside the UV islands keep their input values (--padding keep), or are padded\n"
+    "  from the converted islands as `sgbake bake` pads (--padding extend or adjacent-faces by\n"
+    "  --margin texels, or push-pull): a map padded in the other space holds that space's\n"
+    "  normals there. The output has the input's size;\n"
     "  an alpha channel is kept (unassociated), further channels are dropped. The file is\n"
     "  replaced only once complete.\n"
     "  With --subdivide limit, the frame is the exact limit surface's at each sample, as\n"
@@ -65,6 +70,8 @@ constexpr const char* kFooter =
     "  sgbake convert --mesh suzanne.obj --from object --to tangent n_os.exr -o n_ts.exr\n"
     "  sgbake convert --mesh suzanne.obj --from tangent --to object --green directx \\\n"
     "                 n_ts.png -o n_os.png\n"
+    "  sgbake convert --mesh suzanne.obj --from object --to tangent --padding adjacent-faces \\\n"
+    "                 --margin 16 n_os.exr -o n_ts.exr\n"
     "  sgbake convert --mesh cage.obj --subdivide limit --from object --to tangent \\\n"
     "                 n_os.exr -o n_ts.exr\n"
     "\n";
@@ -106,6 +113,24 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   if (*from == *to) {
     return Error::badInput("convert: --from and --to are both " + args.from +
                            ": there is nothing to convert");
+  }
+  std::optional<PaddingMode> padding;  // none: keep the input's values
+  if (args.padding == "extend") {
+    padding = PaddingMode::kExtend;
+  } else if (args.padding == "adjacent-faces") {
+    padding = PaddingMode::kAdjacentFaces;
+  } else if (args.padding == "push-pull") {
+    padding = PaddingMode::kPushPull;
+  } else if (args.padding != "keep") {
+    return Error::badInput("convert: --padding: unknown value '" + args.padding +
+                           "' (expected keep, extend, adjacent-faces or push-pull)");
+  }
+  if (app.count("--margin") != 0 && padding != PaddingMode::kExtend &&
+      padding != PaddingMode::kAdjacentFaces) {
+    return Error::badInput(
+        "convert: --margin is the width of --padding extend or "
+        "adjacent-faces; with --padding " +
+        args.padding + " it would change nothing");
   }
   if (args.green != "opengl" && args.green != "directx") {
     return Error::badInput("convert: --green: unknown value '" + args.green +
@@ -244,34 +269,48 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   if (!writer) return writer.error();
   std::vector<float> strip, alpha;  // RGB and alpha of rows with more than three channels
   bool writeFailed = false;
-  const Status converted = convertNormalMapRows(
-      *mesh, *tangents, input, *from, *to, settings, [&](const MutableImageRows& rows) -> Status {
-        Status ok = Ok{};
-        for (int row = rows.begin; row < rows.end && ok;) {
-          const int run = std::min(rows.contiguousRows(row), rows.end - row);
-          const std::size_t texels = static_cast<std::size_t>(run) * rows.width;
-          if (rows.channels == 3) {
-            ok = writer->writeRows(row, run, {rows.pixelRow(row), 3 * texels}, {});
-          } else {  // channel 3 is alpha (kept, as coverage); further channels are dropped
-            strip.resize(3 * texels);
-            alpha.resize(texels);
-            const float* in = rows.pixelRow(row);
-            for (std::size_t t = 0; t < texels; ++t, in += rows.channels) {
-              std::copy(in, in + 3, strip.begin() + static_cast<std::ptrdiff_t>(3 * t));
-              alpha[t] = in[3];
-            }
-            ok = writer->writeRows(row, run, strip, alpha);
-          }
-          row += run;
+  const auto writeRows = [&](const MutableImageRows& rows) -> Status {
+    Status ok = Ok{};
+    for (int row = rows.begin; row < rows.end && ok;) {
+      const int run = std::min(rows.contiguousRows(row), rows.end - row);
+      const std::size_t texels = static_cast<std::size_t>(run) * rows.width;
+      if (rows.channels == 3) {
+        ok = writer->writeRows(row, run, {rows.pixelRow(row), 3 * texels}, {});
+      } else {  // channel 3 is alpha (kept, as coverage); further channels are dropped
+        strip.resize(3 * texels);
+        alpha.resize(texels);
+        const float* in = rows.pixelRow(row);
+        for (std::size_t t = 0; t < texels; ++t, in += rows.channels) {
+          std::copy(in, in + 3, strip.begin() + static_cast<std::ptrdiff_t>(3 * t));
+          alpha[t] = in[3];
         }
-        writeFailed = !ok;
-        return ok;
-      });
+        ok = writer->writeRows(row, run, strip, alpha);
+      }
+      row += run;
+    }
+    writeFailed = !ok;
+    return ok;
+  };
+  double padSeconds = 0;
+  Status converted = Ok{};
+  if (!padding) {
+    converted = convertNormalMapRows(*mesh, *tangents, input, *from, *to, settings, writeRows);
+  } else {  // padding reads the whole converted image
+    Result<FloatImage> whole = convertNormalMap(*mesh, *tangents, input, *from, *to, settings);
+    if (!whole) {
+      converted = whole.error();
+    } else {
+      Stopwatch pad;
+      padImage(*whole, *padding, args.margin, *mesh, args.uvSet, tile, args.samples, args.threads);
+      padSeconds = pad.seconds();
+      converted = writeRows(MutableImageRows::of(*whole));
+    }
+  }
   if (!converted) {
     if (writeFailed) return converted.error();  // the writer's errors name the file already
     return Error{converted.error().code, args.input + ": " + converted.error().message};
   }
-  const double convertSeconds = step.lap() - writer->waitSeconds();
+  const double convertSeconds = step.lap() - writer->waitSeconds() - padSeconds;
   const double queueWaits = writer->waitSeconds();
   if (Status ok = writer->commit(); !ok) return ok;
   const double commitSeconds = step.lap();
@@ -305,6 +344,7 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
         {"load_s", loadSeconds},
         {"tangents_s", tangentSeconds},
         {"convert_s", convertSeconds},
+        {"pad_s", padSeconds},
         {"write_s", writer->fileSeconds()},
         {"write_wait_s", queueWaits + commitSeconds},
         {"total_s", total.seconds()},
@@ -350,6 +390,15 @@ CommandAction defineConvertCommand(CLI::App& app) {
   app.add_option("--samples", args->samples, "N: N x N frames per texel, averaged (1 to 16)")
       ->type_name("N")
       ->check(CLI::Range(1, kMaxBakeSamples).description(""))
+      ->capture_default_str();
+  app.add_option("--padding", args->padding,
+                 "keep (IN's values outside the UV islands), extend or adjacent-faces (by "
+                 "--margin), or push-pull (every texel)")
+      ->type_name("MODE")
+      ->capture_default_str();
+  app.add_option("--margin", args->margin, "Texels of extend or adjacent-faces padding")
+      ->type_name("N")
+      ->check(integerIn(0, kMaxBakeSide))
       ->capture_default_str();
   app.add_option("--bit-depth", args->bitDepth, "8, 16 or 32 bits per channel (0 = 16)")
       ->type_name("N")

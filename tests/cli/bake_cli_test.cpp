@@ -12,6 +12,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -983,6 +984,89 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   EXPECT_EQ(alpha.err, "sgbake: warning: " + (dir_ / "ts_alpha.png").string() +
                            ": 64 of 256 values were outside [0, 1], all an integer file stores, "
                            "and were clamped to it: an EXR or a 32-bit TIFF keeps them\n");
+}
+
+TEST_F(BakeCliTest, ConvertPadsTheConvertedIslandsWhenAsked) {
+  // The plane's UVs cover the left half of an 8² map. Left: the object-space +Z the plane
+  // shows; right: +X, as a padding in object space would have left there — not a tangent-space
+  // normal. By default the right half keeps it; with --padding it is padded from the converted
+  // island (tangent-space +Z, (0.5, 0.5, 1)).
+  writeFile(dir_ / "half.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0 1\n"
+            "vn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
+  {
+    std::vector<float> pixels(8 * 8 * 3);
+    for (int row = 0; row < 8; ++row) {
+      for (int x = 0; x < 8; ++x) {
+        const std::array<float, 3> c =
+            x < 4 ? std::array<float, 3>{0.5f, 0.5f, 1.0f} : std::array<float, 3>{1.0f, 0.5f, 0.5f};
+        std::copy(c.begin(), c.end(), pixels.begin() + (row * 8 + x) * 3);
+      }
+    }
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("os.exr");
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open((dir_ / "os_half.exr").string(),
+                          OIIO::ImageSpec(8, 8, 3, OIIO::TypeDesc::FLOAT)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    ASSERT_TRUE(out->close());
+  }
+  // Columns that end up tangent-space +Z, per padding (the rest keep the input's +X).
+  const std::vector<std::pair<std::vector<std::string>, int>> cases{
+      {{}, 4},                                                // keep
+      {{"--padding", "extend", "--margin", "2"}, 6},          // two columns
+      {{"--padding", "adjacent-faces", "--margin", "2"}, 7},  // margin + 1: Blender's reach
+      {{"--padding", "push-pull"}, 8}};                       // all
+  for (const auto& [flags, flat] : cases) {
+    std::vector<std::string> args{"convert",
+                                  "--mesh",
+                                  (dir_ / "half.obj").string(),
+                                  "--from",
+                                  "object",
+                                  "--to",
+                                  "tangent",
+                                  (dir_ / "os_half.exr").string(),
+                                  "-o",
+                                  (dir_ / "ts_half.exr").string()};
+    args.insert(args.end(), flags.begin(), flags.end());
+    const ProcessResult r = run(args);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open((dir_ / "ts_half.exr").string());
+    ASSERT_TRUE(in);
+    std::vector<float> pixels(8 * 8 * 3);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, pixels.data()));
+    for (int row = 0; row < 8; ++row) {
+      for (int x = 0; x < 8; ++x) {
+        const float* c = &pixels[(row * 8 + x) * 3];
+        const std::array<float, 3> expected = x < flat ? std::array<float, 3>{0.5f, 0.5f, 1.0f}
+                                                       : std::array<float, 3>{1.0f, 0.5f, 0.5f};
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_NEAR(c[k], expected[static_cast<std::size_t>(k)], 1e-4)
+              << (flags.empty() ? "keep" : flags[1]) << " texel " << x << "," << row;
+        }
+      }
+    }
+  }
+  // --margin with a padding that has no margin, and an unknown padding: refused, nothing written.
+  fs::remove(dir_ / "ts_half.exr");
+  for (const std::vector<std::string>& flags : {std::vector<std::string>{"--margin", "3"},
+                                                {"--padding", "push-pull", "--margin", "3"},
+                                                {"--padding", "extnd"}}) {
+    std::vector<std::string> args{"convert",
+                                  "--mesh",
+                                  (dir_ / "half.obj").string(),
+                                  "--from",
+                                  "object",
+                                  "--to",
+                                  "tangent",
+                                  (dir_ / "os_half.exr").string(),
+                                  "-o",
+                                  (dir_ / "ts_half.exr").string()};
+    args.insert(args.end(), flags.begin(), flags.end());
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << flags.back();
+    expectOneErrorLine(r);
+    EXPECT_FALSE(fs::exists(dir_ / "ts_half.exr"));
+  }
 }
 
 TEST_F(BakeCliTest, ConvertErrors) {

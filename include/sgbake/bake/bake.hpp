@@ -311,6 +311,22 @@ int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowE
 void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udimTile, int samples,
                          int margin, int threads = 0);
 
+/// @brief How the texels outside the UV islands are filled (a scene output's "padding").
+enum class PaddingMode {
+  kExtend,    ///< "extend": extendMargin by the output's margin (Blender's "Extend")
+  kPushPull,  ///< "push-pull": pushPullFill, every uncovered texel (the margin is ignored)
+  /// "adjacent-faces": adjacentFacesMargin by the output's margin (Blender's "Adjacent Faces",
+  /// its default): texels across a UV seam take the surface's values from the other side
+  kAdjacentFaces,
+};
+
+/// @brief Pads the whole image @p image (tile @p udimTile of UV set @p uvSet of @p mesh, baked
+/// or converted with @p samples² samples per texel) as @p mode says: extendMargin or
+/// adjacentFacesMargin by @p margin texels, or pushPullFill (the margin unused).
+/// @param[in] threads 0 = all cores; the result does not depend on it
+void padImage(FloatImage& image, PaddingMode mode, int margin, const Mesh& mesh, int uvSet,
+              int udimTile, int samples, int threads = 0);
+
 /// @brief Fills every uncovered texel (coverage 0) by push-pull (Gortler et al. 1996): a
 /// pyramid of 2×2 weighted averages of the covered texels (weights clamped to 1), then, from
 /// the coarsest level down, each texel with weight w < 1 becomes w·own + (1−w)·(bilinear

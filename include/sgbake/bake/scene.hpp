@@ -74,15 +74,6 @@ enum class VolumeFunction {
   kNoise,  ///< GradientNoise
 };
 
-/// @brief How an output fills the texels outside the UV islands ("padding").
-enum class PaddingMode {
-  kExtend,    ///< "extend": extendMargin by the output's margin (Blender's "Extend")
-  kPushPull,  ///< "push-pull": pushPullFill, every uncovered texel (the margin is ignored)
-  /// "adjacent-faces": adjacentFacesMargin by the output's margin (Blender's "Adjacent Faces",
-  /// its default): texels across a UV seam take the surface's values from the other side
-  kAdjacentFaces,
-};
-
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
 /// (subdivideMesh) before anything is baked, or with "level": "limit" the exact limit surface
 /// under every sample (LimitSurface, BakeInput::limit).
