@@ -14,7 +14,8 @@
    the image then holds are saved as addon_CASE.npy (rows top first). One case bakes into a
    Target image that starts at 64^2 (the add-on must scale it) with margin 8, 2 x 2 samples
    and alpha from coverage. mesh.obj (objio: every float exact) and height.exr (raw float) are
-   the same mesh and image for the CLI. The UI's way to bake, the bake job on a worker thread
+   the same mesh and image for the CLI. One case is padded by Adjacent Faces (margin 8), the
+   rest by Extend. The UI's way to bake, the bake job on a worker thread
    (as the modal operator runs it), must report a progress rising to 1, and a cancel set from
    the main thread must stop it without creating an image. It also checks that bad input
    becomes an error report,
@@ -122,7 +123,10 @@ CASES = {
     "bitangent": ("bitangent", 0, 1, False, None),
     "mask": ("mask", 0, 1, False, None),
     "tangent-normal-padded": ("tangent-normal", 8, 2, True, 64),
+    "object-normal-adjacent": ("object-normal", 8, 1, False, None),
 }
+# Cases padded otherwise than by the add-on's default, Extend.
+CASE_PADDING = {"object-normal-adjacent": "adjacent-faces"}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -215,10 +219,12 @@ def bake_cases(settings, ob, work, sabotage):
         settings.map = kind
         settings.width = settings.height = SIZE
         settings.margin, settings.samples, settings.use_alpha = margin, samples, alpha
+        settings.padding = CASE_PADDING.get(case, "extend")
         settings.green = "directx" if sabotage else "opengl"
         settings.target_image = (bc.new_float_image(f"target_{case}", target_side, target_side)
                                  if target_side else None)
-        entry = cases[case] = {"map": kind, "margin": margin, "samples": samples, "alpha": alpha}
+        entry = cases[case] = {"map": kind, "margin": margin, "samples": samples, "alpha": alpha,
+                               "padding": settings.padding}
         try:
             entry["result"] = sorted(bpy.ops.object.sgbake_bake())
         except RuntimeError as exc:  # the operator reported an error
@@ -228,6 +234,7 @@ def bake_cases(settings, ob, work, sabotage):
         np.save(os.path.join(work, f"addon_{case}.npy"), bc.image_array(image))
         entry.update(image=image.name, image_size=list(image.size))
     settings.target_image = None
+    settings.padding = "extend"  # what the bakes after these expect
     return cases
 
 
@@ -825,6 +832,7 @@ def run_cli(cli, work, manifest):
                "--height", os.path.join(work, "height.exr"),
                "--height-scale", repr(manifest["scale"]), "--filter", "bilinear",
                "--map", entry["map"], "--size", manifest["size"], "--margin", entry["margin"],
+               "--padding", entry["padding"],
                "--samples", entry["samples"], "--bit-depth", 32, "--no-manifest",
                "-o", os.path.join(work, f"cli_{case}.exr")]
         if entry["map"] == "tangent-normal":
