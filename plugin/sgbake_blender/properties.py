@@ -127,7 +127,8 @@ class SgbakeSettings(bpy.types.PropertyGroup):
                         subtype="PIXEL")
     margin: IntProperty(name="Margin", default=16, min=0, soft_max=64, subtype="PIXEL",
                         description="Texels of padding around the UV islands")
-    padding: EnumProperty(name="Padding", items=PADDINGS, default="extend")
+    # Adjacent Faces, as Blender's own bake pads by default (Render > Bake > Margin > Type).
+    padding: EnumProperty(name="Padding", items=PADDINGS, default="adjacent-faces")
     samples: IntProperty(name="Samples", default=1, min=1, max=16,
                          description="N x N samples per texel, averaged")
     green: EnumProperty(name="Green", items=GREENS, default="opengl",

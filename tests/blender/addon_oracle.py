@@ -219,7 +219,7 @@ def bake_cases(settings, ob, work, sabotage):
         settings.map = kind
         settings.width = settings.height = SIZE
         settings.margin, settings.samples, settings.use_alpha = margin, samples, alpha
-        settings.padding = CASE_PADDING.get(case, "extend")
+        settings.padding = CASE_PADDING.get(case, "extend")  # (the add-on's default: Adjacent Faces)
         settings.green = "directx" if sabotage else "opengl"
         settings.target_image = (bc.new_float_image(f"target_{case}", target_side, target_side)
                                  if target_side else None)
