@@ -62,38 +62,131 @@ std::vector<std::int64_t> oppositeCorners(const Mesh& mesh) {
 constexpr std::uint32_t kNoFace = std::numeric_limits<std::uint32_t>::max();
 
 /// The face of the triangle that claims each texel (kNoFace: none), as rasterize() assigns
-/// them: the last triangle covering one of the texel's samples. Rows y up.
+/// them: the last triangle covering one of the texel's samples. Rows y up. In parallel over
+/// the raster's row blocks, each walking its triangles in ascending order.
 std::vector<std::uint32_t> texelFaces(std::span<const Vec2f> uvs,
                                       std::span<const std::array<std::uint32_t, 3>> triangles,
                                       std::span<const std::uint32_t> triangleFace, int width,
-                                      int height, int samples, int udimTile) {
+                                      int height, int samples, int udimTile, int threads) {
   std::vector<std::uint32_t> face(static_cast<std::size_t>(width) * height, kNoFace);
   std::vector<double> offsets(static_cast<std::size_t>(samples));
   for (int i = 0; i < samples; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / samples;
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const std::array<Vec2d, 3> texel{uvToTexel(uvs[triangles[t][0]], udimTile, width, height),
-                                     uvToTexel(uvs[triangles[t][1]], udimTile, width, height),
-                                     uvToTexel(uvs[triangles[t][2]], udimTile, width, height)};
-    RasterTriangle tri;
-    if (!bake_detail::setupRasterTriangle(texel, width, height, tri)) continue;
-    for (int y = tri.y0; y <= tri.y1; ++y) {
-      int first = 0, last = -1;
-      bake_detail::rowSpan(tri, y, offsets, first, last);
-      for (int x = first; x <= last; ++x) {
-        bool inside = false;
-        for (std::size_t j = 0; j < offsets.size() && !inside; ++j) {
-          for (std::size_t i = 0; i < offsets.size() && !inside; ++i) {
-            const double px = x + offsets[i], py = y + offsets[j];
-            inside = tri.edge[0].inside(tri.edge[0](px, py)) &&
-                     tri.edge[1].inside(tri.edge[1](px, py)) &&
-                     tri.edge[2].inside(tri.edge[2](px, py));
+  bake_detail::RasterJob job;
+  job.triangles = triangles;
+  job.uvs = uvs;
+  job.width = width;
+  job.height = height;
+  job.samples = samples;
+  job.udimTile = udimTile;
+  const bake_detail::TriangleBins bins = bake_detail::binTriangles(job);
+  const int blocks = (height + bake_detail::kRowsPerBlock - 1) / bake_detail::kRowsPerBlock;
+  runWithThreads(threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
+      for (int block = r.begin(); block != r.end(); ++block) {
+        const int yBegin = block * bake_detail::kRowsPerBlock;
+        const int yEnd = std::min(height, yBegin + bake_detail::kRowsPerBlock);
+        for (std::uint32_t k = bins.start[static_cast<std::size_t>(block)];
+             k < bins.start[static_cast<std::size_t>(block) + 1]; ++k) {
+          const std::uint32_t t = bins.index[k];
+          const std::array<Vec2d, 3> texel{
+              uvToTexel(uvs[triangles[t][0]], udimTile, width, height),
+              uvToTexel(uvs[triangles[t][1]], udimTile, width, height),
+              uvToTexel(uvs[triangles[t][2]], udimTile, width, height)};
+          RasterTriangle tri;
+          if (!bake_detail::setupRasterTriangle(texel, width, height, tri)) continue;
+          for (int y = std::max(tri.y0, yBegin); y <= std::min(tri.y1, yEnd - 1); ++y) {
+            int first = 0, last = -1;
+            bake_detail::rowSpan(tri, y, offsets, first, last);
+            for (int x = first; x <= last; ++x) {
+              bool inside = false;
+              for (std::size_t j = 0; j < offsets.size() && !inside; ++j) {
+                for (std::size_t i = 0; i < offsets.size() && !inside; ++i) {
+                  const double px = x + offsets[i], py = y + offsets[j];
+                  inside = tri.edge[0].inside(tri.edge[0](px, py)) &&
+                           tri.edge[1].inside(tri.edge[1](px, py)) &&
+                           tri.edge[2].inside(tri.edge[2](px, py));
+                }
+              }
+              if (inside) face[static_cast<std::size_t>(y) * width + x] = triangleFace[t];
+            }
           }
         }
-        if (inside) face[static_cast<std::size_t>(y) * width + x] = triangleFace[t];
       }
-    }
-  }
+    });
+  });
   return face;
+}
+
+/// Rows per work item of the distance transform. Fixed, so ties between equally near faces
+/// go the same way for any number of threads.
+constexpr int kDistanceRows = 128;
+
+/// The face of the nearest source texel (face ≠ kNoFace) of every texel less than @p reach
+/// away along 8-connected paths of steps 1 and √2, and that distance (infinite beyond reach),
+/// rows y up. Each block of kDistanceRows rows runs the two passes of a chamfer distance
+/// transform (exact for this 3 × 3 mask) over itself and ⌈reach⌉ rows either side, which hold
+/// every path shorter than reach; ties go to the first neighbour looked at.
+void nearestFaces(std::vector<std::uint32_t>& face, std::vector<float>& distance, int width,
+                  int height, double reach, int threads) {
+  const int halo = static_cast<int>(std::ceil(reach)) + 1;
+  const int blocks = (height + kDistanceRows - 1) / kDistanceRows;
+  const std::vector<std::uint32_t> sources = face;  // read by every block
+  const float diagonal = static_cast<float>(std::sqrt(2.0));
+  runWithThreads(threads, [&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
+      std::vector<std::uint32_t> f;
+      std::vector<float> d;
+      for (int block = r.begin(); block != r.end(); ++block) {
+        const int begin = block * kDistanceRows, end = std::min(height, begin + kDistanceRows);
+        const int w0 = std::max(0, begin - halo), w1 = std::min(height, end + halo);
+        const std::size_t offset = static_cast<std::size_t>(w0) * width;
+        const std::size_t n = static_cast<std::size_t>(w1 - w0) * width;
+        f.assign(sources.begin() + static_cast<std::ptrdiff_t>(offset),
+                 sources.begin() + static_cast<std::ptrdiff_t>(offset + n));
+        d.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+          d[i] = f[i] != kNoFace ? 0.0f : std::numeric_limits<float>::infinity();
+        }
+        const int rows = w1 - w0;
+        auto relax = [&](std::size_t i, int nx, int ny, float step) {
+          if (nx < 0 || ny < 0 || nx >= width || ny >= rows) return;
+          const std::size_t m = static_cast<std::size_t>(ny) * width + nx;
+          if (f[m] != kNoFace && d[m] + step < d[i]) {
+            d[i] = d[m] + step;
+            f[i] = f[m];
+          }
+        };
+        for (int y = 0; y < rows; ++y) {  // forward: from the row below and the texel to the left
+          for (int x = 0; x < width; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * width + x;
+            if (d[i] == 0) continue;
+            relax(i, x - 1, y - 1, diagonal);
+            relax(i, x, y - 1, 1);
+            relax(i, x + 1, y - 1, diagonal);
+            relax(i, x - 1, y, 1);
+          }
+        }
+        for (int y = rows - 1; y >= 0; --y) {  // backward: from above and the right
+          for (int x = width - 1; x >= 0; --x) {
+            const std::size_t i = static_cast<std::size_t>(y) * width + x;
+            if (d[i] == 0) continue;
+            relax(i, x + 1, y + 1, diagonal);
+            relax(i, x, y + 1, 1);
+            relax(i, x - 1, y + 1, diagonal);
+            relax(i, x + 1, y, 1);
+          }
+        }
+        const std::size_t from = static_cast<std::size_t>(begin - w0) * width;
+        const std::size_t count = static_cast<std::size_t>(end - begin) * width;
+        const std::size_t to = static_cast<std::size_t>(begin) * width;
+        for (std::size_t i = 0; i < count; ++i) {
+          const bool near = d[from + i] < reach;
+          face[to + i] = near ? f[from + i] : kNoFace;
+          distance[to + i] = near ? d[from + i] : std::numeric_limits<float>::infinity();
+        }
+      }
+    });
+  });
 }
 
 /// Distance of @p p from the segment [a, b].
@@ -130,54 +223,19 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
     return image.coverage[static_cast<std::size_t>(H - 1 - y) * W + x] > 0;
   };
 
-  // The face of the nearest covered texel of every texel within reach, along 8-connected
-  // paths of steps 1 and √2 (a two-pass chamfer distance transform, exact for this 3 × 3
-  // mask); ties go to the first neighbour looked at.
+  // The face of the nearest covered texel of every texel within reach.
   std::vector<std::uint32_t> face =
-      texelFaces(uvs, triangles, triangleFace, W, H, std::max(samples, 1), udimTile);
+      texelFaces(uvs, triangles, triangleFace, W, H, std::max(samples, 1), udimTile, threads);
   const double reach = margin + kReachBeyondMargin;
   const std::size_t texels = static_cast<std::size_t>(W) * H;
-  std::vector<float> distance(texels, std::numeric_limits<float>::infinity());
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      if (face[i] == kNoFace) continue;
-      if (covered(x, y)) {
-        distance[i] = 0;
-      } else {
-        face[i] = kNoFace;  // a sample inside, but no coverage: not a source
-      }
+      // A sample inside but no coverage (an image not from this raster): not a source.
+      if (!covered(x, y)) face[static_cast<std::size_t>(y) * W + x] = kNoFace;
     }
   }
-  const float diagonal = static_cast<float>(std::sqrt(2.0));
-  auto relax = [&](std::size_t i, int nx, int ny, float step) {
-    if (nx < 0 || ny < 0 || nx >= W || ny >= H) return;
-    const std::size_t n = static_cast<std::size_t>(ny) * W + nx;
-    if (face[n] != kNoFace && distance[n] + step < distance[i]) {
-      distance[i] = distance[n] + step;
-      face[i] = face[n];
-    }
-  };
-  for (int y = 0; y < H; ++y) {  // forward: from the row below and the texel to the left
-    for (int x = 0; x < W; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      if (distance[i] == 0) continue;
-      relax(i, x - 1, y - 1, diagonal);
-      relax(i, x, y - 1, 1);
-      relax(i, x + 1, y - 1, diagonal);
-      relax(i, x - 1, y, 1);
-    }
-  }
-  for (int y = H - 1; y >= 0; --y) {  // backward: from the row above and the texel to the right
-    for (int x = W - 1; x >= 0; --x) {
-      const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      if (distance[i] == 0) continue;
-      relax(i, x + 1, y + 1, diagonal);
-      relax(i, x, y + 1, 1);
-      relax(i, x - 1, y + 1, diagonal);
-      relax(i, x + 1, y, 1);
-    }
-  }
+  std::vector<float> distance(texels);
+  nearestFaces(face, distance, W, H, reach, threads);
   // The margin: uncovered texels within reach, rows y up.
   std::vector<std::size_t> marginTexels;
   for (std::size_t i = 0; i < texels; ++i) {

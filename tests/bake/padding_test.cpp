@@ -333,7 +333,7 @@ Vec2d islandB(Vec2d uv, bool mirrored) {
   return {1 + a, b};
 }
 
-SeamScene seamScene(bool mirrored) {
+SeamScene seamScene(bool mirrored, int size = kSeamSize) {
   SeamScene s;
   s.mirrored = mirrored;
   const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0},
@@ -346,10 +346,10 @@ SeamScene seamScene(bool mirrored) {
   const std::vector<Vec2f> uvs{{0.2f, 0.2f}, {0.4f, 0.2f}, {0.4f, 0.4f}, {0.2f, 0.4f},
                                uvB(1, 0),    uvB(2, 0),    uvB(2, 1),    uvB(1, 1)};
   s.mesh = test::polygonMesh(positions, {{0, 1, 2, 3}, {1, 4, 5, 2}}, uvs);
-  s.image = holes(kSeamSize, kSeamSize, 2);
-  for (int row = 0; row < kSeamSize; ++row) {
-    for (int x = 0; x < kSeamSize; ++x) {
-      const Vec2d uv{(x + 0.5) / kSeamSize, 1 - (row + 0.5) / kSeamSize};
+  s.image = holes(size, size, 2);
+  for (int row = 0; row < size; ++row) {
+    for (int x = 0; x < size; ++x) {
+      const Vec2d uv{(x + 0.5) / size, 1 - (row + 0.5) / size};
       const bool inA = uv.x > 0.2 && uv.x < 0.4 && uv.y > 0.2 && uv.y < 0.4;
       const bool inB = uv.x > 0.5 && uv.x < 0.7 && uv.y > 0.6 && uv.y < 0.8;
       if (!inA && !inB) continue;
@@ -422,7 +422,8 @@ TEST(AdjacentFacesMargin, ABoundaryEdgeRepeatsTheNearestPointOfTheFace) {
 }
 
 TEST(AdjacentFacesMargin, ThreadsGiveIdenticalBits) {
-  SeamScene a = seamScene(true), b = seamScene(true);
+  // 500 rows: several blocks of the distance transform and of the face raster.
+  SeamScene a = seamScene(true, 500), b = seamScene(true, 500);
   adjacentFacesMargin(a.image, a.mesh, 0, kFirstUdimTile, 1, 6, 1);
   adjacentFacesMargin(b.image, b.mesh, 0, kFirstUdimTile, 1, 6, 2);
   EXPECT_EQ(0, std::memcmp(a.image.pixels.data(), b.image.pixels.data(),
