@@ -278,6 +278,28 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
     return Point(p.x, p.y);
   };
 
+  auto inImage = [&](Point q) {
+    return q.real() >= 0 && q.imag() >= 0 && q.real() < W && q.imag() < H;
+  };
+  // Face f's value at the point of its outline nearest p (read from the covered texels there).
+  auto readOutline = [&](std::uint32_t f, Point p, float* out) {
+    const std::uint32_t begin = mesh.faceStart[f], n = mesh.faceSize(f);
+    Point nearest = texelOf(begin);
+    double best = std::numeric_limits<double>::infinity();
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const Point a = texelOf(begin + k), ab = texelOf(begin + (k + 1) % n) - a;
+      const double len2 = std::norm(ab);
+      const double s =
+          len2 > 0 ? std::clamp(((p - a) * std::conj(ab)).real() / len2, 0.0, 1.0) : 0.0;
+      const Point q = a + s * ab;
+      if (std::abs(p - q) < best) {
+        best = std::abs(p - q);
+        nearest = q;
+      }
+    }
+    return inImage(nearest) && sample(nearest, out);
+  };
+
   // Which side of the line a → b face f lies on (+1 left, −1 right, 0 unknown): the sign of
   // its UV area, taken as seen from that edge.
   auto faceSide = [&](std::uint32_t f, Point a, Point b) {
@@ -312,15 +334,14 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
             const int x = static_cast<int>(i % static_cast<std::size_t>(W));
             const int y = static_cast<int>(i / static_cast<std::size_t>(W));
             float* out = &values[m * static_cast<std::size_t>(C)];
-            Point p(x + 0.5, y + 0.5);
+            const Point start(x + 0.5, y + 0.5);
+            Point p = start;
             std::uint32_t f = face[i];
+            bool read = false;
             for (int step = 0; step <= kMaxFaceSteps; ++step) {
               const std::uint32_t begin = mesh.faceStart[f], n = mesh.faceSize(f);
               if (insideFace(f, p)) {  // read the image here
-                if (p.real() >= 0 && p.imag() >= 0 && p.real() < W && p.imag() < H &&
-                    sample(p, out)) {
-                  written[m] = 1;
-                }
+                read = inImage(p) && sample(p, out);
                 break;
               }
               // The face's edge nearest p (the first in corner order on a tie).
@@ -336,16 +357,8 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
               }
               const std::uint32_t ca = begin + edge, cb = begin + (edge + 1) % n;
               const std::int64_t other = across[ca];
-              if (other < 0) {  // a boundary: read the face at the point of the edge nearest p
-                const Point a = texelOf(ca), ab = texelOf(cb) - a;
-                const double len2 = std::norm(ab);
-                const double s =
-                    len2 > 0 ? std::clamp(((p - a) * std::conj(ab)).real() / len2, 0.0, 1.0) : 0.0;
-                const Point q = a + s * ab;
-                if (q.real() >= 0 && q.imag() >= 0 && q.real() < W && q.imag() < H &&
-                    sample(q, out)) {
-                  written[m] = 1;
-                }
+              if (other < 0) {  // a boundary: no face continues p
+                read = readOutline(f, p, out);
                 break;
               }
               const std::uint32_t g = cornerFace[static_cast<std::size_t>(other)];
@@ -368,6 +381,10 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
               }
               f = g;
             }
+            // Nowhere to read (out of the image or the tile, too many seams, a degenerate
+            // edge): the start face's value at the point of its outline nearest the texel.
+            if (!read) read = readOutline(face[i], start, out);
+            written[m] = read ? 1 : 0;
           }
         });
   });

@@ -333,15 +333,15 @@ Vec2d islandB(Vec2d uv, bool mirrored) {
   return {1 + a, b};
 }
 
-SeamScene seamScene(bool mirrored, int size = kSeamSize) {
+SeamScene seamScene(bool mirrored, int size = kSeamSize, float uShiftB = 0) {
   SeamScene s;
   s.mirrored = mirrored;
   const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0},
                                      {0, 1, 0}, {2, 0, 0}, {2, 1, 0}};
   auto uvB = [&](float x, float y) {
     const float a = x - 1, b = y;
-    return mirrored ? Vec2f{0.5f + 0.2f * b, 0.6f + 0.2f * a}
-                    : Vec2f{0.7f - 0.2f * b, 0.6f + 0.2f * a};
+    return mirrored ? Vec2f{uShiftB + 0.5f + 0.2f * b, 0.6f + 0.2f * a}
+                    : Vec2f{uShiftB + 0.7f - 0.2f * b, 0.6f + 0.2f * a};
   };
   const std::vector<Vec2f> uvs{{0.2f, 0.2f}, {0.4f, 0.2f}, {0.4f, 0.4f}, {0.2f, 0.4f},
                                uvB(1, 0),    uvB(2, 0),    uvB(2, 1),    uvB(1, 1)};
@@ -417,6 +417,20 @@ TEST(AdjacentFacesMargin, ABoundaryEdgeRepeatsTheNearestPointOfTheFace) {
       ASSERT_FALSE(isHole(s.image, x, row));
       EXPECT_FLOAT_EQ(s.image.at(x, row, 0), s.image.at(20, row, 0));
       EXPECT_FLOAT_EQ(s.image.at(x, row, 1), s.image.at(20, row, 1));
+    }
+  }
+}
+
+TEST(AdjacentFacesMargin, WhereTheSeamLeadsOutOfTheTileTheFaceIsExtended) {
+  // B in UDIM tile 1002: beyond A's shared edge the surface continues in another image, so
+  // the margin repeats A's value at its outline's nearest point, as at a boundary.
+  SeamScene s = seamScene(false, kSeamSize, 1.0f);
+  adjacentFacesMargin(s.image, s.mesh, 0, kFirstUdimTile, 1, 4);
+  for (int row = kSeamSize - 38; row < kSeamSize - 22; ++row) {
+    for (int x = 40; x < 45; ++x) {
+      ASSERT_FALSE(isHole(s.image, x, row)) << x << "," << row;
+      EXPECT_FLOAT_EQ(s.image.at(x, row, 0), s.image.at(39, row, 0));
+      EXPECT_FLOAT_EQ(s.image.at(x, row, 1), s.image.at(39, row, 1));
     }
   }
 }

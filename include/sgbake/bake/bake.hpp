@@ -298,9 +298,10 @@ int extendMarginRows(const FloatImage& image, int margin, int rowBegin, int rowE
 /// nearest p into the face across it in the mesh, carrying p over with the edge — its position
 /// along the edge in proportion, its distance from the edge in texels, on the far side. Where
 /// p lands inside a face its value is the bilinear interpolation of the covered texels there.
-/// At a boundary edge (no face across) it is the face's value at the edge's point nearest p.
-/// A walk that lands outside the image, or crosses more than 8 edges, leaves the texel as it
-/// is. Values are read only from covered texels, so the result does not depend on the order.
+/// At a boundary edge (no face across) it is the face's value at the edge's point nearest p;
+/// a walk that leaves the image (the face across lies in another UDIM tile) or crosses more
+/// than 8 edges gives the start face's value at its outline's point nearest the texel. Values
+/// are read only from covered texels, so the result does not depend on the order.
 ///
 /// Checked against Blender 3.4 (tests/blender/margin_oracle.py): along seams the values agree
 /// to float precision; where Blender's choice is arbitrary they differ — beyond the corner of
