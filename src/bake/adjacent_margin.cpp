@@ -297,7 +297,27 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
         nearest = q;
       }
     }
-    return inImage(nearest) && sample(nearest, out);
+    return sample(nearest, out);  // (on the image's border, from the texels inside it)
+  };
+  // The value of the covered texel nearest texel (x, y) (y up): there is one within reach.
+  const int searchRadius = static_cast<int>(std::ceil(reach)) + 1;
+  auto readNearestCovered = [&](int x, int y, float* out) {
+    int bestX = -1, bestY = -1;
+    int best = std::numeric_limits<int>::max();
+    for (int dy = -searchRadius; dy <= searchRadius; ++dy) {
+      for (int dx = -searchRadius; dx <= searchRadius; ++dx) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= W || ny >= H || !covered(nx, ny)) continue;
+        if (dx * dx + dy * dy < best) {
+          best = dx * dx + dy * dy;
+          bestX = nx;
+          bestY = ny;
+        }
+      }
+    }
+    if (bestX < 0) return false;
+    std::copy_n(&image.pixels[(static_cast<std::size_t>(H - 1 - bestY) * W + bestX) * C], C, out);
+    return true;
   };
 
   // Which side of the line a → b face f lies on (+1 left, −1 right, 0 unknown): the sign of
@@ -384,6 +404,8 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
             // Nowhere to read (out of the image or the tile, too many seams, a degenerate
             // edge): the start face's value at the point of its outline nearest the texel.
             if (!read) read = readOutline(face[i], start, out);
+            // A face with no covered texel near that point (a sliver): the nearest texel.
+            if (!read) read = readNearestCovered(x, y, out);
             written[m] = read ? 1 : 0;
           }
         });
