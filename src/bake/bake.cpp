@@ -108,6 +108,11 @@ void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
   tri.hasTangents = tangents != nullptr;
   tri.faceNormal = normalizeOr(cross(tri.position[1] - tri.position[0], tri.position[2] - tri.position[0]),
                                Vec3d{0, 0, 1});
+  tri.flat = false;
+  if (!mesh.faceFlat.empty()) {  // the face of the triangle's corners
+    const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), corners[0]);
+    tri.flat = mesh.isFlat(static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1);
+  }
   tri.numUvSets = static_cast<int>(std::min<std::size_t>(mesh.uvSets.size(), kMaxUvSets));
   for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s) {
     for (std::size_t i = 0; i < 3; ++i) tri.uv[s][i] = cast<double>(mesh.uvSets[s].uvs[corners[i]]);

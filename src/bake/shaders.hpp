@@ -160,6 +160,14 @@ inline void batchTexelFrames(const ShadingTriangle& t, const SampleBatch& s, Bat
     unitN.z[i] = inv * nz;
     slow[i] = !((len2 > 0) & finiteLane(len2));
   }
+  if (t.flat) {  // unitNormal: the triangle's own normal
+    for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i) {
+      unitN.x[i] = t.faceNormal.x;
+      unitN.y[i] = t.faceNormal.y;
+      unitN.z[i] = t.faceNormal.z;
+      slow[i] = false;
+    }
+  }
 }
 
 /// shade() of the lanes flagged slow, over what the lane loops wrote for them.

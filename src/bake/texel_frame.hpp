@@ -37,6 +37,11 @@ struct ShadingTriangle {
   std::array<Vec3d, kMaxUvSets> dPdu{}, dPdv{};
   Vec3d bakeDPdu{}, bakeDPdv{};  ///< derivatives w.r.t. the bake's UV set (any index)
   Vec3d faceNormal{0, 0, 1};     ///< geometric normal, fallback when Σ bi·Ni vanishes
+  /// A flat-shaded face's triangle: it is shaded with faceNormal (Cycles' Ng, what Blender's
+  /// bake shows on a flat face: a non-planar flat quad shows each triangle's normal), while the
+  /// tangent frame keeps the corner normals Σ bi·Ni (the polygon's normal, as Blender's
+  /// object → tangent conversion uses).
+  bool flat = false;
   bool hasTangents = false;
 };
 
@@ -77,9 +82,10 @@ inline TexelFrame texelFrame(const ShadingTriangle& t, const Vec3d& b) {
   return f;
 }
 
-/// @brief The unit shading normal normalize(Σ bi·Ni), or the face normal when that vanishes.
+/// @brief The unit shading normal normalize(Σ bi·Ni), or the face normal when that vanishes or
+/// the face is flat-shaded.
 inline Vec3d unitNormal(const ShadingTriangle& t, const TexelFrame& f) {
-  return unitOr(f.normal, t.faceNormal);
+  return t.flat ? t.faceNormal : unitOr(f.normal, t.faceNormal);
 }
 
 /// @brief Sets the fields of @p p that are constant over triangle @p t (UV derivatives, number of

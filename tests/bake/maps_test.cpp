@@ -94,6 +94,26 @@ TEST(Maps, FlatPlaneWithoutLayersBakesTheFlatNormal) {
   }
 }
 
+TEST(Maps, AFlatNonPlanarQuadShowsEachTrianglesNormal) {
+  // Blender 3.4 (Cycles' Ng) bakes a flat-shaded quad whose corners are not coplanar with the
+  // normal of each of its two triangles (0-1-2 and 0-2-3), not the polygon's; smooth, with the
+  // same corner normals, it is their interpolation.
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.4f}, {1, 1, 0}, {0, 1, 0.1f}};
+  const std::vector<Vec2f> uvs{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const Vec3d polygon = normalizeOr(Vec3d{-0.1467348, 0.1467348, 0.9782320}, {});
+  Mesh mesh = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, cast<float>(polygon));
+  const Vec3d first = normalizeOr(cross(Vec3d{1, 0, 0.4}, Vec3d{1, 1, 0}), {});
+  const Vec3d second = normalizeOr(cross(Vec3d{1, 1, 0}, Vec3d{0, 1, 0.1}), {});
+  for (const bool flat : {true, false}) {
+    mesh.faceFlat = {static_cast<std::uint8_t>(flat ? 1 : 0)};
+    const Result<FloatImage> image = bake(mesh, nullptr, {}, MapKind::kObjectNormal, 16);
+    ASSERT_TRUE(image.ok()) << image.error().message;
+    // Texel (12, 3) lies in 0-1-2, (3, 12) in 0-2-3 (y up).
+    expectNear(test::pixelUp(*image, 12, 3), encode(flat ? first : polygon), 1e-6, "first");
+    expectNear(test::pixelUp(*image, 3, 12), encode(flat ? second : polygon), 1e-6, "second");
+  }
+}
+
 TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
   // h = scale·(a·u + b·v) on P = (Lx u, Ly v, 0): Γ = scale·(a/Lx, b/Ly, 0), N' = normalize(−Γ + ẑ),
   // MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself.

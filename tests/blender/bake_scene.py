@@ -140,6 +140,16 @@ def build_sphere():
     return ob
 
 
+@case("suzanne_flat", 256, 0.1)
+def build_suzanne_flat():
+    """Suzanne as the primitive makes it (500 faces, quads and triangles), FLAT shading: its
+    quads are not planar, and Blender shades each of their two triangles with its own normal."""
+    bpy.ops.mesh.primitive_monkey_add(calc_uvs=True)
+    ob = bpy.context.object
+    bake_common.set_smooth(ob, False)
+    return ob
+
+
 @case("cube_flat", 512, 0.25)
 def build_cube_flat():
     """Default cube (size 2) with its cross-shaped UV layout, FLAT shading: the per-texel frame
@@ -236,7 +246,9 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
     if len(me.uv_layers) == 0:
         raise RuntimeError(f"case {name}: no UV map")
     me.calc_normals_split()
-    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me),
+    arrays = objio.mesh_arrays(me)
+    arrays["smooth"] = [p.use_smooth for p in me.polygons]  # `s 0` / `s 1`, as Blender writes
+    objio.write_obj(os.path.join(out_dir, "mesh.obj"), arrays,
                     comment=f"bake oracle case {name} (Blender {bpy.app.version_string})")
 
     height = bake_common.new_float_image("height", height_size, height_size,

@@ -1,6 +1,7 @@
 /// @file bake.hpp
 /// @brief Baking maps in UV space: the texel raster, per-texel frames as Blender's baker builds
-/// them, the map kinds, and edge padding. Pure in-memory; writing files is in bake/image_output.hpp.
+/// them, the map kinds, and edge padding. Pure in-memory; writing files is in
+/// bake/image_output.hpp.
 ///
 /// ## Triangles (Blender's "looptris")
 /// Faces are rasterized as the triangles Blender 3.4 tessellates them into (loopTriangles()):
@@ -47,6 +48,11 @@
 /// `B = sign·N×T`, `P = Σ bi·Pi`, UVs interpolated, and ∂P/∂u, ∂P/∂v the triangle's constant
 /// derivatives. The gradient engine sees a SurfacePoint with normal = normalize(N) and tangent
 /// frame (T, Σ bi·si). Tangent-space output is `normalize(inverse([T B N]) · N')`.
+/// **Flat faces** (Mesh::faceFlat, OBJ `s 0`) are shaded as Cycles shades them: the shading
+/// normal (the SurfacePoint's, the unperturbed normal of object-space maps, the base of the
+/// bump) is the triangle's own geometric normal, so a non-planar flat quad shows two normals;
+/// the frame's N stays Σ bi·Ni (the polygon normal its corners carry), as Blender's object →
+/// tangent conversion uses. Checked on flat Suzanne (BlenderBakeOracle case suzanne_flat).
 ///
 /// ## Threads
 /// The image is cut into blocks of rows processed in parallel (TBB); each texel is written by one
