@@ -107,6 +107,11 @@ typedef struct sgbake_mesh {
   const float* const* corner_uvs;
   size_t num_uv_sets;  ///< at least 1, at most 4 (the UV sets a scene's "uv" keys can name)
   size_t num_corners;  ///< #C (must fit in 32 bits)
+  /// #F flags, nonzero for a flat-shaded face (Blender: `not polygons[f].use_smooth`), or NULL:
+  /// every face smooth. A flat face is shaded with each of its triangles' own normal, as
+  /// Cycles shades it, while its corner normals (the polygon's) give the tangent frame; with
+  /// corner_normals NULL it gets the polygon normal at its corners, and subdivision keeps it flat.
+  const uint8_t* face_flat;
 } sgbake_mesh;
 
 /// @brief An image in memory, laid out as Blender's `Image.pixels`: width × height × channels

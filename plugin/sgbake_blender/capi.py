@@ -65,6 +65,7 @@ class Mesh(ctypes.Structure):
         ("corner_uvs", ctypes.POINTER(_float_p)),
         ("num_uv_sets", ctypes.c_size_t),
         ("num_corners", ctypes.c_size_t),
+        ("face_flat", ctypes.POINTER(ctypes.c_uint8)),
     ]
 
 
@@ -201,7 +202,7 @@ def _image_entry(name, image):
 
 
 def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, uv_sets,
-             images=None, threads=0, progress=None):
+             images=None, threads=0, progress=None, face_flat=None):
     """Bakes one map with sgbake_bake_map and returns its pixels.
 
     scene           dict: a scene as for `sgbake bake SCENE.json` without "mesh", with one
@@ -217,6 +218,8 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
                     name -> (flat pixels, width, height, channels).
     threads         maximum number of threads, 0 = all cores (same result for every value).
     progress        a Progress to follow or cancel the bake from another thread, or None.
+    face_flat       #F flags, nonzero for a flat-shaded face (Blender: not use_smooth), or
+                    None: every face smooth. Flat faces are shaded per triangle, as Cycles does.
 
     Returns a float32 array of width * height * 4 values (RGBA, rows bottom first: the layout
     of Blender's Image.pixels). Raises SgbakeError on any failure, SgbakeCancelled when
@@ -236,6 +239,10 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
         if corner_normals.size != 3 * num_corners:
             raise SgbakeError(f"corner_normals has {corner_normals.size // 3} normals for "
                               f"{num_corners} corners")
+    if face_flat is not None:
+        face_flat = _array(face_flat, np.uint8, "face_flat")
+        if face_flat.size != num_faces:
+            raise SgbakeError(f"face_flat has {face_flat.size} flags for {num_faces} faces")
     uv_arrays = [_array(uv, np.float32, f"uv set {i}", 2) for i, uv in enumerate(uv_sets)]
     for i, uv in enumerate(uv_arrays):
         if uv.size != 2 * num_corners:
@@ -248,7 +255,9 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
                 corner_vertex=_pointer(corner_vertex, _uint32_p),
                 corner_normals=(_pointer(corner_normals, _float_p)
                                 if corner_normals is not None else None),
-                corner_uvs=uv_pointers, num_uv_sets=len(uv_arrays), num_corners=num_corners)
+                corner_uvs=uv_pointers, num_uv_sets=len(uv_arrays), num_corners=num_corners,
+                face_flat=(_pointer(face_flat, ctypes.POINTER(ctypes.c_uint8))
+                           if face_flat is not None else None))
 
     entries = [(name.encode("utf-8"),) + _image_entry(name, image)
                for name, image in (images or {}).items()]

@@ -47,8 +47,8 @@ def uv_sets(mesh, bake_uv_name, layers):
 
 def mesh_arrays(mesh, uv_names):
     """The mesh as sgbake_mesh arrays: positions (#V x 3), face_start (#F + 1), corner_vertex
-    (#C), corner normals (#C x 3, Blender's split normals: calc_normals_split must have run)
-    and one (#C x 2) array per UV map name.
+    (#C), corner normals (#C x 3, Blender's split normals: calc_normals_split must have run),
+    one (#C x 2) array per UV map name, and face_flat (#F, 1 where the face is flat-shaded).
 
     sgbake wants each face's corners contiguous and in face order. Blender's meshes almost
     always store them so; when loop_start says otherwise, the corner arrays are reordered."""
@@ -63,6 +63,9 @@ def mesh_arrays(mesh, uv_names):
     mesh.loops.foreach_get("vertex_index", corner_vertex)
     normals = np.empty(nc * 3, np.float32)
     mesh.loops.foreach_get("normal", normals)
+    smooth = np.empty(nf, bool)
+    mesh.polygons.foreach_get("use_smooth", smooth)
+    face_flat = (~smooth).astype(np.uint8)
     uvs = []
     for name in uv_names:
         uv = np.empty(nc * 2, np.float32)
@@ -77,7 +80,7 @@ def mesh_arrays(mesh, uv_names):
         corner_vertex = corner_vertex[order]
         normals = normals.reshape(-1, 3)[order].reshape(-1)
         uvs = [uv.reshape(-1, 2)[order].reshape(-1) for uv in uvs]
-    return positions, face_start.astype(np.uint32), corner_vertex, normals, uvs
+    return positions, face_start.astype(np.uint32), corner_vertex, normals, uvs, face_flat
 
 
 def limit_modifier(ob):

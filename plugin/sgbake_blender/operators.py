@@ -99,14 +99,15 @@ class BakeJob:
         in self.error."""
         start = time.perf_counter()
         try:
-            positions, face_start, corner_vertex, normals, uvs = self.arrays
+            positions, face_start, corner_vertex, normals, uvs, face_flat = self.arrays
             rgba = {}
             for index, tile in enumerate(self.tiles):
                 self.progress.fraction = 0.0
                 self.tile_index = index
                 rgba[tile] = capi.bake_map(self.lib, self.scenes[tile], positions, face_start,
                                            corner_vertex, normals, uvs, self.images,
-                                           threads=self.threads, progress=self.progress)
+                                           threads=self.threads, progress=self.progress,
+                                           face_flat=face_flat)
             self.rgba = rgba
         except capi.SgbakeError as exc:
             self.error = exc

@@ -86,6 +86,7 @@ struct MeshArrays {
   const std::uint32_t* cornerVertex = nullptr;
   const float* cornerNormals = nullptr;  ///< NULL only where normalsOptional
   bool normalsOptional = false;
+  const std::uint8_t* faceFlat = nullptr;  ///< #F, or NULL: every face smooth
   std::vector<const float*> uvSets;  ///< each #C × 2
   std::vector<std::string> uvNames;  ///< how messages name each UV array
   std::size_t numCorners = 0;
@@ -236,6 +237,11 @@ Mesh toMesh(const MeshArrays& a) {
   for (std::size_t i = 0; i < a.uvSets.size(); ++i) {
     mesh.uvSets.push_back({"UV" + std::to_string(i), toVec2(a.uvSets[i], a.numCorners)});
   }
+  if (a.faceFlat != nullptr &&
+      std::any_of(a.faceFlat, a.faceFlat + a.numFaces, [](std::uint8_t f) { return f != 0; })) {
+    mesh.faceFlat.resize(a.numFaces);
+    for (std::size_t f = 0; f < a.numFaces; ++f) mesh.faceFlat[f] = a.faceFlat[f] != 0 ? 1 : 0;
+  }
   if (a.cornerNormals == nullptr) {
     computeSmoothNormals(mesh);
     return mesh;
@@ -330,8 +336,9 @@ Status bakeMapFromArrays(const BakeArguments& a) {
   }
 
   const sgbake_mesh& m = *a.mesh;
-  MeshArrays arrays{m.positions, m.num_vertices, m.face_start, m.num_faces, m.corner_vertex,
-                    m.corner_normals, true, {}, {}, m.num_corners};
+  MeshArrays arrays{m.positions,      m.num_vertices, m.face_start, m.num_faces, m.corner_vertex,
+                    m.corner_normals, true,           m.face_flat,  {},          {},
+                    m.num_corners};
   if (m.num_uv_sets < 1 || m.num_uv_sets > static_cast<std::size_t>(kMaxUvSets)) {
     return Error::badInput(where + "num_uv_sets = " + std::to_string(m.num_uv_sets) +
                            " (must be 1 to " + std::to_string(kMaxUvSets) + ")");
@@ -436,8 +443,8 @@ int sgbake_compute_tangents(const float* positions, size_t num_vertices,
                             size_t error_buf_size) {
   return sgbake::guarded("sgbake_compute_tangents", error_buf, error_buf_size, [&] {
     const sgbake::MeshArrays arrays{positions,     num_vertices,   face_start, num_faces,
-                                    corner_vertex, corner_normals, false,      {corner_uvs},
-                                    {"corner_uvs"}, num_corners};
+                                    corner_vertex, corner_normals, false,      nullptr,
+                                    {corner_uvs},  {"corner_uvs"}, num_corners};
     return sgbake::computeTangentsFromArrays(arrays, threads, out_tangents, out_signs);
   });
 }

@@ -162,14 +162,19 @@ def enable_addon(library_path):
 
 
 def build_scene(work):
-    """Suzanne with the bump material; writes mesh.obj and height.exr. Returns (object, height
-    image, Bump Distance)."""
+    """Suzanne with the bump material, every seventh face flat-shaded (the add-on must say so:
+    flat faces are shaded per triangle); writes mesh.obj (with `s 0` / `s 1`) and height.exr.
+    Returns (object, height image, Bump Distance)."""
     import bake_scene
     bc.reset_scene()
     ob = bake_scene.build_suzanne()
     me = ob.data
+    for polygon in me.polygons:
+        polygon.use_smooth = polygon.index % 7 != 0
     me.calc_normals_split()
-    objio.write_obj(os.path.join(work, "mesh.obj"), objio.mesh_arrays(me),
+    arrays = objio.mesh_arrays(me)
+    arrays["smooth"] = [p.use_smooth for p in me.polygons]
+    objio.write_obj(os.path.join(work, "mesh.obj"), arrays,
                     comment="add-on test Suzanne (tests/blender/addon_oracle.py)")
     side = bake_scene.HEIGHT_SIZE
     height = bc.new_float_image("height", side, side, bake_scene.height_field(side))
@@ -366,7 +371,9 @@ def shifted_suzanne(ob, work):
     udim = bpy.data.objects.new("SuzanneUdim", me)
     bpy.context.scene.collection.objects.link(udim)
     me.calc_normals_split()
-    objio.write_obj(os.path.join(work, "mesh_udim.obj"), objio.mesh_arrays(me),
+    arrays = objio.mesh_arrays(me)
+    arrays["smooth"] = [p.use_smooth for p in me.polygons]  # the copy keeps the flat faces
+    objio.write_obj(os.path.join(work, "mesh_udim.obj"), arrays,
                     comment="add-on test Suzanne on UDIM tiles 1001 and 1002")
     return udim
 

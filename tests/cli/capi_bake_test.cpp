@@ -14,11 +14,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/bake/planner.hpp"
 #include "sgbake/bake/scene.hpp"
+#include "sgbake/core/math.hpp"
 #include "sgbake/gradient/image.hpp"
 #include "sgbake/mesh/io.hpp"
 #include "sgbake/sgbake.h"
@@ -146,9 +148,16 @@ class CApiBake : public ::testing::Test {
     for (const Vec3f& n : mesh_.cornerNormals) normalsArray.insert(normalsArray.end(), {n.x, n.y, n.z});
     for (const Vec2f& uv : mesh_.uvSets[0].uvs) uvs.insert(uvs.end(), {uv.x, uv.y});
     const float* uvSets[] = {uvs.data()};
-    const sgbake_mesh mesh{positions.data(),      mesh_.numVertices(), mesh_.faceStart.data(),
-                           mesh_.numFaces(),      mesh_.cornerVertex.data(), normalsArray.data(),
-                           uvSets,                1,                   mesh_.numCorners()};
+    const sgbake_mesh mesh{positions.data(),
+                           mesh_.numVertices(),
+                           mesh_.faceStart.data(),
+                           mesh_.numFaces(),
+                           mesh_.cornerVertex.data(),
+                           normalsArray.data(),
+                           uvSets,
+                           1,
+                           mesh_.numCorners(),
+                           nullptr};
     rgba.assign(static_cast<std::size_t>(size) * size * 4, -1.0f);
     char error[512] = "";
     const int status = sgbake_bake_map(scene.c_str(), &mesh, images, 2, 0, nullptr,
@@ -241,6 +250,43 @@ TEST_F(CApiBake, MaskIsTheCoverage) {
   expectSameAsFile(R"({"map": "mask", "size": 64, "alpha": true})", 64, 1, true);
 }
 
+TEST_F(CApiBake, FlatFacesAreShadedPerTriangle) {
+  // A quad whose corners are not coplanar: flagged flat (face_flat), each of its triangles
+  // (0-1-2, 0-2-3) shows its own normal, as Cycles shades it; smooth, with the same corner
+  // normals (the polygon's), it shows their interpolation.
+  const float positions[] = {0, 0, 0, 1, 0, 0.4f, 1, 1, 0, 0, 1, 0.1f};
+  const float uv[] = {0, 0, 1, 0, 1, 1, 0, 1};
+  const float* uvSets[] = {uv};
+  const Vec3d polygon = normalizeOr(Vec3d{-0.1467348, 0.1467348, 0.9782320}, {});
+  std::vector<float> normals;
+  for (int i = 0; i < 4; ++i) {
+    normals.insert(normals.end(), {static_cast<float>(polygon.x), static_cast<float>(polygon.y),
+                                   static_cast<float>(polygon.z)});
+  }
+  const std::uint32_t faceStart[] = {0, 4}, corners[] = {0, 1, 2, 3};
+  const Vec3d first = normalizeOr(cross(Vec3d{1, 0, 0.4}, Vec3d{1, 1, 0}), {});
+  const Vec3d second = normalizeOr(cross(Vec3d{1, 1, 0}, Vec3d{0, 1, 0.1}), {});
+  for (const bool flat : {true, false}) {
+    const std::uint8_t faceFlat[] = {static_cast<std::uint8_t>(flat ? 1 : 0)};
+    const sgbake_mesh mesh{positions,      4,      faceStart, 1, corners,
+                           normals.data(), uvSets, 1,         4, faceFlat};
+    std::vector<float> out(16 * 16 * 4);
+    char error[256] = "";
+    ASSERT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "object-normal", "size": 16}]})", &mesh,
+                              nullptr, 0, 0, nullptr, out.data(), out.size(), error, sizeof error),
+              SGBAKE_OK)
+        << error;
+    // (12, 3) lies in 0-1-2 and (3, 12) in 0-2-3; rows from the bottom.
+    for (const auto& [x, y, n] :
+         {std::tuple{12, 3, flat ? first : polygon}, std::tuple{3, 12, flat ? second : polygon}}) {
+      const float* texel = &out[4 * (static_cast<std::size_t>(y) * 16 + x)];
+      EXPECT_NEAR(texel[0], 0.5 * n.x + 0.5, 1e-6) << int(flat) << " " << x << "," << y;
+      EXPECT_NEAR(texel[1], 0.5 * n.y + 0.5, 1e-6) << int(flat) << " " << x << "," << y;
+      EXPECT_NEAR(texel[2], 0.5 * n.z + 0.5, 1e-6) << int(flat) << " " << x << "," << y;
+    }
+  }
+}
+
 TEST_F(CApiBake, NamesAMissingImageAndAWrongBufferSize) {
   std::vector<float> rgba;
   std::string message;
@@ -258,7 +304,7 @@ TEST_F(CApiBake, NamesAMissingImageAndAWrongBufferSize) {
   const float* uvSets[] = {uv};
   const float positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const std::uint32_t faceStart[] = {0, 3}, corners[] = {0, 1, 2};
-  const sgbake_mesh mesh{positions, 3, faceStart, 1, corners, nullptr, uvSets, 1, 3};
+  const sgbake_mesh mesh{positions, 3, faceStart, 1, corners, nullptr, uvSets, 1, 3, nullptr};
   std::vector<float> out(16 * 16 * 4);
   char error[256] = "";
   EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}],

@@ -120,9 +120,16 @@ TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
   // must not load the image I/O module either.
   const FlatMesh m;
   const float* uvSets[] = {m.cornerUvs.data()};
-  const sgbake_mesh mesh{m.positions.data(), m.numVertices(), m.faceStart.data(), m.numFaces(),
-                         m.cornerVertex.data(), m.cornerNormals.data(), uvSets, 1,
-                         m.numCorners()};
+  const sgbake_mesh mesh{m.positions.data(),
+                         m.numVertices(),
+                         m.faceStart.data(),
+                         m.numFaces(),
+                         m.cornerVertex.data(),
+                         m.cornerNormals.data(),
+                         uvSets,
+                         1,
+                         m.numCorners(),
+                         nullptr};
   std::vector<float> rgba(32 * 32 * 4);
   char error[256] = "";
   ASSERT_EQ(sgbake_bake_map(R"({"layers": [{"type": "volume", "function": "noise"}],
@@ -140,9 +147,16 @@ TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
 TEST(CApi, BakeMapReportsProgressAndStopsWhenCancelled) {
   const FlatMesh m;
   const float* uvSets[] = {m.cornerUvs.data()};
-  const sgbake_mesh mesh{m.positions.data(), m.numVertices(), m.faceStart.data(), m.numFaces(),
-                         m.cornerVertex.data(), m.cornerNormals.data(), uvSets, 1,
-                         m.numCorners()};
+  const sgbake_mesh mesh{m.positions.data(),
+                         m.numVertices(),
+                         m.faceStart.data(),
+                         m.numFaces(),
+                         m.cornerVertex.data(),
+                         m.cornerNormals.data(),
+                         uvSets,
+                         1,
+                         m.numCorners(),
+                         nullptr};
   const char* scene = R"({"layers": [{"type": "volume", "function": "noise"}],
                           "outputs": [{"map": "tangent-normal", "size": 1024}]})";
   std::vector<float> plain(1024 * 1024 * 4), tracked(plain.size());
