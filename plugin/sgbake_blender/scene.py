@@ -139,9 +139,10 @@ def output_json(settings, tile=1001):
     """The single entry of "outputs" (no "file": the pixels come back in memory) for UDIM
     tile `tile` (1001: the 0-1 UV square)."""
     output = {"map": settings.map, "width": int(settings.width), "height": int(settings.height),
-              "margin": int(settings.margin), "padding": settings.padding,
-              "samples": int(settings.samples), "alpha": bool(settings.use_alpha),
-              "tile": int(tile)}
+              "padding": settings.padding, "samples": int(settings.samples),
+              "alpha": bool(settings.use_alpha), "tile": int(tile)}
+    if settings.padding != "push-pull":  # push-pull fills every texel: no margin
+        output["margin"] = int(settings.margin)
     if settings.map == "tangent-normal":
         output["green"] = settings.green
     return output

@@ -768,6 +768,11 @@ SceneOutput parseOutput(const json& value, const std::string& where,
       output.range = reader.numberAtLeast("range", 0, true);
     }
   }
+  if (reader.has("margin") && output.padding == PaddingMode::kPushPull) {
+    fail(where,
+         "key 'margin' applies to padding \"extend\" and \"adjacent-faces\"; "
+         "\"push-pull\" fills every texel outside the UV islands");
+  }
   if (reader.has("green") && output.map != MapKind::kTangentNormal) {
     fail(where, "key 'green' applies only to tangent-normal maps");
   }

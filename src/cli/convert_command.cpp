@@ -191,9 +191,9 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   const std::string map = saidOf("sgbake:map");
   if ((map == "object-normal" || map == "tangent-normal") &&
       map != std::string(normalSpaceName(*from)) + "-normal") {
-    return Error::badInput(args.input + ": the file says it is a " + map +
-                           " map (sgbake:map); --from " + std::string(normalSpaceName(*from)) +
-                           " would misread it");
+    return Error::badInput(
+        args.input + ": the file says it is " + (map == "object-normal" ? "an " : "a ") + map +
+        " map (sgbake:map); --from " + std::string(normalSpaceName(*from)) + " would misread it");
   }
   int tile = args.tile;
   const std::string saidTile = saidOf("sgbake:udim_tile");

@@ -125,6 +125,11 @@ TEST_F(BakeCliTest, BadScenesExitTwoNamingTheProblemAndCreateNothing) {
       "outputs[0]: size 100000 is out of range 1..65536", before, dir_);
   expectBadScene(bakeScene(planeScene(kHeightLayer, R"({"map": "albedo", "file": "out.png"})")),
                  "outputs[0]: unknown map 'albedo'", before, dir_);
+  expectBadScene(
+      bakeScene(planeScene(kHeightLayer,
+                           "{" + std::string(out) + R"(, "padding": "push-pull", "margin": 4})")),
+      "outputs[0]: key 'margin' applies to padding \"extend\" and \"adjacent-faces\"", before,
+      dir_);
   expectBadScene(bakeScene(planeScene(R"({"type": "height", "image": "nothere.png"})",
                                       "{" + std::string(out) + "}")),
                  "layers[0]: image " + (dir_ / "nothere.png").string() + " does not exist", before,
@@ -495,6 +500,12 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
            {"bake", (dir_ / "scene.json").string(), "--mesh", mesh},
            {"bake"},
            {"bake", "--mesh", mesh, "--padding", "extnd", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--padding", "push-pull", "--margin", "4", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "mask", "--margin", "4", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--map", "mask", "--padding", "adjacent-faces", "-o",
+            (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--map", "derivative", "--range", "0", "-o",
             (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--map", "corners", "--size", "64", "-o",
