@@ -768,7 +768,7 @@ SceneOutput parseOutput(const json& value, const std::string& where,
       output.range = reader.numberAtLeast("range", 0, true);
     }
   }
-  if (reader.has("margin") && output.padding == PaddingMode::kPushPull) {
+  if (reader.has("margin") && output.margin > 0 && output.padding == PaddingMode::kPushPull) {
     fail(where,
          "key 'margin' applies to padding \"extend\" and \"adjacent-faces\"; "
          "\"push-pull\" fills every texel outside the UV islands");

@@ -423,19 +423,19 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
       return Error::badInput(std::string("bake: ") + option + " applies only with " + needs);
     }
   }
-  if (args.padding == "push-pull" && app.count("--margin") > 0) {
+  // A margin or padding that would be ignored (0 and extend, the defaults, may be said).
+  if (args.padding == "push-pull" && app.count("--margin") > 0 && args.margin > 0) {
     return Error::badInput(
         "bake: --margin is the width of --padding extend or adjacent-faces; push-pull fills "
         "every texel outside the UV islands");
   }
-  if (args.map == "mask") {  // masks show the coverage: never padded
-    for (const char* option : {"--margin", "--padding"}) {
-      if (app.count(option) > 0) {
-        return Error::badInput(std::string("bake: ") + option +
-                               " does not apply to --map mask: a mask shows the coverage and is "
-                               "never padded");
-      }
-    }
+  if (args.map == "mask" && ((app.count("--margin") > 0 && args.margin > 0) ||
+                             (app.count("--padding") > 0 && args.padding != "extend"))) {
+    return Error::badInput(
+        std::string("bake: ") +
+        (app.count("--padding") > 0 && args.padding != "extend" ? "--padding" : "--margin") +
+        " does not apply to --map mask: a mask shows the coverage and is "
+        "never padded");
   }
   if (args.map == "corners") {  // a CSV table of the mesh's corners: no image options
     for (const char* option :

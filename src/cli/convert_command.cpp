@@ -125,7 +125,7 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
     return Error::badInput("convert: --padding: unknown value '" + args.padding +
                            "' (expected keep, extend, adjacent-faces or push-pull)");
   }
-  if (app.count("--margin") != 0 && padding != PaddingMode::kExtend &&
+  if (app.count("--margin") != 0 && args.margin > 0 && padding != PaddingMode::kExtend &&
       padding != PaddingMode::kAdjacentFaces) {
     return Error::badInput(
         "convert: --margin is the width of --padding extend or "
