@@ -104,14 +104,7 @@ def blender_main(argv):
 
 def run_blender(blender, args):
     """Runs this file in Blender; returns the JSON after RESULT_TAG, or None (output shown)."""
-    proc = objio.run_blender(blender, os.path.abspath(__file__), args, capture_output=True,
-                             text=True)
-    for line in proc.stdout.splitlines():
-        if proc.returncode == 0 and line.startswith(RESULT_TAG):
-            return json.loads(line[len(RESULT_TAG):])
-    print(f"error: Blender {' '.join(args[:1])} failed ({proc.returncode})\n"
-          f"{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-    return None
+    return objio.run_blender_result(blender, os.path.abspath(__file__), args, RESULT_TAG)
 
 
 def bake(cli, case, padding, out, kind="object-normal", margin=MARGIN):

@@ -50,6 +50,19 @@ def run_blender(blender, script, args, blender_options=(), **kwargs):
     return subprocess.run(cmd, env=env, check=False, **kwargs)
 
 
+def run_blender_result(blender, script, args, tag):
+    """Runs SCRIPT in Blender (run_blender) and returns the JSON it printed after `tag`, or
+    None when it failed (its output shown)."""
+    import json
+    proc = run_blender(blender, script, args, capture_output=True, text=True)
+    for line in proc.stdout.splitlines():
+        if proc.returncode == 0 and line.startswith(tag):
+            return json.loads(line[len(tag):])
+    print(f"error: Blender {' '.join(args[:1])} failed ({proc.returncode})\n"
+          f"{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
+    return None
+
+
 def run_script(blender_main, main):
     """The entry point of a script that is both the driver (plain python3) and, re-run by
     run_blender, the Blender half: inside Blender (bpy importable) calls blender_main with the
