@@ -108,10 +108,13 @@ typedef struct sgbake_mesh {
   size_t num_uv_sets;  ///< at least 1, at most 4 (the UV sets a scene's "uv" keys can name)
   size_t num_corners;  ///< #C (must fit in 32 bits)
   /// #F flags, nonzero for a flat-shaded face (Blender: `not polygons[f].use_smooth`), or NULL:
-  /// every face smooth. A flat face is shaded with each of its triangles' own normal, as
-  /// Cycles shades it, while its corner normals (the polygon's) give the tangent frame; with
+  /// every face smooth. Without auto_smooth a flat face is shaded with each of its triangles'
+  /// own normal, as Cycles shades it; its tangent frame uses its polygon normal. With
   /// corner_normals NULL it gets the polygon normal at its corners, and subdivision keeps it flat.
   const uint8_t* face_flat;
+  /// Nonzero when Blender's Auto Smooth is on (`mesh.use_auto_smooth`; custom normals need it):
+  /// Cycles then shades every face, flat ones included, with its corner normals.
+  int auto_smooth;
 } sgbake_mesh;
 
 /// @brief An image in memory, laid out as Blender's `Image.pixels`: width × height × channels

@@ -66,6 +66,7 @@ class Mesh(ctypes.Structure):
         ("num_uv_sets", ctypes.c_size_t),
         ("num_corners", ctypes.c_size_t),
         ("face_flat", ctypes.POINTER(ctypes.c_uint8)),
+        ("auto_smooth", ctypes.c_int),
     ]
 
 
@@ -202,7 +203,7 @@ def _image_entry(name, image):
 
 
 def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, uv_sets,
-             images=None, threads=0, progress=None, face_flat=None):
+             images=None, threads=0, progress=None, face_flat=None, auto_smooth=False):
     """Bakes one map with sgbake_bake_map and returns its pixels.
 
     scene           dict: a scene as for `sgbake bake SCENE.json` without "mesh", with one
@@ -219,7 +220,10 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
     threads         maximum number of threads, 0 = all cores (same result for every value).
     progress        a Progress to follow or cancel the bake from another thread, or None.
     face_flat       #F flags, nonzero for a flat-shaded face (Blender: not use_smooth), or
-                    None: every face smooth. Flat faces are shaded per triangle, as Cycles does.
+                    None: every face smooth. Flat faces are shaded per triangle, as Cycles does,
+                    unless auto_smooth.
+    auto_smooth     Blender's Auto Smooth (mesh.use_auto_smooth): every face, flat ones
+                    included, is shaded with its corner normals.
 
     Returns a float32 array of width * height * 4 values (RGBA, rows bottom first: the layout
     of Blender's Image.pixels). Raises SgbakeError on any failure, SgbakeCancelled when
@@ -257,7 +261,8 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
                                 if corner_normals is not None else None),
                 corner_uvs=uv_pointers, num_uv_sets=len(uv_arrays), num_corners=num_corners,
                 face_flat=(_pointer(face_flat, ctypes.POINTER(ctypes.c_uint8))
-                           if face_flat is not None else None))
+                           if face_flat is not None else None),
+                auto_smooth=1 if auto_smooth else 0)
 
     entries = [(name.encode("utf-8"),) + _image_entry(name, image)
                for name, image in (images or {}).items()]

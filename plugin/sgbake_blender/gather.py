@@ -48,7 +48,8 @@ def uv_sets(mesh, bake_uv_name, layers):
 def mesh_arrays(mesh, uv_names):
     """The mesh as sgbake_mesh arrays: positions (#V x 3), face_start (#F + 1), corner_vertex
     (#C), corner normals (#C x 3, Blender's split normals: calc_normals_split must have run),
-    one (#C x 2) array per UV map name, and face_flat (#F, 1 where the face is flat-shaded).
+    one (#C x 2) array per UV map name, face_flat (#F, 1 where the face is flat-shaded) and
+    whether Auto Smooth is on.
 
     sgbake wants each face's corners contiguous and in face order. Blender's meshes almost
     always store them so; when loop_start says otherwise, the corner arrays are reordered."""
@@ -66,6 +67,8 @@ def mesh_arrays(mesh, uv_names):
     smooth = np.empty(nf, bool)
     mesh.polygons.foreach_get("use_smooth", smooth)
     face_flat = (~smooth).astype(np.uint8)
+    # Auto Smooth on (custom normals need it): Cycles shades flat faces with their split normals.
+    auto_smooth = bool(mesh.use_auto_smooth)
     uvs = []
     for name in uv_names:
         uv = np.empty(nc * 2, np.float32)
@@ -80,7 +83,8 @@ def mesh_arrays(mesh, uv_names):
         corner_vertex = corner_vertex[order]
         normals = normals.reshape(-1, 3)[order].reshape(-1)
         uvs = [uv.reshape(-1, 2)[order].reshape(-1) for uv in uvs]
-    return positions, face_start.astype(np.uint32), corner_vertex, normals, uvs, face_flat
+    return (positions, face_start.astype(np.uint32), corner_vertex, normals, uvs, face_flat,
+            auto_smooth)
 
 
 def limit_modifier(ob):

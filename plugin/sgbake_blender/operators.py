@@ -99,7 +99,8 @@ class BakeJob:
         in self.error."""
         start = time.perf_counter()
         try:
-            positions, face_start, corner_vertex, normals, uvs, face_flat = self.arrays
+            positions, face_start, corner_vertex, normals, uvs, face_flat, auto_smooth = \
+                self.arrays
             rgba = {}
             for index, tile in enumerate(self.tiles):
                 self.progress.fraction = 0.0
@@ -107,7 +108,7 @@ class BakeJob:
                 rgba[tile] = capi.bake_map(self.lib, self.scenes[tile], positions, face_start,
                                            corner_vertex, normals, uvs, self.images,
                                            threads=self.threads, progress=self.progress,
-                                           face_flat=face_flat)
+                                           face_flat=face_flat, auto_smooth=auto_smooth)
             self.rgba = rgba
         except capi.SgbakeError as exc:
             self.error = exc

@@ -108,10 +108,22 @@ void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
   tri.hasTangents = tangents != nullptr;
   tri.faceNormal = normalizeOr(cross(tri.position[1] - tri.position[0], tri.position[2] - tri.position[0]),
                                Vec3d{0, 0, 1});
-  tri.flat = false;
+  tri.flat = tri.polygonFrame = false;
   if (!mesh.faceFlat.empty()) {  // the face of the triangle's corners
     const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), corners[0]);
-    tri.flat = mesh.isFlat(static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1);
+    const auto face = static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1;
+    if (mesh.isFlat(face)) {
+      tri.flat = !mesh.autoSmooth;
+      tri.polygonFrame = true;
+      Vec3d newell{};  // twice the vector area of the polygon
+      const std::uint32_t begin = mesh.faceStart[face], n = mesh.faceSize(face);
+      for (std::uint32_t k = 0; k < n; ++k) {
+        const Vec3d a = cast<double>(mesh.positions[mesh.cornerVertex[begin + k]]);
+        const Vec3d b = cast<double>(mesh.positions[mesh.cornerVertex[begin + (k + 1) % n]]);
+        newell = newell + cross(a, b);
+      }
+      tri.polygonNormal = normalizeOr(newell, tri.faceNormal);
+    }
   }
   tri.numUvSets = static_cast<int>(std::min<std::size_t>(mesh.uvSets.size(), kMaxUvSets));
   for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s) {

@@ -119,6 +119,7 @@ struct LimitShader {
     t.position = {p.position, p.position, p.position};
     t.normal = {n, n, n};
     t.faceNormal = n;
+    t.flat = t.polygonFrame = false;  // the limit surface is smooth
     t.tangent = {tangent, tangent, tangent};
     t.sign = {sign, sign, sign};
   }

@@ -37,11 +37,14 @@ struct ShadingTriangle {
   std::array<Vec3d, kMaxUvSets> dPdu{}, dPdv{};
   Vec3d bakeDPdu{}, bakeDPdv{};  ///< derivatives w.r.t. the bake's UV set (any index)
   Vec3d faceNormal{0, 0, 1};     ///< geometric normal, fallback when Σ bi·Ni vanishes
-  /// A flat-shaded face's triangle: it is shaded with faceNormal (Cycles' Ng, what Blender's
-  /// bake shows on a flat face: a non-planar flat quad shows each triangle's normal), while the
-  /// tangent frame keeps the corner normals Σ bi·Ni (the polygon's normal, as Blender's
-  /// object → tangent conversion uses).
+  /// Shaded with faceNormal (a flat face without Auto Smooth: Cycles' Ng, so a non-planar
+  /// flat quad shows each triangle's normal) instead of the corner normals Σ bi·Ni.
   bool flat = false;
+  /// A flat face's triangle: the tangent frame's N is polygonNormal (the face's unit Newell
+  /// normal, as Blender's object → tangent conversion uses), not Σ bi·Ni (which differ from it
+  /// only with custom normals).
+  bool polygonFrame = false;
+  Vec3d polygonNormal{0, 0, 1};
   bool hasTangents = false;
 };
 
@@ -66,26 +69,29 @@ inline Vec3d unitOr(const Vec3d& a, const Vec3d& fallback) {
   return normalizeOr(a, fallback);
 }
 
-/// @brief The per-texel frame at barycentrics b: T, N interpolated and not renormalized,
-/// sign = Σ bi·si < 0 ? −1 : +1, B = sign·N×T.
+/// @brief The per-texel frame at barycentrics b: T, N interpolated and not renormalized (N the
+/// polygon normal on a flat face), sign = Σ bi·si < 0 ? −1 : +1, B = sign·N×T; and the
+/// interpolated corner normal Σ bi·Ni the shading normal comes from.
 struct TexelFrame {
   Vec3d tangent, bitangent, normal;
+  Vec3d cornerNormal;       ///< Σ bi·Ni (= normal unless the face is flat)
   double interpolatedSign;  ///< Σ bi·si, as the SurfacePoint carries it
 };
 
 inline TexelFrame texelFrame(const ShadingTriangle& t, const Vec3d& b) {
   TexelFrame f;
   f.tangent = b.x * t.tangent[0] + b.y * t.tangent[1] + b.z * t.tangent[2];
-  f.normal = b.x * t.normal[0] + b.y * t.normal[1] + b.z * t.normal[2];
+  f.cornerNormal = b.x * t.normal[0] + b.y * t.normal[1] + b.z * t.normal[2];
+  f.normal = t.polygonFrame ? t.polygonNormal : f.cornerNormal;
   f.interpolatedSign = b.x * t.sign[0] + b.y * t.sign[1] + b.z * t.sign[2];
   f.bitangent = (f.interpolatedSign < 0 ? -1.0 : 1.0) * cross(f.normal, f.tangent);
   return f;
 }
 
-/// @brief The unit shading normal normalize(Σ bi·Ni), or the face normal when that vanishes or
-/// the face is flat-shaded.
+/// @brief The unit shading normal: normalize(Σ bi·Ni), or the triangle's normal when that
+/// vanishes or the face is shaded flat (ShadingTriangle::flat).
 inline Vec3d unitNormal(const ShadingTriangle& t, const TexelFrame& f) {
-  return t.flat ? t.faceNormal : unitOr(f.normal, t.faceNormal);
+  return t.flat ? t.faceNormal : unitOr(f.cornerNormal, t.faceNormal);
 }
 
 /// @brief Sets the fields of @p p that are constant over triangle @p t (UV derivatives, number of

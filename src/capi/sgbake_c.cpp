@@ -87,6 +87,7 @@ struct MeshArrays {
   const float* cornerNormals = nullptr;  ///< NULL only where normalsOptional
   bool normalsOptional = false;
   const std::uint8_t* faceFlat = nullptr;  ///< #F, or NULL: every face smooth
+  bool autoSmooth = false;
   std::vector<const float*> uvSets;  ///< each #C × 2
   std::vector<std::string> uvNames;  ///< how messages name each UV array
   std::size_t numCorners = 0;
@@ -244,8 +245,10 @@ Mesh toMesh(const MeshArrays& a) {
   }
   if (a.cornerNormals == nullptr) {
     computeSmoothNormals(mesh);
+    mesh.autoSmooth = a.autoSmooth;
     return mesh;
   }
+  mesh.autoSmooth = a.autoSmooth;
   mesh.cornerNormals = toVec3(a.cornerNormals, a.numCorners);
   for (Vec3f& n : mesh.cornerNormals) n = unitNormal(n);
   return mesh;
@@ -336,8 +339,17 @@ Status bakeMapFromArrays(const BakeArguments& a) {
   }
 
   const sgbake_mesh& m = *a.mesh;
-  MeshArrays arrays{m.positions,      m.num_vertices, m.face_start, m.num_faces, m.corner_vertex,
-                    m.corner_normals, true,           m.face_flat,  {},          {},
+  MeshArrays arrays{m.positions,
+                    m.num_vertices,
+                    m.face_start,
+                    m.num_faces,
+                    m.corner_vertex,
+                    m.corner_normals,
+                    true,
+                    m.face_flat,
+                    m.auto_smooth != 0,
+                    {},
+                    {},
                     m.num_corners};
   if (m.num_uv_sets < 1 || m.num_uv_sets > static_cast<std::size_t>(kMaxUvSets)) {
     return Error::badInput(where + "num_uv_sets = " + std::to_string(m.num_uv_sets) +
@@ -442,9 +454,9 @@ int sgbake_compute_tangents(const float* positions, size_t num_vertices,
                             float* out_tangents, float* out_signs, char* error_buf,
                             size_t error_buf_size) {
   return sgbake::guarded("sgbake_compute_tangents", error_buf, error_buf_size, [&] {
-    const sgbake::MeshArrays arrays{positions,     num_vertices,   face_start, num_faces,
-                                    corner_vertex, corner_normals, false,      nullptr,
-                                    {corner_uvs},  {"corner_uvs"}, num_corners};
+    const sgbake::MeshArrays arrays{positions,     num_vertices,   face_start,     num_faces,
+                                    corner_vertex, corner_normals, false,          nullptr,
+                                    false,         {corner_uvs},   {"corner_uvs"}, num_corners};
     return sgbake::computeTangentsFromArrays(arrays, threads, out_tangents, out_signs);
   });
 }

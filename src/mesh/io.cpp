@@ -229,6 +229,7 @@ Result<Mesh> readWithOpenMesh(const ValidatedFile& file, std::string_view name) 
           unitNormal(parsed.normals[static_cast<std::size_t>(parsed.cornerNormal[c])]);
     }
     mesh.normalSource = NormalSource::kFile;
+    mesh.autoSmooth = normalsShowAutoSmooth(mesh);
   } else if (perVertexNormals) {
     std::vector<Vec3f> vertexNormals(numVertices);
     for (std::size_t v = 0; v < numVertices; ++v) {

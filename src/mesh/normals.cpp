@@ -248,6 +248,7 @@ void computeSplitNormals(Mesh& mesh, double angle,
         normalOfSum(fanSum[fans.find(c)], mesh.positions[mesh.cornerVertex[c]]);
   }
   mesh.normalSource = NormalSource::kComputed;
+  mesh.autoSmooth = true;
 }
 
 Status validate(const Mesh& mesh) {
@@ -317,6 +318,31 @@ Vec3f unitNormal(Vec3f n) {
   const double len = length(cast<double>(n));
   if (std::abs(len - 1.0) <= detail::kUnitLengthTolerance) return n;
   return cast<float>(normalizeOr(cast<double>(n), Vec3d{0, 0, 1}));
+}
+
+bool normalsShowAutoSmooth(const Mesh& mesh) {
+  if (mesh.cornerNormals.size() != mesh.numCorners()) return false;
+  const std::vector<Vec3f> faceNormals = computeFaceNormals(mesh.view());
+  const double cosTolerance = std::cos(0.1 * kPi / 180);
+  // The normal of each vertex's first corner on a smooth face.
+  std::vector<std::int64_t> firstSmoothCorner(mesh.numVertices(), -1);
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
+      const Vec3f n = mesh.cornerNormals[c];
+      if (mesh.isFlat(f)) {
+        const Vec3d a = cast<double>(n), b = cast<double>(faceNormals[f]);
+        if (dot(a, b) < cosTolerance * std::sqrt(dot(a, a) * dot(b, b))) return true;
+        continue;
+      }
+      std::int64_t& first = firstSmoothCorner[mesh.cornerVertex[c]];
+      if (first < 0) {
+        first = c;
+      } else if (!(mesh.cornerNormals[static_cast<std::size_t>(first)] == n)) {
+        return true;
+      }
+    }
+  }
+  return false;
 }
 
 }  // namespace sgbake

@@ -104,8 +104,12 @@ TEST(Maps, AFlatNonPlanarQuadShowsEachTrianglesNormal) {
   Mesh mesh = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, cast<float>(polygon));
   const Vec3d first = normalizeOr(cross(Vec3d{1, 0, 0.4}, Vec3d{1, 1, 0}), {});
   const Vec3d second = normalizeOr(cross(Vec3d{1, 1, 0}, Vec3d{0, 1, 0.1}), {});
-  for (const bool flat : {true, false}) {
-    mesh.faceFlat = {static_cast<std::uint8_t>(flat ? 1 : 0)};
+  for (const auto& [flagged, autoSmooth] :
+       {std::pair{true, false}, std::pair{false, false}, std::pair{true, true}}) {
+    // With Blender's Auto Smooth on, Cycles shades flat faces with their corner normals too.
+    const bool flat = flagged && !autoSmooth;
+    mesh.faceFlat = {static_cast<std::uint8_t>(flagged ? 1 : 0)};
+    mesh.autoSmooth = autoSmooth;
     const Result<FloatImage> image = bake(mesh, nullptr, {}, MapKind::kObjectNormal, 16);
     ASSERT_TRUE(image.ok()) << image.error().message;
     // Texel (12, 3) lies in 0-1-2, (3, 12) in 0-2-3 (y up).

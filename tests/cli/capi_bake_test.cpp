@@ -157,7 +157,8 @@ class CApiBake : public ::testing::Test {
                            uvSets,
                            1,
                            mesh_.numCorners(),
-                           nullptr};
+                           nullptr,
+                           0};
     rgba.assign(static_cast<std::size_t>(size) * size * 4, -1.0f);
     char error[512] = "";
     const int status = sgbake_bake_map(scene.c_str(), &mesh, images, 2, 0, nullptr,
@@ -252,8 +253,8 @@ TEST_F(CApiBake, MaskIsTheCoverage) {
 
 TEST_F(CApiBake, FlatFacesAreShadedPerTriangle) {
   // A quad whose corners are not coplanar: flagged flat (face_flat), each of its triangles
-  // (0-1-2, 0-2-3) shows its own normal, as Cycles shades it; smooth, with the same corner
-  // normals (the polygon's), it shows their interpolation.
+  // (0-1-2, 0-2-3) shows its own normal, as Cycles shades it; smooth, or flat with Auto Smooth
+  // on (auto_smooth), the corner normals (the polygon's) show.
   const float positions[] = {0, 0, 0, 1, 0, 0.4f, 1, 1, 0, 0, 1, 0.1f};
   const float uv[] = {0, 0, 1, 0, 1, 1, 0, 1};
   const float* uvSets[] = {uv};
@@ -266,10 +267,12 @@ TEST_F(CApiBake, FlatFacesAreShadedPerTriangle) {
   const std::uint32_t faceStart[] = {0, 4}, corners[] = {0, 1, 2, 3};
   const Vec3d first = normalizeOr(cross(Vec3d{1, 0, 0.4}, Vec3d{1, 1, 0}), {});
   const Vec3d second = normalizeOr(cross(Vec3d{1, 1, 0}, Vec3d{0, 1, 0.1}), {});
-  for (const bool flat : {true, false}) {
-    const std::uint8_t faceFlat[] = {static_cast<std::uint8_t>(flat ? 1 : 0)};
-    const sgbake_mesh mesh{positions,      4,      faceStart, 1, corners,
-                           normals.data(), uvSets, 1,         4, faceFlat};
+  for (const auto& [flagged, autoSmooth] :
+       {std::pair{true, false}, std::pair{false, false}, std::pair{true, true}}) {
+    const bool flat = flagged && !autoSmooth;
+    const std::uint8_t faceFlat[] = {static_cast<std::uint8_t>(flagged ? 1 : 0)};
+    const sgbake_mesh mesh{positions, 4, faceStart, 1,        corners,           normals.data(),
+                           uvSets,    1, 4,         faceFlat, autoSmooth ? 1 : 0};
     std::vector<float> out(16 * 16 * 4);
     char error[256] = "";
     ASSERT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "object-normal", "size": 16}]})", &mesh,
@@ -304,7 +307,7 @@ TEST_F(CApiBake, NamesAMissingImageAndAWrongBufferSize) {
   const float* uvSets[] = {uv};
   const float positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const std::uint32_t faceStart[] = {0, 3}, corners[] = {0, 1, 2};
-  const sgbake_mesh mesh{positions, 3, faceStart, 1, corners, nullptr, uvSets, 1, 3, nullptr};
+  const sgbake_mesh mesh{positions, 3, faceStart, 1, corners, nullptr, uvSets, 1, 3, nullptr, 0};
   std::vector<float> out(16 * 16 * 4);
   char error[256] = "";
   EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}],

@@ -129,7 +129,8 @@ TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
                          uvSets,
                          1,
                          m.numCorners(),
-                         nullptr};
+                         nullptr,
+                         0};
   std::vector<float> rgba(32 * 32 * 4);
   char error[256] = "";
   ASSERT_EQ(sgbake_bake_map(R"({"layers": [{"type": "volume", "function": "noise"}],
@@ -156,7 +157,8 @@ TEST(CApi, BakeMapReportsProgressAndStopsWhenCancelled) {
                          uvSets,
                          1,
                          m.numCorners(),
-                         nullptr};
+                         nullptr,
+                         0};
   const char* scene = R"({"layers": [{"type": "volume", "function": "noise"}],
                           "outputs": [{"map": "tangent-normal", "size": 1024}]})";
   std::vector<float> plain(1024 * 1024 * 4), tracked(plain.size());

@@ -87,6 +87,23 @@ TEST(MeshObj, SmoothingStatementsMarkFlatFacesAsBlendersImporterDoes) {
   EXPECT_EQ(formatObj(unmarked).find("\ns "), std::string::npos);
 }
 
+TEST(MeshObj, NormalsThatOnlyAutoSmoothMakesSayItIsOn) {
+  // Two triangles of a square, z up. Without Blender's Auto Smooth a flat face's corners carry
+  // its polygon normal and a vertex's smooth corners share one normal; anything else in the
+  // file is split or custom normals, which need Auto Smooth (Cycles then shades flat faces
+  // with them).
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvn 0.1 0 0.995\n";
+  const Mesh flat = loadObjText(square + "s 0\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\n");
+  EXPECT_FALSE(flat.autoSmooth);
+  const Mesh smooth = loadObjText(square + "s 1\nf 1//1 2//1 3//2\nf 1//1 3//2 4//1\n");
+  EXPECT_FALSE(smooth.autoSmooth) << "vertex 3 has one normal on both faces";
+  const Mesh split = loadObjText(square + "s 1\nf 1//1 2//1 3//2\nf 1//1 3//1 4//1\n");
+  EXPECT_TRUE(split.autoSmooth) << "vertex 3 has two normals";
+  const Mesh custom = loadObjText(square + "s 0\nf 1//1 2//1 3//2\nf 1//1 3//1 4//1\n");
+  EXPECT_TRUE(custom.autoSmooth) << "a flat face's corner off its polygon normal";
+  EXPECT_FALSE(loadObjText(square + "s 0\nf 1 2 3\nf 1 3 4\n").autoSmooth) << "no normals";
+}
+
 TEST(MeshObj, WithoutNormalsFlatFacesAreShadedFlat) {
   // Blender 3.4 imports an OBJ without `vn` with the normals it computes: a face after `s off`
   // gets its own face normal (measured: the cube of flat quads imports with loop normals equal

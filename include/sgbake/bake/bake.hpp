@@ -48,10 +48,11 @@
 /// `B = sign·N×T`, `P = Σ bi·Pi`, UVs interpolated, and ∂P/∂u, ∂P/∂v the triangle's constant
 /// derivatives. The gradient engine sees a SurfacePoint with normal = normalize(N) and tangent
 /// frame (T, Σ bi·si). Tangent-space output is `normalize(inverse([T B N]) · N')`.
-/// **Flat faces** (Mesh::faceFlat, OBJ `s 0`) are shaded as Cycles shades them: the shading
-/// normal (the SurfacePoint's, the unperturbed normal of object-space maps, the base of the
-/// bump) is the triangle's own geometric normal, so a non-planar flat quad shows two normals;
-/// the frame's N stays Σ bi·Ni (the polygon normal its corners carry), as Blender's object →
+/// **Flat faces** (Mesh::faceFlat, OBJ `s 0`) are shaded as Cycles shades them: without Auto
+/// Smooth (Mesh::autoSmooth) the shading normal (the SurfacePoint's, the unperturbed normal of
+/// object-space maps, the base of the bump) is the triangle's own geometric normal, so a
+/// non-planar flat quad shows two normals; with it, the corner normals as on smooth faces. The
+/// frame's N on a flat face is its polygon normal (Newell) either way, as Blender's object →
 /// tangent conversion uses. Checked on flat Suzanne (BlenderBakeOracle case suzanne_flat).
 ///
 /// ## Threads

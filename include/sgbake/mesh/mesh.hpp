@@ -61,6 +61,11 @@ struct Mesh {
   std::vector<std::uint8_t> faceFlat;
   /// @brief Whether face @p f is flat-shaded (faceFlat says so).
   bool isFlat(std::size_t f) const { return f < faceFlat.size() && faceFlat[f] != 0; }
+  /// Blender's Auto Smooth is on (split or custom normals; computeSplitNormals sets it): Cycles
+  /// then shades every face, flat ones included, with its corner normals. Off (an OBJ does not
+  /// say; Blender's default), a flat face is shaded with each of its triangles' own normal. A
+  /// flat face's tangent frame uses its polygon normal either way.
+  bool autoSmooth = false;
 
   std::size_t numVertices() const { return positions.size(); }
   std::size_t numFaces() const { return faceStart.size() - 1; }

@@ -46,6 +46,14 @@ void computeSplitNormals(
     Mesh& mesh, double angle,
     std::span<const std::pair<std::uint32_t, std::uint32_t>> sharpEdges = {});
 
+/// @brief Whether @p mesh's corner normals (read from a file) can only be Blender's Auto Smooth
+/// split or custom normals, which an OBJ does not otherwise say: corners of one vertex on
+/// smooth faces with different normals (without Auto Smooth they share the vertex normal), or
+/// a flat face with a corner normal more than 0.1° from its polygon normal (without Auto
+/// Smooth a flat face's corners carry it). The mesh is then shaded as Cycles shades an Auto
+/// Smooth mesh (Mesh::autoSmooth).
+bool normalsShowAutoSmooth(const Mesh& mesh);
+
 /// @brief A given normal (read from a file, or handed to the C ABI) as a corner normal: kept
 /// bit-exact when its length is 1 within eight float ulps (about 9.5e-7; a normal normalized in
 /// float stays as it is), normalized in double otherwise.

@@ -35,6 +35,7 @@ int consumer_c_bake(float out_rgba[64], char* error, size_t size) {
   mesh.num_uv_sets = 1;
   mesh.num_corners = 3;
   mesh.face_flat = NULL; /* every face smooth */
+  mesh.auto_smooth = 0;
   return sgbake_bake_map("{\"outputs\": [{\"map\": \"object-normal\", \"size\": 4}]}", &mesh,
                          NULL, 0, 0, &progress, out_rgba, 64, error, size);
 }
