@@ -364,7 +364,7 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
                 read = inImage(p) && sample(p, out);
                 break;
               }
-              // The face's edge nearest p (the first in corner order on a tie).
+              // The face's edge nearest p (the last in corner order on a tie).
               std::uint32_t edge = 0;
               double best = std::numeric_limits<double>::infinity();
               for (std::uint32_t k = 0; k < n; ++k) {
