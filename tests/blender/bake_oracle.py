@@ -2,7 +2,7 @@
 """The BlenderBakeOracle test: sgbake's normal maps against Cycles' bakes of the same scenes.
 
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
-        [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat]
+        [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist]
         [--sabotage green|scale|input]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
@@ -234,7 +234,7 @@ def main():
     parser.add_argument("--cli", required=True, help="path to the sgbake executable")
     parser.add_argument("--blender", default="blender", help="Blender executable")
     parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
-    parser.add_argument("--cases", default="suzanne,suzanne_live,sphere,cube_flat,suzanne_flat")
+    parser.add_argument("--cases", default="suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist")
     parser.add_argument("--threads", type=int, help="pass --threads N to sgbake")
     parser.add_argument("--sabotage", choices=("green", "scale", "input"),
                         help="make sgbake answer wrongly on purpose (the test must fail)")
