@@ -115,22 +115,27 @@ TEST(CApi, DoesNotLoadOpenImageIO) {
   EXPECT_EQ(maps.find("libsgbake_oiio"), std::string::npos);
 }
 
+/// @p m as an sgbake_mesh with its one UV set at @p uvSets[0]; every face smooth.
+sgbake_mesh meshOf(const FlatMesh& m, const float* const* uvSets) {
+  return {m.positions.data(),
+          m.numVertices(),
+          m.faceStart.data(),
+          m.numFaces(),
+          m.cornerVertex.data(),
+          m.cornerNormals.data(),
+          uvSets,
+          1,
+          m.numCorners(),
+          nullptr,
+          0};
+}
+
 TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
   // An in-memory bake (images as arrays, if any) reads and writes no file: the add-on's bakes
   // must not load the image I/O module either.
   const FlatMesh m;
   const float* uvSets[] = {m.cornerUvs.data()};
-  const sgbake_mesh mesh{m.positions.data(),
-                         m.numVertices(),
-                         m.faceStart.data(),
-                         m.numFaces(),
-                         m.cornerVertex.data(),
-                         m.cornerNormals.data(),
-                         uvSets,
-                         1,
-                         m.numCorners(),
-                         nullptr,
-                         0};
+  const sgbake_mesh mesh = meshOf(m, uvSets);
   std::vector<float> rgba(32 * 32 * 4);
   char error[256] = "";
   ASSERT_EQ(sgbake_bake_map(R"({"layers": [{"type": "volume", "function": "noise"}],
@@ -148,17 +153,7 @@ TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {
 TEST(CApi, BakeMapReportsProgressAndStopsWhenCancelled) {
   const FlatMesh m;
   const float* uvSets[] = {m.cornerUvs.data()};
-  const sgbake_mesh mesh{m.positions.data(),
-                         m.numVertices(),
-                         m.faceStart.data(),
-                         m.numFaces(),
-                         m.cornerVertex.data(),
-                         m.cornerNormals.data(),
-                         uvSets,
-                         1,
-                         m.numCorners(),
-                         nullptr,
-                         0};
+  const sgbake_mesh mesh = meshOf(m, uvSets);
   const char* scene = R"({"layers": [{"type": "volume", "function": "noise"}],
                           "outputs": [{"map": "tangent-normal", "size": 1024}]})";
   std::vector<float> plain(1024 * 1024 * 4), tracked(plain.size());
