@@ -29,7 +29,9 @@
 #endif
 
 /// The version of this header, as "MAJOR.MINOR.PATCH"; sgbake_version() reports the library's.
-#define SGBAKE_VERSION_STRING "0.1.0"
+/// 0.2.0 appended sgbake_mesh::face_flat and sgbake_mesh::auto_smooth: a caller built against
+/// 0.1.0's header passes a shorter struct, so rebuild (and set both fields).
+#define SGBAKE_VERSION_STRING "0.2.0"
 
 #ifdef __cplusplus
 extern "C" {

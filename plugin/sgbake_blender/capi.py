@@ -152,7 +152,7 @@ def load_library(path=None, path_source="the given path"):
 
 
 def version(lib):
-    """The library's version string, e.g. "0.1.0"."""
+    """The library's version string, e.g. "0.2.0"."""
     return lib.sgbake_version().decode("utf-8", "replace")
 
 

@@ -49,7 +49,7 @@ def get(context, retry=True):
 
 
 def describe(context):
-    """One line for the panel: "libsgbake 0.1.0" or the reason it cannot be loaded."""
+    """One line for the panel: "libsgbake 0.2.0" or the reason it cannot be loaded."""
     try:
         return True, f"libsgbake {capi.version(get(context, retry=False))}"
     except capi.SgbakeError as exc:
