@@ -19,6 +19,7 @@
 #include "gradient/prepared_uv_frame.hpp"
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/projection.hpp"
+#include "sgbake/mesh/normals.hpp"
 
 namespace sgbake {
 
@@ -115,14 +116,7 @@ void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
     if (mesh.isFlat(face)) {
       tri.flat = !mesh.autoSmooth;
       tri.polygonFrame = true;
-      Vec3d newell{};  // twice the vector area of the polygon
-      const std::uint32_t begin = mesh.faceStart[face], n = mesh.faceSize(face);
-      for (std::uint32_t k = 0; k < n; ++k) {
-        const Vec3d a = cast<double>(mesh.positions[mesh.cornerVertex[begin + k]]);
-        const Vec3d b = cast<double>(mesh.positions[mesh.cornerVertex[begin + (k + 1) % n]]);
-        newell = newell + cross(a, b);
-      }
-      tri.polygonNormal = normalizeOr(newell, tri.faceNormal);
+      tri.polygonNormal = normalizeOr(faceNormalDirection(mesh.view(), face), tri.faceNormal);
     }
   }
   tri.numUvSets = static_cast<int>(std::min<std::size_t>(mesh.uvSets.size(), kMaxUvSets));

@@ -40,9 +40,9 @@ struct ShadingTriangle {
   /// Shaded with faceNormal (a flat face without Auto Smooth: Cycles' Ng, so a non-planar
   /// flat quad shows each triangle's normal) instead of the corner normals Σ bi·Ni.
   bool flat = false;
-  /// A flat face's triangle: the tangent frame's N is polygonNormal (the face's unit Newell
-  /// normal, as Blender's object → tangent conversion uses), not Σ bi·Ni (which differ from it
-  /// only with custom normals).
+  /// A flat face's triangle: the tangent frame's N is polygonNormal (the face's unit polygon
+  /// normal, faceNormalDirection, as Blender's object → tangent conversion uses), not Σ bi·Ni
+  /// (which differ from it only with custom normals).
   bool polygonFrame = false;
   Vec3d polygonNormal{0, 0, 1};
   bool hasTangents = false;

@@ -40,37 +40,6 @@ Vec3d cornerPosition(const MeshView& mesh, std::uint32_t corner) {
   return cast<double>(mesh.positions[mesh.cornerVertex[corner]]);
 }
 
-/// Face @p f's normal direction, not normalized: triangles (p0-p1)×(p1-p2), quads the cross
-/// product of the diagonals (p0-p2)×(p1-p3), larger faces Newell's sum (twice the vector area,
-/// well defined for non-planar faces). All three point the same way for a planar face with
-/// counter-clockwise corners seen from the front.
-Vec3d faceNormalDirection(const MeshView& mesh, std::size_t f) {
-  const std::uint32_t b = mesh.faceStart[f];
-  const std::uint32_t n = mesh.faceSize(f);
-  if (n == 3) {
-    const Vec3d p0 = cornerPosition(mesh, b), p1 = cornerPosition(mesh, b + 1),
-                p2 = cornerPosition(mesh, b + 2);
-    return cross(p0 - p1, p1 - p2);
-  }
-  if (n == 4) {
-    const Vec3d p0 = cornerPosition(mesh, b), p1 = cornerPosition(mesh, b + 1),
-                p2 = cornerPosition(mesh, b + 2), p3 = cornerPosition(mesh, b + 3);
-    return cross(p0 - p2, p1 - p3);
-  }
-  // Newell: for each edge prev → curr, the projected areas under the edge on the three axis
-  // planes.
-  Vec3d sum{};
-  Vec3d prev = cornerPosition(mesh, b + n - 1);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const Vec3d curr = cornerPosition(mesh, b + i);
-    sum.x += (prev.y - curr.y) * (prev.z + curr.z);
-    sum.y += (prev.z - curr.z) * (prev.x + curr.x);
-    sum.z += (prev.x - curr.x) * (prev.y + curr.y);
-    prev = curr;
-  }
-  return sum;
-}
-
 /// Interior angle between the edges from a corner to its previous and next corners, from their
 /// normalized directions: atan2(|a×b|, a·b), accurate also for nearly straight corners.
 double cornerAngle(Vec3d toPrev, Vec3d toNext) {
@@ -124,6 +93,33 @@ struct CornerSets {
 };
 
 }  // namespace
+
+Vec3d faceNormalDirection(const MeshView& mesh, std::size_t f) {
+  const std::uint32_t b = mesh.faceStart[f];
+  const std::uint32_t n = mesh.faceSize(f);
+  if (n == 3) {
+    const Vec3d p0 = cornerPosition(mesh, b), p1 = cornerPosition(mesh, b + 1),
+                p2 = cornerPosition(mesh, b + 2);
+    return cross(p0 - p1, p1 - p2);
+  }
+  if (n == 4) {
+    const Vec3d p0 = cornerPosition(mesh, b), p1 = cornerPosition(mesh, b + 1),
+                p2 = cornerPosition(mesh, b + 2), p3 = cornerPosition(mesh, b + 3);
+    return cross(p0 - p2, p1 - p3);
+  }
+  // Newell: for each edge prev → curr, the projected areas under the edge on the three axis
+  // planes.
+  Vec3d sum{};
+  Vec3d prev = cornerPosition(mesh, b + n - 1);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec3d curr = cornerPosition(mesh, b + i);
+    sum.x += (prev.y - curr.y) * (prev.z + curr.z);
+    sum.y += (prev.z - curr.z) * (prev.x + curr.x);
+    sum.z += (prev.x - curr.x) * (prev.y + curr.y);
+    prev = curr;
+  }
+  return sum;
+}
 
 std::vector<Vec3f> computeFaceNormals(const MeshView& mesh) {
   std::vector<Vec3f> normals(mesh.numFaces());

@@ -12,6 +12,12 @@
 
 namespace sgbake {
 
+/// @brief Face @p f's normal direction, not normalized (Blender's polygon normal): triangles
+/// (p0-p1)×(p1-p2), quads the cross product of the diagonals (p0-p2)×(p1-p3), larger faces
+/// Newell's sum (twice the vector area, well defined for non-planar faces). All three point the
+/// same way for a planar face with counter-clockwise corners seen from the front.
+Vec3d faceNormalDirection(const MeshView& mesh, std::size_t f);
+
 /// @brief Unit face normals, #F. Triangles: normalize((p0-p1)×(p1-p2)); quads: normalize of the
 /// cross product of the diagonals (p0-p2)×(p1-p3); n-gons: Newell's method. All point to the side
 /// from which the corners are counter-clockwise. A face of zero area (its cross product, computed
