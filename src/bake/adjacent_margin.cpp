@@ -66,7 +66,7 @@ constexpr std::uint32_t kNoFace = std::numeric_limits<std::uint32_t>::max();
 /// the raster's row blocks, each walking its triangles in ascending order.
 std::vector<std::uint32_t> texelFaces(std::span<const Vec2f> uvs,
                                       std::span<const std::array<std::uint32_t, 3>> triangles,
-                                      std::span<const std::uint32_t> triangleFace, int width,
+                                      std::span<const std::uint32_t> cornerFace, int width,
                                       int height, int samples, int udimTile, int threads) {
   std::vector<std::uint32_t> face(static_cast<std::size_t>(width) * height, kNoFace);
   std::vector<double> offsets(static_cast<std::size_t>(samples));
@@ -107,7 +107,8 @@ std::vector<std::uint32_t> texelFaces(std::span<const Vec2f> uvs,
                            tri.edge[2].inside(tri.edge[2](px, py));
                 }
               }
-              if (inside) face[static_cast<std::size_t>(y) * width + x] = triangleFace[t];
+              if (inside)
+                face[static_cast<std::size_t>(y) * width + x] = cornerFace[triangles[t][0]];
             }
           }
         }
@@ -189,14 +190,19 @@ void nearestFaces(std::vector<std::uint32_t>& face, std::vector<float>& distance
   });
 }
 
-/// Distance of @p p from the segment [a, b].
-double segmentDistance(Point p, Point a, Point b) {
+/// The point of the segment [a, b] nearest @p p.
+Point nearestOnSegment(Point p, Point a, Point b) {
   const Point ab = b - a;
   const double len2 = std::norm(ab);
   const double s = len2 > 0 ? ((p - a) * std::conj(ab)).real() / len2 : 0.0;
-  if (s <= 0) return std::abs(p - a);  // the vertices exactly, so ties between edges are exact
-  if (s >= 1) return std::abs(p - b);
-  return std::abs(p - (a + s * ab));
+  if (s <= 0) return a;  // the vertices exactly, so ties between edges are exact
+  if (s >= 1) return b;
+  return a + s * ab;
+}
+
+/// Distance of @p p from the segment [a, b].
+double segmentDistance(Point p, Point a, Point b) {
+  return std::abs(p - nearestOnSegment(p, a, b));
 }
 
 /// Twice the signed area of (a, b, p): positive when p is left of a → b.
@@ -212,12 +218,10 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
   const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
   const std::vector<std::int64_t> across = oppositeCorners(mesh);
   const std::vector<std::uint32_t> cornerFace = cornerFaces(mesh.faceStart);
+  // loopTriangles gives each face its k − 2 triangles in turn.
   std::vector<std::uint32_t> faceFirstTriangle(mesh.numFaces() + 1, 0);
-  std::vector<std::uint32_t> triangleFace(triangles.size());
   for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
     faceFirstTriangle[f + 1] = faceFirstTriangle[f] + (mesh.faceSize(f) - 2);
-    for (std::uint32_t t = faceFirstTriangle[f]; t < faceFirstTriangle[f + 1]; ++t)
-      triangleFace[t] = static_cast<std::uint32_t>(f);
   }
   auto covered = [&](int x, int y) {  // y up
     return image.coverage[static_cast<std::size_t>(H - 1 - y) * W + x] > 0;
@@ -225,7 +229,7 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
 
   // The face of the nearest covered texel of every texel within reach.
   std::vector<std::uint32_t> face =
-      texelFaces(uvs, triangles, triangleFace, W, H, std::max(samples, 1), udimTile, threads);
+      texelFaces(uvs, triangles, cornerFace, W, H, std::max(samples, 1), udimTile, threads);
   const double reach = margin + kReachBeyondMargin;
   const std::size_t texels = static_cast<std::size_t>(W) * H;
   for (int y = 0; y < H; ++y) {
@@ -287,11 +291,7 @@ void adjacentFacesMargin(FloatImage& image, const Mesh& mesh, int uvSet, int udi
     Point nearest = texelOf(begin);
     double best = std::numeric_limits<double>::infinity();
     for (std::uint32_t k = 0; k < n; ++k) {
-      const Point a = texelOf(begin + k), ab = texelOf(begin + (k + 1) % n) - a;
-      const double len2 = std::norm(ab);
-      const double s =
-          len2 > 0 ? std::clamp(((p - a) * std::conj(ab)).real() / len2, 0.0, 1.0) : 0.0;
-      const Point q = a + s * ab;
+      const Point q = nearestOnSegment(p, texelOf(begin + k), texelOf(begin + (k + 1) % n));
       if (std::abs(p - q) < best) {
         best = std::abs(p - q);
         nearest = q;
