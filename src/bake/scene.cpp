@@ -1037,6 +1037,13 @@ std::size_t editDistance(std::string_view a, std::string_view b) {
 
 // ---- Public API --------------------------------------------------------------------------------
 
+Result<PaddingMode> parsePaddingMode(std::string_view name) {
+  for (const Named<PaddingMode>& entry : kPaddings) {
+    if (entry.name == name) return entry.value;
+  }
+  return Error::badInput("unknown padding '" + std::string(name) + "'");
+}
+
 std::string_view sceneLayerTypeName(SceneLayerType type) {
   for (const Named<SceneLayerType>& entry : kLayerTypes) {
     if (entry.value == type) return entry.name;

@@ -243,12 +243,11 @@ Mesh toMesh(const MeshArrays& a) {
     mesh.faceFlat.resize(a.numFaces);
     for (std::size_t f = 0; f < a.numFaces; ++f) mesh.faceFlat[f] = a.faceFlat[f] != 0 ? 1 : 0;
   }
+  mesh.autoSmooth = a.autoSmooth;
   if (a.cornerNormals == nullptr) {
     computeSmoothNormals(mesh);
-    mesh.autoSmooth = a.autoSmooth;
     return mesh;
   }
-  mesh.autoSmooth = a.autoSmooth;
   mesh.cornerNormals = toVec3(a.cornerNormals, a.numCorners);
   for (Vec3f& n : mesh.cornerNormals) n = unitNormal(n);
   return mesh;

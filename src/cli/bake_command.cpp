@@ -329,9 +329,7 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   if (Status ok = parseName("--green", args.green, {"opengl", "directx"}); !ok) return ok.error();
   output.width = output.height = args.size;
   output.margin = args.margin;
-  output.padding = args.padding == "push-pull"        ? PaddingMode::kPushPull
-                   : args.padding == "adjacent-faces" ? PaddingMode::kAdjacentFaces
-                                                      : PaddingMode::kExtend;
+  output.padding = *parsePaddingMode(args.padding);  // (a name parseName accepted)
   output.samples = args.samples;
   output.uvSet = args.uvSet;
   output.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;

@@ -115,15 +115,13 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
                            ": there is nothing to convert");
   }
   std::optional<PaddingMode> padding;  // none: keep the input's values
-  if (args.padding == "extend") {
-    padding = PaddingMode::kExtend;
-  } else if (args.padding == "adjacent-faces") {
-    padding = PaddingMode::kAdjacentFaces;
-  } else if (args.padding == "push-pull") {
-    padding = PaddingMode::kPushPull;
-  } else if (args.padding != "keep") {
-    return Error::badInput("convert: --padding: unknown value '" + args.padding +
-                           "' (expected keep, extend, adjacent-faces or push-pull)");
+  if (args.padding != "keep") {
+    Result<PaddingMode> mode = parsePaddingMode(args.padding);
+    if (!mode) {
+      return Error::badInput("convert: --padding: unknown value '" + args.padding +
+                             "' (expected keep, extend, adjacent-faces or push-pull)");
+    }
+    padding = *mode;
   }
   if (app.count("--margin") != 0 && args.margin > 0 && padding != PaddingMode::kExtend &&
       padding != PaddingMode::kAdjacentFaces) {

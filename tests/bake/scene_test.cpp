@@ -775,6 +775,15 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   EXPECT_EQ(status.error().message, "layers[0]: weight must be a finite number");
 }
 
+TEST(Scene, PaddingModesAreParsedByTheirSceneNames) {
+  EXPECT_EQ(*parsePaddingMode("extend"), PaddingMode::kExtend);
+  EXPECT_EQ(*parsePaddingMode("push-pull"), PaddingMode::kPushPull);
+  EXPECT_EQ(*parsePaddingMode("adjacent-faces"), PaddingMode::kAdjacentFaces);
+  const Result<PaddingMode> bad = parsePaddingMode("keep");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("unknown padding 'keep'"), std::string::npos);
+}
+
 TEST(Scene, ClosestMatch) {
   const std::vector<std::string> keys{"size", "samples", "margin", "map"};
   EXPECT_EQ(closestMatch("sise", keys), "size");

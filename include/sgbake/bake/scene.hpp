@@ -255,6 +255,10 @@ Status validateScene(const Scene& scene);
 /// @brief The scene name of @p filter ("bilinear", "bicubic", "hermite").
 std::string_view filterName(Filter filter);
 
+/// @brief The padding a scene's "padding" (and the CLI's --padding) names: "extend",
+/// "push-pull" or "adjacent-faces"; kBadInput for any other name.
+Result<PaddingMode> parsePaddingMode(std::string_view name);
+
 /// @brief A short description of @p layer for messages and --explain, e.g.
 /// `height image meshes/h.png`, `tangent-space normal map n.png`, `volume noise`,
 /// `triplanar height t.png`; prefixed with the layer's "name" when it has one.
