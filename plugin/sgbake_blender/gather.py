@@ -272,11 +272,12 @@ def check_target(image):
                              "missing? reload it or pick another image)")
 
 
-def check_memory(width, height):
+def check_memory(width, height, padding):
     """Raises BakeInputError when a width x height bake cannot fit in this machine's memory:
-    the library holds ~6 floats per texel (the map, its coverage, a copy for padding) and the
+    the library holds ~6 floats per texel (the map, its coverage, a copy for padding; Adjacent
+    Faces padding 3 more: each texel's face, twice, and its distance to the islands) and the
     add-on 4 more (the RGBA pixels it gets back)."""
-    needed = width * height * 10 * 4
+    needed = width * height * (13 if padding == "adjacent-faces" else 10) * 4
     try:
         memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (ValueError, OSError):

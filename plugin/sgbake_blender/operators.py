@@ -76,7 +76,7 @@ class BakeJob:
         self.tiled = image is not None and image.source == "TILED"
         if image is not None and not self.tiled:
             gather.check_target(image)
-        gather.check_memory(self.width, self.height)
+        gather.check_memory(self.width, self.height, settings.padding)
         self.tiles = gather.image_tiles(image)
         self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
                                               subdivision)
