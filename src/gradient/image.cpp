@@ -20,6 +20,7 @@
 
 #include "gradient/parallel_rows.hpp"
 #include "io/image_codec.hpp"
+#include "io/png_check.hpp"
 
 namespace sgbake {
 
@@ -97,6 +98,10 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
   if (std::filesystem::is_regular_file(status)) {
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     if (!ec && size == 0) return fileError(path, "file is empty");
+  }
+  // A damaged PNG is told here, in one line: decoding it lets libpng print its own line too.
+  if (const std::string damage = io_detail::pngDamage(path); !damage.empty()) {
+    return fileError(path, "cannot read image (" + damage + ")");
   }
 
   Result<const io_detail::ImageCodec*> codec = io_detail::imageCodec();

@@ -51,13 +51,18 @@ class OiioReader final : public ImageReader {
   }
   bool readFloat(int channels, float* first, std::ptrdiff_t pixelStride,
                  std::ptrdiff_t rowStride) override {
-    return in_->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, first, pixelStride,
-                           rowStride);
+    const bool read =
+        in_->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, first, pixelStride, rowStride);
+    // OpenImageIO's TIFF reader reports a strip it could not read (a truncated file) only in
+    // geterror() and returns true, its pixels left unread: the text decides.
+    error_ = in_->geterror();
+    return read && error_.empty();
   }
-  std::string error() override { return in_->geterror(); }
+  std::string error() override { return error_.empty() ? in_->geterror() : error_; }
 
  private:
   std::unique_ptr<OIIO::ImageInput> in_;
+  std::string error_;  ///< of the last readFloat
 };
 
 /// An output file that remembers the first failed write. OpenImageIO's PNG writer writes

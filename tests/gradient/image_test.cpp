@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "io/png_check.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/image.hpp"
 
@@ -273,6 +274,108 @@ TEST(LoadImage, BadFilesAreOneLineBadInputErrors) {
     expectFileError(loadImage(bomb), bomb,
                     "image is too large to load on this machine (65536x65536, 1 channel: about "
                     "34.4 GB; the machine has");
+  }
+}
+
+std::string readBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The byte offset of @p type's chunk in a PNG file's bytes (its length field).
+std::size_t chunkOffset(const std::string& png, const std::string& type) {
+  const std::size_t at = png.find(type);
+  EXPECT_NE(at, std::string::npos) << type;
+  return at - 4;
+}
+
+// A 64x64 PNG of noise (so that its IDAT is large), as bytes.
+std::string noisePng(const fs::path& dir) {
+  std::vector<std::uint8_t> noise(64 * 64 * 3);
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<std::uint8_t>(i * 7919);
+  writeImage(dir / "noise.png", 64, 64, 3, OIIO::TypeDesc::UINT8, noise);
+  return readBytes(dir / "noise.png");
+}
+
+TEST(PngCheck, Crc32IsTheIsoCrc) {
+  const std::string check = "123456789";  // the CRC-32 check value of the catalogue
+  const auto* bytes = reinterpret_cast<const unsigned char*>(check.data());
+  EXPECT_EQ(io_detail::crc32(0, bytes, check.size()), 0xCBF43926u);
+  // Continued over pieces of every length around the 8-byte steps, the same value.
+  for (std::size_t split = 0; split <= check.size(); ++split) {
+    EXPECT_EQ(
+        io_detail::crc32(io_detail::crc32(0, bytes, split), bytes + split, check.size() - split),
+        0xCBF43926u)
+        << split;
+  }
+}
+
+// A damaged PNG is refused in one line of sgbake's, and nothing else reaches standard error
+// (decoded, libpng would print "libpng error: ..." of its own).
+TEST(LoadImage, DamagedPngIsRefusedInOneLineAndNothingElse) {
+  const fs::path dir = testDir();
+  const std::string png = noisePng(dir);
+  const std::size_t idat = chunkOffset(png, "IDAT");
+  const std::size_t iend = chunkOffset(png, "IEND");
+  ASSERT_TRUE(io_detail::pngDamage(dir / "noise.png").empty());
+
+  struct Case {
+    std::string name, bytes, start;
+  };
+  std::string flipped = png;
+  flipped[idat + 8 + 100] = static_cast<char>(flipped[idat + 8 + 100] ^ 0x20);
+  const std::vector<Case> cases = {
+      {"half.png", png.substr(0, png.size() / 2),
+       "cannot read image (truncated PNG: the file ends inside its IDAT chunk (at byte " +
+           std::to_string(idat) + "))"},
+      {"no_crc.png", png.substr(0, iend - 2),
+       "cannot read image (truncated PNG: the file ends inside its IDAT chunk"},
+      {"no_end.png", png.substr(0, iend),
+       "cannot read image (truncated PNG: the file ends at byte " + std::to_string(iend) +
+           ", before its IEND chunk)"},
+      {"flipped.png", flipped,
+       "cannot read image (corrupt PNG: its IDAT chunk at byte " + std::to_string(idat) +
+           " fails its CRC check)"},
+  };
+  for (const Case& c : cases) {
+    const fs::path path = dir / c.name;
+    writeBytes(path, c.bytes);
+    testing::internal::CaptureStderr();
+    const Result<Image> image = loadImage(path);
+    const std::string printed = testing::internal::GetCapturedStderr();
+    expectFileError(image, path, c.start);
+    EXPECT_EQ(printed, "") << c.name;
+  }
+}
+
+// An ancillary chunk with a bad CRC is skipped by libpng (and Blender): the image loads.
+TEST(LoadImage, AncillaryChunkWithABadCrcIsTolerated) {
+  const fs::path dir = testDir();
+  const std::string png = noisePng(dir);
+  const std::size_t idat = chunkOffset(png, "IDAT");
+  const std::string text = std::string("\0\0\0\4tEXtabcd\0\0\0\0", 16);  // CRC 0: wrong
+  const fs::path path = dir / "text.png";
+  writeBytes(path, png.substr(0, idat) + text + png.substr(idat));
+  EXPECT_TRUE(io_detail::pngDamage(path).empty());
+  const Result<Image> image = loadImage(path);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(image->width(), 64);
+}
+
+// OpenImageIO's TIFF reader returns success on a file cut short, its missing strips unread:
+// refused all the same, for every strip layout.
+TEST(LoadImage, TruncatedTiffIsRefused) {
+  const fs::path dir = testDir();
+  std::vector<float> noise(96 * 96);
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<float>(i % 97) / 97.0f;
+  for (const int tile : {0, 16}) {
+    const fs::path full = dir / "full.tif";
+    writeImage(full, 96, 96, 1, OIIO::TypeDesc::FLOAT, noise, false, tile);
+    ASSERT_TRUE(loadImage(full).ok());
+    const std::string bytes = readBytes(full);
+    const fs::path cut = dir / "cut.tif";
+    writeBytes(cut, bytes.substr(0, bytes.size() / 2));
+    expectFileError(loadImage(cut), cut, "cannot read image (");
   }
 }
 
