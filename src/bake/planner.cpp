@@ -1203,6 +1203,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       plan_detail::loadTextures(plan, imageFiles, loaded, progress, report, load);
   if (!mesh) mesh = meshLoad.get();
   if (!*mesh) return mesh->error();
+  report.warnings.insert(report.warnings.end(), loaded.warnings.begin(), loaded.warnings.end());
   progress.finishOne();
   if (!textures) return textures.error();
   // Layers, and tangent frames if the plan needs them (timed apart from the loading).

@@ -37,6 +37,17 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
                            std::to_string(issue->index) + "]: " + issue->what +
                            (scene.inMemory ? std::string() : " (" + scene.mesh.string() + ")"));
   }
+  // An OBJ's normals can show that Auto Smooth split them (normalsShowAutoSmooth), not at
+  // which angle: the subdivided mesh, which Blender splits again by that angle, cannot be.
+  if (coarse.autoSmooth && !subdivision.options().autoSmoothDegrees) {
+    loaded.warnings.push_back(
+        scene.mesh.string() + ": its normals are split at sharp edges (Auto Smooth), but " +
+        (subdivision.limitSurface()
+             ? std::string("the exact limit surface is shaded with its own smooth normals")
+             : std::string("the subdivided mesh is shaded smooth: give \"auto_smooth\" "
+                           "(--auto-smooth DEG) with the object's Auto Smooth angle to split its "
+                           "normals as Blender does")));
+  }
   if (!subdivision.limitSurface()) {
     Result<Mesh> subdivided = subdivideMesh(coarse, subdivision.options());
     if (!subdivided) return subdivided.error();

@@ -70,6 +70,7 @@ struct Loaded {
   std::vector<std::unique_ptr<HeightVolume>> volumes;
   std::vector<Layer> layers;  ///< per plan layer
   std::optional<CornerTangents> tangents;
+  std::vector<std::string> warnings;  ///< about the inputs, for ExecuteReport::warnings
 };
 
 /// Calls the progress callback, if any.

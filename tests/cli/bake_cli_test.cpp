@@ -822,6 +822,53 @@ TEST_F(BakeCliTest, AutoSmoothWithoutSubdivisionFromSceneAndFlag) {
   EXPECT_EQ(readPixels(dir_ / "split_flag.exr"), split);
 }
 
+// An OBJ whose normals only Auto Smooth makes (split at vertex 3) says Auto Smooth was on, not
+// its angle: subdivided without "auto_smooth", it is shaded smooth, which a warning says.
+TEST_F(BakeCliTest, SubdividingSplitNormalsWithoutAnAngleWarns) {
+  const std::string square =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+      "vn 0 0 1\nvn 0.1 0 0.995\ns 1\n";
+  writeFile(dir_ / "split.obj", square + "f 1/1/1 2/2/1 3/3/2\nf 1/1/1 3/3/1 4/4/1\n");
+  writeFile(dir_ / "shared.obj", square + "f 1/1/1 2/2/1 3/3/2\nf 1/1/1 3/3/2 4/4/1\n");
+  const auto bake = [&](const std::string& mesh, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"bake",
+                                     "--mesh",
+                                     (dir_ / mesh).string(),
+                                     "--map",
+                                     "object-normal",
+                                     "--size",
+                                     "16",
+                                     "--margin",
+                                     "0",
+                                     "--no-manifest",
+                                     "-o",
+                                     (dir_ / "n.exr").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  };
+  const std::string prefix = "sgbake: warning: " + (dir_ / "split.obj").string() +
+                             ": its normals are split at sharp edges (Auto Smooth), but ";
+  const ProcessResult subdivided = bake("split.obj", {"--subdivide", "1"});
+  ASSERT_EQ(subdivided.exitCode, 0) << subdivided.err;
+  EXPECT_EQ(subdivided.err,
+            prefix +
+                "the subdivided mesh is shaded smooth: give \"auto_smooth\" "
+                "(--auto-smooth DEG) with the object's Auto Smooth angle to split its "
+                "normals as Blender does\n");
+  const ProcessResult limit = bake("split.obj", {"--subdivide", "limit"});
+  ASSERT_EQ(limit.exitCode, 0) << limit.err;
+  EXPECT_EQ(limit.err, prefix + "the exact limit surface is shaded with its own smooth normals\n");
+  // No warning: an angle given, no subdivision, or normals that do not show Auto Smooth.
+  for (const auto& [mesh, extra] : std::vector<std::pair<std::string, std::vector<std::string>>>{
+           {"split.obj", {"--subdivide", "1", "--auto-smooth", "30"}},
+           {"split.obj", {}},
+           {"shared.obj", {"--subdivide", "1"}}}) {
+    const ProcessResult quiet = bake(mesh, extra);
+    ASSERT_EQ(quiet.exitCode, 0) << quiet.err;
+    EXPECT_EQ(quiet.err, "") << mesh << " " << extra.size();
+  }
+}
+
 TEST_F(BakeCliTest, CreasesFromSceneAndFlags) {
   writeFile(dir_ / "cube.obj", kCubeObj);
   const std::string mesh = (dir_ / "cube.obj").string();
