@@ -355,6 +355,9 @@ Status prepareLayers(const Plan& plan, int threads, Loaded& loaded, ProgressRepo
   if (!tangents) {
     return Error{tangents.error().code, s.mesh.string() + ": " + tangents.error().message};
   }
+  if (std::string warning = missingTangentsWarning(*tangents, s.mesh.string()); !warning.empty()) {
+    report.warnings.push_back(std::move(warning));
+  }
   loaded.tangents = std::move(*tangents);
   report.tangentsComputed = true;
   progress.finishOne();

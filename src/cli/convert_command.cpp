@@ -233,6 +233,9 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   if (!tangents) {
     return Error{tangents.error().code, args.mesh + ": " + tangents.error().message};
   }
+  if (const std::string warning = missingTangentsWarning(*tangents, args.mesh); !warning.empty()) {
+    std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
+  }
   const double tangentSeconds = step.lap();
 
   ConvertSettings settings;

@@ -195,6 +195,9 @@ Status runTangents(const TangentsArguments& args, const CLI::App& app) {
                            std::to_string(mesh->numCorners()) + " corners");
   }
   const double tangentSeconds = step.lap();
+  if (const std::string warning = missingTangentsWarning(*frames, args.mesh); !warning.empty()) {
+    std::fprintf(stderr, "sgbake: warning: %s\n", warning.c_str());
+  }
 
   if (!args.meshOut.empty()) {
     if (Status written = writeFileAtomically(args.meshOut, formatObj(*mesh, uvSet)); !written) {

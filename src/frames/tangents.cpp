@@ -118,4 +118,16 @@ Result<CornerTangents> computeTangents(const MeshView& mesh, const TangentOption
   return result;
 }
 
+std::string missingTangentsWarning(const CornerTangents& tangents, const std::string& meshName) {
+  const auto missing = static_cast<std::size_t>(
+      std::count_if(tangents.tangent.begin(), tangents.tangent.end(),
+                    [](const Vec3f& t) { return !(t.x != 0 || t.y != 0 || t.z != 0); }));
+  if (missing == 0) return "";
+  return meshName + ": " + std::to_string(missing) + " of " +
+         std::to_string(tangents.tangent.size()) +
+         " face corners have no tangent (MikkTSpace found no usable position and UV differences "
+         "there, as when coordinates beyond ~1e19 overflow single precision): tangent-space "
+         "values there mean nothing";
+}
+
 }  // namespace sgbake

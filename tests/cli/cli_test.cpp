@@ -207,6 +207,36 @@ TEST_F(CliTest, WritesOneUnitTangentAndSignPerCorner) {
   }
 }
 
+// A quad whose coordinates overflow single precision's squares (1e25) gets zero tangents, as
+// it does in MikkTSpace; tangents and bake say so in one warning, the same quad at 1e18 not.
+TEST_F(CliTest, CornersWithoutATangentAreAWarning) {
+  const std::string quad =
+      "v 0 0 0\nv S 0 0\nv S S 0\nv 0 S 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+  const auto scaled = [&](const std::string& scale) {
+    std::string text = quad;
+    for (std::size_t at = text.find('S'); at != std::string::npos; at = text.find('S', at)) {
+      text.replace(at, 1, scale);
+    }
+    return text;
+  };
+  const fs::path huge = file("huge.obj", scaled("1e25"));
+  const std::string warning = "sgbake: warning: " + huge.string() +
+                              ": 4 of 4 face corners have no tangent (MikkTSpace found no usable "
+                              "position and UV differences there, as when coordinates beyond "
+                              "~1e19 overflow single precision): tangent-space values there mean "
+                              "nothing\n";
+  const ProcessResult tangents = sgbake({"tangents", huge.string()});
+  ASSERT_EQ(tangents.exitCode, 0) << tangents.err;
+  EXPECT_EQ(tangents.err, warning);
+  const ProcessResult bake = sgbake({"bake", "--mesh", huge.string(), "--map", "tangent", "--size",
+                                     "8", "--no-manifest", "-o", (dir_ / "t.exr").string()});
+  ASSERT_EQ(bake.exitCode, 0) << bake.err;
+  EXPECT_EQ(bake.err, warning);
+  const ProcessResult large = sgbake({"tangents", file("large.obj", scaled("1e18")).string()});
+  ASSERT_EQ(large.exitCode, 0) << large.err;
+  EXPECT_EQ(large.err, "");
+}
+
 TEST_F(CliTest, FileOutputEqualsStdoutAndLeavesNoTemporaryFiles) {
   const fs::path mesh = file("small.obj", kSmallObj);
   const ProcessResult toStdout = sgbake({"tangents", mesh.string()});

@@ -2,6 +2,7 @@
 /// @brief MikkTSpace tangent frames per face corner, identical to Blender's.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "sgbake/core/result.hpp"
@@ -35,5 +36,11 @@ struct TangentOptions {
 /// @param[in] mesh corner normals must be unit; corner UVs must be present
 /// @return kBadInput when the mesh has no UVs
 Result<CornerTangents> computeTangents(const MeshView& mesh, const TangentOptions& options = {});
+
+/// @brief A warning about corners left without a tangent (a zero tangent, which MikkTSpace
+/// leaves where no triangle has usable position and UV differences: single-precision overflow
+/// of coordinates beyond ~1e19, where Blender's tangents are NaN; degenerate UVs alone get
+/// their neighbours' frames), naming @p meshName; "" when every corner has one.
+std::string missingTangentsWarning(const CornerTangents& tangents, const std::string& meshName);
 
 }  // namespace sgbake
