@@ -19,8 +19,8 @@
 #include <utility>
 
 #include "gradient/parallel_rows.hpp"
+#include "io/image_check.hpp"
 #include "io/image_codec.hpp"
-#include "io/png_check.hpp"
 
 namespace sgbake {
 
@@ -99,8 +99,9 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     if (!ec && size == 0) return fileError(path, "file is empty");
   }
-  // A damaged PNG is told here, in one line: decoding it lets libpng print its own line too.
-  if (const std::string damage = io_detail::pngDamage(path); !damage.empty()) {
+  // A damaged PNG or JPEG is told here: decoded, it prints a line of its own (libpng) or comes
+  // back padded with grey (libjpeg).
+  if (const std::string damage = io_detail::imageDamage(path); !damage.empty()) {
     return fileError(path, "cannot read image (" + damage + ")");
   }
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "io/png_check.hpp"
+#include "io/image_check.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/image.hpp"
 
@@ -317,7 +317,7 @@ TEST(LoadImage, DamagedPngIsRefusedInOneLineAndNothingElse) {
   const std::string png = noisePng(dir);
   const std::size_t idat = chunkOffset(png, "IDAT");
   const std::size_t iend = chunkOffset(png, "IEND");
-  ASSERT_TRUE(io_detail::pngDamage(dir / "noise.png").empty());
+  ASSERT_TRUE(io_detail::imageDamage(dir / "noise.png").empty());
 
   struct Case {
     std::string name, bytes, start;
@@ -348,6 +348,39 @@ TEST(LoadImage, DamagedPngIsRefusedInOneLineAndNothingElse) {
   }
 }
 
+// libjpeg only warns about a JPEG cut short (OpenImageIO returns its rows padded with grey):
+// refused, wherever the cut; bytes after EOI and stray bytes before a marker are tolerated,
+// as libjpeg tolerates them.
+TEST(LoadImage, TruncatedJpegIsRefused) {
+  const fs::path dir = testDir();
+  std::vector<std::uint8_t> noise(64 * 64 * 3);
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<std::uint8_t>(i * 7919);
+  writeImage(dir / "noise.jpg", 64, 64, 3, OIIO::TypeDesc::UINT8, noise);
+  const std::string jpeg = readBytes(dir / "noise.jpg");
+  const std::size_t scan = jpeg.find("\xFF\xDA");
+  ASSERT_NE(scan, std::string::npos);
+  const Result<Image> whole = loadImage(dir / "noise.jpg");
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  for (const auto& [cut, reason] : std::vector<std::pair<std::size_t, std::string>>{
+           {jpeg.size() * 9 / 10, "inside its image data, before its EOI marker"},
+           {jpeg.size() - 2, "inside its image data, before its EOI marker"},
+           {scan + 5, "inside a segment, before its EOI marker"},
+           {scan / 2, "inside a segment, before its EOI marker"}}) {
+    const fs::path path = dir / ("cut" + std::to_string(cut) + ".jpg");
+    writeBytes(path, jpeg.substr(0, cut));
+    testing::internal::CaptureStderr();
+    expectFileError(loadImage(path), path,
+                    "cannot read image (truncated JPEG: the file ends " + reason + ")");
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  }
+  const fs::path tail = dir / "tail.jpg";
+  writeBytes(tail, jpeg + std::string("\0\0trailing\xFF", 11));
+  EXPECT_TRUE(loadImage(tail).ok());
+  const fs::path stray = dir / "stray.jpg";
+  writeBytes(stray, jpeg.substr(0, scan) + "ab" + jpeg.substr(scan));
+  EXPECT_EQ(io_detail::imageDamage(stray), "");
+}
+
 // An ancillary chunk with a bad CRC is skipped by libpng (and Blender): the image loads.
 TEST(LoadImage, AncillaryChunkWithABadCrcIsTolerated) {
   const fs::path dir = testDir();
@@ -356,7 +389,7 @@ TEST(LoadImage, AncillaryChunkWithABadCrcIsTolerated) {
   const std::string text = std::string("\0\0\0\4tEXtabcd\0\0\0\0", 16);  // CRC 0: wrong
   const fs::path path = dir / "text.png";
   writeBytes(path, png.substr(0, idat) + text + png.substr(idat));
-  EXPECT_TRUE(io_detail::pngDamage(path).empty());
+  EXPECT_TRUE(io_detail::imageDamage(path).empty());
   const Result<Image> image = loadImage(path);
   ASSERT_TRUE(image.ok()) << image.error().message;
   EXPECT_EQ(image->width(), 64);

@@ -3,4 +3,4 @@
 sgbake_add_gtest(gradient_images_tests image_test.cpp filters_test.cpp udim_test.cpp)
 # The tests write their input images with OpenImageIO (the library links it privately).
 target_link_libraries(gradient_images_tests PRIVATE OpenImageIO::OpenImageIO)
-target_include_directories(gradient_images_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)  # io/png_check.hpp
+target_include_directories(gradient_images_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)  # io/image_check.hpp
