@@ -939,10 +939,7 @@ def main():
                         help="bake the add-on's normal maps with green DirectX (must fail)")
     args = parser.parse_args()
 
-    blender = bc.find_blender(args.blender)
-    if blender is None:
-        print(f"SKIP: {args.blender} is not on PATH; the Blender add-on test needs Blender")
-        return bc.SKIP
+    blender = bc.blender_or_skip(args.blender, test="add-on")
     for path, what in ((args.cli, "sgbake_cli"), (args.library, "sgbake")):
         if not os.path.isfile(path):
             print(f"error: {path} is not a file (build {what} first)")
@@ -954,16 +951,10 @@ def main():
         return bc.SKIP
 
     def run_half(*half_args):
-        proc = objio.run_blender(blender, os.path.abspath(__file__), list(half_args),
-                                 capture_output=True, text=True, timeout=150)
-        if proc.returncode != 0:
-            print(f"error: Blender ({half_args[0]}) exited with {proc.returncode}\n"
-                  f"{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
-        return proc.returncode == 0
+        return objio.run_blender_half(blender, os.path.abspath(__file__), list(half_args),
+                                      timeout=150, tail=4000)
 
-    with tempfile.TemporaryDirectory(prefix="sgbake-addon-") as tmp:
-        work = os.path.abspath(args.keep or tmp)
-        os.makedirs(work, exist_ok=True)
+    with bc.work_dir(args.keep, "sgbake-addon-") as work:
         if not run_half("make", work, library, "sabotage" if args.sabotage else "honest"):
             return 1
         with open(os.path.join(work, "manifest.json"), encoding="ascii") as f:
@@ -978,13 +969,7 @@ def main():
         failures += evaluate(manifest, results)
         if args.keep:
             print(f"files kept in {work}")
-    if failures:
-        print(f"FAIL: {len(failures)} problem(s):")
-        for line in failures:
-            print("  " + line)
-        return 1
-    print("PASS")
-    return 0
+    return bc.report(failures)
 
 
 if __name__ == "__main__":

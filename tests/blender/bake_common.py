@@ -10,6 +10,12 @@ Plain-Python part
     find_blender, run_tool, parse_stats, cli_has_command, read_png (a small PNG decoder using
     only zlib, so that a driver can look at the bytes sgbake wrote without Blender or numpy).
 
+Plain-Python part, the oracle drivers' common start and end (tests/blender/*_oracle.py,
+bake_orientation.py)
+    oracle_parser (--cli, --blender, --keep), blender_or_skip (exit 77 without Blender),
+    require_executable (exit 2 when --cli is not a program), work_dir (a temporary directory,
+    or --keep DIR left in place), report (the FAIL list or PASS, and the exit status).
+
 Blender part (numpy and bpy)
     setup_cycles, reset_scene, new_float_image, image_array, save_exr, load_raw,
     decode_normals, angle_deg, erode, angle_stats.
@@ -21,14 +27,19 @@ Conventions (docs: /work/shared/CONVENTIONS.md)
     Normal maps store n / 2 + 0.5 (R = +T, G = +B, B = +N in tangent space).
 """
 
+import argparse
+import contextlib
 import json
 import os
 import shutil
 import struct
 import subprocess
+import sys
+import tempfile
 import zlib
 
 SKIP = 77  # exit status CTest treats as "skipped" (SKIP_RETURN_CODE)
+NOT_EXECUTABLE = "error: {} is not an executable file (build sgbake_cli first)"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -38,6 +49,68 @@ SKIP = 77  # exit status CTest treats as "skipped" (SKIP_RETURN_CODE)
 def find_blender(name):
     """Absolute path of the Blender executable `name` (a path or a name on PATH), or None."""
     return shutil.which(name)
+
+
+def oracle_parser(doc, blender_help="Blender executable",
+                  keep_help="write every file here and keep it"):
+    """The argument parser of an oracle driver, described by the first line of `doc` (the
+    script's __doc__), with the options they all take: --cli (required: the sgbake
+    executable), --blender (default `blender`; `blender_help` None shows no help text) and
+    --keep DIR. The caller adds its own options after these."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
+    parser.add_argument("--blender", default="blender", help=blender_help)
+    parser.add_argument("--keep", metavar="DIR", help=keep_help)
+    return parser
+
+
+def blender_or_skip(name, test="oracle"):
+    """The Blender executable `name` (a path or a name on PATH) stands for. Without one, prints
+    "SKIP: NAME is not on PATH; the Blender TEST test needs Blender" and exits with SKIP (77),
+    which CTest reports as a skipped test (SKIP_RETURN_CODE)."""
+    blender = find_blender(name)
+    if blender is None:
+        print(f"SKIP: {name} is not on PATH; the Blender {test} test needs Blender")
+        sys.exit(SKIP)
+    return blender
+
+
+def require_executable(path, message=NOT_EXECUTABLE):
+    """When `path` is not an executable file, prints `message` with `path` in its {} and exits
+    with 2 (a usage error, as argparse does)."""
+    if not (os.path.isfile(path) and os.access(path, os.X_OK)):
+        print(message.format(path))
+        sys.exit(2)
+
+
+@contextlib.contextmanager
+def work_dir(keep, prefix):
+    """`with work_dir(args.keep, prefix) as work:` - the absolute path of the directory a
+    driver writes its files in: KEEP (made if need be), which is left in place, or else a new
+    temporary directory named PREFIX..., which is removed with everything in it when the
+    `with` block ends, however it ends."""
+    if keep:
+        path = os.path.abspath(keep)
+        os.makedirs(path, exist_ok=True)
+        yield path
+        return
+    path = tempfile.mkdtemp(prefix=prefix)
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def report(failures, passed="PASS"):
+    """Prints a driver's verdict and returns its exit status: with failures, "FAIL: N
+    problem(s):" and each failure on an indented line, 1; without, the line `passed`, 0."""
+    if failures:
+        print(f"FAIL: {len(failures)} problem(s):")
+        for line in failures:
+            print("  " + line)
+        return 1
+    print(passed)
+    return 0
 
 
 def run_tool(cmd, timeout=600, quiet=False):

@@ -48,11 +48,9 @@ Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not
 (CTest: SKIP_RETURN_CODE 77). Takes ~15 s (Blender starts twice).
 """
 
-import argparse
 import json
 import os
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
@@ -230,31 +228,21 @@ def evaluate(name, r):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
-    parser.add_argument("--blender", default="blender", help="Blender executable")
-    parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
+    parser = bc.oracle_parser(__doc__)
     parser.add_argument("--cases", default="suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist")
     parser.add_argument("--threads", type=int, help="pass --threads N to sgbake")
     parser.add_argument("--sabotage", choices=("green", "scale", "input"),
                         help="make sgbake answer wrongly on purpose (the test must fail)")
     args = parser.parse_args()
 
-    blender = bc.find_blender(args.blender)
-    if blender is None:
-        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
-        return bc.SKIP
-    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
-        print(f"error: {args.cli} is not an executable file (build sgbake_cli first)")
-        return 2
+    blender = bc.blender_or_skip(args.blender)
+    bc.require_executable(args.cli)
     for command in ("bake", "convert"):
         if not bc.cli_has_command(args.cli, command):
             print(f"FAIL: `{args.cli} --help` lists no `{command}` command")
             return 1
 
-    with tempfile.TemporaryDirectory(prefix="sgbake-bake-oracle-") as tmp:
-        work = os.path.abspath(args.keep or tmp)
-        os.makedirs(work, exist_ok=True)
+    with bc.work_dir(args.keep, "sgbake-bake-oracle-") as work:
         if not run_blender_script(blender, "bake_scene.py", [work, "--cases", args.cases]):
             return 1
         with open(os.path.join(work, "cases.json"), encoding="ascii") as f:
@@ -274,14 +262,7 @@ def main():
             failures += evaluate(entry["name"], results[entry["name"]])
         if args.keep:
             print(f"files kept in {work}")
-
-    if failures:
-        print(f"FAIL: {len(failures)} problem(s):")
-        for line in failures:
-            print("  " + line)
-        return 1
-    print("PASS")
-    return 0
+    return bc.report(failures)
 
 
 if __name__ == "__main__":

@@ -32,12 +32,10 @@ to the right, G DEcreases upwards, at different rates.
 Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed. Takes ~6 s.
 """
 
-import argparse
 import json
 import math
 import os
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
@@ -218,36 +216,22 @@ def check(work, size, sabotage):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
-    parser.add_argument("--blender", default="blender", help="Blender executable")
-    parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
+    parser = bc.oracle_parser(__doc__)
     parser.add_argument("--size", type=int, default=64)
     parser.add_argument("--sabotage", choices=("flip",), help="check our image upside down")
     args = parser.parse_args()
 
-    blender = bc.find_blender(args.blender)
-    if blender is None:
-        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
-        return bc.SKIP
-    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
-        print(f"error: {args.cli} is not an executable file (build sgbake_cli first)")
-        return 2
+    blender = bc.blender_or_skip(args.blender)
+    bc.require_executable(args.cli)
     if not bc.cli_has_command(args.cli, "bake"):
         print(f"FAIL: `{args.cli} --help` lists no `bake` command")
         return 1
 
     def run_half(*half_args):
-        proc = objio.run_blender(blender, os.path.abspath(__file__), list(half_args),
-                                 capture_output=True, text=True, timeout=120)
-        if proc.returncode != 0:
-            print(f"error: Blender ({' '.join(half_args[:1])}) exited with {proc.returncode}\n"
-                  f"{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-        return proc.returncode == 0
+        return objio.run_blender_half(blender, os.path.abspath(__file__), list(half_args),
+                                      timeout=120)
 
-    with tempfile.TemporaryDirectory(prefix="sgbake-orientation-") as tmp:
-        work = os.path.abspath(args.keep or tmp)
-        os.makedirs(work, exist_ok=True)
+    with bc.work_dir(args.keep, "sgbake-orientation-") as work:
         if not run_half("make", work, str(args.size)):
             return 1
         mesh = os.path.join(work, "plane.obj")

@@ -63,6 +63,17 @@ def run_blender_result(blender, script, args, tag):
     return None
 
 
+def run_blender_half(blender, script, args, timeout, tail=3000):
+    """Runs SCRIPT in Blender (run_blender) with ARGS, at most `timeout` seconds; returns
+    whether it exited with 0. When it did not, prints "error: Blender (ARGS[0]) exited with N"
+    and the last `tail` characters of its standard output and of its standard error."""
+    proc = run_blender(blender, script, args, capture_output=True, text=True, timeout=timeout)
+    if proc.returncode != 0:
+        print(f"error: Blender ({' '.join(args[:1])}) exited with {proc.returncode}\n"
+              f"{proc.stdout[-tail:]}\n{proc.stderr[-tail:]}")
+    return proc.returncode == 0
+
+
 def run_script(blender_main, main):
     """The entry point of a script that is both the driver (plain python3) and, re-run by
     run_blender, the Blender half: inside Blender (bpy importable) calls blender_main with the

@@ -14,19 +14,15 @@ Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed (CTest c
 as skipped via SKIP_RETURN_CODE 77). Takes ~10 s: Blender starts once for all cases.
 """
 
-import argparse
 import os
-import shutil
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
 sys.path.insert(0, HERE)
-import compare_tangents  # noqa: E402  (needs the sys.path entry above)
+import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
+import compare_tangents  # noqa: E402
 import objio  # noqa: E402
-
-SKIP = 77
 
 
 def make_cases(blender, out_dir):
@@ -45,32 +41,20 @@ def make_cases(blender, out_dir):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
-    parser.add_argument("--blender", default="blender",
-                        help="Blender executable (default: `blender` on PATH)")
-    parser.add_argument("--keep", metavar="DIR", help="write the cases here and keep them")
+    parser = bc.oracle_parser(
+        __doc__, blender_help="Blender executable (default: `blender` on PATH)",
+        keep_help="write the cases here and keep them")
     args, rest = parser.parse_known_args()
+    blender = bc.blender_or_skip(args.blender)
+    bc.require_executable(args.cli)
 
-    blender = shutil.which(args.blender)
-    if blender is None:
-        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
-        return SKIP
-
-    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
-        print(f"error: {args.cli} is not an executable file (build sgbake_cli first)")
-        return 2
-
-    if args.keep:
-        os.makedirs(args.keep, exist_ok=True)
-        if not make_cases(blender, args.keep):
+    with bc.work_dir(args.keep, "sgbake-oracle-") as work:
+        if not make_cases(blender, work):
             return 1
-        return compare_tangents.main(["--cli", args.cli, "--cases", args.keep,
-                                      "--out-dir", args.keep] + rest)
-    with tempfile.TemporaryDirectory(prefix="sgbake-oracle-") as tmp:
-        if not make_cases(blender, tmp):
-            return 1
-        return compare_tangents.main(["--cli", args.cli, "--cases", tmp] + rest)
+        # With --keep, sgbake's CSVs are kept beside the cases (else compare_tangents writes
+        # them in a temporary directory of its own).
+        out_dir = ["--out-dir", work] if args.keep else []
+        return compare_tangents.main(["--cli", args.cli, "--cases", work] + out_dir + rest)
 
 
 if __name__ == "__main__":

@@ -86,7 +86,6 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -95,7 +94,6 @@ sys.path.insert(0, HERE)
 import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
 import objio  # noqa: E402
 
-SKIP = bc.SKIP
 BLENDER_TIMEOUT = 240
 SGBAKE_TIMEOUT = 120
 
@@ -535,13 +533,8 @@ def compare_all(cli, work):
                             f"{must_fail} check against {tag}, so the check cannot tell right "
                             "from wrong")
 
-    if failures:
-        print(f"FAIL: {len(failures)} problem(s):")
-        for line in failures:
-            print("  " + line)
-        return 1
-    print(f"PASS: {len(cases)} cases agree with Blender, {len(CONTROLS)} negative controls fail")
-    return 0
+    return bc.report(failures, f"PASS: {len(cases)} cases agree with Blender, {len(CONTROLS)} "
+                               "negative controls fail")
 
 
 def has_numpy():
@@ -553,11 +546,8 @@ def has_numpy():
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
-    parser.add_argument("--blender", default="blender",
-                        help="Blender executable (default: `blender` on PATH)")
-    parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
+    parser = bc.oracle_parser(
+        __doc__, blender_help="Blender executable (default: `blender` on PATH)")
     # Internal: compare the cases already in DIR (how the driver hands the comparison to
     # Blender's Python when its own has no numpy).
     parser.add_argument("--compare-only", metavar="DIR", help=argparse.SUPPRESS)
@@ -569,19 +559,12 @@ def main():
             return 2
         return compare_all(args.cli, args.compare_only)
 
-    blender = bc.find_blender(args.blender)
-    if blender is None:
-        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
-        return SKIP
-    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
-        print(f"error: {args.cli} is not an executable file (build sgbake_cli first)")
-        return 2
+    blender = bc.blender_or_skip(args.blender)
+    bc.require_executable(args.cli)
     cli = os.path.abspath(args.cli)
 
     started = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="sgbake-subdiv-oracle-") as tmp:
-        work = os.path.abspath(args.keep or tmp)
-        os.makedirs(work, exist_ok=True)
+    with bc.work_dir(args.keep, "sgbake-subdiv-oracle-") as work:
         if not make_cases(blender, work):
             return 1
         blender_s = time.perf_counter() - started

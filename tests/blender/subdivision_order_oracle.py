@@ -24,9 +24,9 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
 import objio  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -127,38 +127,35 @@ def main():
     if shutil.which(args.blender) is None:
         print(f"skipped: no Blender ('{args.blender}')")
         return 77
-    work = args.keep or tempfile.mkdtemp(prefix="sgbake_subdiv_order_")
-    os.makedirs(work, exist_ok=True)
-    meshes = {"mixed": os.path.join(work, "mixed.obj"), "suzanne": os.path.abspath(SUZANNE)}
-    with open(meshes["mixed"], "w", encoding="ascii") as f:
-        f.write(MIXED_OBJ)
-    script = os.path.join(work, "dump_subdivided.py")
-    with open(script, "w", encoding="ascii") as f:
-        f.write(BLENDER_SCRIPT)
-    jobs = [(meshes[m], level, os.path.join(work, f"{m}_L{level}.blender.json"))
-            for m, level in CASES]
-    blender = objio.run_blender(args.blender, script, [json.dumps(jobs)],
-                                capture_output=True, text=True)
-    if blender.returncode != 0:
-        print(f"Blender failed ({blender.returncode}):\n{blender.stderr[-2000:]}")
-        return 1
-    failures = []
-    for (mesh, level, reference), (name, _) in zip(jobs, CASES):
-        tag = f"{name} level {level}"
-        out = os.path.join(work, f"{name}_L{level}.sgbake.obj")
-        run = subprocess.run([args.cli, "tangents", mesh, "--subdivide", str(level),
-                              "--mesh-out", out, "-o", out + ".csv"],
-                             capture_output=True, text=True, check=False)
-        if run.returncode != 0:
-            failures.append(f"{tag}: sgbake exited {run.returncode}: {run.stderr.strip()}")
-            continue
-        ours = read_obj(out)
-        if args.sabotage:
-            ours[0][0], ours[0][-1] = ours[0][-1], ours[0][0]
-        with open(reference, encoding="ascii") as f:
-            failures += compare(tag, json.load(f), ours)
-    if not args.keep:
-        shutil.rmtree(work, ignore_errors=True)
+    with bc.work_dir(args.keep, "sgbake_subdiv_order_") as work:
+        meshes = {"mixed": os.path.join(work, "mixed.obj"), "suzanne": os.path.abspath(SUZANNE)}
+        with open(meshes["mixed"], "w", encoding="ascii") as f:
+            f.write(MIXED_OBJ)
+        script = os.path.join(work, "dump_subdivided.py")
+        with open(script, "w", encoding="ascii") as f:
+            f.write(BLENDER_SCRIPT)
+        jobs = [(meshes[m], level, os.path.join(work, f"{m}_L{level}.blender.json"))
+                for m, level in CASES]
+        blender = objio.run_blender(args.blender, script, [json.dumps(jobs)],
+                                    capture_output=True, text=True)
+        if blender.returncode != 0:
+            print(f"Blender failed ({blender.returncode}):\n{blender.stderr[-2000:]}")
+            return 1
+        failures = []
+        for (mesh, level, reference), (name, _) in zip(jobs, CASES):
+            tag = f"{name} level {level}"
+            out = os.path.join(work, f"{name}_L{level}.sgbake.obj")
+            run = subprocess.run([args.cli, "tangents", mesh, "--subdivide", str(level),
+                                  "--mesh-out", out, "-o", out + ".csv"],
+                                 capture_output=True, text=True, check=False)
+            if run.returncode != 0:
+                failures.append(f"{tag}: sgbake exited {run.returncode}: {run.stderr.strip()}")
+                continue
+            ours = read_obj(out)
+            if args.sabotage:
+                ours[0][0], ours[0][-1] = ours[0][-1], ours[0][0]
+            with open(reference, encoding="ascii") as f:
+                failures += compare(tag, json.load(f), ours)
     for failure in failures:
         print("FAIL", failure)
     return 1 if failures else 0

@@ -24,12 +24,10 @@ swapped tiles, to see the test fail.
 Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed. Takes ~5 s.
 """
 
-import argparse
 import json
 import os
 import shutil
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
@@ -37,7 +35,6 @@ sys.path.insert(0, HERE)
 import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
 import objio  # noqa: E402
 
-SKIP = 77
 SCALE = 0.1
 SIZE = 256          # bake size of each tile
 HEIGHT_SIZE = 256   # size of each height tile
@@ -144,23 +141,13 @@ def bake(cli, out_dir, heights, prefix):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cli", required=True, help="path to the sgbake executable")
-    parser.add_argument("--blender", default="blender")
-    parser.add_argument("--keep", metavar="DIR", help="write every file here and keep it")
+    parser = bc.oracle_parser(__doc__, blender_help=None)
     parser.add_argument("--sabotage", choices=["swap"], help="bake from swapped tiles")
     args = parser.parse_args()
-    blender = bc.find_blender(args.blender)
-    if blender is None:
-        print(f"SKIP: {args.blender} is not on PATH; the Blender oracle test needs Blender")
-        return SKIP
-    if not (os.path.isfile(args.cli) and os.access(args.cli, os.X_OK)):
-        print(f"error: --cli {args.cli} is not an executable file")
-        return 2
+    blender = bc.blender_or_skip(args.blender)
+    bc.require_executable(args.cli, "error: --cli {} is not an executable file")
 
-    out_dir = args.keep or tempfile.mkdtemp(prefix="sgbake_udim_oracle_")
-    os.makedirs(out_dir, exist_ok=True)
-    try:
+    with bc.work_dir(args.keep, "sgbake_udim_oracle_") as out_dir:
         if run_blender(blender, ["build", out_dir]) is None:
             return 1
         # The negative control's tiles: each file holds the other tile's heights.
@@ -187,9 +174,6 @@ def main():
                   f"{control['median_deg']:.3f} deg (must exceed {CONTROL_MIN_DEG})")
         print("FAILED" if failed else "PASSED")
         return 1 if failed else 0
-    finally:
-        if not args.keep:
-            shutil.rmtree(out_dir, ignore_errors=True)
 
 
 if __name__ == "__main__":
