@@ -333,6 +333,10 @@ std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key
                                 const InputPaths& paths) {
   const std::string text = reader.string(key);
   if (text.empty()) fail(reader.where(), quote(key) + " is empty");
+  // JSON can spell a NUL ("\u0000"); a file name cannot hold one (the system would cut it).
+  if (text.find('\0') != std::string::npos) {
+    fail(reader.where(), quote(key) + " holds a NUL character, which no file name can");
+  }
   return paths(text);
 }
 

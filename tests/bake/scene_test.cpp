@@ -310,6 +310,11 @@ TEST(Scene, MissingAndEmpty) {
             "scene.json: layers[0]: missing key 'image' in a height layer");
   EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": ""})")),
             "scene.json: outputs[0]: 'file' is empty");
+  // A NUL would cut the name where the system reads it: "keep.exr\0.png" writes keep.exr.
+  EXPECT_EQ(parseError(withOutput(R"({"map": "mask", "file": "keep.exr\u0000.png"})")),
+            "scene.json: outputs[0]: 'file' holds a NUL character, which no file name can");
+  EXPECT_EQ(parseError(R"({"mesh": "m\u0000.obj", "outputs": [{"map": "mask", "file": "m.png"}]})"),
+            "scene.json: 'mesh' holds a NUL character, which no file name can");
 }
 
 TEST(Scene, SyntaxErrorsAndDuplicates) {
