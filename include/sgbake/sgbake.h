@@ -30,8 +30,10 @@
 
 /// The version of this header, as "MAJOR.MINOR.PATCH"; sgbake_version() reports the library's.
 /// 0.2.0 appended sgbake_mesh::face_flat and sgbake_mesh::auto_smooth: a caller built against
-/// 0.1.0's header passes a shorter struct, so rebuild (and set both fields).
-#define SGBAKE_VERSION_STRING "0.2.0"
+/// 0.1.0's header passes a shorter struct, so rebuild (and set both fields). 0.3.0 changes no
+/// C declaration: normal-map layers and steep bumps bake as Cycles shades them (manifests of
+/// 0.2.0 re-bake).
+#define SGBAKE_VERSION_STRING "0.3.0"
 
 #ifdef __cplusplus
 extern "C" {

@@ -90,10 +90,12 @@ struct BakeShaderBase {
 
   /// perturbedNormal(point, layers) in object space: N' = normalize(N − Γ) (eq. 33 with the
   /// identity cofactor). Equal to resolveNormal(N, Γ) up to the sign of zero components, without
-  /// its identity matrix products and its fallback normalization (computed for every texel).
+  /// its identity matrix products and its fallback normalization (computed for every texel);
+  /// then Cycles' validReflectionNormal with the triangle's geometric normal, as Blender bakes.
   Vec3d perturbed(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& p = pointAt(b, f);
-    return unitOr(p.normal - gradient(p), p.normal);
+    return validReflectionNormal(unitOr(p.normal - gradient(p), p.normal), tri.faceNormal,
+                                 p.normal);
   }
   static void put(const Vec3d& v, double* out) {
     out[0] = v.x;
@@ -286,11 +288,13 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
 }
 
 /// v = N̂ − Γ of every sample (batchGradients), not normalized; slow[i] also when |v|² is not a
-/// normal positive number (zero, subnormal, overflowing), whose normalization takes a fallback.
+/// normal positive number (zero, subnormal, overflowing), whose normalization takes a fallback,
+/// and when v fails reflectsAboveSurface (validReflectionNormal turns it: the scalar path).
 inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
                                      Lanes3& v, LaneFlags& slow) {
   Lanes3 gamma;
   batchGradients(shader, s, unitN, gamma);
+  const Vec3d ng = shader.tri.faceNormal;
   for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i) {
     const double vx = unitN.x[i] - gamma.x[i];
     const double vy = unitN.y[i] - gamma.y[i];
@@ -299,7 +303,13 @@ inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& 
     v.x[i] = vx;
     v.y[i] = vy;
     v.z[i] = vz;
-    slow[i] = slow[i] | !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2));
+    // reflectsAboveSurface(v, Ng, N̂, |v|²), lane by lane.
+    const double iz = unitN.x[i] * ng.x + unitN.y[i] * ng.y + unitN.z[i] * ng.z;
+    const double vi = vx * unitN.x[i] + vy * unitN.y[i] + vz * unitN.z[i];
+    const double vn = vx * ng.x + vy * ng.y + vz * ng.z;
+    const double threshold = std::min(0.9 * iz, 0.01);
+    const bool above = 2 * vi * vn - iz * len2 >= threshold * len2;
+    slow[i] = slow[i] | !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2) & above);
   }
 }
 
@@ -314,8 +324,11 @@ struct TangentNormalShader : BakeShaderBase {
     const SurfacePoint& p = pointAt(b, f);
     const Vec3d v = p.normal - gradient(p);
     const double len2 = lengthSquared(v);
-    if (len2 >= std::numeric_limits<double>::min() && std::isfinite(len2)) return v;
-    return normalizeOr(v, p.normal);
+    if (len2 >= std::numeric_limits<double>::min() && std::isfinite(len2) &&
+        reflectsAboveSurface(v, tri.faceNormal, p.normal, len2)) {
+      return v;
+    }
+    return validReflectionNormal(normalizeOr(v, p.normal), tri.faceNormal, p.normal);
   }
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);

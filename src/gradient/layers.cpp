@@ -38,9 +38,8 @@ Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const Vec2d st = textureCoordinates(uvFrame(point, s.uvSet).uv, s.tiling, s.offset);
   const Vec3d gamma =
-      s.strength *
       gradientFromObjectNormal(decodeNormalTexel(s.texture->sample(st)), point.normal, s.minCosine);
-  return isFinite(gamma) ? gamma : Vec3d{};
+  return withNormalMapStrength(isFinite(gamma) ? gamma : Vec3d{}, point.normal, s.strength);
 }
 
 Vec3d evaluate(const VolumeSource& s, const SurfacePoint& point) {

@@ -54,17 +54,20 @@ bool uvDerivativeTangentFrame(const UvFrame& frame, Vec3d normal, Vec3d& tangent
 Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
                                 const TangentNormalOptions& options) {
   const Vec2d s = slopesFromTangentNormal(n, options.minNormalZ);
-  const Vec2d slopes{options.strength * options.tiling.x * s.x,
-                     options.strength * options.tiling.y * s.y};
+  const Vec2d slopes{options.tiling.x * s.x, options.tiling.y * s.y};
 
   const bool mikk =
       point.hasTangentFrame && (options.frame == TangentFrameChoice::kMikkTSpace ||
                                 (options.frame == TangentFrameChoice::kAuto && uvSet == 0));
   if (mikk) {
-    // Blender: B = sign · N × T with sign = (interpolated sign < 0 ? −1 : +1).
+    // Blender's Normal Map node: normalize(x·T + y·B_i + z·N_i) with the unnormalized
+    // interpolated normal N_i = L·N and B_i = sign · N_i × T (sign = interpolated sign < 0 ?
+    // −1 : +1). Divided by L: x·T/L + y·B + z·N with B = sign · N × T, so T/L decodes.
     const double sign = point.bitangentSign < 0 ? -1.0 : 1.0;
     const Vec3d bitangent = sign * cross(point.normal, point.tangent);
-    return finiteOrZero(gradientFromTangentFrame(slopes, point.tangent, bitangent));
+    const Vec3d tangent = (1 / point.normalLength) * point.tangent;
+    return withNormalMapStrength(finiteOrZero(gradientFromTangentFrame(slopes, tangent, bitangent)),
+                                 point.normal, options.strength);
   }
   if (uvSet < 0 || uvSet >= point.numUvSets || uvSet >= kMaxUvSets) return {};
   Vec3d tangent, bitangent;
@@ -72,7 +75,17 @@ Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
                                 bitangent, options.minFrameSine)) {
     return {};
   }
-  return finiteOrZero(gradientFromTangentFrame(slopes, tangent, bitangent));
+  return withNormalMapStrength(finiteOrZero(gradientFromTangentFrame(slopes, tangent, bitangent)),
+                               point.normal, options.strength);
+}
+
+Vec3d withNormalMapStrength(Vec3d gamma, Vec3d normal, double strength) {
+  if (strength == 1) return gamma;
+  if (!(strength > 0)) return {};  // Blender clamps Strength at 0 (and NaN is no bump)
+  // n' = normalize(N − Γ) has a positive N component (Γ is tangent), so the blend has too.
+  const Vec3d decoded = normalizeOr(normal - gamma, normal);
+  const Vec3d blended = normal + strength * (decoded - normal);
+  return finiteOrZero(gradientFromObjectNormal(blended, normal));
 }
 
 Vec3d gradientFromObjectNormal(Vec3d objectNormal, Vec3d normal, double minCosine) {

@@ -6,13 +6,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <vector>
 
+#include "bake/texel_frame.hpp"
 #include "bake_test_util.hpp"
-#include "support/parametric_mesh.hpp"
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/volume.hpp"
+#include "support/parametric_mesh.hpp"
 
 namespace sgbake {
 namespace {
@@ -154,6 +156,66 @@ TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
       }
     }
   }
+}
+
+// Cycles bends a bumped normal whose reflection of the incoming direction (at a bake, the
+// shading normal: ẑ on this plane) would go below the surface: on a flat plane no normal leans
+// more than acos(0.01)/2 = 44.71° from ẑ. A steep linear height (60°) bakes that tilt, in the
+// same azimuth, while the surface-gradient and derivative maps keep the height's own slope.
+TEST(Maps, SteepBumpsAreBentToCyclesValidReflection) {
+  const Mesh mesh = scaledPlane(1, 1);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const double slope = std::tan(60 * kPi / 180);
+  const test::LinearHeight height(0.6, 0.8);  // gradient direction (0.6, 0.8), |∇h| = 1
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, slope}, 1.0, {}}};
+  const double tilt = std::acos(0.01) / 2;
+  const Vec3d bent{-0.6 * std::sin(tilt), -0.8 * std::sin(tilt), std::cos(tilt)};
+  const auto on = bake(mesh, &*tangents, layers, MapKind::kObjectNormal, 16, 1);
+  const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal, 16, 1);
+  const auto sg = bake(mesh, &*tangents, layers, MapKind::kSurfaceGradient, 16, 1);
+  ASSERT_TRUE(on.ok() && tn.ok() && sg.ok());
+  int covered = 0;
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      if (test::coverageUp(*on, x, y) != 1.0f) continue;
+      ++covered;
+      const std::string at = std::to_string(x) + "," + std::to_string(y);
+      expectNear(test::pixelUp(*on, x, y), encode(bent), kFloatTol, "object-normal " + at);
+      expectNear(test::pixelUp(*tn, x, y), encode(bent), kFloatTol, "tangent-normal " + at);
+      expectNear(test::pixelUp(*sg, x, y), Vec3d{0.6 * slope, 0.8 * slope, 0}, 1e-6,
+                 "surface gradient " + at);
+    }
+  }
+  EXPECT_GT(covered, 100);
+}
+
+// validReflectionNormal: kept when valid; otherwise in the plane of n and Ng, with the
+// reflection rising exactly by min(0.9⟨Ng, I⟩, 0.01), for random incoming directions.
+TEST(Maps, ValidReflectionNormalMeetsItsThresholdInThePlaneOfNAndNg) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto unit = [](const Vec3d& v) { return (1 / std::sqrt(lengthSquared(v))) * v; };
+  int bent = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3d ng = unit({u(rng), u(rng), u(rng)});
+    const Vec3d incoming = unit(ng + 0.6 * Vec3d{u(rng), u(rng), u(rng)});
+    const Vec3d n = unit(ng + 2.0 * Vec3d{u(rng), u(rng), u(rng)});
+    const Vec3d out = bake_detail::validReflectionNormal(n, ng, incoming);
+    if (bake_detail::reflectsAboveSurface(n, ng, incoming)) {
+      EXPECT_EQ(out, n);
+      continue;
+    }
+    if (out == ng) continue;  // no tilt reaches the threshold
+    ++bent;
+    const double threshold = std::min(0.9 * dot(ng, incoming), 0.01);
+    const Vec3d r = 2 * dot(out, incoming) * out - incoming;
+    EXPECT_NEAR(dot(ng, r), threshold, 1e-12) << i;
+    EXPECT_NEAR(lengthSquared(out), 1.0, 1e-12) << i;
+    EXPECT_NEAR(dot(out, cross(n, ng)), 0.0, 1e-12) << i;  // in the plane of n and Ng
+    EXPECT_GT(dot(out, ng), 0.0) << i;
+  }
+  EXPECT_GT(bent, 200);
 }
 
 TEST(Maps, HeightSumsWeightedMaskedHeightLayers) {

@@ -242,8 +242,10 @@ TEST(Layers, PlanarAndObjectSpaceSourcesDispatchToTheirKernels) {
   EXPECT_EQ(layerGradient(planar, p), planarTangentNormalGradient(ts, planar.mapping, 0.5, p));
   const ObjectNormalSource os{&ts, 1, {2, 2}, {0, 0}, 0.5};
   const Vec2d st = textureCoordinates(p.uv[1].uv, {2, 2}, {0, 0});
-  EXPECT_EQ(layerGradient(os, p),
-            0.5 * gradientFromObjectNormal(decodeNormalTexel(ts.sample(st)), p.normal));
+  EXPECT_EQ(
+      layerGradient(os, p),
+      withNormalMapStrength(gradientFromObjectNormal(decodeNormalTexel(ts.sample(st)), p.normal),
+                            p.normal, 0.5));
 }
 
 // No NaN from any layer kind at random points with extreme parameters (1e±8 scales, tilings and

@@ -334,17 +334,61 @@ TEST(GradientFromTangentNormal, UvDerivativeFrameEqualsMikkTSpaceWhenTheFramesAg
   }
 }
 
-TEST(GradientFromTangentNormal, AppliesTilingAndStrengthToTheSlopes) {
+Vec3d unit(const Vec3d& v) { return (1 / std::sqrt(dot(v, v))) * v; }
+
+TEST(GradientFromTangentNormal, AppliesTilingToTheSlopes) {
   SurfacePoint p;
   p.hasTangentFrame = true;  // T = +x, B = +y, N = +z
   const Vec3d n{0.2, -0.1, 0.8};
   TangentNormalOptions o;
   o.tiling = {2, 3};
-  o.strength = 0.5;
   const Vec3d gamma = gradientFromTangentNormal(n, p, 0, o);
-  EXPECT_NEAR(gamma.x, 0.5 * 2 * (-0.2 / 0.8), 1e-15);
-  EXPECT_NEAR(gamma.y, 0.5 * 3 * (0.1 / 0.8), 1e-15);
+  EXPECT_NEAR(gamma.x, 2 * (-0.2 / 0.8), 1e-15);
+  EXPECT_NEAR(gamma.y, 3 * (0.1 / 0.8), 1e-15);
   EXPECT_EQ(gamma.z, 0.0);
+}
+
+// Strength is Blender's Normal Map node's: the decoded normal n' is blended with N as
+// unit(N + s·(n' − N)), not a scaled height (which would give unit(s·x, s·y, z)).
+TEST(GradientFromTangentNormal, StrengthBlendsNormalsAsBlenderDoes) {
+  SurfacePoint p;
+  p.hasTangentFrame = true;  // T = +x, B = +y, N = +z
+  const Vec3d n{0.3, -0.4, 0.6};
+  const Vec3d decoded = unit(n);
+  for (const double s : {0.0, 0.25, 0.5, 2.0, 3.0}) {
+    TangentNormalOptions o;
+    o.strength = s;
+    const Vec3d gamma = gradientFromTangentNormal(n, p, 0, o);
+    const Vec3d expected = unit(p.normal + s * (decoded - p.normal));
+    EXPECT_LT(maxAbsDiff(unit(p.normal - gamma), expected), 1e-14) << s;
+    EXPECT_NEAR(dot(gamma, p.normal), 0.0, 1e-15) << s;
+  }
+  TangentNormalOptions negative;
+  negative.strength = -1;  // Blender clamps Strength at 0: no bump
+  EXPECT_EQ(gradientFromTangentNormal(n, p, 0, negative), Vec3d{});
+  // Strength 1 is the decode itself, bit for bit.
+  TangentNormalOptions one;
+  EXPECT_EQ(withNormalMapStrength(gradientFromTangentNormal(n, p, 0, one), p.normal, 1),
+            gradientFromTangentNormal(n, p, 0, one));
+}
+
+// Blender's Normal Map node decodes with the interpolated normal before it is renormalized,
+// N_i = L·N: unit(x·T + y·sign·(N_i × T) + z·N_i). SurfacePoint::normalLength carries L.
+TEST(GradientFromTangentNormal, DecodesWithTheUnnormalizedInterpolatedNormal) {
+  SurfacePoint p;
+  p.hasTangentFrame = true;
+  p.normal = unit(Vec3d{0.1, 0.2, 1});
+  p.tangent = Vec3d{0.9, 0.05, -0.1};  // interpolated: not unit, not orthogonal to N
+  p.bitangentSign = -1;
+  const Vec3d n{0.35, 0.2, 0.8};
+  for (const double length : {1.0, 0.93, 0.7}) {
+    p.normalLength = length;
+    const Vec3d gamma = gradientFromTangentNormal(n, p, 0);
+    const Vec3d interpolated = length * p.normal;
+    const Vec3d expected =
+        unit(n.x * p.tangent + n.y * -1.0 * cross(interpolated, p.tangent) + n.z * interpolated);
+    EXPECT_LT(maxAbsDiff(unit(p.normal - gamma), expected), 1e-14) << length;
+  }
 }
 
 TEST(GradientFromTangentNormal, DegenerateFramesAndMissingUvSetsGiveZero) {
@@ -415,7 +459,7 @@ TEST(GradientFromObjectNormal, GrazingZeroAndNanInputsAreFinite) {
 
 // The perturbed normal of the explicitly displaced and transformed surface
 // P(u,v) = M (S(u,v) + h(u,v) N) with a linear h: T_p = M(T + h_u N), B_p = M(B + h_v N),
-// N_p = normalize(T_p × B_p) (eq. 17-19), equals resolveNormal(N, Γ, cof(M)).
+// N_p = unit(T_p × B_p) (eq. 17-19), equals resolveNormal(N, Γ, cof(M)).
 TEST(ResolveNormal, MatchesTheExplicitlyDisplacedAndScaledSurface) {
   Random rng(9);
   double worst = 0;

@@ -53,7 +53,7 @@ struct ObjectNormalSource {
   int uvSet = 0;
   Vec2d tiling{1, 1};
   Vec2d offset{0, 0};
-  double strength = 1;  ///< multiplies Γ
+  double strength = 1;  ///< Blender's Normal Map Strength (withNormalMapStrength)
   double minCosine = kMinObjectNormalCosine;
 };
 

@@ -208,8 +208,8 @@ bool uvDerivativeTangentFrame(const UvFrame& frame, Vec3d normal, Vec3d& tangent
 struct TangentNormalOptions {
   NormalMapGreen green = NormalMapGreen::kOpenGL;
   TangentFrameChoice frame = TangentFrameChoice::kAuto;
-  /// Multiplies Γ (eq. 34: the map's height scaled by strength). Strength 1 reproduces the map
-  /// exactly; other values differ from Blender's Normal Map node, which lerps normals instead.
+  /// Blender's Normal Map node Strength (withNormalMapStrength): 1 reproduces the map exactly,
+  /// 0 is no bump, other values blend the decoded normal with N.
   double strength = 1;
   Vec2d tiling{1, 1};  ///< (s, t) = tiling ∘ uv + offset; the slopes are multiplied by tiling
   Vec2d offset{0, 0};
@@ -217,12 +217,20 @@ struct TangentNormalOptions {
   double minFrameSine = kMinFrameSine;     ///< see gradientFromUvDerivatives
 };
 
+/// @brief Blender's Normal Map node Strength s on a layer's Γ: the decoded normal
+/// n' = normalize(N − Γ) becomes normalize(N + s·(n' − N)) (a blend of normals, not a scaled
+/// height), whose Γ (gradientFromObjectNormal) is returned; Γ itself for s = 1, zero for s ≤ 0
+/// (Blender clamps Strength at 0) and NaN.
+Vec3d withNormalMapStrength(Vec3d gamma, Vec3d normal, double strength);
+
 /// @brief Γ of a decoded tangent-space normal @p n (eq. 14-15) at @p point on UV set @p uvSet.
 ///
-/// Slopes = tiling ∘ slopesFromTangentNormal(n) · strength, then gradientFromTangentFrame in the
-/// frame chosen by options.frame: the MikkTSpace frame T_m = point.tangent,
-/// B_m = bitangentSign · N × T_m, or uvDerivativeTangentFrame of the UV set. A degenerate frame
-/// (zero MikkTSpace tangent, degenerate UV set, uvSet out of range) gives Γ = 0.
+/// Slopes = tiling ∘ slopesFromTangentNormal(n), then gradientFromTangentFrame in the frame
+/// chosen by options.frame: the MikkTSpace frame T_m = point.tangent / point.normalLength,
+/// B_m = bitangentSign · N × point.tangent (so that N − Γ is Blender's Normal Map node decode
+/// normalize(x·T + y·B_i + z·N_i) with the unnormalized interpolated normal N_i), or
+/// uvDerivativeTangentFrame of the UV set; then withNormalMapStrength. A degenerate frame (zero
+/// MikkTSpace tangent, degenerate UV set, uvSet out of range) gives Γ = 0.
 ///
 /// @param[in] n decoded normal (decodeNormalTexel), any length
 Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,

@@ -30,6 +30,10 @@ struct UvFrame {
 struct SurfacePoint {
   Vec3d position{};  ///< P
   Vec3d normal{0, 0, 1};  ///< N, the unit shading normal (interpolated and renormalized)
+  /// |Σ bi·Ni|, the length of the interpolated normal N was renormalized from (< 1 inside a
+  /// curved smooth triangle; 1 where N is not interpolated: flat faces, corners, limit
+  /// surfaces). Blender's Normal Map node decodes with the unnormalized normal.
+  double normalLength = 1;
   std::array<UvFrame, kMaxUvSets> uv{};  ///< UV sets 0 .. numUvSets-1
   int numUvSets = 0;
   /// MikkTSpace frame of UV set 0, interpolated as the consumer of a tangent-space normal map
