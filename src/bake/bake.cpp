@@ -230,6 +230,15 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
     return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
                                    "(subdivideMesh with its SurfaceParameters)");
   }
+  if (input.triangleTangents != nullptr) {
+    const std::size_t frames = 3 * loopTriangles(mesh).size();
+    if (input.triangleTangents->tangent.size() != frames ||
+        input.triangleTangents->sign.size() != frames) {
+      return Error::badInput(where + ": " + std::to_string(input.triangleTangents->tangent.size()) +
+                             " loop-triangle tangents for " + std::to_string(frames) +
+                             " triangle corners");
+    }
+  }
   return validateLayers(input.layers, static_cast<int>(mesh.uvSets.size()));
 }
 
@@ -241,6 +250,7 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   BakeShaderBase base;
   base.mesh = input.mesh;
   base.tangents = input.tangents;
+  base.triangleTangents = input.triangleTangents;
   base.layers = input.layers;
   base.uvSet = settings.uvSet;
   base.green = settings.green;
@@ -282,6 +292,39 @@ Error outOfMemory(const BakeSettings& settings) {
 }
 
 }  // namespace
+
+Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh,
+                                                   const TangentOptions& options) {
+  if (!mesh.hasUvSet(0)) return Error::badInput("loop-triangle tangents need UV set 0");
+  const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  const std::size_t n = 3 * triangles.size();
+  std::vector<std::uint32_t> faceStart(triangles.size() + 1), cornerVertex(n);
+  std::vector<Vec3f> normals(n);
+  std::vector<Vec2f> uvs(n);
+  const std::vector<Vec2f>& meshUvs = mesh.uvSets[0].uvs;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    faceStart[t + 1] = static_cast<std::uint32_t>(3 * (t + 1));
+    const std::array<std::uint32_t, 3>& c = triangles[t];
+    // Cycles shades a flat face without Auto Smooth, and gives MikkTSpace, its triangle's normal.
+    bool triangleNormal = false;
+    if (!mesh.faceFlat.empty() && !mesh.autoSmooth) {
+      const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), c[0]);
+      triangleNormal = mesh.isFlat(static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1);
+    }
+    const Vec3f p0 = mesh.positions[mesh.cornerVertex[c[0]]];
+    const Vec3f flat =
+        cast<float>(normalizeOr(cast<double>(cross(mesh.positions[mesh.cornerVertex[c[1]]] - p0,
+                                                   mesh.positions[mesh.cornerVertex[c[2]]] - p0)),
+                                Vec3d{0, 0, 1}));
+    for (std::size_t i = 0; i < 3; ++i) {
+      cornerVertex[3 * t + i] = mesh.cornerVertex[c[i]];
+      normals[3 * t + i] = triangleNormal ? flat : mesh.cornerNormals[c[i]];
+      uvs[3 * t + i] = meshUvs[c[i]];
+    }
+  }
+  const MeshView view{mesh.positions, faceStart, cornerVertex, normals, uvs};
+  return computeTangents(view, options);
+}
 
 Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings) {
   return bakeMap(input, settings, {});

@@ -36,7 +36,7 @@ struct ConvertShader {
   int uvSet = 0;
   ShadingTriangle tri;
 
-  void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
+  void beginTriangle(std::uint32_t, const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
   }
   /// Nothing is derived from `tri` (LimitShader calls this after rewriting it).

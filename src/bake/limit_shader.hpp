@@ -63,9 +63,10 @@ struct LimitShader {
       : inner(other.inner), limit(other.limit), parameters(other.parameters) {}
   LimitShader& operator=(const LimitShader&) = delete;
 
-  void beginTriangle(const std::array<std::uint32_t, 3>& c) {
+  void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& c) {
     corners = c;
-    inner.beginTriangle(c);  // the tessellation's triangle: the fallback where Bfr has nothing
+    inner.beginTriangle(triangle,
+                        c);  // the tessellation's triangle: the fallback where Bfr has nothing
     meshTriangle = inner.tri;
     if (!meshTriangle.hasTangents) {  // no MikkTSpace frames (the planner skips them): the
       // triangle's own, as the limit surface's are made (T = ∂P/∂u made orthogonal to N)

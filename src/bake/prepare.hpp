@@ -70,6 +70,8 @@ struct Loaded {
   std::vector<std::unique_ptr<HeightVolume>> volumes;
   std::vector<Layer> layers;  ///< per plan layer
   std::optional<CornerTangents> tangents;
+  /// computeLoopTriangleTangents, when a tangent-space layer decodes in the MikkTSpace frame
+  std::optional<CornerTangents> triangleTangents;
   std::vector<std::string> warnings;  ///< about the inputs, for ExecuteReport::warnings
 };
 

@@ -7,9 +7,9 @@
 ///
 ///     struct Shader {
 ///       static constexpr int kChannels = 3;
-///       // Called once per (row block, triangle) before its samples; `corners` are global corner
-///       // indices of the triangle.
-///       void beginTriangle(const std::array<std::uint32_t, 3>& corners);
+///       // Called once per (row block, triangle) before its samples: `triangle` is its index in
+///       // RasterJob::triangles, `corners` its global corner indices.
+///       void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners);
 ///       // One covered sample; writes kChannels values to out. x, y: texel, y up.
 ///       void shade(const Vec3d& bary, int x, int y, double* out);
 ///     };
@@ -379,7 +379,7 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
                 owner = 1;
               }
               if (!begun) {
-                shader.beginTriangle(corners);
+                shader.beginTriangle(bins.index[k], corners);
                 begun = true;
               }
               // Barycentrics from the edge functions; all three are ≥ 0 here.

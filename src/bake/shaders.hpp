@@ -31,6 +31,7 @@ inline bool hasUvSet(const SurfacePoint& point, int uvSet) {
 struct BakeShaderBase {
   const Mesh* mesh = nullptr;
   const CornerTangents* tangents = nullptr;
+  const CornerTangents* triangleTangents = nullptr;  ///< BakeInput::triangleTangents
   std::span<const Layer> layers;
   int uvSet = 0;
   NormalMapGreen green = NormalMapGreen::kOpenGL;
@@ -41,8 +42,16 @@ struct BakeShaderBase {
   /// ∂P/∂v, lengths, T̂ × B̂) computed once, for the UV height layers (see gradient()).
   std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};
 
-  void beginTriangle(const std::array<std::uint32_t, 3>& corners) {
+  void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+    tri.hasLayerTangents = triangleTangents != nullptr;
+    if (tri.hasLayerTangents) {
+      for (std::size_t i = 0; i < 3; ++i) {
+        const std::size_t k = 3 * static_cast<std::size_t>(triangle) + i;
+        tri.layerTangent[i] = cast<double>(triangleTangents->tangent[k]);
+        tri.layerSign[i] = triangleTangents->sign[k];
+      }
+    }
     triangleChanged();
   }
   /// Updates what is derived from `tri` (after beginTriangle, or after LimitShader rewrote it).
@@ -524,7 +533,7 @@ struct BitangentShader : BakeShaderBase {
 
 struct MaskShader {
   static constexpr int kChannels = 1;
-  void beginTriangle(const std::array<std::uint32_t, 3>&) {}
+  void beginTriangle(std::uint32_t, const std::array<std::uint32_t, 3>&) {}
   void shade(const Vec3d&, int, int, double* out) const { out[0] = 1; }
 };
 

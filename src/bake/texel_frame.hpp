@@ -46,6 +46,11 @@ struct ShadingTriangle {
   bool polygonFrame = false;
   Vec3d polygonNormal{0, 0, 1};
   bool hasTangents = false;
+  /// The frames tangent-space layers decode with (BakeInput::triangleTangents: MikkTSpace of the
+  /// loop triangles, as Cycles' Normal Map node), when given; otherwise tangent/sign.
+  std::array<Vec3d, 3> layerTangent{};
+  std::array<double, 3> layerSign{1, 1, 1};
+  bool hasLayerTangents = false;
 };
 
 /// @brief ∂P/∂u, ∂P/∂v of the affine map of a triangle from its positions and UVs; both 0 when the
@@ -143,7 +148,7 @@ inline void beginSurfacePoint(const ShadingTriangle& t, SurfacePoint& p) {
     p.uv[k].dPdu = t.dPdu[k];
     p.uv[k].dPdv = t.dPdv[k];
   }
-  p.hasTangentFrame = t.hasTangents;
+  p.hasTangentFrame = t.hasTangents || t.hasLayerTangents;
 }
 
 /// @brief Completes @p p (prepared by beginSurfacePoint for @p t) for the sample at barycentrics
@@ -159,7 +164,10 @@ inline const SurfacePoint& surfacePointAt(const ShadingTriangle& t, const Vec3d&
     const std::size_t k = static_cast<std::size_t>(s);
     p.uv[k].uv = b.x * t.uv[k][0] + b.y * t.uv[k][1] + b.z * t.uv[k][2];
   }
-  if (t.hasTangents) {
+  if (t.hasLayerTangents) {
+    p.tangent = b.x * t.layerTangent[0] + b.y * t.layerTangent[1] + b.z * t.layerTangent[2];
+    p.bitangentSign = b.x * t.layerSign[0] + b.y * t.layerSign[1] + b.z * t.layerSign[2];
+  } else if (t.hasTangents) {
     p.tangent = f.tangent;
     p.bitangentSign = f.interpolatedSign;
   }

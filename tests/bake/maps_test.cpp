@@ -218,6 +218,69 @@ TEST(Maps, ValidReflectionNormalMeetsItsThresholdInThePlaneOfNAndNg) {
   EXPECT_GT(bent, 200);
 }
 
+// Cycles' Normal Map node decodes with MikkTSpace of the triangulated mesh. On a quad with
+// curved normals and UVs that are no parallelogram, those tangents differ from the quad's, and
+// a tangent-space layer with BakeInput::triangleTangents bakes exactly as the same two
+// triangles given as faces of their own do.
+TEST(Maps, TangentSpaceLayersDecodeWithTheLoopTrianglesTangents) {
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.1f}, {1.1f, 1, 0.3f}, {0, 0.9f, 0}};
+  const std::vector<Vec2f> uvs{{0.1f, 0.1f}, {0.8f, 0.15f}, {0.9f, 0.9f}, {0.05f, 0.7f}};
+  const std::vector<Vec3f> normals{
+      {0, 0, 1}, {-0.2f, 0, 0.98f}, {-0.3f, -0.3f, 0.905f}, {0, -0.1f, 0.995f}};
+  const auto unitNormals = [](std::vector<Vec3f> n) {
+    for (Vec3f& v : n) v = cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1}));
+    return n;
+  };
+  const Mesh quad = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, {}, unitNormals(normals));
+  const std::vector<std::array<std::uint32_t, 3>> split = loopTriangles(quad);
+  ASSERT_EQ(split.size(), 2u);
+  std::vector<std::vector<std::uint32_t>> faces;
+  std::vector<Vec2f> splitUvs;
+  std::vector<Vec3f> splitNormals;
+  for (const auto& t : split) {
+    faces.push_back({quad.cornerVertex[t[0]], quad.cornerVertex[t[1]], quad.cornerVertex[t[2]]});
+    for (const std::uint32_t c : t) {
+      splitUvs.push_back(quad.uvSets[0].uvs[c]);
+      splitNormals.push_back(quad.cornerNormals[c]);
+    }
+  }
+  const Mesh triangles = test::polygonMesh(positions, faces, splitUvs, {}, splitNormals);
+
+  const Result<CornerTangents> quadTangents = computeTangents(quad.view(0));
+  const Result<CornerTangents> loopTangents = computeLoopTriangleTangents(quad);
+  const Result<CornerTangents> splitTangents = computeTangents(triangles.view(0));
+  ASSERT_TRUE(quadTangents.ok() && loopTangents.ok() && splitTangents.ok());
+  EXPECT_EQ(loopTangents->tangent, splitTangents->tangent);
+  EXPECT_EQ(loopTangents->sign, splitTangents->sign);
+  double largest = 0;  // how far the quad's frames are from the triangles' (same corners)
+  for (std::size_t k = 0; k < 6; ++k) {
+    const std::uint32_t c = split[k / 3][k % 3];
+    largest = std::max(largest, std::sqrt(lengthSquared(cast<double>(quadTangents->tangent[c] -
+                                                                     loopTangents->tangent[k]))));
+  }
+  EXPECT_GT(largest, 1e-3);
+
+  const test::ConstantColour texel(Vec3d{0.75, 0.35, 0.8});  // a tilted tangent-space normal
+  TangentNormalSource source;
+  source.texture = &texel;
+  const std::vector<Layer> layers{Layer{source, 1.0, {}}};
+  BakeSettings settings;
+  settings.map = MapKind::kObjectNormal;
+  settings.width = settings.height = 32;
+  BakeInput withLoop{&quad, &*quadTangents, layers};
+  withLoop.triangleTangents = &*loopTangents;
+  const Result<FloatImage> ours = bakeMap(withLoop, settings);
+  const Result<FloatImage> faces2 = bakeMap({&triangles, &*splitTangents, layers}, settings);
+  const Result<FloatImage> polygon = bakeMap({&quad, &*quadTangents, layers}, settings);
+  ASSERT_TRUE(ours.ok() && faces2.ok() && polygon.ok());
+  EXPECT_EQ(ours->pixels, faces2->pixels);
+  EXPECT_NE(ours->pixels, polygon->pixels);
+  // A wrong number of frames is refused.
+  const CornerTangents shortList{{Vec3f{1, 0, 0}}, {1}};
+  withLoop.triangleTangents = &shortList;
+  EXPECT_FALSE(bakeMap(withLoop, settings).ok());
+}
+
 TEST(Maps, HeightSumsWeightedMaskedHeightLayers) {
   // On the plane P = (2u, 0.5v, 0): a volume sine along x, a planar (Z) linear height map and a
   // triplanar one (only the Z plane is active for N = ẑ), weighted, one of them masked by 0.5;

@@ -130,8 +130,8 @@ class ShadeBatch : public ::testing::Test {
     int fallbacks = 0;
     for (std::uint32_t t = 0; t < scene.mesh.numFaces(); ++t) {
       const std::array<std::uint32_t, 3> corners{3 * t, 3 * t + 1, 3 * t + 2};
-      batchShader.beginTriangle(corners);
-      sampleShader.beginTriangle(corners);
+      batchShader.beginTriangle(t, corners);
+      sampleShader.beginTriangle(t, corners);
       for (const int count : {1, 2, 3, 17, SampleBatch::kMax}) {
         const SampleBatch batch = randomBatch(rng, count);
         std::vector<double> lanes(static_cast<std::size_t>(count) * kC);
