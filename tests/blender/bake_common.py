@@ -407,12 +407,14 @@ def erode(mask, texels=1):
 
 
 def angle_stats(angles):
-    """Median, 99th percentile, max (degrees) and count of a 1-D array of angles."""
+    """Median, 90th and 99th percentile, max (degrees) and count of a 1-D array of angles."""
     import numpy as np
     angles = np.asarray(angles, dtype=np.float64)
     if angles.size == 0:
-        return {"median_deg": None, "p99_deg": None, "max_deg": None, "texels": 0}
+        return {"median_deg": None, "p90_deg": None, "p99_deg": None, "max_deg": None,
+                "texels": 0}
     return {"median_deg": float(np.median(angles)),
+            "p90_deg": float(np.percentile(angles, 90)),
             "p99_deg": float(np.percentile(angles, 99)),
             "max_deg": float(angles.max()),
             "texels": int(angles.size)}

@@ -13,18 +13,24 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
   ours_bake_json.exr `sgbake bake scene.json` (the same bake described as JSON)
   ours_bake_x2.exr   the same bake with twice the height scale (a negative control)
   ours_mask.exr      `sgbake bake --map mask`
+  ours_nmap_tangent.exr, ours_nmap_object.exr   a normal-map case's scene (normal layer,
+                     tangent- and object-normal outputs), against Blender's tangent and
+                     object bakes
+  ours_nmap_flags.exr  the same tangent-normal bake from --normal flags (Strength 1 cases)
+  ours_nmap_weak.exr   the scene's tangent-normal bake at 0.9 x Strength (negative control)
 
 it computes, over the texels Blender's EMIT mask covers, minus those within one texel of an
 island border (3 x 3 erosion: texels whose centres straddle a UV edge may fall in different
 triangles for Blender and us):
-  - the angle between the decoded normals (n = 2c - 1, normalised), as median / 99th
+  - the angle between the decoded normals (n = 2c - 1, normalised), as median / 90th and 99th
     percentile / max in degrees and the number of texels compared;
   - the same for our map with its green channel flipped (negative control: a wrong bitangent
     must be visible);
   - outside: the largest |difference| from the expected background over texels at least two
     texels away from any covered texel (convert keeps its input there; bake writes
     (0.5, 0.5, 1));
-  - json_vs_flags: largest |difference| between the JSON-scene and the command-line bake;
+  - json_vs_flags: largest |difference| between the JSON-scene and the command-line bake
+    (normal-map cases: ours_nmap_flags against ours_nmap_tangent);
   - mask: texels where our coverage (> 0.5) and Blender's differ, and Blender's covered count;
   - tilt: the median/p99 angle of Blender's tangent-space normal from +Z (how strong the bump
     is; the scale control is meaningless on a flat map).
@@ -108,6 +114,28 @@ def compare_case(entry):
             bake = img
         elif key == "bake_json" and bake is not None:
             out[key]["json_vs_flags_max_abs"] = float(np.abs(img[..., :3] - bake[..., :3]).max())
+
+    refs = {"tangent": ref_tangent, "object": ref_object}
+    nmap = None
+    for key, name, space in (("nmap_tangent", "ours_nmap_tangent.exr", "tangent"),
+                             ("nmap_object", "ours_nmap_object.exr", "object"),
+                             ("nmap_flags", "ours_nmap_flags.exr", "tangent"),
+                             ("nmap_weak", "ours_nmap_weak.exr", "tangent")):
+        img = load_if(os.path.join(d, name))
+        if img is None:
+            continue
+        ref = refs[space]
+        if img.shape != ref.shape:
+            out[key] = {"error": f"size {img.shape[:2]} != {ref.shape[:2]}"}
+            continue
+        out[key] = compare_normals(img, ref, inner)
+        if space == "tangent":
+            background = np.abs(img[..., :3] - np.array([0.5, 0.5, 1.0], np.float32))[outside]
+            out[key]["outside_max_abs"] = float(background.max()) if background.size else 0.0
+        if key == "nmap_tangent":
+            nmap = img
+        elif key == "nmap_flags" and nmap is not None:
+            out[key]["json_vs_flags_max_abs"] = float(np.abs(img[..., :3] - nmap[..., :3]).max())
 
     mask = load_if(os.path.join(d, "ours_mask.exr"))
     if mask is not None:

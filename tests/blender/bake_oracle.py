@@ -2,8 +2,10 @@
 """The BlenderBakeOracle test: sgbake's normal maps against Cycles' bakes of the same scenes.
 
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
-        [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist]
-        [--sabotage green|scale|input]
+        [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist,
+                 nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
+                 nmap_cube_s2]
+        [--sabotage green|scale|input|strength|normal-green]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
    once, smooth, 512^2; the same Suzanne with the Subdivision Surface modifier kept live, so
@@ -23,8 +25,20 @@
      sgbake bake scene.json         (the same bake as a JSON scene -> ours_bake_json.exr)
      sgbake bake ... --height-scale 2S -o ours_bake_x2.exr   (negative control)
      sgbake bake --mesh mesh.obj --map mask --size N --margin 0 -o ours_mask.exr
+   A normal-map case (the nmap_* cases: no Bump node but a Normal Map node fed by normal.exr,
+   a smooth procedural 512^2 float EXR whose normals lean up to 60 deg - 40 deg at Strength
+   2 - from the surface normal, so that Cycles' valid-reflection guard bends a good part of
+   them; tangent space on the UV sphere at Strength 1, 0.5 and 2 and on the flat cube at
+   Strength 1 and 2, object space on the UV sphere; 256^2, see bake_scene.py) runs instead
+     sgbake bake scene.json   (normal layer: normal.exr, space, strength, bilinear; outputs
+                               tangent-normal -> ours_nmap_tangent.exr and object-normal ->
+                               ours_nmap_object.exr; the same flags as above)
+     sgbake bake --mesh mesh.obj --normal normal.exr --normal-space SPACE
+                 --map tangent-normal ... -o ours_nmap_flags.exr   (Strength 1 cases only)
+     sgbake bake scene_weak.json   (Strength x 0.9 -> ours_nmap_weak.exr, negative control)
 3. bake_compare.py (inside Blender, as the EXR reader) measures the angles between our
-   normals and Cycles' tangent-space bake over the covered texels minus a one-texel border.
+   normals and Cycles' bake (tangent space; object space for ours_nmap_object.exr) over the
+   covered texels minus a one-texel border.
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -38,14 +52,29 @@ Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.
   (c) mask: at most 0.1 % of Blender's covered texels (and at least 5 texels of slack) differ;
   negative controls: our maps with the green channel flipped, and the bake with twice the
   scale, must FAIL (a) / (b) - otherwise the comparison could not tell right from wrong.
-Prints one line per check with median, p99, max and the number of texels compared.
+Per normal-map case:
+  (d) the tangent-normal bake vs Blender's tangent bake and the object-normal bake vs
+      Blender's object bake: median <= 0.05 deg, 90th percentile <= 0.1 deg and 99th
+      percentile <= 0.3 deg each (sgbake decodes as the Normal Map node does: measured
+      median <= 0.005, p90 <= 0.009, p99 <= 0.026 deg, max 0.31 deg at a few texels by the
+      sphere's poles and seam; the decode before it, with the unit normal, Strength as a
+      scaled slope and no valid-reflection guard, was off by p90 5.8-9.9 deg on every case,
+      and by medians 0.075 deg at Strength 1 on the sphere, 1.1-1.8 deg at Strength 0.5 and
+      2); the --normal flags give the scene's image
+      (|diff| <= 1e-6); background (0.5, 0.5, 1) outside the islands;
+  negative controls: our tangent-normal map with green flipped, and the bake at 0.9 x
+  Strength (medians 1.5-2.5 deg), must FAIL (d).
+Prints one line per check with median, p99 (normal-map cases: p90 and p99), max and the
+number of texels compared.
 
 --sabotage makes sgbake produce a wrong answer on purpose, to see the test fail: `green` bakes
 with --green directx, `scale` with 1.5 S, `input` hands convert Blender's tangent-space map
-instead of the object-space one. --keep DIR keeps every file for inspection.
+instead of the object-space one; for the normal-map cases `strength` gives the layer 0.8 x
+its Strength and `normal-green` reads the tangent-space map with green flipped
+("green": "directx", --normal-green directx). --keep DIR keeps every file for inspection.
 
 Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed
-(CTest: SKIP_RETURN_CODE 77). Takes ~15 s (Blender starts twice).
+(CTest: SKIP_RETURN_CODE 77). Takes ~18 s (Blender starts twice).
 """
 
 import json
@@ -63,9 +92,15 @@ CONVERT_P99_DEG = 0.5
 BAKE_MEDIAN_DEG = 1.0
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
+NMAP_MEDIAN_DEG = 0.05
+NMAP_P90_DEG = 0.1
+NMAP_P99_DEG = 0.3
 MASK_MISMATCH_FRACTION = 1e-3
 MASK_MISMATCH_SLACK = 5
 SGBAKE_TIMEOUT = 120
+DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
+                 "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
+                 "nmap_sphere_object", "nmap_cube", "nmap_cube_s2")
 
 
 def run_blender_script(blender, script, args):
@@ -141,11 +176,67 @@ def sgbake_case(cli, entry, sabotage, threads):
     return failed
 
 
+def sgbake_nmap_case(cli, entry, sabotage, threads):
+    """Runs the sgbake commands of a normal-map case (entry["normal_map"]); returns a list of
+    failed command lines."""
+    d = entry["dir"]
+    p = lambda name: os.path.join(d, name)  # noqa: E731
+    nmap, size = entry["normal_map"], entry["size"]
+    common = ["--margin", 0, "--samples", 1, "--bit-depth", 32, "--no-manifest"]
+    if threads:
+        common += ["--threads", threads]
+    failed, log = [], []
+    strength = nmap["strength"] * (0.8 if sabotage == "strength" else 1.0)
+    map_green = "directx" if sabotage == "normal-green" else "opengl"
+    green = "directx" if sabotage == "green" else "opengl"
+
+    def scene_file(name, layer_strength, outputs):
+        layer = {"type": "normal", "image": p("normal.exr"), "space": nmap["space"],
+                 "strength": layer_strength, "filter": "bilinear", "uv": 0, "weight": 1.0}
+        if nmap["space"] == "tangent":
+            layer["green"] = map_green
+        scene = {"mesh": p("mesh.obj"), "layers": [layer], "outputs": []}
+        for kind, file in outputs:
+            out = {"map": kind, "file": p(file), "size": size, "margin": 0, "samples": 1,
+                   "bit_depth": 32}
+            if kind == "tangent-normal":
+                out["green"] = green
+            scene["outputs"].append(out)
+        with open(p(name), "w", encoding="ascii") as f:
+            json.dump(scene, f, indent=1)
+        return ["bake", p(name), "--no-manifest"] + (["--threads", threads] if threads else [])
+
+    for args in (scene_file("scene.json", strength,
+                            [("tangent-normal", "ours_nmap_tangent.exr"),
+                             ("object-normal", "ours_nmap_object.exr")]),
+                 scene_file("scene_weak.json", 0.9 * strength,
+                            [("tangent-normal", "ours_nmap_weak.exr")])):
+        if not run_sgbake(cli, args, log):
+            failed.append(log[-1])
+    if nmap["strength"] == 1.0:  # the flags have no Strength
+        flags = ["bake", "--mesh", p("mesh.obj"), "--normal", p("normal.exr"), "--normal-space",
+                 nmap["space"], "--map", "tangent-normal", "--size", size, "--green", green,
+                 "-o", p("ours_nmap_flags.exr")] + common
+        if nmap["space"] == "tangent":
+            flags += ["--normal-green", map_green]
+        if not run_sgbake(cli, flags, log):
+            failed.append(log[-1])
+    return failed
+
+
 def fmt(stats):
     if not stats or stats.get("median_deg") is None:
         return "no texels"
     return (f"median {stats['median_deg']:.4f} deg, p99 {stats['p99_deg']:.4f} deg, "
             f"max {stats['max_deg']:.3f} deg, {stats['texels']} texels")
+
+
+def fmt_nmap(stats):
+    if not stats or stats.get("median_deg") is None:
+        return "no texels"
+    return (f"median {stats['median_deg']:.4f}, p90 {stats['p90_deg']:.4f}, "
+            f"p99 {stats['p99_deg']:.4f}, max {stats['max_deg']:.3f} deg, "
+            f"{stats['texels']} texels")
 
 
 def passes_convert(s):
@@ -154,6 +245,61 @@ def passes_convert(s):
 
 def passes_bake(s):
     return s["median_deg"] <= BAKE_MEDIAN_DEG
+
+
+def passes_nmap(s):
+    return (s["median_deg"] <= NMAP_MEDIAN_DEG and s["p90_deg"] <= NMAP_P90_DEG
+            and s["p99_deg"] <= NMAP_P99_DEG)
+
+
+def evaluate_nmap(name, r, nmap):
+    """Prints the figures of a normal-map case; returns a list of failure descriptions."""
+    fails = []
+    print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {nmap['space']}-space normal map "
+          f"(tilts up to {nmap['tilt_deg']:g} deg), Strength {nmap['strength']:g}, "
+          f"{r['covered']} covered texels, {r['compared']} compared; Blender's tangent bake "
+          f"tilt from +Z: {fmt_nmap(r['tilt'])}")
+    bars = f"(median <= {NMAP_MEDIAN_DEG}, p90 <= {NMAP_P90_DEG}, p99 <= {NMAP_P99_DEG})"
+    for key, what in (("nmap_tangent", "tangent-normal vs Blender tangent"),
+                      ("nmap_object", "object-normal vs Blender object ")):
+        if key not in r or "error" in r[key]:
+            fails.append(f"{name}: {what.strip()}: " + (r[key]["error"] if key in r
+                                                         else "no output to compare"))
+            continue
+        s = r[key]
+        ok = passes_nmap(s)
+        print(f"  (d) {what}: {fmt_nmap(s)} worst at (x, row) {s.get('worst_at')} -> "
+              f"{'ok' if ok else 'FAIL'} {bars}")
+        if not ok:
+            fails.append(f"{name}: {what.strip()}: {fmt_nmap(s)}")
+        if key == "nmap_tangent":
+            if s["outside_max_abs"] > BACKGROUND_ABS:
+                fails.append(f"{name}: normal-map bake background is not (0.5, 0.5, 1) outside "
+                             f"the islands (max |diff| {s['outside_max_abs']:.3g})")
+            print(f"      control, green flipped:            {fmt_nmap(s['flipped_green'])}")
+            if passes_nmap(s["flipped_green"]):
+                fails.append(f"{name}: negative control: the normal-map bake with green "
+                             f"flipped still passes")
+    if nmap["strength"] == 1.0:
+        s = r.get("nmap_flags")
+        same = s.get("json_vs_flags_max_abs") if s else None
+        if s is None or "error" in s:
+            fails.append(f"{name}: no --normal flags bake to compare")
+        else:
+            print(f"  (d) --normal flags bake:                {fmt_nmap(s)}; "
+                  f"max |JSON - flags| = {same}")
+        if same is None or same > SAME_IMAGE_ABS:
+            fails.append(f"{name}: the JSON scene and the --normal flags give different images "
+                         f"(max |diff| {same})")
+    s = r.get("nmap_weak")
+    if s is None or "error" in s:
+        fails.append(f"{name}: no 0.9 x Strength control bake to compare")
+    else:
+        print(f"      control, 0.9 x Strength:           {fmt_nmap(s)}")
+        if passes_nmap(s):
+            fails.append(f"{name}: negative control: the bake at 0.9 x Strength still passes "
+                         f"({fmt_nmap(s)})")
+    return fails
 
 
 def evaluate(name, r):
@@ -229,9 +375,10 @@ def evaluate(name, r):
 
 def main():
     parser = bc.oracle_parser(__doc__)
-    parser.add_argument("--cases", default="suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist")
+    parser.add_argument("--cases", default=",".join(DEFAULT_CASES))
     parser.add_argument("--threads", type=int, help="pass --threads N to sgbake")
-    parser.add_argument("--sabotage", choices=("green", "scale", "input"),
+    parser.add_argument("--sabotage", choices=("green", "scale", "input", "strength",
+                                               "normal-green"),
                         help="make sgbake answer wrongly on purpose (the test must fail)")
     args = parser.parse_args()
 
@@ -249,17 +396,25 @@ def main():
             entries = json.load(f)
         failures = []
         for entry in entries:
-            for cmd in sgbake_case(args.cli, entry, args.sabotage, args.threads):
+            run = sgbake_nmap_case if "normal_map" in entry else sgbake_case
+            for cmd in run(args.cli, entry, args.sabotage, args.threads):
                 failures.append(f"{entry['name']}: command failed: {cmd}")
         if not run_blender_script(blender, "bake_compare.py", [work]):
             return 1
         with open(os.path.join(work, "results.json"), encoding="ascii") as f:
             results = json.load(f)
         for entry in entries:
-            print(f"blender: {entry['name']}: {entry['faces']} faces, scale {entry['scale']}, "
+            layer = (f"{entry['normal_map']['space']} normal map, Strength "
+                     f"{entry['normal_map']['strength']:g}" if "normal_map" in entry
+                     else f"scale {entry['scale']}")
+            print(f"blender: {entry['name']}: {entry['faces']} faces, {layer}, "
                   f"bakes {', '.join(f'{k} {v:.2f} s' for k, v in entry['bake_s'].items())}")
         for entry in entries:
-            failures += evaluate(entry["name"], results[entry["name"]])
+            if "normal_map" in entry:
+                failures += evaluate_nmap(entry["name"], results[entry["name"]],
+                                          entry["normal_map"])
+            else:
+                failures += evaluate(entry["name"], results[entry["name"]])
         if args.keep:
             print(f"files kept in {work}")
     return bc.report(failures)

@@ -13,6 +13,12 @@ transform, so object space = world space), gives it the material
     Bump (Strength 1, Distance = the case's scale S, not inverted) --Normal--> Diffuse BSDF.Normal
     Add Shader(Diffuse BSDF, Emission(white, strength 1)) --> Material Output.Surface
 
+or, for the normal-map cases (NORMAL_MAPS: the names that start with nmap_),
+
+    Image Texture (normal.exr, Non-Color, Linear, Repeat) --Color--> Normal Map.Color
+    Normal Map (space TANGENT or OBJECT, UV map = the mesh's, Strength s) --Normal-->
+        Diffuse BSDF.Normal
+
 and bakes with Cycles on the CPU (1 sample, denoising off, margin 0 unless --margin, of
 --margin-type, default EXTEND):
   blender_object.exr   NORMAL, normal_space OBJECT,  channels POS_X / POS_Y / POS_Z
@@ -24,7 +30,9 @@ reloading. The case directory OUT_DIR/NAME also receives
   mesh.obj    the baked mesh, written by objio.write_obj (every float exact)
   height.exr  the height image, h in R = G = B (see below), A = 1
 and OUT_DIR/cases.json lists the cases: name, dir, size, scale, filter, faces, corners,
-covered texels, bake seconds per pass, Blender version and Cycles thread count.
+covered texels, bake seconds per pass, Blender version and Cycles thread count. A normal-map
+case writes normal.exr (normal_field or object_normal_field, 512^2, RGB = n / 2 + 0.5, A = 1)
+instead of height.exr, has scale 0 and lists "normal_map": {space, strength, tilt_deg}.
 
 What we learnt about Cycles' bake (Blender 3.4.1), checked with a plane and linear/sine heights:
 - Bump Distance is exactly sgbake's --height-scale: Cycles computes
@@ -51,6 +59,13 @@ What we learnt about Cycles' bake (Blender 3.4.1), checked with a plane and line
   than ~44.7 deg from the geometric (flat) normal are bent back. The scales below keep the
   bumps well under that.
 - Uncovered texels are left untouched with margin 0 (use_clear=False).
+- The Normal Map node (Cycles' svm_node_normal_map) decodes c -> n = 2c - 1 without clamping;
+  in tangent space N' = normalize(n.x T + n.y sign (N_i x T) + n.z N_i) with N_i the
+  interpolated normal BEFORE it is renormalized (shorter than 1 inside a curved smooth
+  triangle), in object space N' = normalize(n); Strength s then gives
+  normalize(N + s (N' - N)) (a blend of normals, not a scaled slope), and the result goes
+  through ensure_valid_reflection like the Bump node's: on a flat face nothing leans more than
+  44.71 deg, which is why the maps tilt up to 60 deg.
 """
 
 import json
@@ -85,6 +100,21 @@ def case(name, size, scale, subdivision=0):
         SUBDIVISION[name] = subdivision
         return fn
     return register
+
+
+# name -> the normal map of a normal-map case: space (TANGENT / OBJECT), Normal Map Strength,
+# largest tilt of the map's normals from the surface normal (degrees). Such a case bakes the
+# mesh of `mesh_case` with Normal Map node instead of a Bump node (make_normal_material).
+NORMAL_MAPS = {}
+
+
+def normal_map_case(name, mesh_case, size, space, strength, tilt_deg):
+    """Registers case `name`: the mesh of case `mesh_case`, its material a Normal Map node in
+    `space` with `strength`, fed by a normal image whose normals lean up to `tilt_deg` from the
+    surface normal (normal_field, or object_normal_field in object space)."""
+    CASES[name] = (CASES[mesh_case][0], size, 0.0)
+    SUBDIVISION[name] = SUBDIVISION[mesh_case]
+    NORMAL_MAPS[name] = {"space": space, "strength": strength, "tilt_deg": tilt_deg}
 
 
 def apply_subdivision(ob, levels):
@@ -178,6 +208,59 @@ def build_cube_flat():
     return ob
 
 
+# The normal-map cases (bake_oracle.py checks them with sgbake bake --normal). Tilts up to 60 deg
+# so that Cycles' valid-reflection guard bends a good part of them (> 44.71 deg on the cube's
+# flat faces); Strength 0.5 and 2 (40 deg map: up to 67 deg after the blend) for the node's
+# blend of normals; one object-space map. 256^2 bakes: ~1 s each in Cycles.
+normal_map_case("nmap_sphere", "sphere", 256, "TANGENT", 1.0, 60.0)
+normal_map_case("nmap_sphere_s05", "sphere", 256, "TANGENT", 0.5, 60.0)
+normal_map_case("nmap_sphere_s2", "sphere", 256, "TANGENT", 2.0, 40.0)
+normal_map_case("nmap_sphere_object", "sphere", 256, "OBJECT", 1.0, 60.0)
+normal_map_case("nmap_cube", "cube_flat", 256, "TANGENT", 1.0, 60.0)
+normal_map_case("nmap_cube_s2", "cube_flat", 256, "TANGENT", 2.0, 40.0)
+
+
+def tilt_field(size, tilt_deg):
+    """Tilt (radians) and azimuth over the image, (size, size) float64 rows top first: smooth
+    and periodic in u and v; the tilt spans [0, tilt_deg] (about a fifth of the texels above
+    3/4 of it), the azimuth turns all the way round."""
+    import numpy as np
+    c = (np.arange(size, dtype=np.float64) + 0.5) / size
+    u = c[None, :]
+    v = 1.0 - c[:, None]  # file row r has v = 1 - (r + 0.5) / H
+    s = 0.5 + 0.5 * np.sin(2 * math.pi * (2 * u + v)) * np.cos(2 * math.pi * 3 * v)
+    tilt = math.radians(tilt_deg) * s
+    azimuth = 2 * math.pi * (u - 2 * v) + 0.8 * np.sin(2 * math.pi * 3 * u)
+    return tilt, azimuth
+
+
+def normal_field(size, tilt_deg):
+    """A tangent-space normal image (size, size, 3), rows top first, encoded n / 2 + 0.5: the
+    unit normal (sin t cos a, sin t sin a, cos t) of tilt_field."""
+    import numpy as np
+    tilt, azimuth = tilt_field(size, tilt_deg)
+    n = np.stack([np.sin(tilt) * np.cos(azimuth), np.sin(tilt) * np.sin(azimuth), np.cos(tilt)],
+                 axis=-1)
+    return (0.5 * n + 0.5).astype(np.float32)
+
+
+def object_normal_field(normals, tilt_deg):
+    """An object-space normal image from `normals` (H, W, 3: the mesh's own interpolated unit
+    normal per texel, Blender's OBJECT bake with an Extend margin), encoded n / 2 + 0.5: each
+    normal N turned by tilt_field's tilt towards a smooth direction field d projected across N,
+    normalize(N + tan(t) d_perp / |d_perp|) (N itself where d is along N)."""
+    import numpy as np
+    size = normals.shape[0]
+    tilt, azimuth = tilt_field(size, tilt_deg)
+    n = normals / np.maximum(np.linalg.norm(normals, axis=-1, keepdims=True), 1e-12)
+    d = np.stack([np.cos(azimuth), np.sin(azimuth), np.sin(2 * azimuth + 1.0)], axis=-1)
+    across = d - np.sum(d * n, axis=-1, keepdims=True) * n
+    length = np.linalg.norm(across, axis=-1, keepdims=True)
+    out = n + np.tan(tilt)[..., None] * across / np.maximum(length, 1e-6)
+    out /= np.linalg.norm(out, axis=-1, keepdims=True)
+    return (0.5 * out + 0.5).astype(np.float32)
+
+
 def height_field(size):
     """The height image, (size, size) float32 rows top first: smooth, periodic in u and v (so
     the Repeat extension and any wrap mode agree), values in [0.1, 0.9]."""
@@ -219,6 +302,26 @@ def make_material(height_image, scale):
     nt.links.new(add.outputs["Shader"], out.inputs["Surface"])
     target = nodes.new("ShaderNodeTexImage")  # the bake target: the active Image Texture node
     target.name = "bake_target"
+    return mat, target
+
+
+def make_normal_material(normal_image, space, strength, uv_map):
+    """The normal-map material of the module docstring: an Image Texture of `normal_image`
+    (Linear = sgbake's bilinear, Repeat) into a Normal Map node in `space` on UV map `uv_map`
+    with `strength`; returns (material, bake target node)."""
+    mat, target = make_material(normal_image, 0.0)
+    nt = mat.node_tree
+    nodes = nt.nodes
+    bump = next(n for n in nodes if n.bl_idname == "ShaderNodeBump")
+    tex = next(n for n in nodes if n.bl_idname == "ShaderNodeTexImage" and n != target)
+    diffuse = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfDiffuse")
+    nodes.remove(bump)
+    nmap = nodes.new("ShaderNodeNormalMap")
+    nmap.space = space
+    nmap.uv_map = uv_map
+    nmap.inputs["Strength"].default_value = strength
+    nt.links.new(tex.outputs["Color"], nmap.inputs["Color"])
+    nt.links.new(nmap.outputs["Normal"], diffuse.inputs["Normal"])
     return mat, target
 
 
@@ -269,11 +372,32 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
     objio.write_obj(os.path.join(out_dir, "mesh.obj"), arrays,
                     comment=f"bake oracle case {name} (Blender {bpy.app.version_string})")
 
-    height = bake_common.new_float_image("height", height_size, height_size,
-                                         height_field(height_size))
-    height_path = os.path.join(out_dir, "height.exr")
-    bake_common.save_exr(height, height_path)
-    mat, target = make_material(height, scale)
+    nmap = NORMAL_MAPS.get(name)
+    if nmap is None:
+        height = bake_common.new_float_image("height", height_size, height_size,
+                                             height_field(height_size))
+        bake_common.save_exr(height, os.path.join(out_dir, "height.exr"))
+        mat, target = make_material(height, scale)
+    else:
+        if nmap["space"] == "TANGENT":
+            field = normal_field(height_size, nmap["tilt_deg"])
+        else:
+            # The mesh's own normals, baked with a plain material (margin: the texels the
+            # bilinear filter reaches across island borders get the nearest island's normal).
+            plain, plain_target = make_material(None, 0.0)
+            plain.node_tree.nodes.remove(plain.node_tree.nodes["Bump"])
+            me.materials.clear()
+            me.materials.append(plain)
+            own = bake_common.new_float_image("own_normals", height_size, height_size)
+            bake_pass(ob, plain, plain_target, own, "object", 8)
+            field = object_normal_field(
+                bake_common.image_array(own)[..., :3].astype(np.float64) * 2.0 - 1.0,
+                nmap["tilt_deg"])
+            bpy.data.images.remove(own)
+        normal = bake_common.new_float_image("normal", height_size, height_size, field)
+        bake_common.save_exr(normal, os.path.join(out_dir, "normal.exr"))
+        mat, target = make_normal_material(normal, nmap["space"], nmap["strength"],
+                                           me.uv_layers[0].name)
     me.materials.clear()
     me.materials.append(mat)
 
@@ -282,6 +406,9 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
              "margin_type": margin_type,
              "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {},
              "subdivision": SUBDIVISION[name]}
+    if nmap is not None:
+        entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
+                               "tilt_deg": nmap["tilt_deg"], "size": height_size}
     for kind in passes:
         img = bake_common.new_float_image(f"blender_{kind}", size, size)
         for _ in range(runs):
