@@ -1194,6 +1194,28 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         loaded.mesh, [&](int uvSet) -> const std::vector<int>& { return uvSetTiles(uvSet).tiles; },
         cornerTable);
     load = plan_detail::imagesToLoad(plan, reached);
+    // A tile the UVs reach without a file is read as no bump (documented), but is more often a
+    // file forgotten or misnamed: said once per UDIM image and UV set.
+    std::set<std::pair<std::size_t, int>> told;
+    for (const PlannedLayer& layer : plan.layers) {
+      const SceneLayer& scene = s.layers[layer.sceneLayer];
+      const auto tell = [&](std::optional<std::size_t> t, int uvSet) {
+        if (!t || plan.textures[*t].udimTiles.empty() || !told.insert({*t, uvSet}).second) return;
+        const PlannedTexture& texture = plan.textures[*t];
+        std::vector<std::string> missing;
+        for (const int tile : uvSetTiles(uvSet).tiles) {
+          if (!texture.udimTiles.contains(tile)) {
+            missing.push_back(expandUdimToken(texture.udimImage.string(), tile));
+          }
+        }
+        if (missing.empty()) return;
+        report.warnings.push_back(texture.udimImage.string() + ": UV set " + std::to_string(uvSet) +
+                                  " reaches tiles without a file (" + joinLabels(missing) +
+                                  "): no bump there");
+      };
+      tell(layer.texture, scene.uvSet);
+      if (scene.mask) tell(layer.mask, scene.mask->uvSet);
+    }
   }
   std::set<int> reachedTiles;  // for the manifest
   for (int tile = kFirstUdimTile; tile < static_cast<int>(reached.size()); ++tile) {

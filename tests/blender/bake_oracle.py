@@ -4,7 +4,7 @@
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
         [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist,
                  nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
-                 nmap_cube_s2]
+                 nmap_cube_s2,nmap_suzanne]
         [--sabotage green|scale|input|strength|normal-green]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
@@ -100,7 +100,7 @@ MASK_MISMATCH_SLACK = 5
 SGBAKE_TIMEOUT = 120
 DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
                  "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
-                 "nmap_sphere_object", "nmap_cube", "nmap_cube_s2")
+                 "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne")
 
 
 def run_blender_script(blender, script, args):
