@@ -98,7 +98,7 @@ constexpr const char* kFooter =
     "               filter, wrap, green\n"
     "  A height, normal or mask image named with '<UDIM>' (h.<UDIM>.exr) reads tile 1001 + u +\n"
     "  10 v where the UVs lie in [u, u+1) x [v, v+1); no tiling or offset; no bump where the\n"
-    "  UVs reach no tile file.\n"
+    "  UVs reach no tile file (a warning names the missing files).\n"
     "  Output keys: map (tangent-normal, object-normal, height, derivative, surface-gradient,\n"
     "    tangent, bitangent, mask, or corners for the per-corner CSV table), file (.png, .exr,\n"
     "    .tif; '<UDIM>' in the name bakes every UDIM tile the UV set touches),\n"

@@ -733,10 +733,17 @@ TEST_F(PlannerTest, UdimNormalMapsAreFlatWhereNoTileIs) {
   for (const char* space : {"object", "tangent"}) {
     const std::string layer =
         R"({"type": "normal", "image": "n_<UDIM>.png", "space": ")" + std::string(space) + "\"}";
-    bake(planeScene(layer,
-                    R"({"map": "object-normal", "file": "o_<UDIM>.exr", "size": 8,
-                        "bit_depth": 32, "margin": 0, "alpha": true})",
-                    "tilted.obj"));
+    const ExecuteReport report =
+        bake(planeScene(layer,
+                        R"({"map": "object-normal", "file": "o_<UDIM>.exr", "size": 8,
+                            "bit_depth": 32, "margin": 0, "alpha": true})",
+                        "tilted.obj"));
+    // Said once: the UVs reach tile 1002, which has no file.
+    EXPECT_EQ(report.warnings,
+              std::vector<std::string>{(dir_ / "n_<UDIM>.png").string() +
+                                       ": UV set 0 reaches tiles without a file (" +
+                                       (dir_ / "n_1002.png").string() + "): no bump there"})
+        << space;
     const std::vector<float> pixels = readPixels(dir_ / "o_1002.exr");
     ASSERT_EQ(pixels.size(), std::size_t{8 * 8 * 4}) << space;
     int covered = 0;
