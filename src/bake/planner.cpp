@@ -178,6 +178,75 @@ ReadManifest readManifest(const fs::path& path) {
   return {std::move(parsed), "its entries for " + names + " are not what sgbake writes"};
 }
 
+/// The length of the UTF-8 sequence that starts at @p text[i], or 0 when none valid does.
+std::size_t utf8SequenceLength(std::string_view text, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char lead = byte(i);
+  if (lead < 0x80) return 1;
+  std::size_t length = 0;
+  std::uint32_t code = 0;
+  if ((lead & 0xE0) == 0xC0) {
+    length = 2;
+    code = lead & 0x1Fu;
+  } else if ((lead & 0xF0) == 0xE0) {
+    length = 3;
+    code = lead & 0x0Fu;
+  } else if ((lead & 0xF8) == 0xF0) {
+    length = 4;
+    code = lead & 0x07u;
+  } else {
+    return 0;
+  }
+  if (i + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k) {
+    if ((byte(i + k) & 0xC0) != 0x80) return 0;
+    code = code << 6 | (byte(i + k) & 0x3Fu);
+  }
+  constexpr std::uint32_t kSmallest[5] = {0, 0, 0x80, 0x800, 0x10000};
+  if (code < kSmallest[length] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return 0;
+  return length;
+}
+
+/// A file name as the manifest (JSON: UTF-8 text) stores it: bytes that are not UTF-8 (a Linux
+/// name may hold any) and '%' itself become %HH, so that every name is text and the mapping
+/// is reversible (fileNameBytes); a UTF-8 name without '%' is itself.
+std::string manifestText(std::string_view name) {
+  std::string text;
+  for (std::size_t i = 0; i < name.size();) {
+    const std::size_t length = name[i] == '%' ? 0 : utf8SequenceLength(name, i);
+    if (length > 0) {
+      text.append(name.substr(i, length));
+      i += length;
+      continue;
+    }
+    static constexpr char kHex[] = "0123456789ABCDEF";
+    const auto b = static_cast<unsigned char>(name[i++]);
+    text += '%';
+    text += kHex[b >> 4];
+    text += kHex[b & 0xF];
+  }
+  return text;
+}
+
+/// The bytes of a name manifestText made.
+std::string fileNameBytes(std::string_view text) {
+  const auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  std::string bytes;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '%' && i + 2 < text.size() && hex(text[i + 1]) >= 0 && hex(text[i + 2]) >= 0) {
+      bytes += static_cast<char>(hex(text[i + 1]) << 4 | hex(text[i + 2]));
+      i += 2;
+    } else {
+      bytes += text[i];
+    }
+  }
+  return bytes;
+}
+
 /// The manifests of the output directories, read once per plan.
 class ManifestCache {
  public:
@@ -186,7 +255,7 @@ class ManifestCache {
     const json& manifest = load(directoryOf(file));
     const auto outputs = manifest.find("outputs");
     if (outputs == manifest.end() || !outputs->is_object()) return nullptr;
-    const auto found = outputs->find(file.filename().string());
+    const auto found = outputs->find(manifestText(file.filename().string()));
     return found == outputs->end() ? nullptr : &*found;
   }
 
@@ -220,7 +289,7 @@ Status recordInManifest(const fs::path& file, const json& entry) {
   if (!manifest.contains("outputs") || !manifest["outputs"].is_object()) {
     manifest["outputs"] = json::object();
   }
-  manifest["outputs"][file.filename().string()] = entry;
+  manifest["outputs"][manifestText(file.filename().string())] = entry;
   const std::string text = manifest.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
   return writeFileAtomically(path, text);
 }
@@ -240,7 +309,7 @@ std::string joinLabels(const std::vector<std::string>& labels) {
 /// root).
 std::string manifestName(const fs::path& canonical, const fs::path& dir) {
   const fs::path relative = canonical.lexically_relative(dir);
-  return relative.empty() ? canonical.generic_string() : relative.generic_string();
+  return manifestText(relative.empty() ? canonical.generic_string() : relative.generic_string());
 }
 
 /// Why @p planned must be baked, as the manifest entry @p entry of its @p file says (one
@@ -250,7 +319,7 @@ std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::p
   // Inputs are named relative to the manifest's directory: said as full paths.
   const fs::path dir = canonicalPath(directoryOf(file));
   const auto full = [&dir](const std::string& name) {
-    return (dir / name).lexically_normal().string();
+    return (dir / fileNameBytes(name)).lexically_normal().string();
   };
   if (entry == nullptr || !entry->is_object()) return "it is not in " + manifest + " yet";
   const auto parameters = entry->find("parameters");
@@ -292,7 +361,7 @@ std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::p
     return "its files are not in " + manifest;
   }
   for (const auto& [name, hash] : files->items()) {
-    const fs::path path = directoryOf(file) / name;
+    const fs::path path = directoryOf(file) / fileNameBytes(name);
     Result<std::string> now = hashFile(path);
     if (!now) return path.string() + " is missing";
     if (!hash.is_string() || *now != hash.get<std::string>()) {
@@ -757,7 +826,8 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     // moved or checked out elsewhere as a whole is still up to date.
     const fs::path manifestDir = canonicalPath(directoryOf(output.file));
     const PathNamer name = [&](const fs::path& path) {
-      return s.inMemory ? path.string() : manifestName(canonicalOf(path), manifestDir);
+      return s.inMemory ? manifestText(path.string())
+                        : manifestName(canonicalOf(path), manifestDir);
     };
     const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
                                "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
@@ -1365,7 +1435,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       if (plan.options.useManifest) {
         Result<std::string> hash = hashFile(pending.back().tempPath());
         if (!hash) return Error::internal(hash.error().message);
-        files[file.filename().string()] = *hash;
+        files[manifestText(file.filename().string())] = *hash;
       }
       report.writeSeconds += secondsSince(start);
       progress.finishOne();

@@ -353,6 +353,32 @@ TEST_F(BakeCliTest, BakesAScene) {
             (std::set<std::string>{"n.png", "m.png", ".sgbake-manifest.json"}));
 }
 
+// Linux file names are bytes, not always UTF-8, and a manifest is JSON text: such names (and
+// '%', which their encoding uses) bake, are recorded, and are up to date the second time.
+TEST_F(BakeCliTest, FileNamesThatAreNotUtf8AreBakedAndRecorded) {
+  const std::string mesh = (dir_ / "m\xff.obj").string(), height = (dir_ / "h\xfe%41.png").string();
+  fs::copy_file(dir_ / "plane.obj", mesh);
+  fs::copy_file(dir_ / "h.png", height);
+  const std::string output = (dir_ / "o\xfd%.png").string();
+  const std::vector<std::string> args = {"bake",   "--mesh", mesh, "--height", height,
+                                         "--size", "8",      "-o", output};
+  const ProcessResult first = run(args);
+  ASSERT_EQ(first.exitCode, 0) << first.err;
+  EXPECT_EQ(first.out, "wrote " + output + "\n");
+  const ProcessResult again = run(args);
+  ASSERT_EQ(again.exitCode, 0) << again.err;
+  EXPECT_EQ(again.out, "up to date: " + output + "\n");
+  // The manifest is valid UTF-8 JSON naming them with %HH.
+  const std::string manifest = readFile(dir_ / ".sgbake-manifest.json");
+  EXPECT_NE(manifest.find("o%FD%25.png"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("h%FE%2541.png"), std::string::npos) << manifest;
+  // Changing the height image with the odd name re-bakes.
+  writeTestImage(height, 16, {0.5f}, true);
+  const ProcessResult touched = run(args);
+  ASSERT_EQ(touched.exitCode, 0) << touched.err;
+  EXPECT_EQ(touched.out, "wrote " + output + "\n");
+}
+
 TEST_F(BakeCliTest, ManifestUpToDateForceAndTouchedInputs) {
   const std::string json =
       planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},
