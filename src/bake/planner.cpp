@@ -1225,9 +1225,11 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   // dynamic loader's lock until the whole module is loaded (seen in 1 run of 10 of the Cycles
   // benchmark, the mesh then parsed during the image's decoding instead of beside the load).
   if (readsOrWritesImages) preloadImageIo();
-  const plan_detail::ImageSource imageFiles = [](const PlannedImage& image) {
+  std::vector<std::string> imageWarnings;  // images are loaded here, on this thread
+  const plan_detail::ImageSource imageFiles = [&imageWarnings](const PlannedImage& image) {
     LoadImageOptions imageOptions;
     imageOptions.channels = image.channels;
+    imageOptions.warnings = &imageWarnings;
     return loadImage(image.path, imageOptions);
   };
   // With UDIM images the mesh comes first: only the tiles its UVs reach are loaded.
@@ -1296,6 +1298,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   if (!mesh) mesh = meshLoad.get();
   if (!*mesh) return mesh->error();
   report.warnings.insert(report.warnings.end(), loaded.warnings.begin(), loaded.warnings.end());
+  report.warnings.insert(report.warnings.end(), imageWarnings.begin(), imageWarnings.end());
   progress.finishOne();
   if (!textures) return textures.error();
   // Layers, and tangent frames if the plan needs them (timed apart from the loading).

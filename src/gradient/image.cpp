@@ -118,6 +118,17 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
                                ")");
   }
   if (spec.depth > 1) return fileError(path, "volume images are not supported");
+  if (spec.uintChannels) {
+    return fileError(path,
+                     "holds 32-bit unsigned integer channels (an ID or count pass), not "
+                     "heights or normals");
+  }
+  if (spec.subimages > 1 && options.warnings != nullptr) {
+    const std::string first =
+        spec.subimageName.empty() ? "the first" : "the first ('" + spec.subimageName + "')";
+    options.warnings->push_back(path.string() + ": holds " + std::to_string(spec.subimages) +
+                                " images (EXR parts or pages); only " + first + " is read");
+  }
   if (spec.width > kMaxImageSide || spec.height > kMaxImageSide) {
     return fileError(path, "image is too large (" + std::to_string(spec.width) + "x" +
                                std::to_string(spec.height) + "; at most " +

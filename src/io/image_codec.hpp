@@ -28,7 +28,7 @@
 namespace sgbake::io_detail {
 
 /// Bumped whenever anything in this header changes.
-inline constexpr int kImageCodecVersion = 2;
+inline constexpr int kImageCodecVersion = 3;
 /// The module's entry point: `const ImageCodec* sgbake_image_codec(int version)`, nullptr when
 /// @p version is not the module's.
 inline constexpr const char* kImageCodecEntryPoint = "sgbake_image_codec";
@@ -55,6 +55,12 @@ struct ImageHeader {
   int width = 0, height = 0, depth = 1, channels = 0;
   /// The file's string attributes named "sgbake:…" (name, value), as baked files carry them
   std::vector<std::pair<std::string, std::string>> attributes;
+  int subimages = 1;         ///< images (EXR parts, TIFF pages, …) in the file; the first is read
+  std::string subimageName;  ///< the first's name, when it has one (an EXR part's)
+  std::vector<std::string> channelNames;
+  /// A floating-point format (EXR) holding 32-bit unsigned integer channels, which the codec
+  /// would scale by 1/(2^32 − 1) as if they were colour (ID or count passes, not heights).
+  bool uintChannels = false;
 };
 
 /// An image file opened for reading.

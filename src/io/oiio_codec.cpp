@@ -11,6 +11,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -35,16 +36,33 @@ OIIO::TypeDesc oiioType(PixelType type) {
 
 class OiioReader final : public ImageReader {
  public:
-  explicit OiioReader(std::unique_ptr<OIIO::ImageInput> in) : in_(std::move(in)) {}
+  explicit OiioReader(std::unique_ptr<OIIO::ImageInput> in) : in_(std::move(in)) {
+    // How many subimages there are (EXR parts, TIFF pages): seeking past the last fails.
+    while (subimages_ < 64 && in_->seek_subimage(subimages_, 0)) ++subimages_;
+    in_->seek_subimage(0, 0);
+    (void)in_->geterror();  // the failed seek's text
+  }
   ~OiioReader() override { in_->close(); }
 
   ImageHeader header() const override {
     const OIIO::ImageSpec& spec = in_->spec();
-    ImageHeader header{spec.width, spec.height, spec.depth, spec.nchannels, {}};
+    ImageHeader header;
+    header.width = spec.width;
+    header.height = spec.height;
+    header.depth = spec.depth;
+    header.channels = spec.nchannels;
     for (const OIIO::ParamValue& p : spec.extra_attribs) {
       const std::string name = p.name().string();
       if (name.starts_with("sgbake:") && p.type() == OIIO::TypeDesc::STRING) {
         header.attributes.emplace_back(name, p.get_string());
+      }
+    }
+    header.subimages = subimages_;
+    header.subimageName = spec.get_string_attribute("name");
+    header.channelNames = spec.channelnames;
+    if (std::string_view(in_->format_name()) == "openexr") {
+      for (int c = 0; c < spec.nchannels; ++c) {
+        if (spec.channelformat(c) == OIIO::TypeDesc::UINT) header.uintChannels = true;
       }
     }
     return header;
@@ -62,6 +80,7 @@ class OiioReader final : public ImageReader {
 
  private:
   std::unique_ptr<OIIO::ImageInput> in_;
+  int subimages_ = 1;
   std::string error_;  ///< of the last readFloat
 };
 

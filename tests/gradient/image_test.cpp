@@ -412,6 +412,46 @@ TEST(LoadImage, TruncatedTiffIsRefused) {
   }
 }
 
+// A multi-part EXR is read from its first part, which a warning names; an EXR of 32-bit
+// unsigned integers (an ID pass), which the codec would scale by 2^-32, is refused.
+TEST(LoadImage, MultiPartAndIntegerExrsAreSaid) {
+  const fs::path dir = testDir();
+  const fs::path parts = dir / "parts.exr";
+  {
+    OIIO::ImageSpec specs[2] = {OIIO::ImageSpec(4, 4, 1, OIIO::TypeDesc::FLOAT),
+                                OIIO::ImageSpec(4, 4, 1, OIIO::TypeDesc::FLOAT)};
+    specs[0].attribute("name", "preview");
+    specs[1].attribute("name", "height");
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(parts.string());
+    ASSERT_TRUE(out && out->supports("multiimage"));
+    ASSERT_TRUE(out->open(parts.string(), 2, specs)) << out->geterror();
+    const std::vector<float> zeros(16, 0.0f), ones(16, 1.0f);
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, zeros.data()));
+    ASSERT_TRUE(out->open(parts.string(), specs[1], OIIO::ImageOutput::AppendSubimage));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, ones.data()));
+    ASSERT_TRUE(out->close());
+  }
+  std::vector<std::string> warnings;
+  LoadImageOptions options;
+  options.warnings = &warnings;
+  const Result<Image> image = loadImage(parts, options);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(image->at(0, 0, 0), 0.0f);  // the first part's
+  EXPECT_EQ(warnings, std::vector<std::string>{parts.string() +
+                                               ": holds 2 images (EXR parts or pages); only the "
+                                               "first ('preview') is read"});
+  warnings.clear();
+  writeImage(dir / "one.exr", 2, 2, 1, OIIO::TypeDesc::FLOAT, std::vector<float>(4, 0.5f));
+  ASSERT_TRUE(loadImage(dir / "one.exr", options).ok());
+  EXPECT_TRUE(warnings.empty());
+
+  const fs::path ids = dir / "ids.exr";
+  writeImage(ids, 2, 2, 1, OIIO::TypeDesc::UINT, std::vector<std::uint32_t>{1, 2, 3, 945});
+  expectFileError(loadImage(ids), ids,
+                  "holds 32-bit unsigned integer channels (an ID or count pass), not heights or "
+                  "normals");
+}
+
 TEST(LoadImage, NonFiniteTexelsAreNamedFromTheTop) {
   const fs::path dir = testDir();
   // 5×4 RGB float EXR: bad values at column 3, file row 1, channel 2 and at column 0 of file
