@@ -1433,6 +1433,11 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         }
       }
       outputReport.files.push_back(file);
+      for (const fs::path& stale : staleTemporaries(file)) {
+        report.warnings.push_back(stale.string() +
+                                  ": a temporary left by a run that was killed (its process is "
+                                  "gone); remove it");
+      }
       ++report.tilesBaked;
       start = Clock::now();
       if (plan.options.useManifest) {

@@ -3,13 +3,16 @@
 #include "sgbake/io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
@@ -238,6 +241,33 @@ Status AtomicFile::commit() {
     }
   }
   return Ok{};
+}
+
+std::vector<std::filesystem::path> staleTemporaries(const std::filesystem::path& target) {
+  std::vector<std::filesystem::path> stale;
+  const std::string prefix = target.filename().string() + ".tmp-";
+  std::filesystem::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    // <pid>-<16 hex digits>, as makeTempName writes them
+    const std::string rest = name.substr(prefix.size());
+    const std::size_t dash = rest.find('-');
+    if (dash == 0 || dash == std::string::npos || rest.size() - dash - 1 != 16 ||
+        rest.find_first_not_of("0123456789") != dash ||
+        rest.find_first_not_of("0123456789abcdef", dash + 1) != std::string::npos) {
+      continue;
+    }
+    const long pid = std::strtol(rest.c_str(), nullptr, 10);
+    if (pid <= 0 || pid == static_cast<long>(::getpid())) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+      stale.push_back(target.parent_path() / name);
+    }
+  }
+  std::sort(stale.begin(), stale.end());
+  return stale;
 }
 
 Status writeFileAtomically(const std::filesystem::path& target, std::string_view bytes,

@@ -379,6 +379,30 @@ TEST_F(BakeCliTest, FileNamesThatAreNotUtf8AreBakedAndRecorded) {
   EXPECT_EQ(touched.out, "wrote " + output + "\n");
 }
 
+// A run killed outright (SIGKILL) leaves its temporary, which nothing can remove then: the
+// next run writing that output names it (its process is gone), and leaves other files alone.
+TEST_F(BakeCliTest, TemporariesOfKilledRunsAreNamed) {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // a pid whose process is gone
+  const std::string dead =
+      dir_.string() + "/m.png.tmp-" + std::to_string(child) + "-0123456789abcdef";
+  const std::string alive =
+      dir_.string() + "/m.png.tmp-" + std::to_string(::getpid()) + "-0123456789abcdef";
+  writeFile(dead, "partial");
+  writeFile(alive, "partial");
+  writeFile(dir_ / "m.png.tmp-notes", "mine");
+  const ProcessResult r = run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "mask",
+                               "--size", "8", "--no-manifest", "-o", (dir_ / "m.png").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "sgbake: warning: " + dead +
+                       ": a temporary left by a run that was killed (its process is gone); "
+                       "remove it\n");
+  EXPECT_TRUE(fs::exists(dead));  // said, not removed
+  EXPECT_TRUE(fs::exists(alive));
+}
+
 TEST_F(BakeCliTest, ManifestUpToDateForceAndTouchedInputs) {
   const std::string json =
       planeScene(kHeightLayer, R"({"map": "height", "file": "h.exr", "size": 8},

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <string_view>
+#include <vector>
 
 #include "sgbake/core/result.hpp"
 
@@ -91,6 +92,12 @@ class AtomicFile {
 /// themselves stay as they are (their commits will fail).
 /// @note Up to 64 temporaries, of paths up to 4095 bytes, are tracked; others are not removed.
 void removeTemporaryFiles() noexcept;
+
+/// @brief The temporaries of @p target (`<target>.tmp-<pid>-<hex>`) whose process no longer
+/// runs on this machine: left by a run that was killed outright (SIGKILL, a crash, a power
+/// loss), which nothing removes. Reported, not removed: on a shared network directory the
+/// process may be another machine's.
+std::vector<std::filesystem::path> staleTemporaries(const std::filesystem::path& target);
 
 /// @brief Writes @p bytes to @p target all-or-nothing (AtomicFile::create, write, commit).
 Status writeFileAtomically(const std::filesystem::path& target, std::string_view bytes,
