@@ -230,11 +230,11 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
     return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
                                    "(subdivideMesh with its SurfaceParameters)");
   }
-  if (input.triangleTangents != nullptr) {
+  for (const CornerTangents* given : input.triangleTangents) {
+    if (given == nullptr) continue;
     const std::size_t frames = 3 * loopTriangles(mesh).size();
-    if (input.triangleTangents->tangent.size() != frames ||
-        input.triangleTangents->sign.size() != frames) {
-      return Error::badInput(where + ": " + std::to_string(input.triangleTangents->tangent.size()) +
+    if (given->tangent.size() != frames || given->sign.size() != frames) {
+      return Error::badInput(where + ": " + std::to_string(given->tangent.size()) +
                              " loop-triangle tangents for " + std::to_string(frames) +
                              " triangle corners");
     }
@@ -293,15 +293,18 @@ Error outOfMemory(const BakeSettings& settings) {
 
 }  // namespace
 
-Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh,
+Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
                                                    const TangentOptions& options) {
-  if (!mesh.hasUvSet(0)) return Error::badInput("loop-triangle tangents need UV set 0");
+  if (uvSet < 0 || !mesh.hasUvSet(static_cast<std::size_t>(uvSet))) {
+    return Error::badInput("loop-triangle tangents: the mesh has no UV set " +
+                           std::to_string(uvSet));
+  }
   const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
   const std::size_t n = 3 * triangles.size();
   std::vector<std::uint32_t> faceStart(triangles.size() + 1), cornerVertex(n);
   std::vector<Vec3f> normals(n);
   std::vector<Vec2f> uvs(n);
-  const std::vector<Vec2f>& meshUvs = mesh.uvSets[0].uvs;
+  const std::vector<Vec2f>& meshUvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     faceStart[t + 1] = static_cast<std::uint32_t>(3 * (t + 1));
     const std::array<std::uint32_t, 3>& c = triangles[t];

@@ -123,7 +123,7 @@ struct LimitShader {
     t.flat = t.polygonFrame = false;  // the limit surface is smooth
     t.tangent = {tangent, tangent, tangent};
     t.sign = {sign, sign, sign};
-    t.hasLayerTangents = false;  // the surface's own frame decodes its layers too
+    t.hasLayerTangents = {};  // the surface's own frames decode its layers too
   }
 };
 

@@ -82,8 +82,7 @@ std::string whyNotRead(const SceneOutput& output, const SceneLayer& layer) {
 /// Whether a layer read by a baked map needs MikkTSpace frames: a tangent-space normal map on
 /// UV set 0 is decoded in them (TangentFrameChoice::kAuto).
 bool layerNeedsTangents(const SceneLayer& layer) {
-  return layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent &&
-         layer.uvSet == 0;
+  return layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent;
 }
 
 std::string describeOutput(const SceneOutput& output) {
@@ -582,8 +581,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
     }
   }
   if (plan.computeTangents) {
-    plan.steps.push_back(
-        {"compute MikkTSpace tangent frames of UV set 0", joinLabels(tangentReasons)});
+    plan.steps.push_back({"compute MikkTSpace tangent frames", joinLabels(tangentReasons)});
   }
   for (const PlannedOutput& planned : plan.outputs) {
     if (planned.upToDate) continue;
@@ -917,9 +915,9 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     for (const std::size_t l : output.layers) {
       used.insert(l);
       if (out.kind == OutputKind::kMap && layerNeedsTangents(s.layers[l]) && !limitFrames) {
-        tangentReasons.push_back(layerLabel(l) +
-                                 ", a tangent-space normal map on UV set 0, is "
-                                 "decoded in them for " +
+        tangentReasons.push_back(layerLabel(l) + ", a tangent-space normal map on UV set " +
+                                 std::to_string(s.layers[l].uvSet) +
+                                 ", is decoded in them (those of the loop triangles) for " +
                                  out.file.string());
       }
     }

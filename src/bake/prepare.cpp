@@ -359,21 +359,23 @@ Status prepareLayers(const Plan& plan, int threads, Loaded& loaded, ProgressRepo
     report.warnings.push_back(std::move(warning));
   }
   loaded.tangents = std::move(*tangents);
-  // Cycles' Normal Map node decodes with MikkTSpace of its triangulated mesh: a tangent-space
-  // layer in the MikkTSpace frame (UV set 0) gets those, not the polygon mesh's. (On a limit
-  // surface the frames are the surface's own.)
-  const bool mikkLayer =
-      std::any_of(loaded.layers.begin(), loaded.layers.end(), [](const Layer& l) {
-        const auto* normal = std::get_if<TangentNormalSource>(&l.source);
-        return normal != nullptr && normal->uvSet == 0 &&
-               normal->options.frame != TangentFrameChoice::kUvDerivatives;
-      });
-  if (mikkLayer && !loaded.limit) {
-    Result<CornerTangents> triangles = computeLoopTriangleTangents(loaded.mesh, tangentOptions);
+  // Cycles' Normal Map node decodes with MikkTSpace of its triangulated mesh, on the UV map it
+  // names: a tangent-space layer in the MikkTSpace frame gets those of its UV set, not the
+  // polygon mesh's. (On a limit surface the frames are the surface's own.)
+  for (const Layer& layer : loaded.layers) {
+    const auto* normal = std::get_if<TangentNormalSource>(&layer.source);
+    if (normal == nullptr || normal->options.frame == TangentFrameChoice::kUvDerivatives ||
+        loaded.limit || normal->uvSet < 0 || normal->uvSet >= kMaxUvSets ||
+        !loaded.mesh.hasUvSet(static_cast<std::size_t>(normal->uvSet)) ||
+        loaded.triangleTangents[static_cast<std::size_t>(normal->uvSet)]) {
+      continue;
+    }
+    Result<CornerTangents> triangles =
+        computeLoopTriangleTangents(loaded.mesh, normal->uvSet, tangentOptions);
     if (!triangles) {
       return Error{triangles.error().code, s.mesh.string() + ": " + triangles.error().message};
     }
-    loaded.triangleTangents = std::move(*triangles);
+    loaded.triangleTangents[static_cast<std::size_t>(normal->uvSet)] = std::move(*triangles);
   }
   report.tangentsComputed = true;
   progress.finishOne();
@@ -391,7 +393,9 @@ BakeInput bakeInputFor(const Loaded& loaded, std::span<const Layer> layers) {
   BakeInput input;
   input.mesh = &loaded.mesh;
   input.tangents = loaded.tangents ? &*loaded.tangents : nullptr;
-  input.triangleTangents = loaded.triangleTangents ? &*loaded.triangleTangents : nullptr;
+  for (std::size_t s = 0; s < kMaxUvSets; ++s) {
+    if (loaded.triangleTangents[s]) input.triangleTangents[s] = &*loaded.triangleTangents[s];
+  }
   input.layers = layers;
   if (loaded.limit) {
     input.limit = &*loaded.limit;

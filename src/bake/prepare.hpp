@@ -70,8 +70,8 @@ struct Loaded {
   std::vector<std::unique_ptr<HeightVolume>> volumes;
   std::vector<Layer> layers;  ///< per plan layer
   std::optional<CornerTangents> tangents;
-  /// computeLoopTriangleTangents, when a tangent-space layer decodes in the MikkTSpace frame
-  std::optional<CornerTangents> triangleTangents;
+  /// computeLoopTriangleTangents per UV set a tangent-space layer decodes on (MikkTSpace frame)
+  std::array<std::optional<CornerTangents>, kMaxUvSets> triangleTangents;
   std::vector<std::string> warnings;  ///< about the inputs, for ExecuteReport::warnings
 };
 

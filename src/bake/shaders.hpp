@@ -31,7 +31,7 @@ inline bool hasUvSet(const SurfacePoint& point, int uvSet) {
 struct BakeShaderBase {
   const Mesh* mesh = nullptr;
   const CornerTangents* tangents = nullptr;
-  const CornerTangents* triangleTangents = nullptr;  ///< BakeInput::triangleTangents
+  std::array<const CornerTangents*, kMaxUvSets> triangleTangents{};  ///< BakeInput's
   std::span<const Layer> layers;
   int uvSet = 0;
   NormalMapGreen green = NormalMapGreen::kOpenGL;
@@ -44,12 +44,14 @@ struct BakeShaderBase {
 
   void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
-    tri.hasLayerTangents = triangleTangents != nullptr;
-    if (tri.hasLayerTangents) {
+    for (std::size_t s = 0; s < kMaxUvSets; ++s) {
+      const CornerTangents* frames = triangleTangents[s];
+      tri.hasLayerTangents[s] = frames != nullptr;
+      if (frames == nullptr) continue;
       for (std::size_t i = 0; i < 3; ++i) {
         const std::size_t k = 3 * static_cast<std::size_t>(triangle) + i;
-        tri.layerTangent[i] = cast<double>(triangleTangents->tangent[k]);
-        tri.layerSign[i] = triangleTangents->sign[k];
+        tri.layerTangent[s][i] = cast<double>(frames->tangent[k]);
+        tri.layerSign[s][i] = frames->sign[k];
       }
     }
     triangleChanged();

@@ -46,11 +46,12 @@ struct ShadingTriangle {
   bool polygonFrame = false;
   Vec3d polygonNormal{0, 0, 1};
   bool hasTangents = false;
-  /// The frames tangent-space layers decode with (BakeInput::triangleTangents: MikkTSpace of the
-  /// loop triangles, as Cycles' Normal Map node), when given; otherwise tangent/sign.
-  std::array<Vec3d, 3> layerTangent{};
-  std::array<double, 3> layerSign{1, 1, 1};
-  bool hasLayerTangents = false;
+  /// Per UV set, the frames tangent-space layers on it decode with (BakeInput::triangleTangents:
+  /// MikkTSpace of the loop triangles, as Cycles' Normal Map node), when given; otherwise set
+  /// 0's layers use tangent/sign and the other sets' their UV-derivative frames.
+  std::array<std::array<Vec3d, 3>, kMaxUvSets> layerTangent{};
+  std::array<std::array<double, 3>, kMaxUvSets> layerSign{};
+  std::array<bool, kMaxUvSets> hasLayerTangents{};
 };
 
 /// @brief ∂P/∂u, ∂P/∂v of the affine map of a triangle from its positions and UVs; both 0 when the
@@ -148,7 +149,10 @@ inline void beginSurfacePoint(const ShadingTriangle& t, SurfacePoint& p) {
     p.uv[k].dPdu = t.dPdu[k];
     p.uv[k].dPdv = t.dPdv[k];
   }
-  p.hasTangentFrame = t.hasTangents || t.hasLayerTangents;
+  p.hasTangentFrame = t.hasTangents || t.hasLayerTangents[0];
+  for (std::size_t s = 1; s < kMaxUvSets; ++s) {
+    p.hasUvTangentFrame[s] = t.hasLayerTangents[s] && static_cast<int>(s) < t.numUvSets;
+  }
 }
 
 /// @brief Completes @p p (prepared by beginSurfacePoint for @p t) for the sample at barycentrics
@@ -164,12 +168,20 @@ inline const SurfacePoint& surfacePointAt(const ShadingTriangle& t, const Vec3d&
     const std::size_t k = static_cast<std::size_t>(s);
     p.uv[k].uv = b.x * t.uv[k][0] + b.y * t.uv[k][1] + b.z * t.uv[k][2];
   }
-  if (t.hasLayerTangents) {
-    p.tangent = b.x * t.layerTangent[0] + b.y * t.layerTangent[1] + b.z * t.layerTangent[2];
-    p.bitangentSign = b.x * t.layerSign[0] + b.y * t.layerSign[1] + b.z * t.layerSign[2];
+  const auto interpolate = [&b](const auto& corners) {
+    return b.x * corners[0] + b.y * corners[1] + b.z * corners[2];
+  };
+  if (t.hasLayerTangents[0]) {
+    p.tangent = interpolate(t.layerTangent[0]);
+    p.bitangentSign = interpolate(t.layerSign[0]);
   } else if (t.hasTangents) {
     p.tangent = f.tangent;
     p.bitangentSign = f.interpolatedSign;
+  }
+  for (std::size_t s = 1; s < kMaxUvSets; ++s) {
+    if (!p.hasUvTangentFrame[s]) continue;
+    p.uvTangent[s] = interpolate(t.layerTangent[s]);
+    p.uvBitangentSign[s] = interpolate(t.layerSign[s]);
   }
   return p;
 }

@@ -56,16 +56,28 @@ Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
   const Vec2d s = slopesFromTangentNormal(n, options.minNormalZ);
   const Vec2d slopes{options.tiling.x * s.x, options.tiling.y * s.y};
 
-  const bool mikk =
-      point.hasTangentFrame && (options.frame == TangentFrameChoice::kMikkTSpace ||
-                                (options.frame == TangentFrameChoice::kAuto && uvSet == 0));
-  if (mikk) {
+  // The MikkTSpace frame of the map's UV set, if the point has one (set 0's is point.tangent);
+  // kMikkTSpace falls back on set 0's.
+  const Vec3d* mikkTangent = nullptr;
+  double mikkSign = 1;
+  if (options.frame != TangentFrameChoice::kUvDerivatives) {
+    if (uvSet > 0 && uvSet < kMaxUvSets &&
+        point.hasUvTangentFrame[static_cast<std::size_t>(uvSet)]) {
+      mikkTangent = &point.uvTangent[static_cast<std::size_t>(uvSet)];
+      mikkSign = point.uvBitangentSign[static_cast<std::size_t>(uvSet)];
+    } else if (point.hasTangentFrame &&
+               (uvSet == 0 || options.frame == TangentFrameChoice::kMikkTSpace)) {
+      mikkTangent = &point.tangent;
+      mikkSign = point.bitangentSign;
+    }
+  }
+  if (mikkTangent != nullptr) {
     // Blender's Normal Map node: normalize(x·T + y·B_i + z·N_i) with the unnormalized
     // interpolated normal N_i = L·N and B_i = sign · N_i × T (sign = interpolated sign < 0 ?
     // −1 : +1). Divided by L: x·T/L + y·B + z·N with B = sign · N × T, so T/L decodes.
-    const double sign = point.bitangentSign < 0 ? -1.0 : 1.0;
-    const Vec3d bitangent = sign * cross(point.normal, point.tangent);
-    const Vec3d tangent = (1 / point.normalLength) * point.tangent;
+    const double sign = mikkSign < 0 ? -1.0 : 1.0;
+    const Vec3d bitangent = sign * cross(point.normal, *mikkTangent);
+    const Vec3d tangent = (1 / point.normalLength) * *mikkTangent;
     return withNormalMapStrength(finiteOrZero(gradientFromTangentFrame(slopes, tangent, bitangent)),
                                  point.normal, options.strength);
   }

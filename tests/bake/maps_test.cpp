@@ -268,7 +268,7 @@ TEST(Maps, TangentSpaceLayersDecodeWithTheLoopTrianglesTangents) {
   settings.map = MapKind::kObjectNormal;
   settings.width = settings.height = 32;
   BakeInput withLoop{&quad, &*quadTangents, layers};
-  withLoop.triangleTangents = &*loopTangents;
+  withLoop.triangleTangents[0] = &*loopTangents;
   const Result<FloatImage> ours = bakeMap(withLoop, settings);
   const Result<FloatImage> faces2 = bakeMap({&triangles, &*splitTangents, layers}, settings);
   const Result<FloatImage> polygon = bakeMap({&quad, &*quadTangents, layers}, settings);
@@ -277,8 +277,54 @@ TEST(Maps, TangentSpaceLayersDecodeWithTheLoopTrianglesTangents) {
   EXPECT_NE(ours->pixels, polygon->pixels);
   // A wrong number of frames is refused.
   const CornerTangents shortList{{Vec3f{1, 0, 0}}, {1}};
-  withLoop.triangleTangents = &shortList;
+  withLoop.triangleTangents[0] = &shortList;
   EXPECT_FALSE(bakeMap(withLoop, settings).ok());
+}
+
+// A tangent-space layer on UV set 1 decodes in MikkTSpace of that set (as Cycles does for the
+// UV map a Normal Map node names): the same as the mesh with that set first, and not the
+// per-point UV-derivative frame it used without.
+TEST(Maps, TangentSpaceLayersOnAnotherUvSetDecodeInItsOwnFrames) {
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.1f}, {1.1f, 1, 0.3f}, {0, 0.9f, 0}};
+  const std::vector<Vec2f> first{{0.1f, 0.1f}, {0.9f, 0.1f}, {0.9f, 0.9f}, {0.1f, 0.9f}};
+  const std::vector<Vec2f> second{{0.2f, 0.1f}, {0.8f, 0.15f}, {0.9f, 0.9f}, {0.05f, 0.7f}};
+  std::vector<Vec3f> normals{
+      {0, 0, 1}, {-0.2f, 0, 0.98f}, {-0.3f, -0.3f, 0.905f}, {0, -0.1f, 0.995f}};
+  for (Vec3f& v : normals) v = cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1}));
+  Mesh twoSets = test::polygonMesh(positions, {{0, 1, 2, 3}}, first, {}, normals);
+  twoSets.uvSets.push_back({"second", second});
+  Mesh swapped = twoSets;
+  std::swap(swapped.uvSets[0], swapped.uvSets[1]);
+
+  const test::ConstantColour texel(Vec3d{0.75, 0.35, 0.8});
+  const auto layerOn = [&texel](int uvSet) {
+    TangentNormalSource source;
+    source.texture = &texel;
+    source.uvSet = uvSet;
+    return std::vector<Layer>{Layer{source, 1.0, {}}};
+  };
+  BakeSettings settings;
+  settings.map = MapKind::kObjectNormal;
+  settings.width = settings.height = 32;
+  settings.uvSet = 1;  // placed by the second set in both (swapped: its set 0) ...
+  const Result<CornerTangents> onSecond = computeLoopTriangleTangents(twoSets, 1);
+  const Result<CornerTangents> swappedFirst = computeLoopTriangleTangents(swapped, 0);
+  ASSERT_TRUE(onSecond.ok() && swappedFirst.ok());
+  EXPECT_EQ(onSecond->tangent, swappedFirst->tangent);
+  const std::vector<Layer> layers1 = layerOn(1), layers0 = layerOn(0);
+  BakeInput ours{&twoSets, nullptr, layers1};
+  ours.triangleTangents[1] = &*onSecond;
+  BakeInput reference{&swapped, nullptr, layers0};
+  reference.triangleTangents[0] = &*swappedFirst;
+  const Result<FloatImage> a = bakeMap(ours, settings);
+  settings.uvSet = 0;  // ... which is set 0 of the swapped mesh
+  const Result<FloatImage> b = bakeMap(reference, settings);
+  settings.uvSet = 1;
+  const Result<FloatImage> derivativeFrame = bakeMap({&twoSets, nullptr, layers1}, settings);
+  ASSERT_TRUE(a.ok() && b.ok() && derivativeFrame.ok());
+  EXPECT_EQ(a->pixels, b->pixels);
+  EXPECT_NE(a->pixels, derivativeFrame->pixels);
+  EXPECT_FALSE(computeLoopTriangleTangents(twoSets, 2).ok());
 }
 
 TEST(Maps, HeightSumsWeightedMaskedHeightLayers) {

@@ -192,20 +192,20 @@ struct BakeInput {
   /// the normal). Masks are the tessellation's coverage. Null: shade the mesh as it is.
   const LimitSurface* limit = nullptr;
   const SurfaceParameters* limitParameters = nullptr;
-  /// MikkTSpace frames of the loop triangles (computeLoopTriangleTangents: 3 per triangle of
-  /// Blender's looptris), or nullptr. Given, they are the SurfacePoint's tangent frame for
-  /// tangent-space layers, as Cycles' Normal Map node decodes with them; the map's own frame
-  /// (kTangentNormal's) stays `tangents`, as Blender's baker uses the mesh's.
-  const CornerTangents* triangleTangents = nullptr;
+  /// Per UV set, MikkTSpace frames of the loop triangles (computeLoopTriangleTangents: 3 per
+  /// triangle of Blender's looptris), or nullptr. Given, they are the SurfacePoint's tangent
+  /// frames for tangent-space layers on that set, as Cycles' Normal Map node decodes with them;
+  /// the map's own frame (kTangentNormal's) stays `tangents`, as Blender's baker uses the mesh's.
+  std::array<const CornerTangents*, kMaxUvSets> triangleTangents{};
 };
 
 /// @brief MikkTSpace frames of @p mesh's loop triangles (Blender's looptris, the triangles the
 /// raster walks), each handed to MikkTSpace as a face of its own: the tangents Cycles computes
 /// for its Normal Map node (on its triangulated mesh), which differ from the polygon mesh's
 /// (computeTangents) inside quads and n-gons. Normals as Cycles gives them: a flat face without
-/// Auto Smooth its triangle's normal, every other face its corner normals. UV set 0.
-/// @return 3 frames per triangle, in loop-triangle order; kBadInput without UV set 0
-Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh,
+/// Auto Smooth its triangle's normal, every other face its corner normals. UV set @p uvSet.
+/// @return 3 frames per triangle, in loop-triangle order; kBadInput without UV set @p uvSet
+Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet = 0,
                                                    const TangentOptions& options = {});
 
 /// @brief Bakes one map. Texels no triangle covers get the map's background (tangent-space

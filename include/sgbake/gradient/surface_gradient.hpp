@@ -187,10 +187,12 @@ constexpr Vec3d gradientFromTangentFrame(Vec2d slopes, Vec3d tangent, Vec3d bita
 
 /// @brief Which tangent frame decodes a tangent-space normal map.
 enum class TangentFrameChoice {
-  /// The point's MikkTSpace frame when the map uses UV set 0 and the point has one
-  /// (SurfacePoint::hasTangentFrame), otherwise the UV-derivative frame.
+  /// The point's MikkTSpace frame of the map's UV set when it has one
+  /// (SurfacePoint::hasTangentFrame for set 0, hasUvTangentFrame for the others), otherwise the
+  /// UV-derivative frame.
   kAuto,
-  kMikkTSpace,     ///< SurfacePoint::tangent / bitangentSign (falls back like kAuto when absent)
+  /// As kAuto, but a set without its own MikkTSpace frame takes set 0's when there is one.
+  kMikkTSpace,
   kUvDerivatives,  ///< always the UV-derivative frame of the map's UV set
 };
 

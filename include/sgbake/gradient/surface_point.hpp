@@ -41,6 +41,12 @@ struct SurfacePoint {
   Vec3d tangent{1, 0, 0};
   double bitangentSign = 1;
   bool hasTangentFrame = false;
+  /// MikkTSpace frames of UV sets 1 … numUvSets − 1 (entry 0 unused: set 0's is the tangent
+  /// above), where hasUvTangentFrame says so: a tangent-space layer on such a set decodes in
+  /// its own (Cycles computes one for the UV map a Normal Map node names).
+  std::array<Vec3d, kMaxUvSets> uvTangent{};
+  std::array<double, kMaxUvSets> uvBitangentSign{};
+  std::array<bool, kMaxUvSets> hasUvTangentFrame{};
 };
 
 }  // namespace sgbake
