@@ -336,8 +336,8 @@ def material_layers(node_tree):
     and each Normal Map node whose Color input is an Image Texture node, in node order; and
     notes on the Bump and Normal Map nodes that were not used.
 
-    Bump: scale = Distance x Strength, negated when Invert is on (Cycles blends the bumped
-    normal by Strength; for a Strength of 1 the two are the same). Normal Map: its space
+    Bump: scale = Distance, negated when Invert is on, and its Strength (the blend of the bumped
+    normal with the original one, as Cycles' Bump node does it). Normal Map: its space
     (Tangent or Object) and its Strength. Then notes on what the layers cannot take over
     (_ignored): the layers are made, and the report says what differs."""
     found, skipped, ignored = [], [], []
@@ -348,9 +348,10 @@ def material_layers(node_tree):
                 skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
                 continue
             ignored += _ignored(node, tex, ("Strength", "Distance"))
-            scale = node.inputs["Distance"].default_value * node.inputs["Strength"].default_value
+            scale = node.inputs["Distance"].default_value
             values = _texture_settings(tex)
-            values.update(type="height", scale=-scale if node.invert else scale)
+            values.update(type="height", scale=-scale if node.invert else scale,
+                          strength=max(node.inputs["Strength"].default_value, 0.0))
             found.append(values)
         elif node.type == "NORMAL_MAP":
             tex = _linked_image_node(node.inputs["Color"])

@@ -62,7 +62,11 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     scale: FloatProperty(
         name="Scale", default=1.0, precision=4, step=1,
         description="Height layers: object units per unit of image value (the Bump node's "
-                    "Distance x Strength). Normal layers: strength. Projections: both")
+                    "Distance). Normal layers: strength. Projections: both")
+    strength: FloatProperty(
+        name="Strength", default=1.0, min=0.0, soft_max=1.0, precision=3,
+        description="Height layers: the Bump node's Strength, which blends the bumped normal "
+                    "with the unbumped one (0: no bump, 1: the full bump)")
     filter: EnumProperty(name="Filter", items=FILTERS, default="bilinear")
     wrap: EnumProperty(name="Wrap", items=WRAPS, default="repeat")
     tiling: FloatVectorProperty(name="Tiling", size=2, default=(1.0, 1.0),

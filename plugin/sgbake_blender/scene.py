@@ -113,6 +113,8 @@ def layer_json(layer, uv_index):
         entry["uv"] = uv_index(layer.uv_map)
     if layer.type == "height":
         entry["scale"] = _number(layer.scale)
+        if layer.strength != 1.0:  # the Bump node's blend of normals (1: none)
+            entry["strength"] = _number(layer.strength)
     elif layer.type == "normal":
         entry.update(space=layer.space, strength=_number(layer.scale))
     elif layer.type == "volume":

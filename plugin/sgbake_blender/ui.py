@@ -107,6 +107,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             if layer.type == "planar":
                 col.prop(layer, "axis")
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
+            if layer.type == "height":
+                col.prop(layer, "strength")
             col.prop(layer, "filter")
             col.prop(layer, "wrap")
             col.prop(layer, "tiling")

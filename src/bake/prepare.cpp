@@ -259,6 +259,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.texture = scalar;
       source.uvSet = layer.uvSet;
       source.scale = layer.scale;
+      source.strength = layer.strength;
       source.tiling = layer.tiling;
       source.offset = layer.offset;
       result.source = source;

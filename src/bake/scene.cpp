@@ -362,7 +362,7 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
     keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
   switch (type) {
     case SceneLayerType::kHeight:
-      add({"uv", "scale"});
+      add({"uv", "scale", "strength"});
       break;
     case SceneLayerType::kNormal:
       add({"uv", "space", "green", "strength"});
@@ -646,7 +646,12 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     layer.mask = parseMask(reader.at("mask"), appendPath(where, "mask"), paths, layer.uvSet);
   }
   if (reader.has("scale")) layer.scale = reader.number("scale");
-  if (reader.has("strength")) layer.scale = reader.number("strength");
+  if (reader.has("strength")) {
+    // A normal map's Strength is its only factor (held as its scale); a height layer's is the
+    // Bump node's, beside its scale (the Bump node's Distance).
+    (layer.type == SceneLayerType::kHeight ? layer.strength : layer.scale) =
+        reader.number("strength");
+  }
   reader.optionalName("green", kGreens, layer.green);
   reader.optionalName("space", kSpaces, layer.space);
   reader.optionalName("kind", kKinds, layer.kind);
@@ -1238,6 +1243,7 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   switch (layer.type) {
     case SceneLayerType::kHeight:
       j["uv"] = layer.uvSet;
+      j["strength"] = layer.strength;
       break;
     case SceneLayerType::kNormal:
       j["uv"] = layer.uvSet;

@@ -72,8 +72,11 @@ struct BakeShaderBase {
     if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return {};
     const std::size_t set = static_cast<std::size_t>(s.uvSet);
     const ScalarSample h = s.texture->sample(textureCoordinates(p.uv[set].uv, s.tiling, s.offset));
-    return gradient_detail::gradientFromPreparedUvFrame(
-        preparedUv[set], p.normal, uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
+    return withNormalMapStrength(
+        gradient_detail::gradientFromPreparedUvFrame(preparedUv[set], p.normal,
+                                                     uvDerivativesFromTexture(h, s.tiling, s.scale),
+                                                     s.minFrameSine),
+        p.normal, s.strength);
   }
 
   /// compositeGradient(layers, p) bit for bit: the same sum in the same order, with UV height
@@ -277,7 +280,7 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
   for (const Layer& layer : shader.layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
     const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-    if (uvHeight != nullptr && layer.mask.texture == nullptr) {
+    if (uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1) {
       batchUvHeightGradient(shader, s, *uvHeight, layer.weight, unitN, gamma);
       continue;
     }

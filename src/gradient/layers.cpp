@@ -22,8 +22,10 @@ Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const UvFrame& frame = uvFrame(point, s.uvSet);
   const ScalarSample h = s.texture->sample(textureCoordinates(frame.uv, s.tiling, s.offset));
-  return gradientFromUvDerivatives(frame, point.normal,
-                                   uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
+  return withNormalMapStrength(
+      gradientFromUvDerivatives(frame, point.normal, uvDerivativesFromTexture(h, s.tiling, s.scale),
+                                s.minFrameSine),
+      point.normal, s.strength);
 }
 
 Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point) {

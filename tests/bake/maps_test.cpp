@@ -327,6 +327,43 @@ TEST(Maps, TangentSpaceLayersOnAnotherUvSetDecodeInItsOwnFrames) {
   EXPECT_FALSE(computeLoopTriangleTangents(twoSets, 2).ok());
 }
 
+// A height layer's strength is Blender's Bump Strength: the bumped normal blended with the
+// unbumped one, normalize(N + s·(n' − N)), not a scaled height; the height map keeps the
+// height, and strength 1 is the plain bump, bit for bit.
+TEST(Maps, HeightStrengthBlendsNormalsAsTheBumpNodeDoes) {
+  const Mesh mesh = scaledPlane(1, 1);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::LinearHeight height(0.6, -0.3);
+  const double scale = 0.8;
+  const Vec3d bumped = normalizeOr(Vec3d{-0.6 * scale, 0.3 * scale, 1}, Vec3d{});
+  for (const double strength : {1.0, 0.5, 1.5}) {
+    UvHeightSource source{&height, 0, scale};
+    source.strength = strength;
+    const std::vector<Layer> layers{Layer{source, 1.0, {}}};
+    const Vec3d z{0, 0, 1};
+    const Vec3d expected = normalizeOr(z + strength * (bumped - z), z);
+    const auto on = bake(mesh, &*tangents, layers, MapKind::kObjectNormal, 16, 1);
+    const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal, 16, 1);
+    const auto ht = bake(mesh, &*tangents, layers, MapKind::kHeight, 16, 1);
+    ASSERT_TRUE(on.ok() && tn.ok() && ht.ok());
+    int covered = 0;
+    for (int y = 0; y < 16; ++y) {
+      for (int x = 0; x < 16; ++x) {
+        if (test::coverageUp(*on, x, y) != 1.0f) continue;
+        ++covered;
+        const std::string at =
+            std::to_string(strength) + " " + std::to_string(x) + "," + std::to_string(y);
+        expectNear(test::pixelUp(*on, x, y), encode(expected), kFloatTol, "object-normal " + at);
+        expectNear(test::pixelUp(*tn, x, y), encode(expected), kFloatTol, "tangent-normal " + at);
+        const double u = (x + 0.5) / 16, v = (y + 0.5) / 16;
+        EXPECT_NEAR(ht->at(x, 15 - y, 0), scale * (0.6 * u - 0.3 * v), 1e-6) << at;
+      }
+    }
+    EXPECT_GT(covered, 50);
+  }
+}
+
 TEST(Maps, HeightSumsWeightedMaskedHeightLayers) {
   // On the plane P = (2u, 0.5v, 0): a volume sine along x, a planar (Z) linear height map and a
   // triplanar one (only the Z plane is active for N = ẑ), weighted, one of them masked by 0.5;

@@ -143,7 +143,7 @@ TEST(Scene, ExtendedKeys) {
   Result<Scene> scene = parseScene(
       R"({"mesh": "/abs/m.obj", "_comment": "ignored",
           "layers": [{"type": "height", "image": "h.png", "tiling": [2, 3], "offset": [0.5, 0],
-                      "wrap": "clamp", "weight": -0.5,
+                      "wrap": "clamp", "weight": -0.5, "scale": 0.2, "strength": 0.25,
                       "mask": {"image": "mask.png", "uv": 1, "tiling": 4, "filter": "bicubic"}},
                      {"type": "volume", "function": "noise", "seed": 42, "octaves": 3,
                       "frequency": 8, "gradient": "central", "_note": "comment"},
@@ -160,6 +160,8 @@ TEST(Scene, ExtendedKeys) {
   EXPECT_EQ(scene->mesh, std::filesystem::path("/abs/m.obj"));
   const SceneLayer& height = scene->layers[0];
   EXPECT_EQ(height.tiling, (Vec2d{2, 3}));
+  EXPECT_EQ(height.scale, 0.2);      // the Bump node's Distance ...
+  EXPECT_EQ(height.strength, 0.25);  // ... and its Strength, apart (a normal map's is its scale)
   EXPECT_EQ(height.offset, (Vec2d{0.5, 0}));
   EXPECT_EQ(height.wrap, Wrap::kClamp);
   EXPECT_EQ(height.weight, -0.5);

@@ -9,7 +9,7 @@
    and bake_scene's material (Image Texture -> Bump, Distance 0.1 -> BSDF). It enables the
    add-on from the repository's plugin/ folder (addon_utils, so that its preferences exist)
    with the preferences' Library path set to --library, runs "Layers from Material" (which
-   must add one height layer with that image and scale = Distance x Strength), then bakes with
+   must add one height layer with that image and scale = Distance, strength 1), then bakes with
    `bpy.ops.object.sgbake_bake()` at 256^2 every map in CASES, each into its image; the pixels
    the image then holds are saved as addon_CASE.npy (rows top first). One case bakes into a
    Target image that starts at 64^2 (the add-on must scale it) with margin 8, 2 x 2 samples
@@ -187,7 +187,7 @@ def build_scene(work):
 
 def layers_from_material(settings, distance):
     """Runs "Layers from Material"; returns its manifest entry (with "error" when the layers
-    are not the one bilinear height layer of 'height' with scale Distance x Strength 1)."""
+    are not the one bilinear height layer of 'height' with scale Distance and strength 1)."""
     import bpy
     result = bpy.ops.object.sgbake_layers_from_material()
     layers = [{"type": layer.type, "image": layer.image.name if layer.image else None,
@@ -206,6 +206,14 @@ def layers_from_material(settings, distance):
     tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
     found, _, ignored = operators.material_layers(tree)
     tree.nodes.remove(mapping)
+    # A Bump Strength is the layer's strength (Cycles' blend of normals), not part of its scale.
+    bump = next(node for node in tree.nodes if node.type == "BUMP")
+    bump.inputs["Strength"].default_value = 0.5
+    weak, _, _ = operators.material_layers(tree)
+    bump.inputs["Strength"].default_value = 1.0
+    if len(weak) != 1 or abs(weak[0].get("strength", 1.0) - 0.5) > 1e-7 \
+            or abs(weak[0]["scale"] - distance) > 1e-7:
+        entry["error"] = f"a Bump Strength 0.5 should give strength 0.5, scale {distance}: {weak}"
     _, _, none_ignored = operators.material_layers(tree)
     if len(found) != 1 or not any("Vector from 'Mapping'" in note for note in ignored) \
             or none_ignored:

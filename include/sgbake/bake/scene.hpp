@@ -138,6 +138,7 @@ struct SceneLayer {
   /// "scale" (height, planar, triplanar: object units per unit of value; strength for projected
   /// normal maps) or "strength" (normal).
   double scale = 1;
+  double strength = 1;  ///< "strength" of a height layer: the Bump node's (a blend of normals)
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps, all projections)
   ProjectedKind kind = ProjectedKind::kHeight;     ///< "kind" (planar, triplanar)

@@ -36,6 +36,9 @@ struct UvHeightSource {
   Vec2d tiling{1, 1};                      ///< repeats per UV unit (eq. 2)
   Vec2d offset{0, 0};                      ///< texture units
   double minFrameSine = kMinFrameSine;     ///< degenerate-frame threshold
+  /// Blender's Bump node Strength (withNormalMapStrength: a blend of the bumped normal with N,
+  /// as Cycles' Bump node ends, not a scale); heights are not changed by it.
+  double strength = 1;
 };
 
 /// @brief A tangent-space normal map on a UV set (eq. 14-15), decoded in the MikkTSpace frame or
