@@ -123,6 +123,22 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
                      "holds 32-bit unsigned integer channels (an ID or count pass), not "
                      "heights or normals");
   }
+  // Channels are read by position: say so when none of the names tells which holds what (an
+  // EXR of layer.pass channels, say, "baz" and "foo.bar").
+  const auto colourName = [](const std::string& name) {
+    const std::string last = name.substr(name.rfind('.') + 1);
+    return last == "R" || last == "G" || last == "B" || last == "Y";
+  };
+  if (spec.channelNames.size() > 1 && options.warnings != nullptr &&
+      std::none_of(spec.channelNames.begin(), spec.channelNames.end(), colourName)) {
+    std::string names;
+    for (const std::string& name : spec.channelNames)
+      names += (names.empty() ? "'" : ", '") + name + "'";
+    const int read = std::max(1, channelsToRead(options.channels, spec.channels));
+    options.warnings->push_back(
+        path.string() + ": no channel is named R, G, B or Y (" + names + "); the first " +
+        (read == 1 ? std::string("one is") : std::to_string(read) + " are") + " read");
+  }
   if (spec.subimages > 1 && options.warnings != nullptr) {
     const std::string first =
         spec.subimageName.empty() ? "the first" : "the first ('" + spec.subimageName + "')";

@@ -412,9 +412,10 @@ TEST(LoadImage, TruncatedTiffIsRefused) {
   }
 }
 
-// A multi-part EXR is read from its first part, which a warning names; an EXR of 32-bit
+// A multi-part EXR is read from its first part, which a warning names, as are channels that are
+// not named R, G, B or Y (read by position); an EXR of 32-bit
 // unsigned integers (an ID pass), which the codec would scale by 2^-32, is refused.
-TEST(LoadImage, MultiPartAndIntegerExrsAreSaid) {
+TEST(LoadImage, MultiPartOddlyNamedAndIntegerExrsAreSaid) {
   const fs::path dir = testDir();
   const fs::path parts = dir / "parts.exr";
   {
@@ -443,6 +444,27 @@ TEST(LoadImage, MultiPartAndIntegerExrsAreSaid) {
   warnings.clear();
   writeImage(dir / "one.exr", 2, 2, 1, OIIO::TypeDesc::FLOAT, std::vector<float>(4, 0.5f));
   ASSERT_TRUE(loadImage(dir / "one.exr", options).ok());
+  EXPECT_TRUE(warnings.empty());
+
+  // Channels read by position, none named R, G, B or Y: said.
+  const fs::path odd = dir / "odd.exr";
+  {
+    OIIO::ImageSpec spec(2, 2, 2, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"baz", "foo.bar"};
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(odd.string());
+    ASSERT_TRUE(out && out->open(odd.string(), spec)) << OIIO::geterror();
+    const std::vector<float> values(8, 0.25f);
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, values.data()));
+    ASSERT_TRUE(out->close());
+  }
+  options.channels = ImageChannels::kFirst;
+  ASSERT_TRUE(loadImage(odd, options).ok());
+  EXPECT_EQ(warnings,
+            std::vector<std::string>{odd.string() + ": no channel is named R, G, B or Y ('baz', "
+                                                    "'foo.bar'); the first one is read"});
+  warnings.clear();
+  writeImage(dir / "rgb.exr", 2, 2, 3, OIIO::TypeDesc::FLOAT, std::vector<float>(12, 0.5f));
+  ASSERT_TRUE(loadImage(dir / "rgb.exr", options).ok());
   EXPECT_TRUE(warnings.empty());
 
   const fs::path ids = dir / "ids.exr";

@@ -97,8 +97,9 @@ struct LoadImageOptions {
   /// When not null, set to the file's "sgbake:…" string attributes (name, value): how a file
   /// sgbake wrote says it is encoded (sgbake:map, sgbake:udim_tile, sgbake:green, …).
   std::vector<std::pair<std::string, std::string>>* attributes = nullptr;
-  /// When not null, gets one line (naming the file) per thing the file holds that is not read:
-  /// the images after the first of a multi-part EXR or a multi-page TIFF.
+  /// When not null, gets one line (naming the file) per thing the file holds that is not read
+  /// or read by guess: the images after the first of a multi-part EXR or a multi-page TIFF, and
+  /// channels read by position because none is named R, G, B or Y.
   std::vector<std::string>* warnings = nullptr;
 };
 
