@@ -53,8 +53,10 @@ bool uvDerivativeTangentFrame(const UvFrame& frame, Vec3d normal, Vec3d& tangent
 
 Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
                                 const TangentNormalOptions& options) {
-  const Vec2d s = slopesFromTangentNormal(n, options.minNormalZ);
-  const Vec2d slopes{options.tiling.x * s.x, options.tiling.y * s.y};
+  // Tiling repeats the map without steepening it: Blender's Normal Map node decodes the texel
+  // in the frame of the untiled UVs (a Mapping node only moves the lookup), and so does every
+  // engine. (A height map's tiling does steepen its slopes: the heights are squeezed.)
+  const Vec2d slopes = slopesFromTangentNormal(n, options.minNormalZ);
 
   // The MikkTSpace frame of the map's UV set, if the point has one (set 0's is point.tangent);
   // kMikkTSpace falls back on set 0's.

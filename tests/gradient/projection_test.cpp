@@ -286,11 +286,14 @@ TEST(Triplanar, NormalAlongAnAxisEqualsTheUvMappedBake) {
       const Vec2d st = textureCoordinates(p.uv[0].uv, o.tiling, o.offset);
       const Vec3d uvHeight = gradientFromUvDerivatives(
           p.uv[0], p.normal, uvDerivativesFromTexture(tex.sample(st), o.tiling, o.scale));
+      // A projection's tangent-space map is a height's slopes under tiling (seed 003's
+      // derivative form), which a UV normal layer is not (it repeats, as in Blender): the UV
+      // layer's texel with its slopes scaled by the tiling.
       TangentNormalOptions ts;
-      ts.tiling = o.tiling;
       ts.frame = TangentFrameChoice::kUvDerivatives;
-      const Vec3d uvTangent =
-          gradientFromTangentNormal(decodeNormalTexel(tsTex.sample(st)), p, 0, ts);
+      const Vec3d texel = decodeNormalTexel(tsTex.sample(st));
+      const Vec3d uvTangent = gradientFromTangentNormal(
+          Vec3d{o.tiling.x * texel.x, o.tiling.y * texel.y, texel.z}, p, 0, ts);
       const Vec3d uvObject =
           gradientFromObjectNormal(decodeNormalTexel(osTex.sample(st)), p.normal);
       worst = std::max({worst, maxAbsDiff(triplanarHeightGradient(tex, o, p), uvHeight),

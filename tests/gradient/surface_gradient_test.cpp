@@ -336,15 +336,17 @@ TEST(GradientFromTangentNormal, UvDerivativeFrameEqualsMikkTSpaceWhenTheFramesAg
 
 Vec3d unit(const Vec3d& v) { return (1 / std::sqrt(dot(v, v))) * v; }
 
-TEST(GradientFromTangentNormal, AppliesTilingToTheSlopes) {
+// Tiling repeats a normal map without steepening it, as in Blender (a Mapping node before the
+// Image Texture only moves the Normal Map node's lookup): the slopes are the texel's own.
+TEST(GradientFromTangentNormal, TilingRepeatsTheMapWithoutSteepeningIt) {
   SurfacePoint p;
   p.hasTangentFrame = true;  // T = +x, B = +y, N = +z
   const Vec3d n{0.2, -0.1, 0.8};
   TangentNormalOptions o;
   o.tiling = {2, 3};
   const Vec3d gamma = gradientFromTangentNormal(n, p, 0, o);
-  EXPECT_NEAR(gamma.x, 2 * (-0.2 / 0.8), 1e-15);
-  EXPECT_NEAR(gamma.y, 3 * (0.1 / 0.8), 1e-15);
+  EXPECT_NEAR(gamma.x, -0.2 / 0.8, 1e-15);
+  EXPECT_NEAR(gamma.y, 0.1 / 0.8, 1e-15);
   EXPECT_EQ(gamma.z, 0.0);
 }
 

@@ -213,7 +213,9 @@ struct TangentNormalOptions {
   /// Blender's Normal Map node Strength (withNormalMapStrength): 1 reproduces the map exactly,
   /// 0 is no bump, other values blend the decoded normal with N.
   double strength = 1;
-  Vec2d tiling{1, 1};  ///< (s, t) = tiling ∘ uv + offset; the slopes are multiplied by tiling
+  /// (s, t) = tiling ∘ uv + offset: the map repeats, its slopes unchanged (as in Blender, where
+  /// a Mapping node only moves the Normal Map node's lookup)
+  Vec2d tiling{1, 1};
   Vec2d offset{0, 0};
   double minNormalZ = kMinTangentNormalZ;  ///< see slopesFromTangentNormal
   double minFrameSine = kMinFrameSine;     ///< see gradientFromUvDerivatives
@@ -227,7 +229,8 @@ Vec3d withNormalMapStrength(Vec3d gamma, Vec3d normal, double strength);
 
 /// @brief Γ of a decoded tangent-space normal @p n (eq. 14-15) at @p point on UV set @p uvSet.
 ///
-/// Slopes = tiling ∘ slopesFromTangentNormal(n), then gradientFromTangentFrame in the frame
+/// Slopes = slopesFromTangentNormal(n) (tiling moves the lookup only), then
+/// gradientFromTangentFrame in the frame
 /// chosen by options.frame: the MikkTSpace frame T_m = point.tangent / point.normalLength,
 /// B_m = bitangentSign · N × point.tangent (so that N − Γ is Blender's Normal Map node decode
 /// normalize(x·T + y·B_i + z·N_i) with the unnormalized interpolated normal N_i), or
