@@ -54,6 +54,12 @@ const MapInfo& info(MapKind kind) {
   return kMaps[0];  // unreachable for valid enumerators
 }
 
+/// The face whose corners include @p corner (faceStart is ascending).
+std::size_t faceOfCorner(const Mesh& mesh, std::uint32_t corner) {
+  const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), corner);
+  return static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1;
+}
+
 }  // namespace
 
 Result<MapKind> parseMapKind(std::string_view name) {
@@ -111,8 +117,7 @@ void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
                                Vec3d{0, 0, 1});
   tri.flat = tri.polygonFrame = false;
   if (!mesh.faceFlat.empty()) {  // the face of the triangle's corners
-    const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), corners[0]);
-    const auto face = static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1;
+    const std::size_t face = faceOfCorner(mesh, corners[0]);
     if (mesh.isFlat(face)) {
       tri.flat = !mesh.autoSmooth;
       tri.polygonFrame = true;
@@ -230,9 +235,10 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
     return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
                                    "(subdivideMesh with its SurfaceParameters)");
   }
+  // loopTriangles cuts every face of k corners into k − 2 triangles (counted, not cut again).
+  const std::size_t frames = 3 * (mesh.numCorners() - 2 * mesh.numFaces());
   for (const CornerTangents* given : input.triangleTangents) {
     if (given == nullptr) continue;
-    const std::size_t frames = 3 * loopTriangles(mesh).size();
     if (given->tangent.size() != frames || given->sign.size() != frames) {
       return Error::badInput(where + ": " + std::to_string(given->tangent.size()) +
                              " loop-triangle tangents for " + std::to_string(frames) +
@@ -309,11 +315,8 @@ Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
     faceStart[t + 1] = static_cast<std::uint32_t>(3 * (t + 1));
     const std::array<std::uint32_t, 3>& c = triangles[t];
     // Cycles shades a flat face without Auto Smooth, and gives MikkTSpace, its triangle's normal.
-    bool triangleNormal = false;
-    if (!mesh.faceFlat.empty() && !mesh.autoSmooth) {
-      const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), c[0]);
-      triangleNormal = mesh.isFlat(static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1);
-    }
+    const bool triangleNormal =
+        !mesh.faceFlat.empty() && !mesh.autoSmooth && mesh.isFlat(faceOfCorner(mesh, c[0]));
     const Vec3f p0 = mesh.positions[mesh.cornerVertex[c[0]]];
     const Vec3f flat =
         cast<float>(normalizeOr(cast<double>(cross(mesh.positions[mesh.cornerVertex[c[1]]] - p0,
