@@ -332,6 +332,25 @@ Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
   return computeTangents(view, options);
 }
 
+CornerTangents loopTriangleFramesAtCorners(const Mesh& mesh, const CornerTangents& triangleFrames) {
+  CornerTangents frames;
+  frames.tangent.assign(mesh.numCorners(), Vec3f{});
+  frames.sign.assign(mesh.numCorners(), 1.0f);
+  std::vector<bool> found(mesh.numCorners(), false);
+  const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t c = triangles[t][i];
+      const std::size_t k = 3 * t + i;
+      if (found[c] || k >= triangleFrames.tangent.size()) continue;
+      found[c] = true;
+      frames.tangent[c] = triangleFrames.tangent[k];
+      frames.sign[c] = triangleFrames.sign[k];
+    }
+  }
+  return frames;
+}
+
 Result<FloatImage> bakeMap(const BakeInput& input, const BakeSettings& settings) {
   return bakeMap(input, settings, {});
 }

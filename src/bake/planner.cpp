@@ -1409,6 +1409,14 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       if (output.kind == OutputKind::kCorners) {
         CornerOptions cornerOptions;
         cornerOptions.threads = options.threads;
+        // Tangent-space layers decode with the loop triangles' frames, as in a baked map.
+        std::array<CornerTangents, kMaxUvSets> cornerFrames;
+        for (std::size_t set = 0; set < kMaxUvSets; ++set) {
+          if (!loaded.triangleTangents[set]) continue;
+          cornerFrames[set] =
+              loopTriangleFramesAtCorners(loaded.mesh, *loaded.triangleTangents[set]);
+          cornerOptions.layerTangents[set] = &cornerFrames[set];
+        }
         Result<std::vector<CornerSample>> corners =
             evaluateCorners(loaded.mesh, layers, cornerOptions);
         if (!corners) {

@@ -102,6 +102,27 @@ void appendVec(std::string& out, Vec3d v) {
   }
 }
 
+/// Makes @p layerTangents (CornerOptions::layerTangents) corner @p c's frames for the layers of
+/// @p point: set 0's is its `tangent`, another set's its `uvTangent`.
+void useLayerTangents(const std::array<const CornerTangents*, kMaxUvSets>& layerTangents,
+                      std::uint32_t c, SurfacePoint& point) {
+  for (std::size_t set = 0; set < kMaxUvSets; ++set) {
+    const CornerTangents* frames = layerTangents[set];
+    if (frames == nullptr || c >= frames->tangent.size()) continue;
+    const Vec3d tangent = cast<double>(frames->tangent[c]);
+    const double sign = frames->sign[c] < 0 ? -1.0 : 1.0;
+    if (set == 0) {
+      point.tangent = tangent;
+      point.bitangentSign = sign;
+      point.hasTangentFrame = true;
+    } else {
+      point.uvTangent[set] = tangent;
+      point.uvBitangentSign[set] = sign;
+      point.hasUvTangentFrame[set] = true;
+    }
+  }
+}
+
 }  // namespace
 
 SurfacePoint cornerSurfacePoint(const Mesh& mesh, const CornerTangents* tangents, std::size_t face,
@@ -142,15 +163,16 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t f = range.begin(); f != range.end(); ++f) {
             for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
-              const SurfacePoint point = cornerSurfacePoint(
-                  mesh, haveTangents ? &tangents : nullptr, f, c, options.minCornerSine);
+              SurfacePoint point = cornerSurfacePoint(mesh, haveTangents ? &tangents : nullptr, f,
+                                                      c, options.minCornerSine);
               CornerSample& s = samples[c];
+              s.tangent = haveTangents ? point.tangent : Vec3d{};
+              s.sign = haveTangents ? point.bitangentSign : 1.0;
+              useLayerTangents(options.layerTangents, c, point);
               s.face = static_cast<std::uint32_t>(f);
               s.corner = c;
               s.position = point.position;
               s.normal = point.normal;
-              s.tangent = haveTangents ? point.tangent : Vec3d{};
-              s.sign = haveTangents ? point.bitangentSign : 1.0;
               s.uv = point.numUvSets > 0 ? point.uv[0].uv : Vec2d{};
               s.gradient = compositeGradient(layers, point);
               s.perturbed = resolveNormal(point.normal, s.gradient, options.objectScaleCofactor);

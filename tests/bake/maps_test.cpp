@@ -13,6 +13,7 @@
 #include "bake_test_util.hpp"
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/frames/tangents.hpp"
+#include "sgbake/gradient/corners.hpp"
 #include "sgbake/gradient/volume.hpp"
 #include "support/parametric_mesh.hpp"
 
@@ -279,6 +280,60 @@ TEST(Maps, TangentSpaceLayersDecodeWithTheLoopTrianglesTangents) {
   const CornerTangents shortList{{Vec3f{1, 0, 0}}, {1}};
   withLoop.triangleTangents[0] = &shortList;
   EXPECT_FALSE(bakeMap(withLoop, settings).ok());
+}
+
+// The corner table decodes tangent-space layers as the bake does: with
+// CornerOptions::layerTangents from loopTriangleFramesAtCorners, each corner of the quad gets the
+// perturbed normal the same corner gets in the two triangles given as faces of their own, and
+// not the one of the quad's MikkTSpace frame (which stays the table's tangent column).
+TEST(Maps, CornerTableDecodesWithTheLoopTrianglesTangents) {
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.1f}, {1.1f, 1, 0.3f}, {0, 0.9f, 0}};
+  const std::vector<Vec2f> uvs{{0.1f, 0.1f}, {0.8f, 0.15f}, {0.9f, 0.9f}, {0.05f, 0.7f}};
+  std::vector<Vec3f> normals{
+      {0, 0, 1}, {-0.2f, 0, 0.98f}, {-0.3f, -0.3f, 0.905f}, {0, -0.1f, 0.995f}};
+  for (Vec3f& v : normals) v = cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1}));
+  const Mesh quad = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, {}, normals);
+  const std::vector<std::array<std::uint32_t, 3>> split = loopTriangles(quad);
+  std::vector<std::vector<std::uint32_t>> faces;
+  std::vector<Vec2f> splitUvs;
+  std::vector<Vec3f> splitNormals;
+  for (const auto& t : split) {
+    faces.push_back({quad.cornerVertex[t[0]], quad.cornerVertex[t[1]], quad.cornerVertex[t[2]]});
+    for (const std::uint32_t c : t) {
+      splitUvs.push_back(quad.uvSets[0].uvs[c]);
+      splitNormals.push_back(quad.cornerNormals[c]);
+    }
+  }
+  const Mesh triangles = test::polygonMesh(positions, faces, splitUvs, {}, splitNormals);
+
+  const Result<CornerTangents> loop = computeLoopTriangleTangents(quad);
+  ASSERT_TRUE(loop.ok());
+  const CornerTangents atCorners = loopTriangleFramesAtCorners(quad, *loop);
+  ASSERT_EQ(atCorners.tangent.size(), quad.numCorners());
+
+  const test::ConstantColour texel(Vec3d{0.75, 0.35, 0.8});
+  TangentNormalSource source;
+  source.texture = &texel;
+  const std::vector<Layer> layers{Layer{source, 1.0, {}}};
+  CornerOptions options;
+  options.layerTangents[0] = &atCorners;
+  const auto ours = evaluateCorners(quad, layers, options);
+  const auto polygon = evaluateCorners(quad, layers);
+  const auto reference = evaluateCorners(triangles, layers);
+  ASSERT_TRUE(ours.ok() && polygon.ok() && reference.ok());
+  double largest = 0;  // how far the quad's own frames would put the normals
+  std::vector<bool> seen(quad.numCorners(), false);
+  for (std::size_t k = 0; k < 3 * split.size(); ++k) {
+    const std::uint32_t c = split[k / 3][k % 3];
+    if (seen[c]) continue;
+    seen[c] = true;
+    expectNear((*ours)[c].perturbed, (*reference)[k].perturbed, 1e-12,
+               "corner " + std::to_string(c));
+    EXPECT_EQ((*ours)[c].tangent, (*polygon)[c].tangent) << c;
+    largest = std::max(largest, length((*ours)[c].perturbed - (*polygon)[c].perturbed));
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), true), 4);
+  EXPECT_GT(largest, 1e-3);
 }
 
 // A tangent-space layer on UV set 1 decodes in MikkTSpace of that set (as Cycles does for the

@@ -208,6 +208,14 @@ struct BakeInput {
 Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet = 0,
                                                    const TangentOptions& options = {});
 
+/// @brief The loop-triangle frames of @p triangleFrames (computeLoopTriangleTangents of @p mesh)
+/// per corner of @p mesh: each corner takes its frame in the first loop triangle through it.
+/// (MikkTSpace gives a corner the same frame in every triangle of its face that it shares with
+/// the same normal and UV, so which triangle is not a choice.) For per-corner evaluation
+/// (CornerOptions::layerTangents) that decodes as the bake does.
+/// @return #C frames in corner order
+CornerTangents loopTriangleFramesAtCorners(const Mesh& mesh, const CornerTangents& triangleFrames);
+
 /// @brief Bakes one map. Texels no triangle covers get the map's background (tangent-space
 /// normal (0.5, 0.5, 1), zero elsewhere) and coverage 0.
 ///

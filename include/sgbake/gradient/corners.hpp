@@ -6,6 +6,7 @@
 /// the result. No bump math lives here.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <span>
@@ -35,6 +36,13 @@ struct CornerOptions {
   /// in object space. Γ itself is always reported in object space.
   Mat3 objectScaleCofactor = Mat3::identity();
   double minCornerSine = kMinCornerSine;  ///< see kMinCornerSine
+  /// Per UV set, the tangent frames (per corner, in corner order) that tangent-space layers on
+  /// that set decode with, or nullptr: the bake's are the loop triangles'
+  /// (loopTriangleFramesAtCorners of BakeInput::triangleTangents), as Cycles' Normal Map node's.
+  /// Without them a layer on set 0 decodes with the polygon mesh's MikkTSpace frame (the
+  /// `tangent` column, which these never change), on another set as TangentNormalOptions::frame
+  /// says.
+  std::array<const CornerTangents*, kMaxUvSets> layerTangents{};
 };
 
 /// @brief The evaluated bump at one face corner. Object space throughout.
