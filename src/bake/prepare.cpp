@@ -251,6 +251,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
     result.mask.tiling = layer.mask->tiling;
     result.mask.offset = layer.mask->offset;
   }
+  result.base = layer.base;
   ProjectedNormalOptions projected;
   projected.green = layer.green;
   switch (layer.type) {

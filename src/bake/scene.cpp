@@ -85,6 +85,8 @@ constexpr Named<Filter> kFilters[] = {
 constexpr Named<Wrap> kWraps[] = {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClamp}};
 constexpr Named<NormalSpace> kSpaces[] = {{"tangent", NormalSpace::kTangent},
                                           {"object", NormalSpace::kObject}};
+constexpr Named<LayerBase> kBases[] = {{"surface", LayerBase::kSurface},
+                                       {"above", LayerBase::kLayersAbove}};
 constexpr Named<NormalMapGreen> kGreens[] = {{"opengl", NormalMapGreen::kOpenGL},
                                              {"directx", NormalMapGreen::kDirectX}};
 constexpr Named<ProjectedKind> kKinds[] = {{"height", ProjectedKind::kHeight},
@@ -362,20 +364,20 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
     keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
   switch (type) {
     case SceneLayerType::kHeight:
-      add({"uv", "scale", "strength"});
+      add({"uv", "scale", "strength", "base"});
       break;
     case SceneLayerType::kNormal:
       add({"uv", "space", "green", "strength"});
       break;
     case SceneLayerType::kVolume:
       add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
-           "gradient", "step"});
+           "gradient", "step", "base"});
       break;
     case SceneLayerType::kPlanar:
-      add({"kind", "axis", "scale", "green"});
+      add({"kind", "axis", "scale", "green", "base"});
       break;
     case SceneLayerType::kTriplanar:
-      add({"kind", "scale", "sharpness", "min_weight", "green"});
+      add({"kind", "scale", "sharpness", "min_weight", "green", "base"});
       break;
   }
   return keys;
@@ -656,6 +658,7 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   reader.optionalName("space", kSpaces, layer.space);
   reader.optionalName("kind", kKinds, layer.kind);
   reader.optionalName("axis", kAxes, layer.axis);
+  reader.optionalName("base", kBases, layer.base);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
   if (reader.has("min_weight")) layer.minWeight = reader.numberAtLeast("min_weight", 0, false);
 
@@ -695,6 +698,10 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
        layer.kind != ProjectedKind::kTangentNormal);
   if (objectSpace && reader.has("green")) {
     fail(where, "key 'green' applies only to tangent-space normal maps");
+  }
+  if (layer.base == LayerBase::kLayersAbove && layer.readsNormals()) {
+    fail(where,
+         "'base': 'above' applies only to heights (a normal map has no normal to start from)");
   }
   return layer;
 }
@@ -1220,6 +1227,7 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   json j;
   j["type"] = sceneLayerTypeName(layer.type);
   j["weight"] = layer.weight;
+  if (layer.base != LayerBase::kSurface) j["base"] = nameIn(kBases, layer.base);
   if (layer.mask) {
     j["mask"] = {{"image", name(layer.mask->image)},
                  {"uv", layer.mask->uvSet},

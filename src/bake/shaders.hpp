@@ -79,8 +79,8 @@ struct BakeShaderBase {
         p.normal, s.strength);
   }
 
-  /// compositeGradient(layers, p) bit for bit: the same sum in the same order, with UV height
-  /// layers through uvHeightGradient (no per-texel std::visit, no per-texel frame
+  /// compositeGradient(layers, p, tri.faceNormal) bit for bit: the same sum in the same order, with
+  /// UV height layers through uvHeightGradient (no per-texel std::visit, no per-texel frame
   /// normalizations) and the mask looked up only when the layer has one (factor 1 otherwise).
   Vec3d gradient(const SurfacePoint& p) const {
     Vec3d gamma{};
@@ -91,8 +91,13 @@ struct BakeShaderBase {
     return isFinite(gamma) ? gamma : Vec3d{};
   }
 
-  /// gamma += weight · mask · Γ of one layer (finite, nonzero weight) at @p p: gradient()'s step.
+  /// gamma += weight · mask · Γ of one layer (finite, nonzero weight) at @p p: gradient()'s step
+  /// (a layer on the layers above: gamma = stackLayerGradient, with the triangle's Ng).
   void addLayerGradient(const Layer& layer, const SurfacePoint& p, Vec3d& gamma) const {
+    if (layer.base == LayerBase::kLayersAbove) {
+      gamma = stackLayerGradient(layer, p, tri.faceNormal, gamma);
+      return;
+    }
     const double factor = layer.mask.texture == nullptr
                               ? layer.weight
                               : layer.weight * layerMask(layer.mask, p);
@@ -280,7 +285,8 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
   for (const Layer& layer : shader.layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
     const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-    if (uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1) {
+    if (uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1 &&
+        layer.base == LayerBase::kSurface) {
       batchUvHeightGradient(shader, s, *uvHeight, layer.weight, unitN, gamma);
       continue;
     }
@@ -414,12 +420,20 @@ struct ObjectNormalShader : BakeShaderBase {
     if (!layers.empty()) {
       Lanes3& w = perturbedNormals;
       batchPerturbedDirections(*this, s, f.unitN, w, f.slow);
+      const Vec3d ng = tri.faceNormal;
       for (std::size_t i = 0; i < n; ++i) {  // unitOr's common case (slow covers the rest)
         const double len2 = w.x[i] * w.x[i] + w.y[i] * w.y[i] + w.z[i] * w.z[i];
         const double inv = 1 / std::sqrt(len2);
         w.x[i] = inv * w.x[i];
         w.y[i] = inv * w.y[i];
         w.z[i] = inv * w.z[i];
+        // perturbed() tests the unit normal (reflectsAboveSurface): one that lies on the guard's
+        // boundary (a layer on the layers above hands on a guarded normal) can pass the test
+        // before normalizing and fail it after.
+        const double iz = f.unitN.x[i] * ng.x + f.unitN.y[i] * ng.y + f.unitN.z[i] * ng.z;
+        const double wi = w.x[i] * f.unitN.x[i] + w.y[i] * f.unitN.y[i] + w.z[i] * f.unitN.z[i];
+        const double wn = w.x[i] * ng.x + w.y[i] * ng.y + w.z[i] * ng.z;
+        f.slow[i] = f.slow[i] | !(2 * wi * wn - iz * 1.0 >= std::min(0.9 * iz, 0.01) * 1.0);
       }
     }
     for (std::size_t i = 0; i < n; ++i) {

@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <string>
 
+#include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
 
 namespace sgbake {
@@ -18,14 +19,17 @@ const UvFrame& uvFrame(const SurfacePoint& point, int uvSet) {
   return point.uv[static_cast<std::size_t>(uvSet)];
 }
 
-Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
+/// Γ of a UV height map before its Strength.
+Vec3d unblendedGradient(const UvHeightSource& s, const SurfacePoint& point) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const UvFrame& frame = uvFrame(point, s.uvSet);
   const ScalarSample h = s.texture->sample(textureCoordinates(frame.uv, s.tiling, s.offset));
-  return withNormalMapStrength(
-      gradientFromUvDerivatives(frame, point.normal, uvDerivativesFromTexture(h, s.tiling, s.scale),
-                                s.minFrameSine),
-      point.normal, s.strength);
+  return gradientFromUvDerivatives(frame, point.normal,
+                                   uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
+}
+
+Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
+  return withNormalMapStrength(unblendedGradient(s, point), point.normal, s.strength);
 }
 
 Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point) {
@@ -149,6 +153,16 @@ class LayerChecker {
   int numUvSets_;
 };
 
+/// Whether @p source is a height (a Bump node's input) rather than a normal map.
+bool bumpsHeights(const LayerSource& source) {
+  if (const auto* planar = std::get_if<PlanarSource>(&source))
+    return planar->kind == ProjectedKind::kHeight;
+  if (const auto* triplanar = std::get_if<TriplanarSource>(&source))
+    return triplanar->kind == ProjectedKind::kHeight;
+  return std::holds_alternative<UvHeightSource>(source) ||
+         std::holds_alternative<VolumeSource>(source);
+}
+
 const char* kindName(const LayerSource& source) {
   constexpr const char* kNames[] = {"UV height map",           "tangent-space normal map",
                                     "object-space normal map", "height volume",
@@ -172,15 +186,52 @@ double layerMask(const LayerMask& mask, const SurfacePoint& point) {
   return m > 0 ? std::min(m, 1.0) : 0.0;  // NaN → 0
 }
 
-Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point) {
+Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point,
+                        const Vec3d& geometricNormal) {
   Vec3d gamma{};
   for (const Layer& layer : layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+    if (layer.base == LayerBase::kLayersAbove) {
+      gamma = stackLayerGradient(layer, point, geometricNormal, gamma);
+      continue;
+    }
     const double factor = layer.weight * layerMask(layer.mask, point);
     if (factor == 0) continue;  // masked out: the source is not sampled
     gamma += factor * layerGradient(layer.source, point);
   }
   return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
+}
+
+Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point) {
+  return compositeGradient(layers, point, point.normal);
+}
+
+Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
+                         const Vec3d& geometricNormal, const Vec3d& gammaAbove) {
+  const double factor = layer.weight * layerMask(layer.mask, point);
+  if (factor == 0) return gammaAbove;  // masked out: the source is not sampled
+  const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+  const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
+  if (!(strength > 0)) return gammaAbove;  // Blender clamps Strength at 0 (and NaN is no bump)
+  const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
+                                                    : layerGradient(layer.source, point));
+  if (!isFinite(gamma) || !isFinite(gammaAbove)) return gammaAbove;
+
+  const Vec3d& n = point.normal;
+  const Vec3d& ng = geometricNormal;
+  // The normal the layers above hand on, guarded as the node that made it guards it.
+  const Vec3d above = gradient_detail::validReflectionNormal(normalizeOr(n - gammaAbove, n), ng, n);
+  // The same derivatives along the plane of Ng, perpendicular to that normal.
+  const double across = dot(ng, above);
+  const Vec3d sigma = std::abs(across) > 0 ? gamma - (dot(gamma, above) / across) * ng : gamma;
+  Vec3d bumped = normalizeOr(above - sigma, above);
+  if (strength != 1) bumped = normalizeOr(strength * bumped + (1 - strength) * above, above);
+  bumped = gradient_detail::validReflectionNormal(bumped, ng, n);
+  // The Γ that resolves to it: N − Γ = n₂ / ⟨n₂, N⟩.
+  const double height = dot(bumped, n);
+  if (!(height > 0)) return gammaAbove;  // only when the guard had nothing to turn to
+  const Vec3d result = n - (1 / height) * bumped;
+  return isFinite(result) ? result : gammaAbove;
 }
 
 Vec3d perturbedNormal(const SurfacePoint& point, std::span<const Layer> layers,
@@ -194,6 +245,11 @@ Status validateLayers(std::span<const Layer> layers, int numUvSets) {
     const Layer& layer = layers[i];
     std::string problem = std::visit(checker, layer.source);
     if (problem.empty() && !std::isfinite(layer.weight)) problem = "weight is not finite";
+    if (problem.empty() && layer.base == LayerBase::kLayersAbove && !bumpsHeights(layer.source)) {
+      problem =
+          "only a height can bump the normal of the layers above (a normal map has no "
+          "normal to start from)";
+    }
     if (problem.empty()) problem = checker.mask(layer.mask);
     if (!problem.empty()) {
       return Error::badInput("layer " + std::to_string(i) + " (" + kindName(layer.source) +

@@ -145,7 +145,7 @@ TEST(Scene, ExtendedKeys) {
           "layers": [{"type": "height", "image": "h.png", "tiling": [2, 3], "offset": [0.5, 0],
                       "wrap": "clamp", "weight": -0.5, "scale": 0.2, "strength": 0.25,
                       "mask": {"image": "mask.png", "uv": 1, "tiling": 4, "filter": "bicubic"}},
-                     {"type": "volume", "function": "noise", "seed": 42, "octaves": 3,
+                     {"type": "volume", "function": "noise", "seed": 42, "octaves": 3, "base": "above",
                       "frequency": 8, "gradient": "central", "_note": "comment"},
                      {"type": "planar", "image": "p.png", "axis": "x", "kind": "object-normal"},
                      {"type": "normal", "image": "os.png", "space": "object", "strength": 0.5,
@@ -165,6 +165,8 @@ TEST(Scene, ExtendedKeys) {
   EXPECT_EQ(height.offset, (Vec2d{0.5, 0}));
   EXPECT_EQ(height.wrap, Wrap::kClamp);
   EXPECT_EQ(height.weight, -0.5);
+  EXPECT_EQ(height.base, LayerBase::kSurface);  // the default
+  EXPECT_EQ(scene->layers[1].base, LayerBase::kLayersAbove);
   ASSERT_TRUE(height.mask.has_value());
   EXPECT_EQ(height.mask->image, std::filesystem::path("scenes/mask.png"));
   EXPECT_EQ(height.mask->uvSet, 1);
@@ -466,6 +468,16 @@ TEST(Scene, InvalidCombinations) {
   EXPECT_EQ(parseError(withLayer(
                 R"({"type": "normal", "image": "n.png", "space": "object", "green": "opengl"})")),
             "scene.json: layers[0]: key 'green' applies only to tangent-space normal maps");
+  EXPECT_EQ(
+      parseError(withLayer(
+          R"({"type": "triplanar", "image": "t.png", "kind": "tangent-normal", "base": "above"})")),
+      "scene.json: layers[0]: 'base': 'above' applies only to heights (a normal map has no "
+      "normal to start from)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "base": "above"})")),
+            "scene.json: layers[0]: key 'base' does not apply to a normal layer (it is for "
+            "height, volume, planar or triplanar layers)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "base": "top"})")),
+            "scene.json: layers[0]: unknown base 'top' (expected surface or above)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "noise", "frequency": 0})")),
             "scene.json: layers[0]: frequency 0 must be greater than 0");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "step": -1})")),

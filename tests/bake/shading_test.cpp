@@ -189,6 +189,26 @@ TEST_F(ShadeBatch, OtherLayersTakeThePerSamplePath) {
   expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "mixed layers");
 }
 
+TEST_F(ShadeBatch, LayersOnTheLayersAbove) {
+  // Layers based on the normal of the layers above (a chain of Bump nodes) interleaved with
+  // layers the batch path takes whole.
+  Layer onTop{UvHeightSource{&bilinear, 0, 0.08}, 1.0, {}};
+  onTop.base = LayerBase::kLayersAbove;
+  Layer strengthOnTop{UvHeightSource{&bicubic, 0, 0.05}, 0.8, {}};
+  std::get<UvHeightSource>(strengthOnTop.source).strength = 0.6;
+  strengthOnTop.base = LayerBase::kLayersAbove;
+  Layer volumeOnTop{VolumeSource{&sine, GradientScheme::kAnalytic, 0, 1}, 1.0, {}};
+  volumeOnTop.base = LayerBase::kLayersAbove;
+  const std::vector<Layer> layers{
+      Layer{UvHeightSource{&bilinear, 0, 0.02, {2, 3}, {0.25, -0.5}}, 1.0, {}},
+      onTop,
+      Layer{UvHeightSource{&bicubic, 0, 0.03}, -0.5, {}},
+      strengthOnTop,
+      volumeOnTop,
+  };
+  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "layers on the layers above");
+}
+
 TEST_F(ShadeBatch, OverflowingAndCancellingGradients) {
   // Γ overflows (dropped as non-finite) or nearly cancels N (N − Γ renormalized the slow way).
   const std::vector<Layer> layers{

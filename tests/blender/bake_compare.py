@@ -18,6 +18,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                      object bakes
   ours_nmap_flags.exr  the same tangent-normal bake from --normal flags (Strength 1 cases)
   ours_nmap_weak.exr   the scene's tangent-normal bake at 0.9 x Strength (negative control)
+  ours_nmap_sum.exr    a chain case's bake with the bump added to the normal map's surface
+                       gradient instead of stacked on its normal (negative control)
 
 it computes, over the texels Blender's EMIT mask covers, minus those within one texel of an
 island border (3 x 3 erosion: texels whose centres straddle a UV edge may fall in different
@@ -120,7 +122,8 @@ def compare_case(entry):
     for key, name, space in (("nmap_tangent", "ours_nmap_tangent.exr", "tangent"),
                              ("nmap_object", "ours_nmap_object.exr", "object"),
                              ("nmap_flags", "ours_nmap_flags.exr", "tangent"),
-                             ("nmap_weak", "ours_nmap_weak.exr", "tangent")):
+                             ("nmap_weak", "ours_nmap_weak.exr", "tangent"),
+                             ("nmap_sum", "ours_nmap_sum.exr", "tangent")):
         img = load_if(os.path.join(d, name))
         if img is None:
             continue

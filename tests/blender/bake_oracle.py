@@ -4,7 +4,7 @@
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
         [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist,
                  nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
-                 nmap_cube_s2,nmap_suzanne]
+                 nmap_cube_s2,nmap_suzanne,chain_sphere,chain_suzanne]
         [--sabotage green|scale|input|strength|normal-green]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
@@ -36,6 +36,10 @@
      sgbake bake --mesh mesh.obj --normal normal.exr --normal-space SPACE
                  --map tangent-normal ... -o ours_nmap_flags.exr   (Strength 1 cases only)
      sgbake bake scene_weak.json   (Strength x 0.9 -> ours_nmap_weak.exr, negative control)
+   A chain case (chain_sphere, chain_suzanne: 512^2, a tangent-space map tilting up to 40 deg
+   whose Normal Map node feeds the Normal input of a Bump node of Distance 0.1 fed by
+   height.exr) has a second layer, the height with "base": "above", and skips the flags; its
+   control scene_sum.json has "base": "surface" (-> ours_nmap_sum.exr).
 3. bake_compare.py (inside Blender, as the EXR reader) measures the angles between our
    normals and Cycles' bake (tangent space; object space for ours_nmap_object.exr) over the
    covered texels minus a one-texel border.
@@ -64,6 +68,10 @@ Per normal-map case:
       (|diff| <= 1e-6); background (0.5, 0.5, 1) outside the islands;
   negative controls: our tangent-normal map with green flipped, and the bake at 0.9 x
   Strength (medians 1.5-2.5 deg), must FAIL (d).
+  A chain case's bars are the Bump node's finite-difference noise instead (CHAIN_*: median
+  <= 0.5, p90 <= 1.5, p99 <= 3 deg; measured 0.22-0.35 / 0.93-1.0 / 1.8, as a plain bump
+  of the sphere at 512^2 gives 0.22 / 0.91 / 1.79); its control with the bump's gradient
+  added to the normal map's (medians 1.0-1.1, p90 3.1-3.4 deg) must FAIL too.
 Prints one line per check with median, p99 (normal-map cases: p90 and p99), max and the
 number of texels compared.
 
@@ -95,12 +103,20 @@ BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
 NMAP_P90_DEG = 0.1
 NMAP_P99_DEG = 0.3
+# A Bump node stacked on the Normal Map's output: Cycles' bump is a finite difference (see (b)),
+# so the bars are the plain bump's noise at 512^2 (UV sphere: median 0.22, p90 0.91, p99 1.79
+# deg) with room; adding the bump's gradient to the normal map's instead is off by medians
+# 1.0-1.1, p90 3.1-3.4, p99 5.6-5.7 deg.
+CHAIN_MEDIAN_DEG = 0.5
+CHAIN_P90_DEG = 1.5
+CHAIN_P99_DEG = 3.0
 MASK_MISMATCH_FRACTION = 1e-3
 MASK_MISMATCH_SLACK = 5
 SGBAKE_TIMEOUT = 120
 DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
                  "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
-                 "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne")
+                 "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne",
+                 "chain_sphere", "chain_suzanne")
 
 
 def run_blender_script(blender, script, args):
@@ -190,12 +206,16 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     map_green = "directx" if sabotage == "normal-green" else "opengl"
     green = "directx" if sabotage == "green" else "opengl"
 
-    def scene_file(name, layer_strength, outputs):
+    def scene_file(name, layer_strength, outputs, base="above"):
         layer = {"type": "normal", "image": p("normal.exr"), "space": nmap["space"],
                  "strength": layer_strength, "filter": "bilinear", "uv": 0, "weight": 1.0}
         if nmap["space"] == "tangent":
             layer["green"] = map_green
-        scene = {"mesh": p("mesh.obj"), "layers": [layer], "outputs": []}
+        layers = [layer]
+        if "bump" in nmap:  # the Bump node on the Normal Map's output
+            layers.append({"type": "height", "image": p("height.exr"), "scale": nmap["bump"],
+                           "filter": "bilinear", "base": base})
+        scene = {"mesh": p("mesh.obj"), "layers": layers, "outputs": []}
         for kind, file in outputs:
             out = {"map": kind, "file": p(file), "size": size, "margin": 0, "samples": 1,
                    "bit_depth": 32}
@@ -213,7 +233,11 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
                             [("tangent-normal", "ours_nmap_weak.exr")])):
         if not run_sgbake(cli, args, log):
             failed.append(log[-1])
-    if nmap["strength"] == 1.0:  # the flags have no Strength
+    if "bump" in nmap and not run_sgbake(
+            cli, scene_file("scene_sum.json", strength, [("tangent-normal", "ours_nmap_sum.exr")],
+                            base="surface"), log):
+        failed.append(log[-1])
+    if nmap["strength"] == 1.0 and "bump" not in nmap:  # the flags have no Strength or chain
         flags = ["bake", "--mesh", p("mesh.obj"), "--normal", p("normal.exr"), "--normal-space",
                  nmap["space"], "--map", "tangent-normal", "--size", size, "--green", green,
                  "-o", p("ours_nmap_flags.exr")] + common
@@ -247,7 +271,10 @@ def passes_bake(s):
     return s["median_deg"] <= BAKE_MEDIAN_DEG
 
 
-def passes_nmap(s):
+def passes_nmap(s, chain=False):
+    if chain:
+        return (s["median_deg"] <= CHAIN_MEDIAN_DEG and s["p90_deg"] <= CHAIN_P90_DEG
+                and s["p99_deg"] <= CHAIN_P99_DEG)
     return (s["median_deg"] <= NMAP_MEDIAN_DEG and s["p90_deg"] <= NMAP_P90_DEG
             and s["p99_deg"] <= NMAP_P99_DEG)
 
@@ -255,11 +282,15 @@ def passes_nmap(s):
 def evaluate_nmap(name, r, nmap):
     """Prints the figures of a normal-map case; returns a list of failure descriptions."""
     fails = []
+    chain = "bump" in nmap
     print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {nmap['space']}-space normal map "
-          f"(tilts up to {nmap['tilt_deg']:g} deg), Strength {nmap['strength']:g}, "
-          f"{r['covered']} covered texels, {r['compared']} compared; Blender's tangent bake "
+          f"(tilts up to {nmap['tilt_deg']:g} deg), Strength {nmap['strength']:g}"
+          + (f", then a Bump node of Distance {nmap['bump']:g} on its output" if chain else "")
+          + f", {r['covered']} covered texels, {r['compared']} compared; Blender's tangent bake "
           f"tilt from +Z: {fmt_nmap(r['tilt'])}")
-    bars = f"(median <= {NMAP_MEDIAN_DEG}, p90 <= {NMAP_P90_DEG}, p99 <= {NMAP_P99_DEG})"
+    bars = (f"(median <= {CHAIN_MEDIAN_DEG}, p90 <= {CHAIN_P90_DEG}, p99 <= {CHAIN_P99_DEG})"
+            if chain else
+            f"(median <= {NMAP_MEDIAN_DEG}, p90 <= {NMAP_P90_DEG}, p99 <= {NMAP_P99_DEG})")
     for key, what in (("nmap_tangent", "tangent-normal vs Blender tangent"),
                       ("nmap_object", "object-normal vs Blender object ")):
         if key not in r or "error" in r[key]:
@@ -267,7 +298,7 @@ def evaluate_nmap(name, r, nmap):
                                                          else "no output to compare"))
             continue
         s = r[key]
-        ok = passes_nmap(s)
+        ok = passes_nmap(s, chain)
         print(f"  (d) {what}: {fmt_nmap(s)} worst at (x, row) {s.get('worst_at')} -> "
               f"{'ok' if ok else 'FAIL'} {bars}")
         if not ok:
@@ -277,10 +308,19 @@ def evaluate_nmap(name, r, nmap):
                 fails.append(f"{name}: normal-map bake background is not (0.5, 0.5, 1) outside "
                              f"the islands (max |diff| {s['outside_max_abs']:.3g})")
             print(f"      control, green flipped:            {fmt_nmap(s['flipped_green'])}")
-            if passes_nmap(s["flipped_green"]):
+            if passes_nmap(s["flipped_green"], chain):
                 fails.append(f"{name}: negative control: the normal-map bake with green "
                              f"flipped still passes")
-    if nmap["strength"] == 1.0:
+    if chain:
+        s = r.get("nmap_sum")
+        if s is None or "error" in s:
+            fails.append(f"{name}: no control bake with the bump's gradient added")
+        else:
+            print(f"      control, bump added, not stacked:  {fmt_nmap(s)}")
+            if passes_nmap(s, chain):
+                fails.append(f"{name}: negative control: the bake with the bump added to the "
+                             f"normal map's gradient still passes ({fmt_nmap(s)})")
+    if nmap["strength"] == 1.0 and not chain:
         s = r.get("nmap_flags")
         same = s.get("json_vs_flags_max_abs") if s else None
         if s is None or "error" in s:
@@ -296,7 +336,7 @@ def evaluate_nmap(name, r, nmap):
         fails.append(f"{name}: no 0.9 x Strength control bake to compare")
     else:
         print(f"      control, 0.9 x Strength:           {fmt_nmap(s)}")
-        if passes_nmap(s):
+        if passes_nmap(s, chain):
             fails.append(f"{name}: negative control: the bake at 0.9 x Strength still passes "
                          f"({fmt_nmap(s)})")
     return fails

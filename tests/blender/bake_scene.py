@@ -108,13 +108,17 @@ def case(name, size, scale, subdivision=0):
 NORMAL_MAPS = {}
 
 
-def normal_map_case(name, mesh_case, size, space, strength, tilt_deg):
+def normal_map_case(name, mesh_case, size, space, strength, tilt_deg, bump=None):
     """Registers case `name`: the mesh of case `mesh_case`, its material a Normal Map node in
     `space` with `strength`, fed by a normal image whose normals lean up to `tilt_deg` from the
-    surface normal (normal_field, or object_normal_field in object space)."""
+    surface normal (normal_field, or object_normal_field in object space). With `bump` (a
+    Distance), a Bump node of that Distance fed by the height image follows it, its Normal
+    input linked to the Normal Map node's output (a chain)."""
     CASES[name] = (CASES[mesh_case][0], size, 0.0)
     SUBDIVISION[name] = SUBDIVISION[mesh_case]
     NORMAL_MAPS[name] = {"space": space, "strength": strength, "tilt_deg": tilt_deg}
+    if bump is not None:
+        NORMAL_MAPS[name]["bump"] = bump
 
 
 def apply_subdivision(ob, levels):
@@ -221,6 +225,9 @@ normal_map_case("nmap_cube_s2", "cube_flat", 256, "TANGENT", 2.0, 40.0)
 # Suzanne's quads (UVs no parallelograms): Cycles' Normal Map node decodes in MikkTSpace of its
 # triangulated mesh, which the polygon mesh's frames miss by a median 0.32 deg here.
 normal_map_case("nmap_suzanne", "suzanne", 256, "TANGENT", 1.0, 40.0)
+# A Bump node on the normal map's output (its Normal input linked): sgbake's "base": "above".
+normal_map_case("chain_sphere", "sphere", 512, "TANGENT", 1.0, 40.0, bump=0.1)
+normal_map_case("chain_suzanne", "suzanne", 512, "TANGENT", 1.0, 40.0, bump=0.1)
 
 
 def tilt_field(size, tilt_deg):
@@ -308,23 +315,33 @@ def make_material(height_image, scale):
     return mat, target
 
 
-def make_normal_material(normal_image, space, strength, uv_map):
+def make_normal_material(normal_image, space, strength, uv_map, height_image=None, bump=None):
     """The normal-map material of the module docstring: an Image Texture of `normal_image`
     (Linear = sgbake's bilinear, Repeat) into a Normal Map node in `space` on UV map `uv_map`
-    with `strength`; returns (material, bake target node)."""
-    mat, target = make_material(normal_image, 0.0)
+    with `strength`; with `height_image`, the Bump node of make_material (Distance `bump`, fed
+    by that image) takes the Normal Map's output into its Normal input and feeds the BSDF.
+    Returns (material, bake target node)."""
+    mat, target = make_material(height_image, 0.0 if bump is None else bump)
     nt = mat.node_tree
     nodes = nt.nodes
-    bump = next(n for n in nodes if n.bl_idname == "ShaderNodeBump")
-    tex = next(n for n in nodes if n.bl_idname == "ShaderNodeTexImage" and n != target)
+    bump_node = next(n for n in nodes if n.bl_idname == "ShaderNodeBump")
     diffuse = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfDiffuse")
-    nodes.remove(bump)
     nmap = nodes.new("ShaderNodeNormalMap")
     nmap.space = space
     nmap.uv_map = uv_map
     nmap.inputs["Strength"].default_value = strength
+    if height_image is None:
+        tex = next(n for n in nodes if n.bl_idname == "ShaderNodeTexImage" and n != target)
+        tex.image = normal_image
+        nodes.remove(bump_node)
+        nt.links.new(nmap.outputs["Normal"], diffuse.inputs["Normal"])
+    else:
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image = normal_image
+        tex.interpolation = "Linear"
+        tex.extension = "REPEAT"
+        nt.links.new(nmap.outputs["Normal"], bump_node.inputs["Normal"])
     nt.links.new(tex.outputs["Color"], nmap.inputs["Color"])
-    nt.links.new(nmap.outputs["Normal"], diffuse.inputs["Normal"])
     return mat, target
 
 
@@ -399,8 +416,13 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             bpy.data.images.remove(own)
         normal = bake_common.new_float_image("normal", height_size, height_size, field)
         bake_common.save_exr(normal, os.path.join(out_dir, "normal.exr"))
+        height = None
+        if "bump" in nmap:
+            height = bake_common.new_float_image("height", height_size, height_size,
+                                                 height_field(height_size))
+            bake_common.save_exr(height, os.path.join(out_dir, "height.exr"))
         mat, target = make_normal_material(normal, nmap["space"], nmap["strength"],
-                                           me.uv_layers[0].name)
+                                           me.uv_layers[0].name, height, nmap.get("bump"))
     me.materials.clear()
     me.materials.append(mat)
 
@@ -412,6 +434,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}
+        if "bump" in nmap:
+            entry["normal_map"]["bump"] = nmap["bump"]
     for kind in passes:
         img = bake_common.new_float_image(f"blender_{kind}", size, size)
         for _ in range(runs):

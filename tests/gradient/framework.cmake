@@ -6,3 +6,5 @@ sgbake_add_gtest(gradient_framework_tests
   projection_test.cpp
   layers_test.cpp
   corners_test.cpp)
+# Cycles' valid-reflection guard, private to the library, is read directly by the layer tests.
+target_include_directories(gradient_framework_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)

@@ -4,11 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/layers.hpp"
 #include "support/analytic_textures.hpp"
@@ -153,6 +155,89 @@ TEST(Composite, ZeroWeightsAndZeroMasksDoNotSample) {
   EXPECT_EQ(compositeGradient(std::vector<Layer>{{src, 1.0, {&half, 3}}}, p), Vec3d{});  // no set 3
   EXPECT_EQ(compositeGradient({}, p), Vec3d{});
   EXPECT_LT(maxAbsDiff(perturbedNormal(p, {}), p.normal), 1e-15);
+}
+
+// A height layer on the layers above is Cycles' Bump node with its Normal input linked to the
+// node before it (svm_node_set_bump): with screen differentials ∂P/∂x, ∂P/∂y in the plane of
+// Ng and the height's differences along them, R_x = ∂P/∂y × n₁, R_y = n₁ × ∂P/∂x,
+// det = ⟨∂P/∂x, R_x⟩, n₂ = normalize(|det| n₁ − sign(det) (Δh_x R_x + Δh_y R_y)) and the
+// Strength blend normalize(s n₂ + (1 − s) n₁). A linear height makes the differences exact, so
+// the composite must give n₂ to round-off for any choice of the two differentials; adding the
+// bump's gradient to the normal map's instead is off by far more.
+TEST(Composite, ALayerOnTheLayersAboveIsCyclesBumpOnTheirNormal) {
+  std::mt19937_64 rng(5);
+  AnalyticHeight ramp(0.8, -0.5, 0);  // linear
+  WavyNormalTexture ts;
+  std::uniform_real_distribution<double> u(-1, 1);
+  double largestSumError = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    SurfacePoint p = samplePoint(rng);
+    const Vec3d ng = p.normal;  // the plane of ∂P/∂u, ∂P/∂v
+    // A smooth normal up to ~14° off the face's.
+    p.normal = normalizeOr(ng + 0.15 * Vec3d{u(rng), u(rng), u(rng)}, ng);
+    p.tangent = normalizeOr(p.tangent - dot(p.tangent, p.normal) * p.normal, Vec3d{1, 0, 0});
+    const double scale = 0.05 + 0.1 * (u(rng) + 1), weight = 1 + 0.5 * u(rng);
+    const double strength = trial % 3 == 0 ? 1.0 : 0.5 + 0.4 * u(rng);
+    const TangentNormalSource map{&ts, 1, {}};
+    Layer bump{UvHeightSource{&ramp, 0, scale}, weight, {}};
+    std::get<UvHeightSource>(bump.source).strength = strength;
+    bump.base = LayerBase::kLayersAbove;
+    const std::vector<Layer> layers{Layer{map, 1.0, {}}, bump};
+
+    // Cycles: the normal the Normal Map node hands on, and the Bump node on it.
+    const Vec3d n1 = normalizeOr(p.normal - layerGradient(map, p), p.normal);
+    const Vec2d dx{0.01 * (1 + u(rng)), 0.004 * u(rng)}, dy{0.003 * u(rng), 0.01 * (1 + u(rng))};
+    const Vec3d dPdx = dx.x * p.uv[0].dPdu + dx.y * p.uv[0].dPdv;
+    const Vec3d dPdy = dy.x * p.uv[0].dPdu + dy.y * p.uv[0].dPdv;
+    const double hx = weight * scale * (0.8 * dx.x - 0.5 * dx.y);  // the ramp's differences
+    const double hy = weight * scale * (0.8 * dy.x - 0.5 * dy.y);
+    const Vec3d rx = cross(dPdy, n1), ry = cross(n1, dPdx);
+    const double det = dot(dPdx, rx);
+    const Vec3d bumped =
+        normalizeOr(std::abs(det) * n1 - (det < 0 ? -1.0 : 1.0) * (hx * rx + hy * ry), n1);
+    const Vec3d expected = normalizeOr(strength * bumped + (1 - strength) * n1, n1);
+
+    // Cycles' guard (validReflectionNormal) leaves both alone here: what is compared is the bump.
+    ASSERT_TRUE(gradient_detail::reflectsAboveSurface(n1, ng, p.normal)) << trial;
+    ASSERT_TRUE(gradient_detail::reflectsAboveSurface(expected, ng, p.normal)) << trial;
+    const Vec3d ours = resolveNormal(p.normal, compositeGradient(layers, p, ng));
+    EXPECT_LT(length(ours - expected), 1e-12) << "trial " << trial;
+    Layer added = bump;
+    added.base = LayerBase::kSurface;
+    const std::vector<Layer> sum{Layer{map, 1.0, {}}, added};
+    largestSumError = std::max(
+        largestSumError, length(resolveNormal(p.normal, compositeGradient(sum, p, ng)) - expected));
+  }
+  EXPECT_GT(largestSumError, 1e-2);
+}
+
+// On nothing (no layers above, or all masked out) a layer on the layers above is the same bump
+// as on the surface; a normal map cannot be one (its node has no Normal input).
+TEST(Composite, ALayerOnNothingIsOnTheSurfaceAndNormalMapsCannotBeOnTop) {
+  std::mt19937_64 rng(9);
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  for (int trial = 0; trial < 20; ++trial) {
+    const SurfacePoint p = samplePoint(rng);
+    // (A weight scales the height of a layer on the layers above, before its Strength blend,
+    // and the Γ of one on the surface, after it: the two agree when either is 1.)
+    const bool blend = trial % 2 == 0;
+    Layer onTop{UvHeightSource{&h, 0, 0.3}, blend ? 1.0 : 0.7, {}};
+    std::get<UvHeightSource>(onTop.source).strength = blend ? 0.75 : 1.0;
+    const std::vector<Layer> surface{onTop};
+    onTop.base = LayerBase::kLayersAbove;
+    const std::vector<Layer> above{onTop};
+    EXPECT_LT(length(resolveNormal(p.normal, compositeGradient(above, p)) -
+                     resolveNormal(p.normal, compositeGradient(surface, p))),
+              1e-12)
+        << trial;
+  }
+  WavyNormalTexture ts;
+  Layer map{TangentNormalSource{&ts, 0, {}}, 1.0, {}};
+  map.base = LayerBase::kLayersAbove;
+  const Status refused = validateLayers(std::vector<Layer>{map}, 1);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("layer 0"), std::string::npos) << refused.error().message;
+  EXPECT_NE(refused.error().message.find("only a height"), std::string::npos);
 }
 
 TEST(Layers, InvalidLayersContributeNothingAndAreReported) {

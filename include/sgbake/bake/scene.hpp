@@ -26,7 +26,8 @@
 ///   range and unknown names. Keys starting with `_` are comments and are ignored.
 /// - Defaults: top-level "uv" (default 0) is the UV set of every layer and output that does not
 ///   give its own; size 1024, margin 16, padding "extend", samples 1, green "opengl", weight 1,
-///   filter "bilinear", tiling 1, offset 0, scale/strength 1, triplanar sharpness 4.
+///   filter "bilinear", tiling 1, offset 0, scale/strength 1, triplanar sharpness 4, base
+///   "surface".
 #pragma once
 
 #include <cstdint>
@@ -145,6 +146,9 @@ struct SceneLayer {
   ProjectionAxis axis = ProjectionAxis::kZ;        ///< "axis" (planar)
   double sharpness = kDefaultTriplanarSharpness;   ///< "sharpness" (triplanar)
   double minWeight = kDefaultMinTriplanarWeight;   ///< "min_weight" (triplanar)
+  /// "base" (heights): "surface" (N, the default) or "above" (the normal the layers above make,
+  /// as a Bump node whose Normal input is linked to them; LayerBase::kLayersAbove)
+  LayerBase base = LayerBase::kSurface;
 
   // Volume layers.
   VolumeFunction function = VolumeFunction::kSine;      ///< "function"

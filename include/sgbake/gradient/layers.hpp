@@ -4,7 +4,9 @@
 /// A Layer names one source of surface gradient (a UV-mapped height map, a tangent- or
 /// object-space normal map, a height volume, a planar or triplanar projection) plus a weight and
 /// an optional mask. Because Γ is linear in the height (eq. 35), blending layers is adding their
-/// surface gradients; the composite is resolved once into the perturbed normal (eq. 33).
+/// surface gradients; the composite is resolved once into the perturbed normal (eq. 33). A
+/// height layer may instead bump the normal the layers above it make (LayerBase::kLayersAbove),
+/// as a chain of Blender's Bump nodes does; that step is not linear.
 ///
 /// Textures and volumes are **non-owning** const pointers: the caller (the baker's planner) owns
 /// them and keeps them alive while layers are evaluated. Every texture is sampled only through
@@ -111,11 +113,24 @@ struct LayerMask {
   Vec2d offset{0, 0};
 };
 
+/// @brief Which normal a layer bumps.
+enum class LayerBase {
+  /// The surface's shading normal N: the layer's Γ is added to the others' (eq. 34-35).
+  kSurface,
+  /// The normal the layers above it make, n₁ = normalize(N − Γ_above) (guarded as Cycles
+  /// guards every Bump and Normal Map node's output): Blender's Bump node with its Normal input
+  /// linked to the node before it (a Normal Map node, another Bump node). Heights only (UV
+  /// height maps, volumes, planar and triplanar heights): a Normal Map node has no Normal input.
+  /// See stackLayerGradient.
+  kLayersAbove,
+};
+
 /// @brief A source with its blend weight and optional mask.
 struct Layer {
   LayerSource source;
   double weight = 1;  ///< any finite value (negative inverts the bumps); 0 disables
   LayerMask mask{};
+  LayerBase base = LayerBase::kSurface;
 };
 
 /// @brief Γ of a layer's source alone (no weight, no mask), object space, at @p point.
@@ -127,12 +142,32 @@ Vec3d layerGradient(const LayerSource& source, const SurfacePoint& point);
 /// set is missing or the mask value is NaN.
 double layerMask(const LayerMask& mask, const SurfacePoint& point);
 
-/// @brief The composite surface gradient Σ_i weight_i · mask_i · Γ_i (eq. 34-35).
+/// @brief The composite surface gradient Σ_i weight_i · mask_i · Γ_i (eq. 34-35), in span
+/// order; a layer based on kLayersAbove replaces the sum so far with stackLayerGradient's.
 ///
 /// Layers with weight 0, a non-finite weight, or mask 0 are skipped without sampling their
-/// source. Layer order does not matter up to round-off (the sum is taken in span order).
+/// source. Without kLayersAbove layers, order does not matter up to round-off.
+/// @param[in] geometricNormal the unit normal of the surface's plane at the point (a mesh
+///            triangle's Ng), for kLayersAbove layers; N where there is none (a corner, a limit
+///            surface), which the two-argument form uses
 /// @return Γ, object space; 0 for an empty span.
+Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point,
+                        const Vec3d& geometricNormal);
 Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point);
+
+/// @brief Γ after a layer based on kLayersAbove (finite nonzero weight), from @p gammaAbove,
+/// the composite of the layers before it: Cycles' Bump node with its Normal input linked.
+///
+/// With n₁ = validReflectionNormal(normalize(N − Γ_above), Ng, N), the normal the layers above
+/// make, and γ = weight · mask · Γ of the layer's source without its Strength (⊥ N, and
+/// ⟨γ, e⟩ = the height's derivative along e for every e in the plane of Ng): the Bump node's
+/// surface gradient relative to n₁ is the vector ⊥ n₁ with the same derivatives along the
+/// plane, σ = γ − (⟨γ, n₁⟩ / ⟨Ng, n₁⟩) Ng (Cycles' (∂h/∂x R_x + ∂h/∂y R_y) / det with
+/// R_x = ∂P/∂y × n₁, R_y = n₁ × ∂P/∂x, for any two directions ∂P/∂x, ∂P/∂y spanning the plane).
+/// Then n₂ = normalize(n₁ − σ), blended with n₁ by the layer's Strength (UV height maps), guarded
+/// again; returned as the Γ that resolves to it, N − n₂ / ⟨n₂, N⟩ (a guarded n₂ has ⟨n₂, N⟩ > 0).
+Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
+                         const Vec3d& geometricNormal, const Vec3d& gammaAbove);
 
 /// @brief The perturbed normal resolveNormal(N, compositeGradient(layers, point), cof) (eq. 33).
 /// @param[in] objectScaleCofactor cof(M) of the object's transform; identity = object space
@@ -141,7 +176,8 @@ Vec3d perturbedNormal(const SurfacePoint& point, std::span<const Layer> layers,
 
 /// @brief Checks every layer for what would make it contribute nothing silently: a missing
 /// texture or volume for its kind, a UV set outside [0, min(numUvSets, kMaxUvSets)), non-finite
-/// weight, scale, strength, tiling, offset, sharpness or step.
+/// weight, scale, strength, tiling, offset, sharpness or step; a normal-map layer based on
+/// kLayersAbove.
 /// @return kBadInput naming the first bad layer ("layer 2 (tangent-space normal map): no texture").
 Status validateLayers(std::span<const Layer> layers, int numUvSets);
 
