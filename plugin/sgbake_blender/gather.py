@@ -21,20 +21,29 @@ class BakeInputError(Exception):
     """The object, its UV maps or the layers' images cannot be baked as they are."""
 
 
+def render_uv_name(mesh):
+    """The name of the mesh's UV map active for rendering (the camera icon of the UV Maps
+    list), which Cycles reads an Image Texture without a UV Map node on; the active UV map
+    when none is marked."""
+    return next((uv.name for uv in mesh.uv_layers if uv.active_render),
+                mesh.uv_layers.active.name)
+
+
 def uv_sets(mesh, bake_uv_name, layers):
     """The UV maps to send, in order, and the index of the bake's UV map among them.
 
     Set 0 is the active UV map: libsgbake builds tangent frames on set 0, and Blender's bake
     builds them on the active UV map whatever UV map it bakes on. The bake's UV map (default:
-    the active one) and the UV maps layers name follow, each once, so that a bake never sends
-    more UV maps than it reads."""
+    the active one) and the UV maps layers read follow (a layer's own, else the render UV map,
+    render_uv_name), each once, so that a bake never sends more UV maps than it reads."""
     if len(mesh.uv_layers) == 0:
         raise BakeInputError("has no UV map")
     names = [mesh.uv_layers.active.name]
     bake_uv_name = bake_uv_name or names[0]
+    render_uv = render_uv_name(mesh)
     wanted = [("the bake", bake_uv_name)]
-    wanted += [(f"layer '{layer.name}'", layer.uv_map) for layer in layers
-               if layer.type in scene.UV_LAYER_TYPES and layer.uv_map]
+    wanted += [(f"layer '{layer.name}'", layer.uv_map or render_uv) for layer in layers
+               if layer.type in scene.UV_LAYER_TYPES]
     wanted += [(f"the mask of layer '{layer.name}'", layer.mask_uv_map) for layer in layers
                if layer.mask_image is not None and layer.mask_uv_map]
     for user, name in wanted:
@@ -117,6 +126,45 @@ def modifier_hidden(modifier):
         yield
     finally:
         modifier.show_viewport = shown
+
+
+def world_scale(ob, layers):
+    """The factor height layers' Scale (world units, as Cycles' Bump Distance) is divided by
+    to become object units for the bake, and notes for the report: the object's scale, or the
+    geometric mean of its axes' when they differ (with a note: Cycles' bumps then differ by
+    direction, which a height in object units cannot follow)."""
+    if not any(layer.type == "height" for layer in layers):
+        return 1.0, []
+    linear = ob.matrix_world.to_3x3()
+    axes = [column.length for column in linear.col]
+    volume = abs(linear.determinant())
+    if not volume > 0:
+        return 1.0, [f"object '{ob.name}' has a zero scale: its heights are taken in object "
+                     "units"]
+    mean = volume ** (1.0 / 3.0)
+    if max(axes) > min(axes) * (1 + 1e-5):
+        return mean, [f"object '{ob.name}' is scaled unevenly ({', '.join(f'{a:.4g}' for a in axes)}):"
+                      f" its heights are divided by {mean:.4g}, but Cycles' bumps in world units "
+                      "differ by direction (apply the scale for an exact match)"]
+    return mean, []
+
+
+def viewport_subdivision_notes(ob, surface):
+    """Notes for Subdivision Surface modifiers whose viewport mesh, which is baked here, is not
+    the one Cycles bakes (render levels, render visibility). Not for the exact limit surface."""
+    if surface == "limit":
+        return []
+    notes = []
+    for modifier in ob.modifiers:
+        if modifier.type != "SUBSURF":
+            continue
+        viewport = modifier.levels if modifier.show_viewport else 0
+        render = modifier.render_levels if modifier.show_render else 0
+        if viewport != render:
+            notes.append(f"modifier '{modifier.name}' subdivides {viewport} time(s) in the "
+                         f"viewport, which is baked, and {render} time(s) for rendering, which "
+                         "Cycles bakes")
+    return notes
 
 
 def creases(mesh):

@@ -20,13 +20,20 @@ _cache = {}  # (preferences path, $SGBAKE_LIBRARY) -> ctypes.CDLL or capi.Sgbake
 
 
 def preferences_path(context):
-    """The Library path of the add-on preferences, "" when unset or when the add-on was
-    registered without being enabled in the Preferences (e.g. by a script)."""
+    """The Library path of the add-on preferences, absolute; "" when unset or when the add-on
+    was registered without being enabled in the Preferences (e.g. by a script). Raises
+    capi.SgbakeError for a path relative to an unsaved .blend file."""
     addon = context.preferences.addons.get(__package__)
     if addon is None or addon.preferences is None:
         return ""
     path = addon.preferences.library_path
-    return bpy.path.abspath(path) if path else ""  # '//' is relative to the .blend file
+    if not path:
+        return ""
+    if path.startswith("//") and not bpy.data.filepath:
+        # bpy.path.abspath would leave a bare file name, which the system's search resolves.
+        raise capi.SgbakeError(f"the add-on preferences' Library path '{path}' is relative to "
+                               "the .blend file, which is not saved yet")
+    return os.path.abspath(bpy.path.abspath(path))  # '//' is relative to the .blend file
 
 
 def get(context, retry=True):

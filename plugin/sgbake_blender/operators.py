@@ -51,6 +51,7 @@ class BakeJob:
             try:
                 try:
                     uv_names, bake_uv = gather.uv_sets(mesh, settings.uv_map, layers)
+                    render_uv = gather.render_uv_name(mesh)
                 except gather.BakeInputError as exc:
                     raise gather.BakeInputError(f"object '{ob.name}' {exc}") from None
                 if len(mesh.polygons) == 0:
@@ -78,8 +79,11 @@ class BakeJob:
             gather.check_target(image)
         gather.check_memory(self.width, self.height, settings.padding)
         self.tiles = gather.image_tiles(image)
+        # Cycles' Bump Distance is in world units, the mesh here in object units.
+        world_scale, self.notes = gather.world_scale(ob, layers)
+        self.notes += gather.viewport_subdivision_notes(ob, self.surface)
         self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
-                                              subdivision)
+                                              subdivision, world_scale, render_uv)
                        for tile in self.tiles}
         self.scene = self.scenes[self.tiles[0]]
         self.uv_tiles = gather.uv_tiles(self.arrays[4][bake_uv], self.arrays[1])
@@ -226,12 +230,14 @@ class OBJECT_OT_sgbake_bake(bpy.types.Operator):
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         level, tile_notes = job.tile_notes(image.name)
+        if job.notes:
+            level = "WARNING"
         tiles = (f" (UDIM tile(s) {_tile_list(job.tiles)}, packed into the .blend file)"
                  if job.tiled else "")
         surface = " of the exact limit surface" if job.surface == "limit" else ""
         self.report({level}, "; ".join([f"sgbake: {job.map} {job.width} x {job.height}{surface} "
                                         f"into '{image.name}'{tiles} in {job.seconds:.2f} s"]
-                                       + notes + tile_notes))
+                                       + notes + job.notes + tile_notes))
         return {"FINISHED"}
 
 
@@ -255,7 +261,11 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
         if material is None or not material.use_nodes:
             self.report({"ERROR"}, "the active object has no active node material")
             return {"CANCELLED"}
-        found, skipped, ignored = material_layers(material.node_tree)
+        render_uv = gather.render_uv_name(ob.data) if ob.data.uv_layers else None
+        found, skipped, ignored = material_layers(material.node_tree, render_uv)
+        if len({slot.material for slot in ob.material_slots if slot.material}) > 1:
+            ignored.append(f"object '{ob.name}' has other materials: the layers bump every "
+                           "face, also those of the other materials")
         if not found:
             self.report({"ERROR"}, f"material '{material.name}' has no Bump or Normal Map node "
                                    "fed by an Image Texture node" + _notes(skipped))
@@ -290,6 +300,36 @@ def _linked_image_node(socket):
     return node if node.type == "TEX_IMAGE" and node.image is not None else None
 
 
+def _source_node(socket):
+    """The node linked into `socket` through any Reroute nodes, or None."""
+    while socket.is_linked:
+        link = socket.links[0]
+        if link.is_muted:
+            return None
+        if link.from_node.type != "REROUTE":
+            return link.from_node
+        socket = link.from_node.inputs[0]
+    return None
+
+
+def _surface_nodes(node_tree):
+    """The names of the nodes whose outputs reach the Surface input of the output node Cycles
+    renders, or None when there is no such node."""
+    output = node_tree.get_output_node("CYCLES")
+    if output is None:
+        return None
+    seen, todo = set(), [link.from_node for link in output.inputs["Surface"].links
+                         if not link.is_muted]
+    while todo:
+        node = todo.pop()
+        if node.name in seen:
+            continue
+        seen.add(node.name)
+        todo += [link.from_node for socket in node.inputs for link in socket.links
+                 if not link.is_muted]
+    return seen
+
+
 def _not_image(socket):
     """Why `socket` gave no layer: what is linked into it instead of an Image Texture node."""
     if socket.is_linked and socket.links[0].from_node.type == "TEX_IMAGE":
@@ -297,12 +337,18 @@ def _not_image(socket):
     return f"{socket.name} is not an Image Texture node"
 
 
-def _ignored(node, tex, inputs):
-    """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` a layer cannot
-    take over: a Vector input other than a UV map (a Mapping node, object or generated
-    coordinates), a projection other than Flat, and node-driven `inputs` (of which the layer
-    takes the unconnected value)."""
+def _ignored(node, tex, inputs, socket):
+    """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
+    `socket` a layer cannot take over: the texture's Alpha output (the layer reads its colour),
+    a Vector input other than a UV map (a Mapping node, object or generated coordinates), a
+    projection other than Flat, Closest interpolation (read bilinear), and node-driven
+    `inputs` (of which the layer takes the unconnected value)."""
     notes = []
+    if node.inputs[socket].links[0].from_socket.name == "Alpha":
+        notes.append(f"'{node.name}' {socket} from '{tex.name}' Alpha (the layer reads its "
+                     "colour)")
+    if tex.interpolation == "Closest":
+        notes.append(f"'{tex.name}' Closest interpolation (read bilinear)")
     vector = tex.inputs["Vector"]
     if vector.is_linked:
         link = vector.links[0]
@@ -319,41 +365,55 @@ def _ignored(node, tex, inputs):
     return notes
 
 
-def _texture_settings(node):
-    """Layer settings taken from an Image Texture node: image, filter, wrap and, when its
-    Vector input comes from a UV Map node, that UV map."""
+def _texture_settings(node, render_uv=None):
+    """Layer settings taken from an Image Texture node: image, filter, wrap and its UV map: a
+    UV Map node's, else `render_uv` (Cycles reads an Image Texture without a UV Map node on
+    the UV map active for rendering, whichever the bake is on)."""
     values = {"image": node.image, "name": node.image.name,
               "filter": INTERPOLATION_FILTERS.get(node.interpolation, "bilinear"),
               "wrap": "clamp" if node.extension == "EXTEND" else "repeat"}
     vector = node.inputs["Vector"]
-    if vector.is_linked and vector.links[0].from_node.type == "UVMAP":
+    if vector.is_linked and vector.links[0].from_node.type == "UVMAP" \
+            and vector.links[0].from_node.uv_map:
         values["uv_map"] = vector.links[0].from_node.uv_map
+    elif render_uv:
+        values["uv_map"] = render_uv
     return values
 
 
-def material_layers(node_tree):
+def material_layers(node_tree, render_uv=None):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
-    and each Normal Map node whose Color input is an Image Texture node, in node order; and
-    notes on the Bump and Normal Map nodes that were not used.
+    and each Normal Map node whose Color input is an Image Texture node, among the nodes that
+    reach the Surface of the material's output; and notes on the Bump and Normal Map nodes that
+    were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV map
+    active for rendering (what Cycles reads a texture without a UV Map node on).
 
     Bump: scale = Distance, negated when Invert is on, and its Strength (the blend of the bumped
-    normal with the original one, as Cycles' Bump node does it). Normal Map: its space
+    normal with the original one, as Cycles' Bump node does it); when its Normal input comes
+    from a Bump or Normal Map node that made a layer, base "above" (it bumps that node's
+    normal), the layers ordered so that such a node's comes first. Normal Map: its space
     (Tangent or Object) and its Strength. Then notes on what the layers cannot take over
     (_ignored): the layers are made, and the report says what differs."""
     found, skipped, ignored = [], [], []
+    reaching = _surface_nodes(node_tree)
+    made = {}  # node name -> its entry of found
     for node in node_tree.nodes:
+        if node.type not in ("BUMP", "NORMAL_MAP"):
+            continue
+        if reaching is not None and node.name not in reaching:
+            skipped.append(f"'{node.name}': not linked to the material output's Surface")
+            continue
         if node.type == "BUMP":
             tex = _linked_image_node(node.inputs["Height"])
             if tex is None:
                 skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
                 continue
-            ignored += _ignored(node, tex, ("Strength", "Distance"))
+            ignored += _ignored(node, tex, ("Strength", "Distance"), "Height")
             scale = node.inputs["Distance"].default_value
-            values = _texture_settings(tex)
+            values = _texture_settings(tex, render_uv)
             values.update(type="height", scale=-scale if node.invert else scale,
                           strength=max(node.inputs["Strength"].default_value, 0.0))
-            found.append(values)
-        elif node.type == "NORMAL_MAP":
+        else:
             tex = _linked_image_node(node.inputs["Color"])
             space = NORMAL_MAP_SPACES.get(node.space)
             if tex is None or space is None:
@@ -361,12 +421,43 @@ def material_layers(node_tree):
                        else f"space {node.space} is not Tangent or Object")
                 skipped.append(f"'{node.name}': {why}")
                 continue
-            ignored += _ignored(node, tex, ("Strength",))
-            values = _texture_settings(tex)
+            ignored += _ignored(node, tex, ("Strength",), "Color")
+            values = _texture_settings(tex, render_uv)
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
-            if space == "tangent" and node.uv_map:
-                values["uv_map"] = node.uv_map
-            found.append(values)
+            if space == "tangent":
+                # Cycles takes the tangents from the node's UV map (empty: the render UV map)
+                # and reads the image on the texture's; a layer has one UV map for both, and
+                # reading the image elsewhere would be far worse than other tangents.
+                frames = node.uv_map or render_uv
+                image_uv = values.get("uv_map") or frames
+                if frames and image_uv and frames != image_uv:
+                    ignored.append(f"'{node.name}' tangents of UV map '{frames}' for an image "
+                                   f"on '{image_uv}' (the layer uses '{image_uv}' for both)")
+                if image_uv:
+                    values["uv_map"] = image_uv
+        made[node.name] = values
+        found.append(values)
+    # A Bump node on the output of another layer's node bumps that node's normal.
+    depth = {}
+
+    def chain_depth(name, seen=()):
+        if name in depth:
+            return depth[name]
+        node = node_tree.nodes[name]
+        below = 0
+        if node.type == "BUMP":
+            source = _source_node(node.inputs["Normal"])
+            if source is not None and source.name in made and source.name not in seen:
+                made[name]["base"] = "above"
+                below = chain_depth(source.name, seen + (name,)) + 1
+            elif source is not None:
+                ignored.append(f"'{node.name}' Normal from '{source.name}' (the layer bumps the "
+                               "surface's normal)")
+        depth[name] = below
+        return below
+
+    order = {id(values): chain_depth(name) for name, values in made.items()}
+    found.sort(key=lambda values: order[id(values)])
     return found, skipped, ignored
 
 

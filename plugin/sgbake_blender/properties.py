@@ -27,6 +27,12 @@ SPACES = (
     ("tangent", "Tangent", "The normal map is in tangent space"),
     ("object", "Object", "The normal map is in object space"),
 )
+BASES = (
+    ("surface", "Surface", "Bump the surface's normal: the layer's surface gradient is added to "
+                           "the others'"),
+    ("above", "Layers Above", "Bump the normal the layers above make, as a Bump node whose "
+                              "Normal input is linked to the node before it"),
+)
 KINDS = (
     ("height", "Height", "The image holds heights"),
     ("tangent-normal", "Tangent Normal", "The image holds tangent-space normals"),
@@ -61,12 +67,15 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                            description="The layer's image (heights, or encoded normals)")
     scale: FloatProperty(
         name="Scale", default=1.0, precision=4, step=1,
-        description="Height layers: object units per unit of image value (the Bump node's "
-                    "Distance). Normal layers: strength. Projections: both")
+        description="Height layers: world units per unit of image value, the Bump node's "
+                    "Distance (divided by the object's scale for the bake). Normal layers: "
+                    "strength. Projections: object units, or strength")
     strength: FloatProperty(
         name="Strength", default=1.0, min=0.0, soft_max=1.0, precision=3,
         description="Height layers: the Bump node's Strength, which blends the bumped normal "
                     "with the unbumped one (0: no bump, 1: the full bump)")
+    base: EnumProperty(name="Bumps", items=BASES, default="surface",
+                       description="Which normal a height layer bumps")
     filter: EnumProperty(name="Filter", items=FILTERS, default="bilinear")
     wrap: EnumProperty(name="Wrap", items=WRAPS, default="repeat")
     tiling: FloatVectorProperty(name="Tiling", size=2, default=(1.0, 1.0),
@@ -76,7 +85,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
         description="Added to the lookup after tiling, in image units: the image is read at "
                     "tiling x (u, v) + offset (projections: of the plane coordinates)")
     uv_map: StringProperty(name="UV Map",
-                           description="UV map the image is on; empty: the bake's UV map")
+                           description="UV map the image is on; empty: the UV map active for "
+                                       "rendering, which Cycles reads textures on")
     space: EnumProperty(name="Space", items=SPACES, default="tangent")
     green: EnumProperty(name="Green", items=GREENS, default="opengl",
                         description="Green channel convention of the normal map image")

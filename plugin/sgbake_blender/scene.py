@@ -37,7 +37,8 @@ UV_LAYER_TYPES = {"height", "normal"}  # layer types with their own "uv"
 
 SURFACES = (
     ("mesh", "Evaluated Mesh",
-     "The mesh as the object's modifiers make it: what Blender itself bakes"),
+     "The mesh as the object's modifiers make it in the viewport (Cycles bakes their render "
+     "settings)"),
     ("limit", "Exact Limit Surface",
      "The exact Catmull-Clark limit surface of the mesh under the object's last modifier, a "
      "Subdivision Surface (its creases, UV Smooth and Boundary Smooth; its levels do not "
@@ -100,21 +101,25 @@ def reads_tangent_normals(layer):
     return False
 
 
-def layer_json(layer, uv_index):
-    """One entry of "layers". uv_index(name) gives the UV set of a UV map name (the layer's own
-    UV map, when it names one, for height and normal layers)."""
+def layer_json(layer, uv_index, world_scale=1.0, default_uv=None):
+    """One entry of "layers". uv_index(name) gives the UV set of a UV map name (for height and
+    normal layers: the layer's own UV map, else `default_uv`, the render UV map, else the
+    scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance: it is
+    divided by `world_scale`, the object's scale."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
     if layer.type in IMAGE_LAYER_TYPES:
         entry.update(image=image_key(layer.image), filter=layer.filter, wrap=layer.wrap,
                      tiling=_pair(layer.tiling), offset=_pair(layer.offset))
     if layer.mask_image is not None:
         entry["mask"] = mask_json(layer, uv_index)
-    if layer.type in UV_LAYER_TYPES and layer.uv_map:
-        entry["uv"] = uv_index(layer.uv_map)
+    if layer.type in UV_LAYER_TYPES and (layer.uv_map or default_uv):
+        entry["uv"] = uv_index(layer.uv_map or default_uv)
     if layer.type == "height":
-        entry["scale"] = _number(layer.scale)
+        entry["scale"] = _number(layer.scale / world_scale)
         if layer.strength != 1.0:  # the Bump node's blend of normals (1: none)
             entry["strength"] = _number(layer.strength)
+        if layer.base != "surface":
+            entry["base"] = layer.base
     elif layer.type == "normal":
         entry.update(space=layer.space, strength=_number(layer.scale))
     elif layer.type == "volume":
@@ -173,12 +178,15 @@ def limit_subdivision_json(modifier, edge_creases, vertex_creases):
     return block
 
 
-def scene_json(settings, layers, bake_uv_set, uv_index, tile=1001, subdivision=None):
+def scene_json(settings, layers, bake_uv_set, uv_index, tile=1001, subdivision=None,
+               world_scale=1.0, default_uv=None):
     """The scene for sgbake_bake_map: the bake's UV set as the default of the layers and the
-    output ("uv"), the layers (baked_layers) and one output, of UDIM tile `tile`, and the
-    "subdivision" block when one is given (limit_subdivision_json)."""
+    output ("uv"), the layers (baked_layers; height scales divided by `world_scale`, their UV
+    map by default `default_uv`) and one output, of UDIM tile `tile`, and the "subdivision"
+    block when one is given (limit_subdivision_json)."""
     result = {"uv": bake_uv_set,
-              "layers": [layer_json(layer, uv_index) for layer in layers],
+              "layers": [layer_json(layer, uv_index, world_scale, default_uv)
+                         for layer in layers],
               "outputs": [output_json(settings, tile)]}
     if subdivision is not None:
         result["subdivision"] = subdivision

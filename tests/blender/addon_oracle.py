@@ -319,6 +319,71 @@ def error_reports(settings, prefs, height, work, library_path):
     return checks
 
 
+def material_checks(settings, ob, distance):
+    """Layers from Material on chains and strays, the UV map textures are read on, and what a
+    bake takes from the object (its scale, a Subdivision Surface's render levels). Returns
+    check records like expect_error's."""
+    import bpy
+    from sgbake_blender import operators
+    tree = ob.active_material.node_tree
+    tex = next(node for node in tree.nodes if node.type == "TEX_IMAGE" and node.image)
+    bump = next(node for node in tree.nodes if node.type == "BUMP")
+    checks = []
+
+    def check(name, ok, expected, message):
+        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
+
+    # A Normal Map node into the Bump's Normal input: its layer first, the height on top of it.
+    nmap = tree.nodes.new("ShaderNodeNormalMap")
+    tree.links.new(tex.outputs["Color"], nmap.inputs["Color"])
+    tree.links.new(nmap.outputs["Normal"], bump.inputs["Normal"])
+    chain, _, _ = operators.material_layers(tree)
+    check("Layers from Material: Normal Map into a Bump's Normal",
+          [(v["type"], v.get("base", "surface")) for v in chain]
+          == [("normal", "surface"), ("height", "above")],
+          "a normal layer, then the height with base 'above'", str(chain))
+    tree.nodes.remove(nmap)
+    # A Bump node linked to nothing makes no layer.
+    stray = tree.nodes.new("ShaderNodeBump")
+    tree.links.new(tex.outputs["Color"], stray.inputs["Height"])
+    found, skipped, _ = operators.material_layers(tree)
+    check("Layers from Material: a Bump linked to nothing",
+          len(found) == 1 and any("not linked" in note for note in skipped),
+          "one layer, the stray Bump skipped", f"{found}; skipped {skipped}")
+    tree.nodes.remove(stray)
+    # An Image Texture without a UV Map node is read on the UV map active for rendering.
+    render_uv, _, _ = operators.material_layers(tree, "UVMap")
+    check("Layers from Material: the render UV map",
+          len(render_uv) == 1 and render_uv[0].get("uv_map") == "UVMap",
+          "uv_map 'UVMap'", str(render_uv))
+
+    # The bake divides a height's Scale (world units) by the object's scale.
+    settings.map = "tangent-normal"
+    ob.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    job = operators.BakeJob(bpy.context)
+    scale = job.scene["layers"][0]["scale"]
+    check("bake: a height's Scale on an object scaled 2x", abs(scale - distance / 2) < 1e-6
+          and not job.notes, f"scale {distance / 2}, no note", f"scale {scale}, {job.notes}")
+    ob.scale = (1.0, 2.0, 1.0)
+    bpy.context.view_layer.update()
+    job = operators.BakeJob(bpy.context)
+    check("bake: an unevenly scaled object", any("unevenly" in n for n in job.notes),
+          "a note", str(job.notes))
+    ob.scale = (1.0, 1.0, 1.0)
+    # A Subdivision Surface with other render levels than viewport levels is named.
+    modifier = ob.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels, modifier.render_levels = 0, 1
+    bpy.context.view_layer.update()
+    job = operators.BakeJob(bpy.context)
+    check("bake: render levels unlike the viewport's",
+          any("'Subdivision'" in n and "for rendering" in n for n in job.notes), "a note",
+          str(job.notes))
+    ob.modifiers.remove(modifier)
+    bpy.context.view_layer.update()
+    return checks
+
+
 def worker_thread_checks(settings, ob):
     """The UI's way to bake (operators.BakeJob.run on a worker thread, as the modal operator
     runs it): progress rises to 1, and a cancel set from this thread stops the bake without
@@ -721,7 +786,8 @@ def blender_make(work, library_path, sabotage):
     manifest["options"] = options_case(settings, height, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["limit"] = limit_case(settings, ob, work, manifest["scale"])
-    manifest["errors"] = (worker_thread_checks(settings, ob)
+    manifest["errors"] = (material_checks(settings, ob, distance)
+                          + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
         json.dump(manifest, f, indent=1)
