@@ -32,8 +32,10 @@
 /// 0.2.0 appended sgbake_mesh::face_flat and sgbake_mesh::auto_smooth: a caller built against
 /// 0.1.0's header passes a shorter struct, so rebuild (and set both fields). 0.3.0 changes no
 /// C declaration: normal-map layers and steep bumps bake as Cycles shades them (manifests of
-/// 0.2.0 re-bake).
-#define SGBAKE_VERSION_STRING "0.3.0"
+/// 0.2.0 re-bake). 0.4.0 changes none either: the scene gains a height layer's "base"
+/// ("above": it bumps the normal of the layers before it, as chained Bump nodes do), and the
+/// corners table decodes tangent-space layers with the loop triangles' frames.
+#define SGBAKE_VERSION_STRING "0.4.0"
 
 #ifdef __cplusplus
 extern "C" {
