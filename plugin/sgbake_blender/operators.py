@@ -426,15 +426,12 @@ def material_layers(node_tree, render_uv=None):
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
             if space == "tangent":
                 # Cycles takes the tangents from the node's UV map (empty: the render UV map)
-                # and reads the image on the texture's; a layer has one UV map for both, and
-                # reading the image elsewhere would be far worse than other tangents.
+                # and reads the image on the texture's.
                 frames = node.uv_map or render_uv
-                image_uv = values.get("uv_map") or frames
-                if frames and image_uv and frames != image_uv:
-                    ignored.append(f"'{node.name}' tangents of UV map '{frames}' for an image "
-                                   f"on '{image_uv}' (the layer uses '{image_uv}' for both)")
-                if image_uv:
-                    values["uv_map"] = image_uv
+                if frames and frames != values.get("uv_map", frames):
+                    values["tangent_uv_map"] = frames
+                elif frames:
+                    values["uv_map"] = frames
         made[node.name] = values
         found.append(values)
     # A Bump node on the output of another layer's node bumps that node's normal.

@@ -88,6 +88,10 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                            description="UV map the image is on; empty: the UV map active for "
                                        "rendering, which Cycles reads textures on")
     space: EnumProperty(name="Space", items=SPACES, default="tangent")
+    tangent_uv_map: StringProperty(
+        name="Tangent UV Map",
+        description="Tangent-space normal layers: the UV map whose tangents decode the map (the "
+                    "Normal Map node's UV Map); empty: the layer's UV Map")
     green: EnumProperty(name="Green", items=GREENS, default="opengl",
                         description="Green channel convention of the normal map image")
     kind: EnumProperty(name="Kind", items=KINDS, default="height",

@@ -122,6 +122,8 @@ def layer_json(layer, uv_index, world_scale=1.0, default_uv=None):
             entry["base"] = layer.base
     elif layer.type == "normal":
         entry.update(space=layer.space, strength=_number(layer.scale))
+        if layer.space == "tangent" and layer.tangent_uv_map:
+            entry["tangent_uv"] = uv_index(layer.tangent_uv_map)
     elif layer.type == "volume":
         entry.update(function=layer.function, amplitude=_number(layer.amplitude),
                      frequency=_number(layer.frequency), gradient=layer.gradient)

@@ -275,6 +275,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
         source.options.strength = layer.scale;
         source.options.tiling = layer.tiling;
         source.options.offset = layer.offset;
+        if (layer.tangentUvSet) source.tangentUvSet = *layer.tangentUvSet;
         result.source = source;
       } else {
         ObjectNormalSource source;
@@ -367,17 +368,17 @@ Status prepareLayers(const Plan& plan, int threads, Loaded& loaded, ProgressRepo
   for (const Layer& layer : loaded.layers) {
     const auto* normal = std::get_if<TangentNormalSource>(&layer.source);
     if (normal == nullptr || normal->options.frame == TangentFrameChoice::kUvDerivatives ||
-        loaded.limit || normal->uvSet < 0 || normal->uvSet >= kMaxUvSets ||
-        !loaded.mesh.hasUvSet(static_cast<std::size_t>(normal->uvSet)) ||
-        loaded.triangleTangents[static_cast<std::size_t>(normal->uvSet)]) {
+        loaded.limit || normal->frameUvSet() < 0 || normal->frameUvSet() >= kMaxUvSets ||
+        !loaded.mesh.hasUvSet(static_cast<std::size_t>(normal->frameUvSet())) ||
+        loaded.triangleTangents[static_cast<std::size_t>(normal->frameUvSet())]) {
       continue;
     }
     Result<CornerTangents> triangles =
-        computeLoopTriangleTangents(loaded.mesh, normal->uvSet, tangentOptions);
+        computeLoopTriangleTangents(loaded.mesh, normal->frameUvSet(), tangentOptions);
     if (!triangles) {
       return Error{triangles.error().code, s.mesh.string() + ": " + triangles.error().message};
     }
-    loaded.triangleTangents[static_cast<std::size_t>(normal->uvSet)] = std::move(*triangles);
+    loaded.triangleTangents[static_cast<std::size_t>(normal->frameUvSet())] = std::move(*triangles);
   }
   report.tangentsComputed = true;
   progress.finishOne();

@@ -367,7 +367,7 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"uv", "scale", "strength", "base"});
       break;
     case SceneLayerType::kNormal:
-      add({"uv", "space", "green", "strength"});
+      add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
       add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
@@ -659,6 +659,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   reader.optionalName("kind", kKinds, layer.kind);
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
+  if (reader.has("tangent_uv"))
+    layer.tangentUvSet = reader.smallInteger("tangent_uv", 0, kMaxUvSets - 1);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
   if (reader.has("min_weight")) layer.minWeight = reader.numberAtLeast("min_weight", 0, false);
 
@@ -698,6 +700,9 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
        layer.kind != ProjectedKind::kTangentNormal);
   if (objectSpace && reader.has("green")) {
     fail(where, "key 'green' applies only to tangent-space normal maps");
+  }
+  if (layer.tangentUvSet && layer.space == NormalSpace::kObject) {
+    fail(where, "key 'tangent_uv' applies only to tangent-space normal maps");
   }
   if (layer.base == LayerBase::kLayersAbove && layer.readsNormals()) {
     fail(where,
@@ -1256,6 +1261,7 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     case SceneLayerType::kNormal:
       j["uv"] = layer.uvSet;
       j["space"] = nameIn(kSpaces, layer.space);
+      if (layer.tangentUvSet) j["tangent_uv"] = *layer.tangentUvSet;
       break;
     case SceneLayerType::kVolume:
       j["function"] = nameIn(kFunctions, layer.function);

@@ -37,7 +37,7 @@ Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point) {
   const Vec2d st =
       textureCoordinates(uvFrame(point, s.uvSet).uv, s.options.tiling, s.options.offset);
   const Vec3d n = decodeNormalTexel(s.texture->sample(st), s.options.green);
-  return gradientFromTangentNormal(n, point, s.uvSet, s.options);
+  return gradientFromTangentNormal(n, point, s.frameUvSet(), s.options);
 }
 
 Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point) {
@@ -94,7 +94,7 @@ class LayerChecker {
                   finite(s.tiling, "tiling"), finite(s.offset, "offset")});
   }
   std::string operator()(const TangentNormalSource& s) const {
-    return first({present(s.texture, "texture"), uvSet(s.uvSet),
+    return first({present(s.texture, "texture"), uvSet(s.uvSet), uvSet(s.frameUvSet()),
                   finite(s.options.strength, "strength"), finite(s.options.tiling, "tiling"),
                   finite(s.options.offset, "offset")});
   }

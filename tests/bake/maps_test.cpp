@@ -380,6 +380,25 @@ TEST(Maps, TangentSpaceLayersOnAnotherUvSetDecodeInItsOwnFrames) {
   EXPECT_EQ(a->pixels, b->pixels);
   EXPECT_NE(a->pixels, derivativeFrame->pixels);
   EXPECT_FALSE(computeLoopTriangleTangents(twoSets, 2).ok());
+
+  // Looked up on set 1 and decoded in set 0's frames (a Normal Map node whose UV Map is not
+  // its image's): the constant texel bakes as on set 0 alone, not as on set 1.
+  const Result<CornerTangents> onFirst = computeLoopTriangleTangents(twoSets, 0);
+  ASSERT_TRUE(onFirst.ok());
+  std::vector<Layer> split = layerOn(1);
+  std::get<TangentNormalSource>(split[0].source).tangentUvSet = 0;
+  BakeInput splitInput{&twoSets, nullptr, split};
+  splitInput.triangleTangents[0] = &*onFirst;
+  BakeInput firstInput{&twoSets, nullptr, layers0};
+  firstInput.triangleTangents[0] = &*onFirst;
+  const Result<FloatImage> splitBake = bakeMap(splitInput, settings);
+  const Result<FloatImage> firstBake = bakeMap(firstInput, settings);
+  ASSERT_TRUE(splitBake.ok() && firstBake.ok());
+  EXPECT_EQ(splitBake->pixels, firstBake->pixels);
+  EXPECT_NE(splitBake->pixels, a->pixels);
+  std::get<TangentNormalSource>(split[0].source).tangentUvSet = 2;  // a set the mesh lacks
+  splitInput.layers = split;
+  EXPECT_FALSE(bakeMap(splitInput, settings).ok());
 }
 
 // A height layer's strength is Blender's Bump Strength: the bumped normal blended with the

@@ -149,7 +149,8 @@ TEST(Scene, ExtendedKeys) {
                       "frequency": 8, "gradient": "central", "_note": "comment"},
                      {"type": "planar", "image": "p.png", "axis": "x", "kind": "object-normal"},
                      {"type": "normal", "image": "os.png", "space": "object", "strength": 0.5,
-                      "mask": "m2.png"}],
+                      "mask": "m2.png"},
+                     {"type": "normal", "image": "ts.png", "uv": 1, "tangent_uv": 0}],
           "outputs": [{"map": "derivative", "file": "d.<UDIM>.exr", "width": 300, "height": 200,
                        "padding": "push-pull", "bit_depth": "float", "alpha": true},
                       {"map": "corners", "file": "corners.csv"},
@@ -181,6 +182,9 @@ TEST(Scene, ExtendedKeys) {
   EXPECT_EQ(scene->layers[3].scale, 0.5);
   ASSERT_TRUE(scene->layers[3].mask.has_value());
   EXPECT_EQ(scene->layers[3].mask->image, std::filesystem::path("scenes/m2.png"));
+  EXPECT_FALSE(scene->layers[3].tangentUvSet.has_value());
+  EXPECT_EQ(scene->layers[4].uvSet, 1);
+  EXPECT_EQ(scene->layers[4].tangentUvSet, std::optional<int>(0));
 
   const SceneOutput& derivative = scene->outputs[0];
   EXPECT_EQ(derivative.width, 300);
@@ -473,6 +477,9 @@ TEST(Scene, InvalidCombinations) {
           R"({"type": "triplanar", "image": "t.png", "kind": "tangent-normal", "base": "above"})")),
       "scene.json: layers[0]: 'base': 'above' applies only to heights (a normal map has no "
       "normal to start from)");
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "normal", "image": "n.png", "space": "object", "tangent_uv": 1})")),
+            "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps");
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "base": "above"})")),
             "scene.json: layers[0]: key 'base' does not apply to a normal layer (it is for "
             "height, volume, planar or triplanar layers)");

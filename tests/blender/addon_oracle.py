@@ -342,6 +342,17 @@ def material_checks(settings, ob, distance):
           [(v["type"], v.get("base", "surface")) for v in chain]
           == [("normal", "surface"), ("height", "above")],
           "a normal layer, then the height with base 'above'", str(chain))
+    # Its image read on UV2 through a UV Map node, its own UV Map empty: the tangents are the
+    # render UV map's (Cycles), the lookup UV2's.
+    uvmap = tree.nodes.new("ShaderNodeUVMap")
+    uvmap.uv_map = "UV2"
+    tree.links.new(uvmap.outputs["UV"], tex.inputs["Vector"])
+    split, _, _ = operators.material_layers(tree, "UVMap")
+    normal = next((v for v in split if v["type"] == "normal"), {})
+    check("Layers from Material: a Normal Map's tangents on another UV map than its image",
+          normal.get("uv_map") == "UV2" and normal.get("tangent_uv_map") == "UVMap",
+          "uv_map 'UV2', tangent_uv_map 'UVMap'", str(normal))
+    tree.nodes.remove(uvmap)
     tree.nodes.remove(nmap)
     # A Bump node linked to nothing makes no layer.
     stray = tree.nodes.new("ShaderNodeBump")

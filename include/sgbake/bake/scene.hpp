@@ -141,6 +141,9 @@ struct SceneLayer {
   double scale = 1;
   double strength = 1;  ///< "strength" of a height layer: the Bump node's (a blend of normals)
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
+  /// "tangent_uv" (tangent-space normal layers): the UV set whose tangent frames decode the
+  /// map, when not its "uv" (TangentNormalSource::tangentUvSet)
+  std::optional<int> tangentUvSet;
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps, all projections)
   ProjectedKind kind = ProjectedKind::kHeight;     ///< "kind" (planar, triplanar)
   ProjectionAxis axis = ProjectionAxis::kZ;        ///< "axis" (planar)

@@ -47,8 +47,13 @@ struct UvHeightSource {
 /// the UV-derivative frame (see TangentNormalOptions and gradientFromTangentNormal).
 struct TangentNormalSource {
   const VectorTexture* texture = nullptr;  ///< [0,1]-encoded channels; not owned
-  int uvSet = 0;
+  int uvSet = 0;                           ///< the UV set the map is looked up on
   TangentNormalOptions options{};  ///< green convention, frame, strength, tiling, offset, guards
+  /// The UV set whose tangent frames decode the map, −1: uvSet. (Blender's Normal Map node
+  /// takes them from its own UV Map, or the render UV map when that is empty, whatever UV map
+  /// its image is read on.)
+  int tangentUvSet = -1;
+  int frameUvSet() const { return tangentUvSet >= 0 ? tangentUvSet : uvSet; }
 };
 
 /// @brief An object-space normal map on a UV set (eq. 38, JCGT form; see
