@@ -455,6 +455,16 @@ def material_layers(node_tree, render_uv=None):
 
     order = {id(values): chain_depth(name) for name, values in made.items()}
     found.sort(key=lambda values: order[id(values)])
+    # Cycles' normal bake averages the normals of every shader the surface mixes: one without
+    # a bump flattens the result, which layers (bumping the whole surface) cannot follow.
+    if found and reaching is not None:
+        for name in sorted(reaching):
+            node = node_tree.nodes[name]
+            normal = node.inputs.get("Normal")
+            shader = any(output.type == "SHADER" for output in node.outputs)
+            if shader and normal is not None and _source_node(normal) is None:
+                ignored.append(f"'{node.name}' has no bump and is mixed in (Cycles averages "
+                               "its normal with the bumped ones)")
     return found, skipped, ignored
 
 

@@ -362,6 +362,23 @@ def material_checks(settings, ob, distance):
           len(found) == 1 and any("not linked" in note for note in skipped),
           "one layer, the stray Bump skipped", f"{found}; skipped {skipped}")
     tree.nodes.remove(stray)
+    # A shader without a bump mixed with the bumped one is named (Cycles averages normals).
+    diffuse = next(node for node in tree.nodes if node.type == "BSDF_DIFFUSE")
+    plain = tree.nodes.new("ShaderNodeBsdfGlossy")
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    add = diffuse.outputs["BSDF"].links[0].to_node
+    tree.links.new(diffuse.outputs["BSDF"], mix.inputs[1])
+    tree.links.new(plain.outputs["BSDF"], mix.inputs[2])
+    tree.links.new(mix.outputs["Shader"], add.inputs[0])
+    _, _, mixed = operators.material_layers(tree)
+    check("Layers from Material: an unbumped shader mixed in",
+          any(f"'{plain.name}' has no bump" in note for note in mixed), "a note", str(mixed))
+    tree.links.new(diffuse.outputs["BSDF"], add.inputs[0])
+    tree.nodes.remove(mix)
+    tree.nodes.remove(plain)
+    _, _, plain_notes = operators.material_layers(tree)
+    check("Layers from Material: no note for the plain material", not plain_notes,
+          "no note", str(plain_notes))
     # An Image Texture without a UV Map node is read on the UV map active for rendering.
     render_uv, _, _ = operators.material_layers(tree, "UVMap")
     check("Layers from Material: the render UV map",
