@@ -219,33 +219,47 @@ TEST(Maps, ValidReflectionNormalMeetsItsThresholdInThePlaneOfNAndNg) {
   EXPECT_GT(bent, 200);
 }
 
+/// A quad with curved normals and UVs that are no parallelogram (its MikkTSpace frames differ
+/// from its two loop triangles'), and the same two triangles as faces of their own.
+struct CurvedQuad {
+  Mesh quad, triangles;
+  std::vector<std::array<std::uint32_t, 3>> split;  ///< loopTriangles(quad)
+};
+
+CurvedQuad curvedQuad() {
+  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.1f}, {1.1f, 1, 0.3f}, {0, 0.9f, 0}};
+  const std::vector<Vec2f> uvs{{0.1f, 0.1f}, {0.8f, 0.15f}, {0.9f, 0.9f}, {0.05f, 0.7f}};
+  std::vector<Vec3f> normals{
+      {0, 0, 1}, {-0.2f, 0, 0.98f}, {-0.3f, -0.3f, 0.905f}, {0, -0.1f, 0.995f}};
+  for (Vec3f& v : normals) v = cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1}));
+  CurvedQuad c;
+  c.quad = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, {}, normals);
+  c.split = loopTriangles(c.quad);
+  std::vector<std::vector<std::uint32_t>> faces;
+  std::vector<Vec2f> splitUvs;
+  std::vector<Vec3f> splitNormals;
+  for (const auto& t : c.split) {
+    faces.push_back(
+        {c.quad.cornerVertex[t[0]], c.quad.cornerVertex[t[1]], c.quad.cornerVertex[t[2]]});
+    for (const std::uint32_t corner : t) {
+      splitUvs.push_back(c.quad.uvSets[0].uvs[corner]);
+      splitNormals.push_back(c.quad.cornerNormals[corner]);
+    }
+  }
+  c.triangles = test::polygonMesh(positions, faces, splitUvs, {}, splitNormals);
+  return c;
+}
+
 // Cycles' Normal Map node decodes with MikkTSpace of the triangulated mesh. On a quad with
 // curved normals and UVs that are no parallelogram, those tangents differ from the quad's, and
 // a tangent-space layer with BakeInput::triangleTangents bakes exactly as the same two
 // triangles given as faces of their own do.
 TEST(Maps, TangentSpaceLayersDecodeWithTheLoopTrianglesTangents) {
-  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.1f}, {1.1f, 1, 0.3f}, {0, 0.9f, 0}};
-  const std::vector<Vec2f> uvs{{0.1f, 0.1f}, {0.8f, 0.15f}, {0.9f, 0.9f}, {0.05f, 0.7f}};
-  const std::vector<Vec3f> normals{
-      {0, 0, 1}, {-0.2f, 0, 0.98f}, {-0.3f, -0.3f, 0.905f}, {0, -0.1f, 0.995f}};
-  const auto unitNormals = [](std::vector<Vec3f> n) {
-    for (Vec3f& v : n) v = cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1}));
-    return n;
-  };
-  const Mesh quad = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, {}, unitNormals(normals));
-  const std::vector<std::array<std::uint32_t, 3>> split = loopTriangles(quad);
+  const CurvedQuad curved = curvedQuad();
+  const Mesh& quad = curved.quad;
+  const Mesh& triangles = curved.triangles;
+  const std::vector<std::array<std::uint32_t, 3>>& split = curved.split;
   ASSERT_EQ(split.size(), 2u);
-  std::vector<std::vector<std::uint32_t>> faces;
-  std::vector<Vec2f> splitUvs;
-  std::vector<Vec3f> splitNormals;
-  for (const auto& t : split) {
-    faces.push_back({quad.cornerVertex[t[0]], quad.cornerVertex[t[1]], quad.cornerVertex[t[2]]});
-    for (const std::uint32_t c : t) {
-      splitUvs.push_back(quad.uvSets[0].uvs[c]);
-      splitNormals.push_back(quad.cornerNormals[c]);
-    }
-  }
-  const Mesh triangles = test::polygonMesh(positions, faces, splitUvs, {}, splitNormals);
 
   const Result<CornerTangents> quadTangents = computeTangents(quad.view(0));
   const Result<CornerTangents> loopTangents = computeLoopTriangleTangents(quad);
@@ -287,24 +301,10 @@ TEST(Maps, TangentSpaceLayersDecodeWithTheLoopTrianglesTangents) {
 // perturbed normal the same corner gets in the two triangles given as faces of their own, and
 // not the one of the quad's MikkTSpace frame (which stays the table's tangent column).
 TEST(Maps, CornerTableDecodesWithTheLoopTrianglesTangents) {
-  const std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0.1f}, {1.1f, 1, 0.3f}, {0, 0.9f, 0}};
-  const std::vector<Vec2f> uvs{{0.1f, 0.1f}, {0.8f, 0.15f}, {0.9f, 0.9f}, {0.05f, 0.7f}};
-  std::vector<Vec3f> normals{
-      {0, 0, 1}, {-0.2f, 0, 0.98f}, {-0.3f, -0.3f, 0.905f}, {0, -0.1f, 0.995f}};
-  for (Vec3f& v : normals) v = cast<float>(normalizeOr(cast<double>(v), Vec3d{0, 0, 1}));
-  const Mesh quad = test::polygonMesh(positions, {{0, 1, 2, 3}}, uvs, {}, normals);
-  const std::vector<std::array<std::uint32_t, 3>> split = loopTriangles(quad);
-  std::vector<std::vector<std::uint32_t>> faces;
-  std::vector<Vec2f> splitUvs;
-  std::vector<Vec3f> splitNormals;
-  for (const auto& t : split) {
-    faces.push_back({quad.cornerVertex[t[0]], quad.cornerVertex[t[1]], quad.cornerVertex[t[2]]});
-    for (const std::uint32_t c : t) {
-      splitUvs.push_back(quad.uvSets[0].uvs[c]);
-      splitNormals.push_back(quad.cornerNormals[c]);
-    }
-  }
-  const Mesh triangles = test::polygonMesh(positions, faces, splitUvs, {}, splitNormals);
+  const CurvedQuad curved = curvedQuad();
+  const Mesh& quad = curved.quad;
+  const Mesh& triangles = curved.triangles;
+  const std::vector<std::array<std::uint32_t, 3>>& split = curved.split;
 
   const Result<CornerTangents> loop = computeLoopTriangleTangents(quad);
   ASSERT_TRUE(loop.ok());

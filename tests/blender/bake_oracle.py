@@ -312,14 +312,9 @@ def evaluate_nmap(name, r, nmap):
                 fails.append(f"{name}: negative control: the normal-map bake with green "
                              f"flipped still passes")
     if chain:
-        s = r.get("nmap_sum")
-        if s is None or "error" in s:
-            fails.append(f"{name}: no control bake with the bump's gradient added")
-        else:
-            print(f"      control, bump added, not stacked:  {fmt_nmap(s)}")
-            if passes_nmap(s, chain):
-                fails.append(f"{name}: negative control: the bake with the bump added to the "
-                             f"normal map's gradient still passes ({fmt_nmap(s)})")
+        negative_control(name, r, "nmap_sum", "bump added, not stacked:  ",
+                         "the bake with the bump added to the normal map's gradient", chain,
+                         fails)
     if nmap["strength"] == 1.0 and not chain:
         s = r.get("nmap_flags")
         same = s.get("json_vs_flags_max_abs") if s else None
@@ -331,15 +326,21 @@ def evaluate_nmap(name, r, nmap):
         if same is None or same > SAME_IMAGE_ABS:
             fails.append(f"{name}: the JSON scene and the --normal flags give different images "
                          f"(max |diff| {same})")
-    s = r.get("nmap_weak")
-    if s is None or "error" in s:
-        fails.append(f"{name}: no 0.9 x Strength control bake to compare")
-    else:
-        print(f"      control, 0.9 x Strength:           {fmt_nmap(s)}")
-        if passes_nmap(s, chain):
-            fails.append(f"{name}: negative control: the bake at 0.9 x Strength still passes "
-                         f"({fmt_nmap(s)})")
+    negative_control(name, r, "nmap_weak", "0.9 x Strength:           ",
+                     "the bake at 0.9 x Strength", chain, fails)
     return fails
+
+
+def negative_control(name, r, key, label, what, chain, fails):
+    """Prints the figures of control bake r[key] and appends to `fails` when it is missing or
+    passes the bars (then the comparison could not tell right from wrong)."""
+    s = r.get(key)
+    if s is None or "error" in s:
+        fails.append(f"{name}: no control bake ({what}) to compare")
+        return
+    print(f"      control, {label}{fmt_nmap(s)}")
+    if passes_nmap(s, chain):
+        fails.append(f"{name}: negative control: {what} still passes ({fmt_nmap(s)})")
 
 
 def evaluate(name, r):
