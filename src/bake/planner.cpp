@@ -112,7 +112,7 @@ bool nestsDeeperThan(const json& value, int limit) {
   return false;
 }
 
-/// Whether @p entry is an output's entry as recordInManifest writes it: "parameters" (an
+/// Whether @p entry is an output's entry as recordInManifests writes it: "parameters" (an
 /// object, a few levels deep), "inputs" and "files" (objects of strings), and "udim_reached"
 /// (tile numbers) when the output reads a UDIM image.
 bool isManifestEntry(const json& entry) {
@@ -139,7 +139,7 @@ bool isManifestEntry(const json& entry) {
 
 /// The manifest at @p path; an empty object when there is none, or when it is not a regular
 /// file, not valid JSON or not of this version (everything then re-bakes and writing it
-/// replaces it), without the entries that are not what recordInManifest writes (those
+/// replaces it), without the entries that are not what recordInManifests writes (those
 /// outputs re-bake); `problem` says what was wrong, for a warning.
 ReadManifest readManifest(const fs::path& path) {
   std::error_code ec;
@@ -157,7 +157,7 @@ ReadManifest readManifest(const fs::path& path) {
                 " sgbake manifest (its \"sgbake_manifest\" is " +
                 (version == parsed.end() ? std::string("missing") : version->dump()) + ")"};
   }
-  // Entries as recordInManifest writes them; anything else (hand-edited, or a foreign value
+  // Entries as recordInManifests writes them; anything else (hand-edited, or a foreign value
   // nested deep enough to exhaust the stack when written back) is dropped with a warning.
   const auto outputs = parsed.find("outputs");
   if (outputs == parsed.end()) return {std::move(parsed), {}};
@@ -280,17 +280,26 @@ class ManifestCache {
   std::map<std::string, ReadManifest> manifests_;
 };
 
-/// Records @p entry for @p file in its directory's manifest (read, modify, write atomically).
-Status recordInManifest(const fs::path& file, const json& entry) {
-  const fs::path path = directoryOf(file) / kManifestName;
-  json manifest = readManifest(path).content;
-  manifest["sgbake_manifest"] = kManifestVersion;
-  if (!manifest.contains("outputs") || !manifest["outputs"].is_object()) {
-    manifest["outputs"] = json::object();
+/// Records each (file, entry) of @p entries in its directory's manifest: each manifest is read,
+/// given all of its entries and written atomically once (not once per output, which made a run
+/// of many outputs in one directory quadratic in their number).
+Status recordInManifests(const std::vector<std::pair<fs::path, json>>& entries) {
+  std::map<fs::path, std::vector<const std::pair<fs::path, json>*>> byDirectory;
+  for (const auto& entry : entries) byDirectory[directoryOf(entry.first)].push_back(&entry);
+  for (const auto& [dir, recorded] : byDirectory) {
+    const fs::path path = dir / kManifestName;
+    json manifest = readManifest(path).content;
+    manifest["sgbake_manifest"] = kManifestVersion;
+    if (!manifest.contains("outputs") || !manifest["outputs"].is_object()) {
+      manifest["outputs"] = json::object();
+    }
+    for (const auto* entry : recorded) {
+      manifest["outputs"][manifestText(entry->first.filename().string())] = entry->second;
+    }
+    const std::string text = manifest.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+    if (Status ok = writeFileAtomically(path, text); !ok) return ok;
   }
-  manifest["outputs"][manifestText(file.filename().string())] = entry;
-  const std::string text = manifest.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
-  return writeFileAtomically(path, text);
+  return Ok{};
 }
 
 std::string joinLabels(const std::vector<std::string>& labels) {
@@ -1480,9 +1489,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   for (AtomicFile& file : pending) {
     if (Status ok = file.commit(); !ok) return ok.error();
   }
-  for (const auto& [file, entry] : manifestEntries) {
-    if (Status ok = recordInManifest(file, entry); !ok) return ok.error();
-  }
+  if (Status ok = recordInManifests(manifestEntries); !ok) return ok.error();
   report.writeSeconds += secondsSince(start);
   progress.finishAll();
   return report;
