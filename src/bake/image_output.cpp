@@ -7,17 +7,22 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <ctime>
 #include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -30,6 +35,23 @@
 
 namespace sgbake {
 namespace {
+
+/// SOURCE_DATE_EPOCH (seconds since 1970, UTC) as a TIFF/EXR DateTime ("YYYY:MM:DD hh:mm:ss"),
+/// or nothing when it is unset or not a whole number of seconds.
+std::optional<std::string> sourceDateTime() {
+  const char* epoch = std::getenv("SOURCE_DATE_EPOCH");
+  if (epoch == nullptr || *epoch == '\0') return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const long long seconds = std::strtoll(epoch, &end, 10);
+  if (errno != 0 || *end != '\0' || seconds < 0) return std::nullopt;
+  const std::time_t time = static_cast<std::time_t>(seconds);
+  std::tm utc{};
+  if (gmtime_r(&time, &utc) == nullptr) return std::nullopt;
+  std::array<char, 32> text{};
+  if (std::strftime(text.data(), text.size(), "%Y:%m:%d %H:%M:%S", &utc) == 0) return std::nullopt;
+  return std::string(text.data());
+}
 
 Error fileError(ErrorCode code, const std::filesystem::path& path, std::string_view what) {
   return {code, path.string() + ": " + std::string(what)};
@@ -378,6 +400,12 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
   }
   spec.software = "sgbake";
   spec.attributes = options.attributes;
+  // OpenImageIO's EXR and TIFF writers stamp the time of writing (DateTime, EXR capDate), so
+  // two identical bakes differ in those bytes: with SOURCE_DATE_EPOCH set (the
+  // reproducible-builds convention) the stamp is that time, and the files are identical.
+  if (const std::optional<std::string> stamp = sourceDateTime()) {
+    spec.attributes.emplace_back("DateTime", *stamp);
+  }
 
   Result<const io_detail::ImageCodec*> codec = io_detail::imageCodec();
   if (!codec) return codec.error();

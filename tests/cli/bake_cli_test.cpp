@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -171,6 +172,31 @@ TEST_F(BakeCliTest, MissingImageModuleIsOneErrorLineNamingItAndWritesNothing) {
   EXPECT_NE(r.err.find(module.string() + ": cannot load the image I/O module"), std::string::npos)
       << r.err;
   EXPECT_EQ(listDirectory(dir_), before) << "no output, no temporary, no manifest";
+}
+
+TEST_F(BakeCliTest, SourceDateEpochMakesExrAndTiffFilesReproducible) {
+  // OpenImageIO stamps EXR and TIFF files with the time of writing; SOURCE_DATE_EPOCH (the
+  // reproducible-builds convention) replaces it, so two bakes give the same bytes.
+  const std::string scene =
+      planeScene(kHeightLayer, R"({"map": "tangent-normal", "file": "n.exr", "size": 8},
+                       {"map": "height", "file": "h.tif", "size": 8})");
+  std::map<std::string, std::string> first;
+  ::setenv("SOURCE_DATE_EPOCH", "1700000000", 1);
+  for (int run = 0; run < 2; ++run) {
+    const ProcessResult r = bakeScene(scene, {"--force"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* name : {"n.exr", "h.tif"}) {
+      const std::string bytes = readFile(dir_ / name);
+      if (run == 0) {
+        first[name] = bytes;
+        // 2023-11-14 22:13:20 UTC, as TIFF's DateTime and EXR's capDate write it.
+        EXPECT_NE(bytes.find("2023:11:14 22:13:20"), std::string::npos) << name;
+      } else {
+        EXPECT_EQ(bytes, first[name]) << name;
+      }
+    }
+  }
+  ::unsetenv("SOURCE_DATE_EPOCH");
 }
 
 TEST_F(BakeCliTest, FailingBakeLeavesTheExistingOutputByteIdentical) {
