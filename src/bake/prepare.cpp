@@ -167,6 +167,10 @@ Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
     Result<Image> image = source(planned);
     if (!image) return image.error();
     ++report.imagesLoaded;
+    std::size_t lastUser = 0;  // the last texture made of this image may take its pixels
+    for (std::size_t t = 0; t < plan.textures.size(); ++t) {
+      if (plan.textures[t].image == i) lastUser = t;
+    }
     for (std::size_t t = 0; t < plan.textures.size(); ++t) {
       const PlannedTexture& texture = plan.textures[t];
       if (texture.image != i) continue;
@@ -174,7 +178,9 @@ Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
         VectorTextureOptions textureOptions;
         textureOptions.filter = texture.filter;
         textureOptions.wrap = texture.wrap;
-        Result<ImageVectorTexture> made = ImageVectorTexture::create(*image, textureOptions);
+        Result<ImageVectorTexture> made =
+            t == lastUser ? ImageVectorTexture::create(std::move(*image), textureOptions)
+                          : ImageVectorTexture::create(*image, textureOptions);
         if (!made)
           return Error{made.error().code, planned.path.string() + ": " + made.error().message};
         loaded.vector[t] = std::make_unique<ImageVectorTexture>(std::move(*made));
@@ -189,7 +195,7 @@ Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
       }
       ++report.texturesCreated;
     }
-    progress.finishOne();  // the Image itself is released here: textures keep their own copy
+    progress.finishOne();  // the Image is released here (scalar textures keep their own copy)
   }
   // UDIM textures take over their tiles' textures.
   for (std::size_t t = 0; t < plan.textures.size(); ++t) {

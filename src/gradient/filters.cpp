@@ -454,8 +454,10 @@ ScalarSample ImageScalarTexture::sampleCell(int cellX, int cellY, Vec2d fraction
 // ---------------------------------------------------------------------------------------------
 // ImageVectorTexture
 
-Result<ImageVectorTexture> ImageVectorTexture::create(const Image& image,
-                                                      const VectorTextureOptions& options) {
+namespace {
+
+/// What makes @p image unusable as a vector texture with @p options (create's errors).
+Status checkVectorSource(const Image& image, const VectorTextureOptions& options) {
   if (image.empty()) return Error::badInput("vector texture: the image is empty");
   if (options.firstChannel < 0 || options.firstChannel + 3 > image.channels()) {
     return Error::badInput("vector texture: channels " + std::to_string(options.firstChannel) +
@@ -465,9 +467,14 @@ Result<ImageVectorTexture> ImageVectorTexture::create(const Image& image,
   if (options.filter == Filter::kHermite) {
     return Error::badInput("vector texture: the Hermite filter is offered for height maps only");
   }
-  if (Status ok = checkFinite(image, options.firstChannel, 3, "vector texture"); !ok) {
-    return ok.error();
-  }
+  return checkFinite(image, options.firstChannel, 3, "vector texture");
+}
+
+}  // namespace
+
+Result<ImageVectorTexture> ImageVectorTexture::create(const Image& image,
+                                                      const VectorTextureOptions& options) {
+  if (Status ok = checkVectorSource(image, options); !ok) return ok.error();
   ImageVectorTexture texture;
   texture.width_ = image.width();
   texture.height_ = image.height();
@@ -482,6 +489,21 @@ Result<ImageVectorTexture> ImageVectorTexture::create(const Image& image,
   for (std::size_t i = 0; i < count; ++i) {
     for (std::size_t c = 0; c < 3; ++c) texture.texels_[i * 3 + c] = pixels[i * stride + first + c];
   }
+  return texture;
+}
+
+Result<ImageVectorTexture> ImageVectorTexture::create(Image&& image,
+                                                      const VectorTextureOptions& options) {
+  if (image.channels() != 3 || options.firstChannel != 0) {
+    return create(static_cast<const Image&>(image), options);
+  }
+  if (Status ok = checkVectorSource(image, options); !ok) return ok.error();
+  ImageVectorTexture texture;  // its texels are the image's own values
+  texture.filter_ = options.filter;
+  texture.wrap_ = options.wrap;
+  texture.width_ = image.width();
+  texture.height_ = image.height();
+  texture.texels_ = image.takePixels();
   return texture;
 }
 

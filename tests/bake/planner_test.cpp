@@ -155,10 +155,12 @@ TEST_F(PlannerTest, ExplainSaysHowMuchOfTheImageIsInMemory) {
   // 556 rows × 1000 × 4 floats × 4 bytes = 8.9 MB; the 100-row height map fits whole: 100 rows.
   EXPECT_NE(text.find("in bands of 256 rows, 556 rows (8.9 MB) in memory at a time"), std::string::npos) << text;
   EXPECT_NE(text.find("in bands of 256 rows, 100 rows (0.1 MB) in memory at a time"), std::string::npos) << text;
-  // 500 × 500 × 4 floats × 4 bytes = 4 MB.
-  EXPECT_NE(text.find("the whole image in memory for push-pull (4.0 MB)"), std::string::npos) << text;
-  // 250 × 250 × 4 floats × 4 bytes = 1 MB, padded once the whole image is baked.
-  EXPECT_NE(text.find("the whole image in memory for adjacent-faces (1.0 MB)"), std::string::npos)
+  // 500 × 500 × 4 floats × 4 bytes = 4 MB, and its pyramid a third of it: 5.3 MB.
+  EXPECT_NE(text.find("the whole image in memory for push-pull (5.3 MB)"), std::string::npos)
+      << text;
+  // 250 × 250 × (4 floats × 4 bytes + 12 bytes of faces, distances and margin lists) = 1.75 MB,
+  // padded once the whole image is baked.
+  EXPECT_NE(text.find("the whole image in memory for adjacent-faces (1.8 MB)"), std::string::npos)
       << text;
   EXPECT_NE(text.find("a.png: adjacent faces, 5 texels"), std::string::npos) << text;
 }

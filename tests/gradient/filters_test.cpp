@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -669,6 +670,40 @@ TEST(ImageFilters, VectorTextureReproducesPolynomialsPerChannel) {
       EXPECT_EQ(texture->sample(st), sample.value);
     }
   }
+}
+
+// A texture made from an image that is not needed afterwards takes its pixels: it samples as
+// the copy does, the image is left empty, and a bad image is refused as the copy refuses it
+// (and kept).
+TEST(ImageFilters, VectorTextureTakesTheImagesPixels) {
+  for (const int channels : {3, 4}) {
+    Image image = randomImage(6, 5, channels, 7);
+    for (Filter filter : {Filter::kBilinear, Filter::kBicubic}) {
+      VectorTextureOptions options;
+      options.filter = filter;
+      options.wrap = Wrap::kClamp;
+      const Result<ImageVectorTexture> copied = ImageVectorTexture::create(image, options);
+      Image moved = image;
+      const Result<ImageVectorTexture> taken =
+          ImageVectorTexture::create(std::move(moved), options);
+      ASSERT_TRUE(copied.ok() && taken.ok());
+      EXPECT_EQ(moved.empty(), channels == 3) << "only a three-channel image's pixels are taken";
+      for (const Vec2d st : pointsInTexelBox(6, 5, -1, 7, -1, 6, 50)) {
+        EXPECT_EQ(taken->sampleWithDerivatives(st).value, copied->sampleWithDerivatives(st).value);
+        EXPECT_EQ(taken->sampleWithDerivatives(st).dds, copied->sampleWithDerivatives(st).dds);
+      }
+    }
+  }
+  Image bad = randomImage(4, 4, 3, 1);
+  bad.at(1, 2, 1) = std::numeric_limits<float>::quiet_NaN();
+  Image kept = bad;
+  const Result<ImageVectorTexture> refused = ImageVectorTexture::create(std::move(kept));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().message, ImageVectorTexture::create(bad).error().message);
+  EXPECT_FALSE(kept.empty());
+  VectorTextureOptions hermite;
+  hermite.filter = Filter::kHermite;
+  EXPECT_FALSE(ImageVectorTexture::create(randomImage(4, 4, 3, 1), hermite).ok());
 }
 
 TEST(ImageFilters, InvalidInputIsReported) {

@@ -195,6 +195,10 @@ class ImageVectorTexture final : public VectorTexture {
   /// a value is not finite, or options.filter is kHermite (not offered for vectors).
   static Result<ImageVectorTexture> create(const Image& image,
                                            const VectorTextureOptions& options = {});
+  /// @brief create() from an image that is not needed afterwards: a three-channel image's
+  /// pixels become the texture's (no copy, half the memory at the peak); @p image is left
+  /// empty on success.
+  static Result<ImageVectorTexture> create(Image&& image, const VectorTextureOptions& options = {});
 
   /// @brief The filtered channels at @p st, as stored (no decoding, no normalization).
   Vec3d sample(Vec2d st) const override;

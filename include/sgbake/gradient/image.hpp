@@ -58,6 +58,13 @@ class Image {
   std::span<const float> pixels() const { return data_; }
   std::span<float> pixels() { return data_; }
 
+  /// @brief Moves the W·H·C values out (as pixels() lays them out), leaving the image empty
+  /// (0×0×0).
+  std::vector<float> takePixels() {
+    width_ = height_ = channels_ = 0;
+    return std::exchange(data_, {});
+  }
+
   /// @brief Texture coordinates (s, t) of the centre of texel (x, y): ((x+0.5)/W, (y+0.5)/H).
   Vec2d texelCentre(int x, int y) const { return {(x + 0.5) / width_, (y + 0.5) / height_}; }
 
