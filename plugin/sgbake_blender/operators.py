@@ -339,12 +339,12 @@ def _not_image(socket):
 
 def _ignored(node, tex, inputs, socket):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
-    `socket` a layer cannot take over: the texture's Alpha output (the layer reads its colour),
-    a Vector input other than a UV map (a Mapping node, object or generated coordinates), a
-    projection other than Flat, Closest interpolation (read bilinear), and node-driven
-    `inputs` (of which the layer takes the unconnected value)."""
+    `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
+    input other than a UV map (a Mapping node, object or generated coordinates), a projection
+    other than Flat, Closest interpolation (read bilinear), and node-driven `inputs` (of which
+    the layer takes the unconnected value)."""
     notes = []
-    if node.inputs[socket].links[0].from_socket.name == "Alpha":
+    if node.type != "BUMP" and node.inputs[socket].links[0].from_socket.name == "Alpha":
         notes.append(f"'{node.name}' {socket} from '{tex.name}' Alpha (the layer reads its "
                      "colour)")
     if tex.interpolation == "Closest":
@@ -413,6 +413,8 @@ def material_layers(node_tree, render_uv=None):
             values = _texture_settings(tex, render_uv)
             values.update(type="height", scale=-scale if node.invert else scale,
                           strength=max(node.inputs["Strength"].default_value, 0.0))
+            if node.inputs["Height"].links[0].from_socket.name == "Alpha":
+                values["channel"] = "a"
         else:
             tex = _linked_image_node(node.inputs["Color"])
             space = NORMAL_MAP_SPACES.get(node.space)

@@ -27,6 +27,14 @@ SPACES = (
     ("tangent", "Tangent", "The normal map is in tangent space"),
     ("object", "Object", "The normal map is in object space"),
 )
+CHANNELS = (
+    ("luminance", "Luminance", "The Rec. 709 luminance of RGB, as a colour into the Bump "
+                               "node's Height"),
+    ("r", "R", "The red channel"),
+    ("g", "G", "The green channel"),
+    ("b", "B", "The blue channel"),
+    ("a", "Alpha", "The alpha channel (the Image Texture node's Alpha output)"),
+)
 BASES = (
     ("surface", "Surface", "Bump the surface's normal: the layer's surface gradient is added to "
                            "the others'"),
@@ -74,6 +82,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
         name="Strength", default=1.0, min=0.0, soft_max=1.0, precision=3,
         description="Height layers: the Bump node's Strength, which blends the bumped normal "
                     "with the unbumped one (0: no bump, 1: the full bump)")
+    channel: EnumProperty(name="Channel", items=CHANNELS, default="luminance",
+                          description="What of a height layer's image is the height")
     base: EnumProperty(name="Bumps", items=BASES, default="surface",
                        description="Which normal a height layer bumps")
     filter: EnumProperty(name="Filter", items=FILTERS, default="bilinear")

@@ -118,6 +118,8 @@ def layer_json(layer, uv_index, world_scale=1.0, default_uv=None):
         entry["scale"] = _number(layer.scale / world_scale)
         if layer.strength != 1.0:  # the Bump node's blend of normals (1: none)
             entry["strength"] = _number(layer.strength)
+        if layer.channel != "luminance":
+            entry["channel"] = layer.channel
         if layer.base != "surface":
             entry["base"] = layer.base
     elif layer.type == "normal":

@@ -109,6 +109,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
             if layer.type == "height":
                 col.prop(layer, "strength")
+                col.prop(layer, "channel")
                 col.prop(layer, "base")
             col.prop(layer, "filter")
             col.prop(layer, "wrap")

@@ -454,8 +454,8 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& u
   std::map<std::pair<std::string, int>, std::size_t> imageIndex;
   std::map<std::tuple<std::size_t, bool, int, int>, std::size_t> textureIndex;
   const auto addTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
-                              const std::string& user) {
-    const ImageChannels channels = vector ? ImageChannels::kRgb : ImageChannels::kLuminance;
+                              const std::string& user, ImageChannels scalarChannel) {
+    const ImageChannels channels = vector ? ImageChannels::kRgb : scalarChannel;
     const fs::path canonical = plan.scene.inMemory ? path : canonicalPath(path);
     const auto imageKey = std::make_pair(canonical.string(), static_cast<int>(channels));
     auto [image, newImage] = imageIndex.emplace(imageKey, plan.images.size());
@@ -468,12 +468,15 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& u
     return texture->second;
   };
   // A UDIM image: a texture per tile file, and one that picks among them by UV.
-  std::map<std::tuple<std::string, bool, int, int>, std::size_t> udimIndex;
+  std::map<std::tuple<std::string, bool, int, int, int>, std::size_t> udimIndex;
   const auto addImageTexture = [&](const fs::path& path, bool vector, Filter filter, Wrap wrap,
-                                   const std::string& user) {
-    if (!hasUdimToken(path.string())) return addTexture(path, vector, filter, wrap, user);
+                                   const std::string& user, ImageChannels scalarChannel) {
+    if (!hasUdimToken(path.string())) {
+      return addTexture(path, vector, filter, wrap, user, scalarChannel);
+    }
     const auto key = std::make_tuple((plan.scene.inMemory ? path : canonicalPath(path)).string(),
-                                     vector, static_cast<int>(filter), static_cast<int>(wrap));
+                                     vector, static_cast<int>(filter), static_cast<int>(wrap),
+                                     static_cast<int>(scalarChannel));
     if (const auto it = udimIndex.find(key); it != udimIndex.end()) {
       for (const auto& [tile, t] : plan.textures[it->second].udimTiles) {
         plan.images[plan.textures[t].image].users.push_back(user);
@@ -482,7 +485,7 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& u
     }
     PlannedTexture udim{std::numeric_limits<std::size_t>::max(), vector, filter, wrap, {}, path};
     for (const auto& [tile, file] : udimTiles.tiles(path)) {  // not empty: makePlan checked
-      udim.udimTiles.emplace(tile, addTexture(file, vector, filter, wrap, user));
+      udim.udimTiles.emplace(tile, addTexture(file, vector, filter, wrap, user, scalarChannel));
     }
     plan.textures.push_back(std::move(udim));
     udimIndex.emplace(key, plan.textures.size() - 1);
@@ -494,11 +497,11 @@ void planLayers(Plan& plan, const std::set<std::size_t>& used, UdimTileFinder& u
     planned.sceneLayer = i;
     if (layer.hasImage()) {
       planned.texture = addImageTexture(layer.image, layer.readsNormals(), layer.filter, layer.wrap,
-                                        layerLabel(i));
+                                        layerLabel(i), layer.channel);
     }
     if (layer.mask) {
       planned.mask = addImageTexture(layer.mask->image, false, layer.mask->filter, Wrap::kRepeat,
-                                     layerLabel(i) + ".mask");
+                                     layerLabel(i) + ".mask", ImageChannels::kLuminance);
     }
     plan.layers.push_back(planned);
   }
@@ -512,7 +515,20 @@ std::string formatNumber(double value) {
 }
 
 std::string channelsName(ImageChannels channels) {
-  return channels == ImageChannels::kRgb ? "RGB" : "luminance";
+  switch (channels) {
+    case ImageChannels::kRgb:
+      return "RGB";
+    case ImageChannels::kRed:
+      return "R";
+    case ImageChannels::kGreen:
+      return "G";
+    case ImageChannels::kBlue:
+      return "B";
+    case ImageChannels::kAlpha:
+      return "alpha";
+    default:
+      return "luminance";
+  }
 }
 
 /// The plan's steps and skipped list, for explainPlan.

@@ -85,6 +85,11 @@ constexpr Named<Filter> kFilters[] = {
 constexpr Named<Wrap> kWraps[] = {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClamp}};
 constexpr Named<NormalSpace> kSpaces[] = {{"tangent", NormalSpace::kTangent},
                                           {"object", NormalSpace::kObject}};
+constexpr Named<ImageChannels> kChannels[] = {{"luminance", ImageChannels::kLuminance},
+                                              {"r", ImageChannels::kRed},
+                                              {"g", ImageChannels::kGreen},
+                                              {"b", ImageChannels::kBlue},
+                                              {"a", ImageChannels::kAlpha}};
 constexpr Named<LayerBase> kBases[] = {{"surface", LayerBase::kSurface},
                                        {"above", LayerBase::kLayersAbove}};
 constexpr Named<NormalMapGreen> kGreens[] = {{"opengl", NormalMapGreen::kOpenGL},
@@ -364,7 +369,7 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
     keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
   switch (type) {
     case SceneLayerType::kHeight:
-      add({"uv", "scale", "strength", "base"});
+      add({"uv", "scale", "strength", "base", "channel"});
       break;
     case SceneLayerType::kNormal:
       add({"uv", "space", "green", "strength", "tangent_uv"});
@@ -659,6 +664,7 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   reader.optionalName("kind", kKinds, layer.kind);
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
+  reader.optionalName("channel", kChannels, layer.channel);
   if (reader.has("tangent_uv"))
     layer.tangentUvSet = reader.smallInteger("tangent_uv", 0, kMaxUvSets - 1);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
@@ -1257,6 +1263,8 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     case SceneLayerType::kHeight:
       j["uv"] = layer.uvSet;
       j["strength"] = layer.strength;
+      if (layer.channel != ImageChannels::kLuminance)
+        j["channel"] = nameIn(kChannels, layer.channel);
       break;
     case SceneLayerType::kNormal:
       j["uv"] = layer.uvSet;

@@ -379,6 +379,11 @@ Status bakeMapFromArrays(const BakeArguments& a) {
                                  std::to_string(a.images[i].channels) +
                                  " channel(s) but normal maps need 3 (RGB)");
         }
+        if (channelsToRead(planned.channels, a.images[i].channels) < 0) {
+          return Error::badInput(where + "image '" + name + "' has " +
+                                 std::to_string(a.images[i].channels) + " channel(s) but " +
+                                 channelsNeeded(planned.channels) + " by " + planned.users.front());
+        }
         return selectChannels(a.images[i], planned.channels);
       }
     }

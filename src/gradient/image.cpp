@@ -55,19 +55,6 @@ Error fileError(const std::filesystem::path& path, std::string_view what) {
 }
 
 // How many leading file channels to read for a selection, or -1 when the file has too few.
-int channelsToRead(ImageChannels selection, int fileChannels) {
-  switch (selection) {
-    case ImageChannels::kAll:
-      return fileChannels;
-    case ImageChannels::kFirst:
-      return 1;
-    case ImageChannels::kLuminance:
-      return fileChannels >= 3 ? 3 : 1;
-    case ImageChannels::kRgb:
-      return fileChannels >= 3 ? 3 : -1;
-  }
-  return -1;
-}
 
 /// The machine's physical memory in bytes (0 when unknown).
 double physicalMemoryBytes() {
@@ -152,7 +139,8 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
   }
   const int readChannels = channelsToRead(options.channels, spec.channels);
   if (readChannels < 0) {
-    return fileError(path, "image has " + channelsText(spec.channels) + " but 3 are needed (RGB)");
+    return fileError(path, "image has " + channelsText(spec.channels) + " but " +
+                               channelsNeeded(options.channels));
   }
 
   const int width = spec.width;
@@ -203,7 +191,61 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
   return selectImageChannels(std::move(read), options.channels);
 }
 
+int channelsToRead(ImageChannels selection, int channels) {
+  switch (selection) {
+    case ImageChannels::kAll:
+      return channels;
+    case ImageChannels::kFirst:
+    case ImageChannels::kRed:
+      return 1;
+    case ImageChannels::kLuminance:
+      return channels >= 3 ? 3 : 1;
+    case ImageChannels::kRgb:
+      return channels >= 3 ? 3 : -1;
+    case ImageChannels::kGreen:
+      return channels >= 2 ? 2 : -1;
+    case ImageChannels::kBlue:
+      return channels >= 3 ? 3 : -1;
+    case ImageChannels::kAlpha:
+      return channels == 2 || channels == 4 ? channels : -1;
+  }
+  return -1;
+}
+
+std::string channelsNeeded(ImageChannels selection) {
+  switch (selection) {
+    case ImageChannels::kRgb:
+      return "3 are needed (RGB)";
+    case ImageChannels::kGreen:
+      return "a green channel is needed (2 or more channels)";
+    case ImageChannels::kBlue:
+      return "a blue channel is needed (3 or more channels)";
+    case ImageChannels::kAlpha:
+      return "an alpha channel is needed (grey + alpha, or RGBA)";
+    default:
+      return "1 is needed";
+  }
+}
+
 Image selectImageChannels(Image image, ImageChannels selection) {
+  if (selection == ImageChannels::kRed || selection == ImageChannels::kGreen ||
+      selection == ImageChannels::kBlue || selection == ImageChannels::kAlpha) {
+    const int index = selection == ImageChannels::kAlpha   ? image.channels() - 1
+                      : selection == ImageChannels::kBlue  ? 2
+                      : selection == ImageChannels::kGreen ? 1
+                                                           : 0;
+    if (image.channels() == 1) return image;
+    Image one(image.width(), image.height(), 1);
+    const auto stride = static_cast<std::size_t>(image.channels());
+    const float* source = image.pixels().data() + index;
+    float* target = one.pixels().data();
+    const std::size_t width = static_cast<std::size_t>(image.width());
+    forEachRow(image.height(), [&](int y) {
+      const std::size_t row = static_cast<std::size_t>(y) * width;
+      for (std::size_t x = 0; x < width; ++x) target[row + x] = source[(row + x) * stride];
+    });
+    return one;
+  }
   const int have = image.channels();
   const int keep = selection == ImageChannels::kAll     ? have
                    : selection == ImageChannels::kRgb && have >= 3 ? 3

@@ -143,7 +143,7 @@ TEST(Scene, ExtendedKeys) {
   Result<Scene> scene = parseScene(
       R"({"mesh": "/abs/m.obj", "_comment": "ignored",
           "layers": [{"type": "height", "image": "h.png", "tiling": [2, 3], "offset": [0.5, 0],
-                      "wrap": "clamp", "weight": -0.5, "scale": 0.2, "strength": 0.25,
+                      "wrap": "clamp", "weight": -0.5, "scale": 0.2, "strength": 0.25, "channel": "a",
                       "mask": {"image": "mask.png", "uv": 1, "tiling": 4, "filter": "bicubic"}},
                      {"type": "volume", "function": "noise", "seed": 42, "octaves": 3, "base": "above",
                       "frequency": 8, "gradient": "central", "_note": "comment"},
@@ -167,6 +167,7 @@ TEST(Scene, ExtendedKeys) {
   EXPECT_EQ(height.wrap, Wrap::kClamp);
   EXPECT_EQ(height.weight, -0.5);
   EXPECT_EQ(height.base, LayerBase::kSurface);  // the default
+  EXPECT_EQ(height.channel, ImageChannels::kAlpha);
   EXPECT_EQ(scene->layers[1].base, LayerBase::kLayersAbove);
   ASSERT_TRUE(height.mask.has_value());
   EXPECT_EQ(height.mask->image, std::filesystem::path("scenes/mask.png"));
@@ -483,6 +484,9 @@ TEST(Scene, InvalidCombinations) {
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "base": "above"})")),
             "scene.json: layers[0]: key 'base' does not apply to a normal layer (it is for "
             "height, volume, planar or triplanar layers)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "channel": "r"})")),
+            "scene.json: layers[0]: key 'channel' does not apply to a normal layer (it is for "
+            "height layers)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "base": "top"})")),
             "scene.json: layers[0]: unknown base 'top' (expected surface or above)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "noise", "frequency": 0})")),

@@ -379,6 +379,12 @@ def material_checks(settings, ob, distance):
     _, _, plain_notes = operators.material_layers(tree)
     check("Layers from Material: no note for the plain material", not plain_notes,
           "no note", str(plain_notes))
+    # A Bump fed by the texture's Alpha output reads the alpha channel.
+    tree.links.new(tex.outputs["Alpha"], bump.inputs["Height"])
+    alpha, _, _ = operators.material_layers(tree)
+    tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    check("Layers from Material: a Height from the Alpha output",
+          len(alpha) == 1 and alpha[0].get("channel") == "a", "channel 'a'", str(alpha))
     # An Image Texture without a UV Map node is read on the UV map active for rendering.
     render_uv, _, _ = operators.material_layers(tree, "UVMap")
     check("Layers from Material: the render UV map",

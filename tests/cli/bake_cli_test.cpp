@@ -174,6 +174,62 @@ TEST_F(BakeCliTest, MissingImageModuleIsOneErrorLineNamingItAndWritesNothing) {
   EXPECT_EQ(listDirectory(dir_), before) << "no output, no temporary, no manifest";
 }
 
+TEST_F(BakeCliTest, HeightLayersReadOneChannelOfAPackedMap) {
+  // A height in the alpha (or blue) channel of an RGBA map bakes as the same height alone in a
+  // grey file; a file without the channel is refused, naming it.
+  const int size = 16;
+  std::vector<float> packed(static_cast<std::size_t>(size * size * 4));
+  std::vector<float> grey(static_cast<std::size_t>(size * size));
+  for (std::size_t i = 0; i < grey.size(); ++i) {
+    const float h = static_cast<float>((i * 37) % 101) / 100.0f;
+    grey[i] = h;
+    packed[4 * i] = 0.9f;
+    packed[4 * i + 1] = 0.1f;
+    packed[4 * i + 2] = h;
+    packed[4 * i + 3] = h;
+  }
+  const auto write = [&](const fs::path& path, int channels, const std::vector<float>& pixels) {
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path.string());
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(size, size, channels, OIIO::TypeDesc::UINT16);
+    if (channels == 4) spec.alpha_channel = 3;
+    ASSERT_TRUE(out->open(path.string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    ASSERT_TRUE(out->close());
+  };
+  write(dir_ / "packed.tif", 4, packed);  // TIFF: alpha kept as stored (not premultiplied)
+  write(dir_ / "grey.tif", 1, grey);
+  ::setenv("SOURCE_DATE_EPOCH", "0", 1);  // the files are compared byte for byte
+  const auto bake = [&](const std::string& layer, const std::string& file) {
+    return bakeScene(planeScene(layer, R"({"map": "object-normal", "file": ")" + file +
+                                           R"(", "size": 24, "bit_depth": 32})"),
+                     {"--no-manifest"});
+  };
+  ASSERT_EQ(bake(R"({"type": "height", "image": "grey.tif", "scale": 0.2})", "grey.exr").exitCode,
+            0);
+  for (const char* channel : {"a", "b"}) {
+    const std::string file = std::string(channel) + ".exr";
+    const ProcessResult r =
+        bake(R"({"type": "height", "image": "packed.tif", "scale": 0.2, "channel": ")" +
+                 std::string(channel) + R"("})",
+             file);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(readFile(dir_ / file), readFile(dir_ / "grey.exr")) << channel;
+  }
+  const ProcessResult luminance =
+      bake(R"({"type": "height", "image": "packed.tif", "scale": 0.2})", "l.exr");
+  ASSERT_EQ(luminance.exitCode, 0) << luminance.err;
+  EXPECT_NE(readFile(dir_ / "l.exr"), readFile(dir_ / "grey.exr"));
+  const ProcessResult noAlpha =
+      bake(R"({"type": "height", "image": "n.png", "scale": 0.2, "channel": "a"})", "x.exr");
+  EXPECT_EQ(noAlpha.exitCode, 2);
+  expectOneErrorLine(noAlpha);
+  EXPECT_NE(noAlpha.err.find("n.png: image has 3 channels but an alpha channel is needed"),
+            std::string::npos)
+      << noAlpha.err;
+  ::unsetenv("SOURCE_DATE_EPOCH");
+}
+
 TEST_F(BakeCliTest, SourceDateEpochMakesExrAndTiffFilesReproducible) {
   // OpenImageIO stamps EXR and TIFF files with the time of writing; SOURCE_DATE_EPOCH (the
   // reproducible-builds convention) replaces it, so two bakes give the same bytes.

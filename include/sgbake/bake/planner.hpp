@@ -72,7 +72,8 @@ Result<std::string> hashFile(const std::filesystem::path& path);
 struct PlannedImage {
   std::filesystem::path path;       ///< as the scene resolved it (for messages)
   std::filesystem::path canonical;  ///< weakly_canonical(path): with channels, the dedupe key
-  ImageChannels channels = ImageChannels::kLuminance;  ///< kLuminance or kRgb (normal maps)
+  ImageChannels channels =
+      ImageChannels::kLuminance;  ///< kRgb (normal maps), kLuminance or one channel (heights)
   std::vector<std::string> users;                      ///< "layers[0]", "layers[2].mask", ...
 };
 
@@ -229,7 +230,7 @@ struct MemoryInputs {
   /// The mesh, before the scene's subdivision. It must have the UV sets the scene uses.
   const Mesh* mesh = nullptr;
   /// The image a scene's "image" key names (PlannedImage::path), with the plan's channels
-  /// (PlannedImage::channels: kLuminance or kRgb); kBadInput naming it when there is none.
+  /// (PlannedImage::channels); kBadInput naming it when there is none.
   std::function<Result<Image>(const PlannedImage& image)> image;
 };
 

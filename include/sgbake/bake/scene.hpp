@@ -140,6 +140,10 @@ struct SceneLayer {
   /// normal maps) or "strength" (normal).
   double scale = 1;
   double strength = 1;  ///< "strength" of a height layer: the Bump node's (a blend of normals)
+  /// "channel" of a height layer: luminance (Rec. 709 of RGB, as a colour into the Bump node's
+  /// Height), or one channel: r, g, b, a (a height packed into another map, or the Image
+  /// Texture's Alpha output)
+  ImageChannels channel = ImageChannels::kLuminance;
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
   /// "tangent_uv" (tangent-space normal layers): the UV set whose tangent frames decode the
   /// map, when not its "uv" (TangentNormalSource::tangentUvSet)

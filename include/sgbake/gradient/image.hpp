@@ -96,7 +96,22 @@ enum class ImageChannels {
   /// RGB image into the Bump node's Height); the values are not linearised (Non-Color).
   kLuminance,
   kRgb,  ///< channels 0, 1, 2 (normal maps) → C = 3; files with fewer channels fail
+  /// One channel as it is stored → C = 1 (a height packed into a channel of another map):
+  /// R, G, B = channel 0, 1, 2; A = the last channel of a grey+alpha or RGBA image. Files
+  /// without it fail.
+  kRed,
+  kGreen,
+  kBlue,
+  kAlpha,
 };
+
+/// @brief How many leading channels of an image of @p channels channels @p selection reads,
+/// or −1 when the image lacks what it needs (kRgb with fewer than 3, kAlpha without 2 or 4…).
+int channelsToRead(ImageChannels selection, int channels);
+
+/// @brief What @p selection needs, for messages after "image has 2 channels but ": "3 are
+/// needed (RGB)", "an alpha channel is needed (grey + alpha, or RGBA)", …
+std::string channelsNeeded(ImageChannels selection);
 
 /// @brief Options for loadImage.
 struct LoadImageOptions {
@@ -133,8 +148,10 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
 
 /// @brief The channels @p selection keeps of an image already in memory, as loadImage keeps
 /// them of a file: kAll all of them, kFirst channel 0, kLuminance the Rec. 709 luminance of
-/// channels 0–2 (channel 0 when there are fewer than three), kRgb channels 0–2.
-/// @note Precondition for kRgb: at least three channels (callers check and report it).
+/// channels 0–2 (channel 0 when there are fewer than three), kRgb channels 0–2, kRed … kAlpha
+/// that one channel.
+/// @note Precondition: channelsToRead(selection, image.channels()) ≥ 0 (callers check and
+/// report it).
 Image selectImageChannels(Image image, ImageChannels selection);
 
 /// @brief The first value that is not a finite number (NaN or ±infinity) among channels
