@@ -145,9 +145,10 @@ def world_scale(ob, layers):
                      "units"]
     mean = volume ** (1.0 / 3.0)
     if max(axes) > min(axes) * (1 + 1e-5):
-        return mean, [f"object '{ob.name}' is scaled unevenly ({', '.join(f'{a:.4g}' for a in axes)}):"
-                      f" its heights are divided by {mean:.4g}, but Cycles' bumps in world units "
-                      "differ by direction (apply the scale for an exact match)"]
+        scales = ", ".join(f"{a:.4g}" for a in axes)
+        return mean, [f"object '{ob.name}' is scaled unevenly ({scales}): its heights are "
+                      f"divided by {mean:.4g}, but Cycles' bumps in world units differ by "
+                      "direction (apply the scale for an exact match)"]
     return mean, []
 
 
