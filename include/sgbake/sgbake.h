@@ -33,8 +33,9 @@
 /// 0.1.0's header passes a shorter struct, so rebuild (and set both fields). 0.3.0 changes no
 /// C declaration: normal-map layers and steep bumps bake as Cycles shades them (manifests of
 /// 0.2.0 re-bake). 0.4.0 changes none either: the scene gains a height layer's "base"
-/// ("above": it bumps the normal of the layers before it, as chained Bump nodes do), and the
-/// corners table decodes tangent-space layers with the loop triangles' frames.
+/// ("above": it bumps the normal of the layers before it, as chained Bump nodes do) and
+/// "channel" (one channel of a packed map), a tangent-space normal layer's "tangent_uv", and
+/// the corners table decodes tangent-space layers with the loop triangles' frames.
 #define SGBAKE_VERSION_STRING "0.4.0"
 
 #ifdef __cplusplus
