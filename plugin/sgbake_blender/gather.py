@@ -152,22 +152,28 @@ def world_scale(ob, layers):
     return mean, []
 
 
-def viewport_subdivision_notes(ob, surface):
-    """Notes for Subdivision Surface modifiers whose viewport mesh, which is baked here, is not
-    the one Cycles bakes (render levels, render visibility). Not for the exact limit surface."""
-    if surface == "limit":
-        return []
-    notes = []
-    for modifier in ob.modifiers:
-        if modifier.type != "SUBSURF":
-            continue
-        viewport = modifier.levels if modifier.show_viewport else 0
-        render = modifier.render_levels if modifier.show_render else 0
-        if viewport != render:
-            notes.append(f"modifier '{modifier.name}' subdivides {viewport} time(s) in the "
-                         f"viewport, which is baked, and {render} time(s) for rendering, which "
-                         "Cycles bakes")
-    return notes
+@contextlib.contextmanager
+def render_settings(ob):
+    """Evaluates the object's modifiers as Cycles bakes them: each shown as it is for rendering
+    (show_render), Subdivision Surface and Multiresolution at their render levels; everything
+    is set back afterwards, as it was."""
+    saved = []
+    try:
+        for modifier in ob.modifiers:
+            levels = modifier.type in ("SUBSURF", "MULTIRES")
+            saved.append((modifier, modifier.show_viewport,
+                          modifier.levels if levels else None))
+            if modifier.show_viewport != modifier.show_render:
+                modifier.show_viewport = modifier.show_render
+            if levels and modifier.levels != modifier.render_levels:
+                modifier.levels = modifier.render_levels
+        yield
+    finally:
+        for modifier, shown, levels in reversed(saved):
+            if modifier.show_viewport != shown:
+                modifier.show_viewport = shown
+            if levels is not None and modifier.levels != levels:
+                modifier.levels = levels
 
 
 def creases(mesh):

@@ -45,7 +45,9 @@ class BakeJob:
             except gather.BakeInputError as exc:
                 raise gather.BakeInputError(f"object '{ob.name}' {exc}") from None
         subdivision = None
-        with gather.modifier_hidden(modifier):
+        # The modifiers as Cycles bakes them (render visibility and levels); the limit
+        # surface's own modifier hidden.
+        with gather.render_settings(ob), gather.modifier_hidden(modifier):
             ob_eval = ob.evaluated_get(context.evaluated_depsgraph_get())
             mesh = ob_eval.to_mesh()
             try:
@@ -81,7 +83,6 @@ class BakeJob:
         self.tiles = gather.image_tiles(image)
         # Cycles' Bump Distance is in world units, the mesh here in object units.
         world_scale, self.notes = gather.world_scale(ob, layers)
-        self.notes += gather.viewport_subdivision_notes(ob, self.surface)
         self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
                                               subdivision, world_scale, render_uv)
                        for tile in self.tiles}

@@ -37,8 +37,8 @@ UV_LAYER_TYPES = {"height", "normal"}  # layer types with their own "uv"
 
 SURFACES = (
     ("mesh", "Evaluated Mesh",
-     "The mesh as the object's modifiers make it in the viewport (Cycles bakes their render "
-     "settings)"),
+     "The mesh as the object's modifiers make it for rendering (their render visibility and "
+     "levels): what Cycles bakes"),
     ("limit", "Exact Limit Surface",
      "The exact Catmull-Clark limit surface of the mesh under the object's last modifier, a "
      "Subdivision Surface (its creases, UV Smooth and Boundary Smooth; its levels do not "

@@ -405,14 +405,26 @@ def material_checks(settings, ob, distance):
     check("bake: an unevenly scaled object", any("unevenly" in n for n in job.notes),
           "a note", str(job.notes))
     ob.scale = (1.0, 1.0, 1.0)
-    # A Subdivision Surface with other render levels than viewport levels is named.
+    # A Subdivision Surface at other render levels than viewport levels bakes its render
+    # levels (as Cycles does), and its viewport levels are set back; one hidden for rendering
+    # is left out.
+    faces = len(ob.data.polygons)
     modifier = ob.modifiers.new("Subdivision", "SUBSURF")
     modifier.levels, modifier.render_levels = 0, 1
     bpy.context.view_layer.update()
     job = operators.BakeJob(bpy.context)
-    check("bake: render levels unlike the viewport's",
-          any("'Subdivision'" in n and "for rendering" in n for n in job.notes), "a note",
-          str(job.notes))
+    baked = len(job.arrays[1]) - 1  # face_start has #F + 1 entries
+    quads = len(ob.data.loops)  # level 1 makes a quad of each corner
+    check("bake: a Subdivision Surface's render levels",
+          baked == quads and modifier.levels == 0 and modifier.show_viewport,
+          f"{quads} faces, viewport levels 0 again", f"{baked} faces (of {faces}), levels "
+          f"{modifier.levels}")
+    modifier.levels, modifier.show_render = 1, False
+    bpy.context.view_layer.update()
+    job = operators.BakeJob(bpy.context)
+    baked = len(job.arrays[1]) - 1
+    check("bake: a modifier hidden for rendering", baked == faces and modifier.show_viewport,
+          f"{faces} faces, shown in the viewport again", f"{baked} faces")
     ob.modifiers.remove(modifier)
     bpy.context.view_layer.update()
     return checks
