@@ -374,11 +374,6 @@ Status bakeMapFromArrays(const BakeArguments& a) {
     const std::string name = planned.path.string();
     for (std::size_t i = 0; i < a.numImages; ++i) {
       if (name == a.images[i].name) {
-        if (planned.channels == ImageChannels::kRgb && a.images[i].channels < 3) {
-          return Error::badInput(where + "image '" + name + "' has " +
-                                 std::to_string(a.images[i].channels) +
-                                 " channel(s) but normal maps need 3 (RGB)");
-        }
         if (channelsToRead(planned.channels, a.images[i].channels) < 0) {
           return Error::badInput(where + "image '" + name + "' has " +
                                  std::to_string(a.images[i].channels) + " channel(s) but " +

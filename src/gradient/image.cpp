@@ -54,8 +54,6 @@ Error fileError(const std::filesystem::path& path, std::string_view what) {
   return Error::badInput(printableText(path.string()) + ": " + std::string(what));
 }
 
-// How many leading file channels to read for a selection, or -1 when the file has too few.
-
 /// The machine's physical memory in bytes (0 when unknown).
 double physicalMemoryBytes() {
   const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
@@ -228,29 +226,16 @@ std::string channelsNeeded(ImageChannels selection) {
 }
 
 Image selectImageChannels(Image image, ImageChannels selection) {
-  if (selection == ImageChannels::kRed || selection == ImageChannels::kGreen ||
-      selection == ImageChannels::kBlue || selection == ImageChannels::kAlpha) {
-    const int index = selection == ImageChannels::kAlpha   ? image.channels() - 1
-                      : selection == ImageChannels::kBlue  ? 2
-                      : selection == ImageChannels::kGreen ? 1
-                                                           : 0;
-    if (image.channels() == 1) return image;
-    Image one(image.width(), image.height(), 1);
-    const auto stride = static_cast<std::size_t>(image.channels());
-    const float* source = image.pixels().data() + index;
-    float* target = one.pixels().data();
-    const std::size_t width = static_cast<std::size_t>(image.width());
-    forEachRow(image.height(), [&](int y) {
-      const std::size_t row = static_cast<std::size_t>(y) * width;
-      for (std::size_t x = 0; x < width; ++x) target[row + x] = source[(row + x) * stride];
-    });
-    return one;
-  }
   const int have = image.channels();
   const int keep = selection == ImageChannels::kAll     ? have
                    : selection == ImageChannels::kRgb && have >= 3 ? 3
                                                                    : 1;
   if (keep == have) return image;
+  // The first channel kept: one channel of a packed map, else channel 0.
+  const std::size_t first = selection == ImageChannels::kAlpha   ? static_cast<std::size_t>(have - 1)
+                            : selection == ImageChannels::kBlue  ? 2
+                            : selection == ImageChannels::kGreen ? 1
+                                                                 : 0;
   const bool luminance = selection == ImageChannels::kLuminance && have >= 3;
   Image selected(image.width(), image.height(), keep);
   const std::size_t width = static_cast<std::size_t>(image.width());
@@ -268,7 +253,7 @@ Image selectImageChannels(Image image, ImageChannels selection) {
             kLumaR * in[x * from] + kLumaG * in[x * from + 1] + kLumaB * in[x * from + 2];
         out[x] = static_cast<float>(luma);
       } else {
-        for (std::size_t c = 0; c < to; ++c) out[x * to + c] = in[x * from + c];
+        for (std::size_t c = 0; c < to; ++c) out[x * to + c] = in[x * from + first + c];
       }
     }
   });
