@@ -115,21 +115,6 @@ def limit_modifier(ob):
     return modifier
 
 
-@contextlib.contextmanager
-def modifier_hidden(modifier):
-    """Evaluates the object without `modifier` (shown again afterwards, as it was); does
-    nothing when it is None."""
-    if modifier is None:
-        yield
-        return
-    shown = modifier.show_viewport
-    modifier.show_viewport = False
-    try:
-        yield
-    finally:
-        modifier.show_viewport = shown
-
-
 def world_scale(ob, layers):
     """The factor height layers' Scale (world units, as Cycles' Bump Distance) is divided by
     to become object units for the bake, and notes for the report: the object's scale, or the
@@ -153,18 +138,20 @@ def world_scale(ob, layers):
 
 
 @contextlib.contextmanager
-def render_settings(ob):
+def render_settings(ob, hidden=None):
     """Evaluates the object's modifiers as Cycles bakes them: each shown as it is for rendering
-    (show_render), Subdivision Surface and Multiresolution at their render levels; everything
-    is set back afterwards, as it was."""
+    (show_render), Subdivision Surface and Multiresolution at their render levels, and the
+    modifier `hidden` (the limit surface's, or None) not at all; everything is set back
+    afterwards, as it was."""
     saved = []
     try:
         for modifier in ob.modifiers:
             levels = modifier.type in ("SUBSURF", "MULTIRES")
             saved.append((modifier, modifier.show_viewport,
                           modifier.levels if levels else None))
-            if modifier.show_viewport != modifier.show_render:
-                modifier.show_viewport = modifier.show_render
+            shown = modifier.show_render and modifier != hidden
+            if modifier.show_viewport != shown:
+                modifier.show_viewport = shown
             if levels and modifier.levels != modifier.render_levels:
                 modifier.levels = modifier.render_levels
         yield

@@ -47,7 +47,7 @@ class BakeJob:
         subdivision = None
         # The modifiers as Cycles bakes them (render visibility and levels); the limit
         # surface's own modifier hidden.
-        with gather.render_settings(ob), gather.modifier_hidden(modifier):
+        with gather.render_settings(ob, hidden=modifier):
             ob_eval = ob.evaluated_get(context.evaluated_depsgraph_get())
             mesh = ob_eval.to_mesh()
             try:
