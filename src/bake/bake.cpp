@@ -245,6 +245,11 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
                              " triangle corners");
     }
   }
+  if (input.transform != nullptr) {
+    if (Result<WorldSpace> space = WorldSpace::of(*input.transform); !space) {
+      return Error::badInput(where + ": " + space.error().message);
+    }
+  }
   return validateLayers(input.layers, static_cast<int>(mesh.uvSets.size()));
 }
 
@@ -260,6 +265,11 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   base.layers = input.layers;
   base.uvSet = settings.uvSet;
   base.green = settings.green;
+  WorldSpace world;
+  if (input.transform != nullptr && !input.transform->shadesAsObjectSpace()) {
+    world = WorldSpace::of(*input.transform).value();  // validateSettings checked it
+    base.world = &world;
+  }
 
   static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
   static constexpr float kZero[3] = {0, 0, 0};
@@ -298,6 +308,25 @@ Error outOfMemory(const BakeSettings& settings) {
 }
 
 }  // namespace
+
+void bake_detail::worldTriangle(const bake_detail::ShadingTriangle& tri, const WorldSpace& space,
+                                bake_detail::ShadingTriangle& world) {
+  world = tri;
+  for (std::size_t i = 0; i < 3; ++i) {
+    world.position[i] = space.toWorld * tri.position[i] + space.translation;
+    world.normal[i] = normalizeOr(space.normalToWorld * tri.normal[i], tri.normal[i]);
+  }
+  world.faceNormal = normalizeOr(space.normalToWorld * tri.faceNormal, tri.faceNormal);
+  for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s) {
+    world.dPdu[s] = space.toWorld * tri.dPdu[s];
+    world.dPdv[s] = space.toWorld * tri.dPdv[s];
+  }
+  world.bakeDPdu = space.toWorld * tri.bakeDPdu;
+  world.bakeDPdv = space.toWorld * tri.bakeDPdv;
+  world.polygonFrame = false;
+  world.hasTangents = false;
+  world.hasLayerTangents = {};
+}
 
 Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
                                                    const TangentOptions& options) {

@@ -320,6 +320,38 @@ std::string manifestName(const fs::path& canonical, const fs::path& dir) {
   return manifestText(relative.empty() ? canonical.generic_string() : relative.generic_string());
 }
 
+/// Whether @p output's values depend on the scene's "transform" (BakeInput::transform): the
+/// maps of the shaded normal and Γ, and the corners table.
+bool shadedThroughTransform(const SceneOutput& output) {
+  if (output.kind == OutputKind::kCorners) return true;
+  switch (output.map) {
+    case MapKind::kTangentNormal:
+    case MapKind::kObjectNormal:
+    case MapKind::kDerivative:
+    case MapKind::kSurfaceGradient:
+      return true;
+    default:
+      return false;
+  }
+}
+
+/// ,"transform":[12 numbers] for the manifest's parameters of @p output when the scene's
+/// transform shades it (not the identity); nothing otherwise, so that adding an identity
+/// transform, or a transform to a scene of height maps, re-bakes nothing.
+std::string transformParametersJson(const Scene& scene, const SceneOutput& output) {
+  if (!scene.transform || scene.transform->shadesAsObjectSpace() || !shadedThroughTransform(output))
+    return {};
+  const ObjectTransform& t = *scene.transform;
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) {
+    const double translation = r == 0   ? t.translation.x
+                               : r == 1 ? t.translation.y
+                                        : t.translation.z;
+    rows.push_back({t.linear(r, 0), t.linear(r, 1), t.linear(r, 2), translation});
+  }
+  return ",\"transform\":" + rows.dump();
+}
+
 /// Why @p planned must be baked, as the manifest entry @p entry of its @p file says (one
 /// phrase for explainPlan: the first difference found); empty when nothing changed.
 std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::path& file) {
@@ -608,6 +640,19 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
   if (plan.computeTangents) {
     plan.steps.push_back({"compute MikkTSpace tangent frames", joinLabels(tangentReasons)});
   }
+  if (scene.transform && !scene.transform->shadesAsObjectSpace()) {
+    std::vector<std::string> shaded;
+    for (const PlannedOutput& output : plan.outputs) {
+      const SceneOutput& o = scene.outputs[output.sceneOutput];
+      if (!output.upToDate && shadedThroughTransform(o)) shaded.push_back(o.file.string());
+    }
+    if (!shaded.empty()) {
+      plan.steps.push_back(
+          {"shade in world space through the object transform, as Cycles does (heights in "
+           "world units), sample by sample",
+           "the scene's \"transform\", for " + joinLabels(shaded)});
+    }
+  }
   for (const PlannedOutput& planned : plan.outputs) {
     if (planned.upToDate) continue;
     const SceneOutput& output = scene.outputs[planned.sceneOutput];
@@ -859,6 +904,7 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     };
     const std::string common = std::string("{\"sgbake\":\"") + sgbake_version() +
                                "\",\"subdivision\":" + subdivisionParametersJson(s.subdivision) +
+                               transformParametersJson(s, output) +
                                ",\"mesh\":" + json(name(s.mesh)).dump();
     std::string layersJson;
     std::vector<fs::path> inputs{s.mesh};
@@ -1439,6 +1485,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       if (output.kind == OutputKind::kCorners) {
         CornerOptions cornerOptions;
         cornerOptions.threads = options.threads;
+        if (loaded.world) cornerOptions.world = &*loaded.world;
         // Tangent-space layers decode with the loop triangles' frames, as in a baked map.
         std::array<CornerTangents, kMaxUvSets> cornerFrames;
         for (std::size_t set = 0; set < kMaxUvSets; ++set) {

@@ -26,6 +26,12 @@ void padImage(FloatImage& image, const OutputPadding& padding, const BakeInput& 
 }
 
 Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
+  if (scene.transform && !scene.transform->shadesAsObjectSpace()) {
+    Result<WorldSpace> world = WorldSpace::of(*scene.transform);
+    if (!world) return world.error();
+    loaded.transform = scene.transform;
+    loaded.world = *world;
+  }
   const SceneSubdivision& subdivision = scene.subdivision;
   if (!subdivision.requested()) {
     loaded.mesh = std::move(coarse);
@@ -406,6 +412,7 @@ BakeInput bakeInputFor(const Loaded& loaded, std::span<const Layer> layers) {
     if (loaded.triangleTangents[s]) input.triangleTangents[s] = &*loaded.triangleTangents[s];
   }
   input.layers = layers;
+  if (loaded.transform) input.transform = &*loaded.transform;
   if (loaded.limit) {
     input.limit = &*loaded.limit;
     input.limitParameters = &loaded.limitParameters;

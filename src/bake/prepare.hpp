@@ -72,6 +72,9 @@ struct Loaded {
   std::optional<CornerTangents> tangents;
   /// computeLoopTriangleTangents per UV set a tangent-space layer decodes on (MikkTSpace frame)
   std::array<std::optional<CornerTangents>, kMaxUvSets> triangleTangents;
+  /// The scene's "transform" when it shades in world space (not the identity), and its matrices.
+  std::optional<ObjectTransform> transform;
+  std::optional<WorldSpace> world;
   std::vector<std::string> warnings;  ///< about the inputs, for ExecuteReport::warnings
 };
 

@@ -349,7 +349,8 @@ std::filesystem::path pathValue(const ObjectReader& reader, std::string_view key
 
 // ---- Keys of each kind of object ---------------------------------------------------------------
 
-const std::vector<std::string> kTopKeys = {"mesh", "uv", "subdivision", "layers", "outputs"};
+const std::vector<std::string> kTopKeys = {"mesh",      "uv",     "subdivision",
+                                           "transform", "layers", "outputs"};
 const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",    "boundary",
                                                    "use_creases", "edge_creases", "vertex_creases",
                                                    "quality",     "use_limit_surface",
@@ -559,6 +560,45 @@ void checkSubdivisionConflict(const ObjectReader& reader, const SceneSubdivision
            "\"level\": \"limit\" shades the exact surface's own normals; it "
            "cannot be combined with \"sharp_edges\"");
   }
+}
+
+/// The top-level "transform": 4 rows of 4 numbers (an affine matrix: last row 0 0 0 1) or 3 rows
+/// of 3, finite, with a nonzero determinant.
+ObjectTransform parseTransform(const json& value) {
+  const auto shape = [&] {
+    fail("",
+         "'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 rows of 3, "
+         "not " +
+             (value.is_array() ? std::string("an array of ") + std::to_string(value.size())
+                               : describeType(value)));
+  };
+  if (!value.is_array() || (value.size() != 4 && value.size() != 3)) shape();
+  const std::size_t n = value.size();
+  double m[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+  for (std::size_t r = 0; r < n; ++r) {
+    const json& row = value[r];
+    if (!row.is_array() || row.size() != n) shape();
+    for (std::size_t c = 0; c < n; ++c) {
+      const std::string where = "transform[" + std::to_string(r) + "][" + std::to_string(c) + "]";
+      if (!row[c].is_number()) fail("", where + " must be a number, not " + describeType(row[c]));
+      m[r][c] = row[c].get<double>();
+      if (!std::isfinite(m[r][c])) fail("", where + " is not finite");
+    }
+  }
+  if (m[3][0] != 0 || m[3][1] != 0 || m[3][2] != 0 || m[3][3] != 1) {
+    fail("",
+         "'transform' row 3 must be [0, 0, 0, 1] (an affine transform), not " + value[3].dump());
+  }
+  ObjectTransform transform;
+  transform.linear = Mat3::fromColumns({m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
+                                       {m[0][2], m[1][2], m[2][2]});
+  transform.translation = {m[0][3], m[1][3], m[2][3]};
+  if (!WorldSpace::of(transform)) {
+    fail("",
+         "'transform' is singular (its 3 x 3 part has determinant 0): no normal can be "
+         "carried through it");
+  }
+  return transform;
 }
 
 SceneSubdivision parseSubdivision(const json& value) {
@@ -833,6 +873,7 @@ Scene parseDocument(const json& document, const SceneParseOptions& options) {
   const InputPaths inputPaths{options.baseDir, options.inMemory};
   if (top.has("uv")) scene.uvSet = top.smallInteger("uv", 0, kMaxUvSets - 1);
   if (top.has("subdivision")) scene.subdivision = parseSubdivision(top.at("subdivision"));
+  if (top.has("transform")) scene.transform = parseTransform(top.at("transform"));
 
   if (top.has("layers")) {
     const json& layers = top.at("layers");

@@ -19,6 +19,7 @@
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 
 namespace sgbake::bake_detail {
 
@@ -42,6 +43,12 @@ struct BakeShaderBase {
   /// ∂P/∂v, lengths, T̂ × B̂) computed once, for the UV height layers (see gradient()).
   std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};
 
+  /// Non-null: the object is shaded in world space through this transform, as Cycles shades
+  /// it (world_shading.hpp), sample by sample (the lane-parallel paths stay object-space).
+  const WorldSpace* world = nullptr;
+  ShadingTriangle worldTri;  ///< tri in world space (worldTriangle), when `world`
+  SurfacePoint worldPoint;   ///< constant fields set per triangle, the rest per sample
+
   void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
     for (std::size_t s = 0; s < kMaxUvSets; ++s) {
@@ -61,6 +68,25 @@ struct BakeShaderBase {
     beginSurfacePoint(tri, point);
     for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s)
       preparedUv[s] = gradient_detail::prepareUvFrame(point.uv[s]);
+    if (world != nullptr) {
+      worldTriangle(tri, *world, worldTri);
+      beginSurfacePoint(worldTri, worldPoint);
+    }
+  }
+
+  /// The object's shading in world space at barycentrics @p b (`world` non-null): the guarded
+  /// world normal (the unperturbed one without layers) and the object-space Γ.
+  WorldShadedNormal shadeInWorld(const Vec3d& b, const TexelFrame& f) {
+    const SurfacePoint& objectPoint = pointAt(b, f);
+    const SurfacePoint& w = surfacePointAt(worldTri, b, texelFrame(worldTri, b), worldPoint);
+    if (layers.empty()) return {w.normal, {}};
+    return shadeLayersInWorld(layers, objectPoint, w, worldTri.faceNormal, *world);
+  }
+  /// shade() of every sample of @p s, for the shaders whose lane-parallel path is object-space.
+  template <class Shader>
+  static void shadeEachSample(Shader& shader, const SampleBatch& s, double* out) {
+    for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i)
+      shader.shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + Shader::kChannels * i);
   }
   const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
     return surfacePointAt(tri, b, f, point);
@@ -352,7 +378,10 @@ struct TangentNormalShader : BakeShaderBase {
   }
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
-    const Vec3d normal = layers.empty() ? unitNormal(tri, f) : unnormalizedPerturbed(b, f);
+    // In world space, Blender's baker brings the normal back to object space as a normal (M^T).
+    const Vec3d normal = world != nullptr ? world->normalToObject * shadeInWorld(b, f).normal
+                         : layers.empty() ? unitNormal(tri, f)
+                                          : unnormalizedPerturbed(b, f);
     Vec3d n = objectToTangent(f, normal);
     if (green == NormalMapGreen::kDirectX) n.y = -n.y;
     put(encodeNormal(n), out);
@@ -360,6 +389,7 @@ struct TangentNormalShader : BakeShaderBase {
 
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames).
   void shadeBatch(const SampleBatch& s, double* out) {
+    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -406,12 +436,17 @@ struct ObjectNormalShader : BakeShaderBase {
   static constexpr int kChannels = 3;
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
+    if (world != nullptr) {  // Blender's baker brings it back as a direction (M^{-1}), measured
+      const Vec3d n = shadeInWorld(b, f).normal;
+      return put(encodeNormal(normalizeOr(world->directionToObject * n, unitNormal(tri, f))), out);
+    }
     put(encodeNormal(layers.empty() ? unitNormal(tri, f) : perturbed(b, f)), out);
   }
 
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames): N̂, or N̂ − Γ
   /// normalized as perturbed() normalizes it, encoded.
   void shadeBatch(const SampleBatch& s, double* out) {
+    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -492,13 +527,14 @@ struct DerivativeShader : BakeShaderBase {
   static constexpr int kChannels = 2;
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
-    const Vec3d gamma = gradient(pointAt(b, f));
+    const Vec3d gamma = world != nullptr ? shadeInWorld(b, f).gradient : gradient(pointAt(b, f));
     out[0] = dot(gamma, tri.bakeDPdu);
     out[1] = dot(gamma, tri.bakeDPdv);
   }
 
   /// shade() of every sample of @p s, lane-parallel (batchGradients).
   void shadeBatch(const SampleBatch& s, double* out) {
+    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -517,11 +553,12 @@ struct SurfaceGradientShader : BakeShaderBase {
   static constexpr int kChannels = 3;
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
-    put(gradient(pointAt(b, f)), out);
+    put(world != nullptr ? shadeInWorld(b, f).gradient : gradient(pointAt(b, f)), out);
   }
 
   /// shade() of every sample of @p s, lane-parallel (batchGradients).
   void shadeBatch(const SampleBatch& s, double* out) {
+    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);

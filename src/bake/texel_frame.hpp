@@ -13,6 +13,7 @@
 #include "sgbake/core/vec.hpp"
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/surface_point.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/mesh/mesh.hpp"
 
 namespace sgbake::bake_detail {
@@ -66,6 +67,12 @@ void triangleDerivatives(const std::array<Vec3d, 3>& p, const std::array<Vec2d, 
 void loadShadingTriangle(const Mesh& mesh, const CornerTangents* tangents,
                          const std::array<std::uint32_t, 3>& corners, int bakeUvSet,
                          ShadingTriangle& tri);
+
+/// @brief @p tri as the world sees it through @p space (world_shading.hpp), for shading: positions
+/// moved, corner normals carried as normals and normalized one by one (as Cycles carries them),
+/// the geometric normal carried as a normal, ∂P/∂u and ∂P/∂v as directions; UVs and flatness
+/// kept. No tangent frames: tangent-space layers decode in object space.
+void worldTriangle(const ShadingTriangle& tri, const WorldSpace& space, ShadingTriangle& world);
 
 /// @brief normalizeOr(a, fallback) bit for bit, with its common case (finite, nonzero squared
 /// length) inlined: the compiler keeps normalizeOr itself out of line, and the shaders call it

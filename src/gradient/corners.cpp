@@ -123,6 +123,18 @@ void useLayerTangents(const std::array<const CornerTangents*, kMaxUvSets>& layer
   }
 }
 
+/// @p point in world space: the normal carried as a normal, ∂P/∂u and ∂P/∂v as directions.
+SurfacePoint worldCornerPoint(const SurfacePoint& point, const WorldSpace& space) {
+  SurfacePoint world = point;
+  world.position = space.toWorld * point.position + space.translation;
+  world.normal = normalizeOr(space.normalToWorld * point.normal, point.normal);
+  for (std::size_t set = 0; set < static_cast<std::size_t>(point.numUvSets); ++set) {
+    world.uv[set].dPdu = space.toWorld * point.uv[set].dPdu;
+    world.uv[set].dPdv = space.toWorld * point.uv[set].dPdv;
+  }
+  return world;
+}
+
 }  // namespace
 
 SurfacePoint cornerSurfacePoint(const Mesh& mesh, const CornerTangents* tangents, std::size_t face,
@@ -174,8 +186,16 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
               s.position = point.position;
               s.normal = point.normal;
               s.uv = point.numUvSets > 0 ? point.uv[0].uv : Vec2d{};
-              s.gradient = compositeGradient(layers, point);
-              s.perturbed = resolveNormal(point.normal, s.gradient, options.objectScaleCofactor);
+              if (options.world != nullptr) {
+                // A corner has no triangle: its own normal is its Ng, as compositeGradient's.
+                const SurfacePoint world = worldCornerPoint(point, *options.world);
+                s.gradient =
+                    shadeLayersInWorld(layers, point, world, world.normal, *options.world).gradient;
+                s.perturbed = resolveNormal(point.normal, s.gradient);
+              } else {
+                s.gradient = compositeGradient(layers, point);
+                s.perturbed = resolveNormal(point.normal, s.gradient, options.objectScaleCofactor);
+              }
             }
           }
         });

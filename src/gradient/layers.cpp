@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <string>
 
+#include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
 
@@ -215,24 +216,30 @@ Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
   if (!(strength > 0)) return gammaAbove;  // Blender clamps Strength at 0 (and NaN is no bump)
   const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
                                                     : layerGradient(layer.source, point));
-  if (!isFinite(gamma) || !isFinite(gammaAbove)) return gammaAbove;
+  return gradient_detail::stackGradient(gamma, strength, point.normal, geometricNormal, gammaAbove);
+}
 
-  const Vec3d& n = point.normal;
-  const Vec3d& ng = geometricNormal;
+namespace gradient_detail {
+
+Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
+                    const Vec3d& gammaAbove) {
+  if (!isFinite(gamma) || !isFinite(gammaAbove)) return gammaAbove;
   // The normal the layers above hand on, guarded as the node that made it guards it.
-  const Vec3d above = gradient_detail::validReflectionNormal(normalizeOr(n - gammaAbove, n), ng, n);
+  const Vec3d above = validReflectionNormal(normalizeOr(n - gammaAbove, n), ng, n);
   // The same derivatives along the plane of Ng, perpendicular to that normal.
   const double across = dot(ng, above);
   const Vec3d sigma = std::abs(across) > 0 ? gamma - (dot(gamma, above) / across) * ng : gamma;
   Vec3d bumped = normalizeOr(above - sigma, above);
   if (strength != 1) bumped = normalizeOr(strength * bumped + (1 - strength) * above, above);
-  bumped = gradient_detail::validReflectionNormal(bumped, ng, n);
+  bumped = validReflectionNormal(bumped, ng, n);
   // The Γ that resolves to it: N − Γ = n₂ / ⟨n₂, N⟩.
   const double height = dot(bumped, n);
   if (!(height > 0)) return gammaAbove;  // only when the guard had nothing to turn to
   const Vec3d result = n - (1 / height) * bumped;
   return isFinite(result) ? result : gammaAbove;
 }
+
+}  // namespace gradient_detail
 
 Vec3d perturbedNormal(const SurfacePoint& point, std::span<const Layer> layers,
                       const Mat3& objectScaleCofactor) {

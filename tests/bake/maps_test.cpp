@@ -159,6 +159,73 @@ TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
   }
 }
 
+// The same plane on an object turned and scaled (sx, sy, sz) = (2, 0.5, 1.5), shaded in world
+// space as Cycles shades it (BakeInput::transform): the world slope along x is a/(sx·Lx), the
+// world normal normalize(−Γ_w + ẑ) turned, and the baker brings it back as a normal (M^T) for
+// the tangent-space map, ∝ (−scale·a/Lx, −scale·b/Ly, sz): only the scale across the plane
+// matters, as a Bump node's Distance is measured along the world normal. The object-space map
+// takes M^{-1} instead, as Blender's baker does. Heights are unchanged; a translation alone
+// changes nothing, bit for bit.
+TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
+  const double lx = 2, ly = 0.5, a = 0.3, b = -0.2, scale = 0.7;
+  const double sx = 2, sy = 0.5, sz = 1.5;
+  const Mesh mesh = scaledPlane(lx, ly);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::LinearHeight height(a, b);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, scale}, 1.0, {}}};
+  const double c = std::cos(0.6), s = std::sin(0.6);
+  const Mat3 turn = Mat3::fromColumns({c, s, 0}, {0, 0, 1}, {s, -c, 0});  // a proper rotation
+  const ObjectTransform transform{turn * Mat3::diagonal({sx, sy, sz}), {3, -1, 2}};
+  const ObjectTransform moved{Mat3::identity(), {3, -1, 2}};
+
+  const Vec3d tangentNormal = normalizeOr(Vec3d{-scale * a / lx, -scale * b / ly, sz}, Vec3d{});
+  const Vec3d objectNormal =
+      normalizeOr(Vec3d{-scale * a / (sx * sx * lx), -scale * b / (sy * sy * ly), 1 / sz}, Vec3d{});
+  const Vec3d gamma{scale * a / (lx * sz), scale * b / (ly * sz), 0};
+  const auto bakeWith = [&](const ObjectTransform* t, MapKind kind) {
+    BakeInput input{&mesh, &*tangents, layers};
+    input.transform = t;
+    BakeSettings settings;
+    settings.map = kind;
+    settings.width = settings.height = 32;
+    Result<FloatImage> image = bakeMap(input, settings);
+    EXPECT_TRUE(image.ok()) << image.error().message;
+    return image.ok() ? std::move(*image) : FloatImage{};
+  };
+  const FloatImage tn = bakeWith(&transform, MapKind::kTangentNormal);
+  const FloatImage on = bakeWith(&transform, MapKind::kObjectNormal);
+  const FloatImage sg = bakeWith(&transform, MapKind::kSurfaceGradient);
+  const FloatImage dv = bakeWith(&transform, MapKind::kDerivative);
+  int covered = 0;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      if (test::coverageUp(tn, x, y) != 1.0f) continue;
+      ++covered;
+      const std::string at = std::to_string(x) + "," + std::to_string(y);
+      expectNear(test::pixelUp(tn, x, y), encode(tangentNormal), kFloatTol, "tangent-normal " + at);
+      expectNear(test::pixelUp(on, x, y), encode(objectNormal), kFloatTol, "object-normal " + at);
+      expectNear(test::pixelUp(sg, x, y), gamma, 1e-6, "surface gradient " + at);
+      EXPECT_NEAR(dv.at(x, 31 - y, 0), scale * a / sz, 1e-6) << at;
+      EXPECT_NEAR(dv.at(x, 31 - y, 1), scale * b / sz, 1e-6) << at;
+    }
+  }
+  EXPECT_GT(covered, 300);
+  for (const MapKind kind : {MapKind::kHeight, MapKind::kTangent, MapKind::kMask}) {
+    EXPECT_EQ(bakeWith(&transform, kind).pixels, bakeWith(nullptr, kind).pixels)
+        << mapKindName(kind);
+  }
+  for (const MapKind kind : {MapKind::kTangentNormal, MapKind::kObjectNormal}) {
+    EXPECT_EQ(bakeWith(&moved, kind).pixels, bakeWith(nullptr, kind).pixels) << mapKindName(kind);
+  }
+  const ObjectTransform singular{Mat3::diagonal({1, 1, 0}), {}};
+  BakeInput bad{&mesh, &*tangents, layers};
+  bad.transform = &singular;
+  const Result<FloatImage> refused = bakeMap(bad, {});
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("singular"), std::string::npos) << refused.error().message;
+}
+
 // Cycles bends a bumped normal whose reflection of the incoming direction (at a bake, the
 // shading normal: ẑ on this plane) would go below the surface: on a flat plane no normal leans
 // more than acos(0.01)/2 = 44.71° from ẑ. A steep linear height (60°) bakes that tilt, in the

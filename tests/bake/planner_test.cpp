@@ -581,6 +581,33 @@ TEST_F(PlannerTest, ASubdivisionBlockThatChangesNothingIsNoChange) {
   EXPECT_EQ(plan(levelOne).outputs[0].whyBake, "its parameters changed: \"subdivision\"");
 }
 
+// The object transform re-bakes the maps it shades (normals, Γ), not heights or masks; a
+// translation alone shades nothing differently and re-bakes nothing. Explain names the step.
+TEST_F(PlannerTest, TheTransformReBakesWhatItShades) {
+  const std::string outputs = R"({"map": "object-normal", "file": "o.exr", "size": 8},
+                       {"map": "height", "file": "h.exr", "size": 8},
+                       {"map": "mask", "file": "m.png", "size": 8})";
+  const std::string plain = planeScene(kHeightLayer, outputs);
+  bake(plain);
+  std::string moved = plain;
+  moved.insert(1, R"("transform": [[1, 0, 0, 5], [0, 1, 0, 6], [0, 0, 1, 7], [0, 0, 0, 1]], )");
+  EXPECT_EQ(plan(moved).outputsToBake(), 0u) << explainPlan(plan(moved));
+  std::string stretched = plain;
+  stretched.insert(1, R"("transform": [[2, 0, 0], [0, 1, 0], [0, 0, 0.5]], )");
+  const Plan p = plan(stretched);
+  EXPECT_EQ(p.outputsToBake(), 1u);
+  EXPECT_FALSE(p.outputs[0].upToDate);
+  EXPECT_EQ(p.outputs[0].whyBake, "its parameters changed: \"transform\"");
+  const std::string explained = explainPlan(p);
+  EXPECT_NE(explained.find("shade in world space through the object transform"), std::string::npos)
+      << explained;
+  EXPECT_EQ(explainPlan(plan(plain)).find("world space"), std::string::npos);
+  const std::string before = readFile(dir_ / "o.exr");
+  ASSERT_TRUE(executePlan(p));
+  EXPECT_NE(readFile(dir_ / "o.exr"), before);
+  EXPECT_EQ(plan(stretched).outputsToBake(), 0u);
+}
+
 TEST_F(PlannerTest, ValuesAFileCannotStoreAreAWarningNamingTheFileAndTheRemedy) {
   // h.png rises by 0.5 across the plane: with scale 4, ∂h/∂u = 2 and heights reach 2.
   const std::string layer = R"({"type": "height", "image": "h.png", "scale": 4})";

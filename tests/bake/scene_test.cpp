@@ -307,6 +307,49 @@ TEST(Scene, WrongTypes) {
             "scene.json: layers[0]: 'direction' must be an array of 3 numbers, not an array");
 }
 
+/// A scene with "transform": @p transform (JSON text) and one mask output.
+std::string withTransform(const std::string& transform) {
+  return R"({"mesh": "m.obj", "transform": )" + transform +
+         R"(, "outputs": [{"map": "mask", "file": "m.png"}]})";
+}
+
+TEST(Scene, TransformIsBlendersMatrixWorld) {
+  Result<Scene> rows4 = parseScene(
+      withTransform("[[2, 0, 0, 1], [0, 1, 0.5, 2], [0, 0, 0.5, 3], [0, 0, 0, 1]]"), options());
+  ASSERT_TRUE(rows4.ok()) << rows4.error().message;
+  ASSERT_TRUE(rows4->transform.has_value());
+  const ObjectTransform& t = *rows4->transform;
+  EXPECT_EQ(t.linear(0, 0), 2);
+  EXPECT_EQ(t.linear(1, 2), 0.5);  // row 1, column 2: rows as Blender lists them
+  EXPECT_EQ(t.linear(2, 1), 0);
+  EXPECT_EQ(t.translation.x, 1);
+  EXPECT_EQ(t.translation.z, 3);
+  EXPECT_FALSE(t.shadesAsObjectSpace());
+  Result<Scene> rows3 = parseScene(withTransform("[[1, 0, 0], [0, 1, 0], [0, 0, 1]]"), options());
+  ASSERT_TRUE(rows3.ok()) << rows3.error().message;
+  EXPECT_TRUE(rows3->transform->shadesAsObjectSpace());
+  EXPECT_FALSE(parseScene(withOutput(R"({"map": "mask", "file": "m.png"})"), options())
+                   ->transform.has_value());
+
+  EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 1, 0]]")),
+            "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 "
+            "rows of 3, not an array of 2");
+  EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 1, 0], [0, 0]]")),
+            "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 "
+            "rows of 3, not an array of 3");
+  EXPECT_EQ(parseError(withTransform(R"([[1, 0, 0], [0, "a", 0], [0, 0, 1]])")),
+            "scene.json: transform[1][1] must be a number, not a string");
+  EXPECT_EQ(parseError(withTransform("[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]")),
+            "scene.json: 'transform' row 3 must be [0, 0, 0, 1] (an affine transform), not "
+            "[0,0,1,1]");
+  EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 0, 0], [0, 0, 1]]")),
+            "scene.json: 'transform' is singular (its 3 x 3 part has determinant 0): no normal "
+            "can be carried through it");
+  EXPECT_EQ(parseError(withTransform("{}")),
+            "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 "
+            "rows of 3, not an object");
+}
+
 TEST(Scene, MissingAndEmpty) {
   EXPECT_EQ(parseError(R"({"outputs": [{"map": "mask", "file": "m.png"}]})"),
             "scene.json: missing key 'mesh' in the scene");

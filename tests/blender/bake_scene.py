@@ -121,6 +121,23 @@ def normal_map_case(name, mesh_case, size, space, strength, tilt_deg, bump=None)
         NORMAL_MAPS[name]["bump"] = bump
 
 
+# name -> the object transform of a case (location, XYZ Euler rotation in radians, scale):
+# mesh.obj stays in object space, Cycles shades the object in world space, and sgbake is given
+# the object's matrix_world ("transform" in the JSON scene). Cases not listed sit at the origin
+# with the identity transform.
+TRANSFORMS = {}
+
+
+def transformed_case(name, of_case, location, rotation, scale):
+    """Registers case `name`: case `of_case` (its mesh, material and bake size) with the object
+    moved, turned and scaled by (location, rotation, scale)."""
+    CASES[name] = CASES[of_case]
+    SUBDIVISION[name] = SUBDIVISION[of_case]
+    if of_case in NORMAL_MAPS:
+        NORMAL_MAPS[name] = dict(NORMAL_MAPS[of_case])
+    TRANSFORMS[name] = (location, rotation, scale)
+
+
 def apply_subdivision(ob, levels):
     mod = ob.modifiers.new("Subdivision", "SUBSURF")
     mod.levels = levels
@@ -228,6 +245,18 @@ normal_map_case("nmap_suzanne", "suzanne", 256, "TANGENT", 1.0, 40.0)
 # A Bump node on the normal map's output (its Normal input linked): sgbake's "base": "above".
 normal_map_case("chain_sphere", "sphere", 512, "TANGENT", 1.0, 40.0, bump=0.1)
 normal_map_case("chain_suzanne", "suzanne", 512, "TANGENT", 1.0, 40.0, bump=0.1)
+# Unevenly scaled objects (a cube scaled without Apply Scale is the everyday example): Cycles
+# bumps in world space (Distance in world units), decodes normal maps in object space and
+# carries them to world space as normals, guards in world space, and the baker brings the
+# result back to object space.
+transformed_case("stretch_sphere", "sphere", (0.5, -1.0, 2.0), (0.4, 0.2, 0.7), (2.0, 1.0, 0.5))
+transformed_case("stretch_nmap_sphere", "nmap_sphere", (0.5, -1.0, 2.0), (0.4, 0.2, 0.7),
+                 (2.0, 1.0, 0.5))
+transformed_case("stretch_nmap_sphere_object", "nmap_sphere_object", (0.5, -1.0, 2.0),
+                 (0.4, 0.2, 0.7), (2.0, 1.0, 0.5))
+transformed_case("stretch_chain_suzanne", "chain_suzanne", (0.0, 0.0, 0.0), (0.0, 0.0, 0.3),
+                 (0.6, 1.5, 1.0))
+transformed_case("stretch_cube", "cube_flat", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (3.0, 1.0, 0.4))
 
 
 def tilt_field(size, tilt_deg):
@@ -383,6 +412,9 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
     bake_common.reset_scene()
     os.makedirs(out_dir, exist_ok=True)
     ob = builder()
+    if name in TRANSFORMS:
+        ob.location, ob.rotation_euler, ob.scale = TRANSFORMS[name]
+        bpy.context.view_layer.update()
     me = ob.data
     if len(me.uv_layers) == 0:
         raise RuntimeError(f"case {name}: no UV map")
@@ -430,7 +462,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
              "filter": "bilinear", "height_size": height_size, "margin": margin,
              "margin_type": margin_type,
              "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {},
-             "subdivision": SUBDIVISION[name]}
+             "subdivision": SUBDIVISION[name],
+             "transform": [list(row) for row in ob.matrix_world]}
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}

@@ -5,6 +5,7 @@ sgbake_add_gtest(gradient_framework_tests
   surface_gradient_test.cpp
   projection_test.cpp
   layers_test.cpp
-  corners_test.cpp)
+  corners_test.cpp
+  world_shading_test.cpp)
 # Cycles' valid-reflection guard, private to the library, is read directly by the layer tests.
 target_include_directories(gradient_framework_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)

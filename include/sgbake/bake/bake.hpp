@@ -73,6 +73,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/surface_gradient.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/mesh/mesh.hpp"
 #include "sgbake/subdiv/limit_surface.hpp"
 
@@ -197,6 +198,15 @@ struct BakeInput {
   /// frames for tangent-space layers on that set, as Cycles' Normal Map node decodes with them;
   /// the map's own frame (kTangentNormal's) stays `tangents`, as Blender's baker uses the mesh's.
   std::array<const CornerTangents*, kMaxUvSets> triangleTangents{};
+  /// The object's placement in the world (Blender's matrix_world), or nullptr. One whose linear
+  /// part is not the identity makes the bake shade the object in world space, as Cycles does
+  /// (world_shading.hpp): height layers' scales are then world distances (a Bump node's
+  /// Distance), normal maps are carried to world space as normals, the guard works there, and
+  /// the normal comes back to object space as Blender's baker brings it (tangent-space maps as a
+  /// normal, object-space maps as a direction). Height, tangent, bitangent and mask maps do not
+  /// change; derivative and surface-gradient maps hold the object-space Γ of the unguarded
+  /// world normal.
+  const ObjectTransform* transform = nullptr;
 };
 
 /// @brief MikkTSpace frames of @p mesh's loop triangles (Blender's looptris, the triangles the

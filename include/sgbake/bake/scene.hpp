@@ -229,6 +229,11 @@ struct Scene {
   bool inMemory = false;
   int uvSet = 0;                 ///< top-level "uv": default UV set of layers and outputs
   SceneSubdivision subdivision;
+  /// Top-level "transform": the object's matrix_world, 4 rows of 4 numbers (the last row
+  /// 0 0 0 1) or 3 rows of 3. When its linear part is not the identity, normal-map, derivative,
+  /// surface-gradient and corners outputs are shaded in world space as Cycles shades the object
+  /// (BakeInput::transform; height scales are then world distances).
+  std::optional<ObjectTransform> transform;
   std::vector<SceneLayer> layers;
   std::vector<SceneOutput> outputs;
 };

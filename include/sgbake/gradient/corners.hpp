@@ -19,6 +19,7 @@
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/surface_gradient.hpp"
 #include "sgbake/gradient/surface_point.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/mesh/mesh.hpp"
 
 namespace sgbake {
@@ -35,6 +36,10 @@ struct CornerOptions {
   /// cof(M) of the object's linear transform for the perturbed normal (eq. 33); identity keeps it
   /// in object space. Γ itself is always reported in object space.
   Mat3 objectScaleCofactor = Mat3::identity();
+  /// Non-null: the layers are shaded in world space through this transform, as a bake with
+  /// BakeInput::transform does (shadeLayersInWorld; the corner's normal is its Ng): Γ is then
+  /// the object-space Γ of the world-space result and objectScaleCofactor is not used.
+  const WorldSpace* world = nullptr;
   double minCornerSine = kMinCornerSine;  ///< see kMinCornerSine
   /// Per UV set, the tangent frames (per corner, in corner order) that tangent-space layers on
   /// that set decode with, or nullptr: the bake's are the loop triangles'

@@ -1,0 +1,146 @@
+#include "sgbake/gradient/world_shading.hpp"
+
+#include <cmath>
+#include <variant>
+
+#include "gradient/stacking.hpp"
+#include "gradient/valid_reflection.hpp"
+#include "sgbake/core/math.hpp"
+
+namespace sgbake {
+namespace {
+
+Mat3 transpose(const Mat3& m) {
+  return Mat3::fromColumns({m(0, 0), m(0, 1), m(0, 2)}, {m(1, 0), m(1, 1), m(1, 2)},
+                           {m(2, 0), m(2, 1), m(2, 2)});
+}
+
+bool isFinite(const Mat3& m) {
+  return sgbake::isFinite(m.col[0]) && sgbake::isFinite(m.col[1]) && sgbake::isFinite(m.col[2]);
+}
+
+/// A layer's Γ in world space before its Strength, and that Strength (1: none, or one the
+/// source applies itself).
+struct WorldGradient {
+  Vec3d gamma;
+  double strength = 1;
+};
+
+/// Carries world normals and heights' gradients for one point.
+class WorldLayerEvaluator {
+ public:
+  WorldLayerEvaluator(const SurfacePoint& objectPoint, const SurfacePoint& worldPoint,
+                      const WorldSpace& space)
+      : object_(objectPoint), world_(worldPoint), space_(space) {}
+
+  WorldGradient operator()(const UvHeightSource& s) const {
+    UvHeightSource unblended = s;  // Strength blends in world space (withNormalMapStrength)
+    unblended.strength = 1;
+    return {layerGradient(unblended, world_), s.strength};
+  }
+  WorldGradient operator()(const TangentNormalSource& s) const {
+    TangentNormalSource unblended = s;
+    unblended.options.strength = 1;
+    return {decodedNormal(layerGradient(unblended, object_)), s.options.strength};
+  }
+  WorldGradient operator()(const ObjectNormalSource& s) const {
+    ObjectNormalSource unblended = s;
+    unblended.strength = 1;
+    return {decodedNormal(layerGradient(unblended, object_)), s.strength};
+  }
+  WorldGradient operator()(const VolumeSource& s) const {
+    return {heightGradient(layerGradient(s, object_))};
+  }
+  WorldGradient operator()(const PlanarSource& s) const { return projected(s.kind, s); }
+  WorldGradient operator()(const TriplanarSource& s) const { return projected(s.kind, s); }
+
+ private:
+  /// A height's object-space surface gradient σ as the world one, P_w(M^{-T} σ): the
+  /// derivatives along the surface are the same, w.r.t. world distances.
+  Vec3d heightGradient(const Vec3d& sigma) const {
+    const Vec3d& n = world_.normal;
+    const Vec3d v = space_.normalToWorld * sigma;
+    return v - dot(v, n) * n;
+  }
+  /// The Γ of a normal map's object-space normal N − Γ_o, carried to world space as a normal.
+  Vec3d decodedNormal(const Vec3d& gammaObject) const {
+    const Vec3d n = space_.normalToWorld * (object_.normal - gammaObject);
+    return finiteOrZero(gradientFromObjectNormal(n, world_.normal));
+  }
+  template <class Source>
+  WorldGradient projected(ProjectedKind kind, const Source& s) const {
+    const Vec3d gamma = layerGradient(s, object_);
+    return {kind == ProjectedKind::kHeight ? heightGradient(gamma) : decodedNormal(gamma)};
+  }
+  static Vec3d finiteOrZero(const Vec3d& v) { return sgbake::isFinite(v) ? v : Vec3d{}; }
+
+  const SurfacePoint& object_;
+  const SurfacePoint& world_;
+  const WorldSpace& space_;
+};
+
+}  // namespace
+
+bool ObjectTransform::shadesAsObjectSpace() const {
+  const Mat3 identity = Mat3::identity();
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (linear(r, c) != identity(r, c)) return false;
+  return true;
+}
+
+Result<WorldSpace> WorldSpace::of(const ObjectTransform& transform) {
+  const Mat3& m = transform.linear;
+  const double det = determinant(m);
+  if (!isFinite(m) || !sgbake::isFinite(transform.translation) || !std::isfinite(det) || det == 0) {
+    return Error::badInput("the object transform is singular or not finite");
+  }
+  // cof(M) = det(M)·M^{-T}: M^{-T} = cof(M)/det, M^{-1} = cof(M)^T/det.
+  const Mat3 cof = cofactor(m);
+  const double inv = 1 / det;
+  const Mat3 normalToWorld =
+      Mat3::fromColumns(inv * cof.col[0], inv * cof.col[1], inv * cof.col[2]);
+  WorldSpace space;
+  space.toWorld = m;
+  space.normalToWorld = normalToWorld;
+  space.normalToObject = transpose(m);
+  space.directionToObject = transpose(normalToWorld);
+  space.translation = transform.translation;
+  if (!isFinite(space.normalToWorld)) {
+    return Error::badInput("the object transform is too close to singular");
+  }
+  return space;
+}
+
+WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
+                                     const SurfacePoint& worldPoint,
+                                     const Vec3d& worldGeometricNormal, const WorldSpace& space) {
+  const Vec3d& n = worldPoint.normal;
+  const WorldLayerEvaluator evaluate(objectPoint, worldPoint, space);
+  Vec3d gamma{};
+  for (const Layer& layer : layers) {
+    if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+    const double factor = layer.weight * layerMask(layer.mask, objectPoint);
+    if (factor == 0) continue;  // masked out: the source is not sampled
+    const WorldGradient g = std::visit(evaluate, layer.source);
+    if (layer.base == LayerBase::kLayersAbove) {
+      if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
+        gamma = gradient_detail::stackGradient(factor * g.gamma, g.strength, n,
+                                               worldGeometricNormal, gamma);
+      continue;
+    }
+    gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
+  }
+  if (!isFinite(gamma)) gamma = {};  // overflow of absurd weights/scales: unperturbed
+
+  WorldShadedNormal result;
+  const Vec3d unguarded = normalizeOr(n - gamma, n);
+  result.normal = layers.empty()
+                      ? n
+                      : gradient_detail::validReflectionNormal(unguarded, worldGeometricNormal, n);
+  const Vec3d back = gradientFromObjectNormal(space.normalToObject * unguarded, objectPoint.normal);
+  result.gradient = isFinite(back) ? back : Vec3d{};
+  return result;
+}
+
+}  // namespace sgbake

@@ -1,0 +1,182 @@
+// Shading in world space through an object transform (world_shading.hpp): analytic references
+// on a plane, the similarity case against object space with heights divided by the scale,
+// normal maps carried as normals, and transforms that cannot be used.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "gradient/valid_reflection.hpp"
+#include "sgbake/core/math.hpp"
+#include "sgbake/gradient/world_shading.hpp"
+#include "support/analytic_textures.hpp"
+
+namespace sgbake {
+namespace {
+
+using test::AnalyticHeight;
+using test::maxAbsDiff;
+
+/// h = slope · s (a ramp along the first texture coordinate).
+class RampTexture final : public ScalarTexture {
+ public:
+  explicit RampTexture(double slope) : slope_(slope) {}
+  ScalarSample sample(Vec2d st) const override { return {slope_ * st.x, {slope_, 0}}; }
+
+ private:
+  double slope_;
+};
+
+/// A tangent-space map whose normals lean a little (no guard acts on them).
+class GentleNormalTexture final : public VectorTexture {
+ public:
+  Vec3d sample(Vec2d st) const override {
+    const Vec3d n = normalizeOr(Vec3d{0.2 * std::sin(3 * st.x), 0.15 * std::cos(2 * st.y), 1}, {});
+    return 0.5 * n + Vec3d{0.5, 0.5, 0.5};
+  }
+};
+
+Mat3 rotation(double yaw, double pitch) {
+  const double cy = std::cos(yaw), sy = std::sin(yaw), cp = std::cos(pitch), sp = std::sin(pitch);
+  const Mat3 z = Mat3::fromColumns({cy, sy, 0}, {-sy, cy, 0}, {0, 0, 1});
+  const Mat3 x = Mat3::fromColumns({1, 0, 0}, {0, cp, sp}, {0, -sp, cp});
+  return z * x;
+}
+
+/// @p object as seen through @p space: the normal carried as a normal, ∂P/∂u, ∂P/∂v as
+/// directions (what the baker's world triangle gives at a point of a flat triangle).
+SurfacePoint toWorld(const SurfacePoint& object, const WorldSpace& space) {
+  SurfacePoint world = object;
+  world.position = space.toWorld * object.position;
+  world.normal = normalizeOr(space.normalToWorld * object.normal, object.normal);
+  for (int s = 0; s < object.numUvSets; ++s) {
+    world.uv[static_cast<std::size_t>(s)].dPdu =
+        space.toWorld * object.uv[static_cast<std::size_t>(s)].dPdu;
+    world.uv[static_cast<std::size_t>(s)].dPdv =
+        space.toWorld * object.uv[static_cast<std::size_t>(s)].dPdv;
+  }
+  return world;
+}
+
+/// A point on a flat sheared triangle (the geometric normal is the shading normal), with a
+/// MikkTSpace-like frame.
+SurfacePoint flatPoint(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  SurfacePoint p;
+  p.position = {u(rng), u(rng), u(rng)};
+  const Vec3d dPdu{1 + 0.3 * u(rng), 0.2 * u(rng), 0.3 * u(rng)};
+  const Vec3d dPdv{0.2 * u(rng), 1 + 0.3 * u(rng), 0.3 * u(rng)};
+  p.normal = normalizeOr(cross(dPdu, dPdv), Vec3d{0, 0, 1});
+  p.numUvSets = 1;
+  p.uv[0] = {{u(rng), u(rng)}, dPdu, dPdv};
+  p.tangent = normalizeOr(dPdu - dot(dPdu, p.normal) * p.normal, Vec3d{1, 0, 0});
+  p.hasTangentFrame = true;
+  return p;
+}
+
+WorldSpace spaceOf(const Mat3& m) {
+  const Result<WorldSpace> space = WorldSpace::of({m, {0.5, -2, 3}});
+  EXPECT_TRUE(space.ok());
+  return space.ok() ? *space : WorldSpace{};
+}
+
+// A ramp h = a·u on the plane z = 0 with ∂P/∂u = x̂, of an object scaled (2, 1, 0.5): in world
+// space the ramp rises a over 2 units of x, so the world normal is (−a/2, 0, 1)/…; carried back
+// to object space as a normal (M^T) it is (−a, 0, 0.5)/…, i.e. Γ = (2a, 0, 0): twice the
+// object-space slope, not the cofactor's (seed 000 eq. 33) half.
+TEST(WorldShading, RampOnAStretchedPlaneFollowsTheWorldSlope) {
+  const double a = 0.3;
+  RampTexture ramp(a);
+  const WorldSpace space = spaceOf(Mat3::diagonal({2, 1, 0.5}));
+  SurfacePoint object;
+  object.numUvSets = 1;
+  object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
+  const SurfacePoint world = toWorld(object, space);
+  const std::vector<Layer> layers{{UvHeightSource{&ramp, 0, 1.0}, 1.0, {}}};
+  const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
+  EXPECT_LT(maxAbsDiff(shaded.gradient, Vec3d{2 * a, 0, 0}), 1e-15);
+  EXPECT_LT(maxAbsDiff(shaded.normal, normalizeOr(Vec3d{-a / 2, 0, 1}, {})), 1e-15);
+  // The framework's object-space composite would give a here, and the cofactor a/4 in world.
+  EXPECT_GT(std::abs(shaded.gradient.x - a), 0.2);
+}
+
+// A rotation times a uniform scale s changes nothing but the unit of height: the world shading
+// brought back to object space is the object-space composite with heights divided by s.
+TEST(WorldShading, ASimilarityIsObjectSpaceWithHeightsDividedByTheScale) {
+  AnalyticHeight h(0.5, -0.2, 0.1);
+  std::mt19937_64 rng(71);
+  for (const double s : {0.25, 1.0, 3.0}) {
+    const WorldSpace space = spaceOf(rotation(0.7, -0.4) * Mat3::diagonal({s, s, s}));
+    for (int i = 0; i < 100; ++i) {
+      const SurfacePoint object = flatPoint(rng);
+      const SurfacePoint world = toWorld(object, space);
+      const std::vector<Layer> inWorld{{UvHeightSource{&h, 0, 0.2}, 1.0, {}}};
+      const std::vector<Layer> inObject{{UvHeightSource{&h, 0, 0.2 / s}, 1.0, {}}};
+      const WorldShadedNormal shaded =
+          shadeLayersInWorld(inWorld, object, world, world.normal, space);
+      EXPECT_LT(maxAbsDiff(shaded.gradient, compositeGradient(inObject, object)), 1e-12);
+      // The guard (here Ng = N) is the same in both spaces for a similarity.
+      const Vec3d guarded = gradient_detail::validReflectionNormal(
+          perturbedNormal(object, inObject), object.normal, object.normal);
+      EXPECT_LT(maxAbsDiff(normalizeOr(space.normalToObject * shaded.normal, {}), guarded), 1e-12);
+    }
+  }
+}
+
+// Cycles decodes a normal map in object space and carries it to world space as a normal; the
+// baker's way back (M^T) undoes that: with no guard acting, any transform gives the
+// object-space result, which is what Blender's tangent-space bake of a normal map shows.
+TEST(WorldShading, ANormalMapComesBackUnchangedThroughAnyTransform) {
+  GentleNormalTexture map;
+  std::mt19937_64 rng(72);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 100; ++i) {
+    Mat3 m = rotation(3 * u(rng), u(rng)) * Mat3::diagonal({2 + u(rng), 1, 0.6 + 0.3 * u(rng)});
+    m.col[1] += 0.3 * u(rng) * m.col[0];  // a shear as well
+    const WorldSpace space = spaceOf(m);
+    const SurfacePoint object = flatPoint(rng);
+    const SurfacePoint world = toWorld(object, space);
+    const std::vector<Layer> layers{{TangentNormalSource{&map, 0, {}}, 1.0, {}}};
+    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
+    EXPECT_LT(maxAbsDiff(normalizeOr(space.normalToObject * shaded.normal, {}),
+                         perturbedNormal(object, layers)),
+              1e-12);
+    EXPECT_LT(maxAbsDiff(shaded.gradient, compositeGradient(layers, object)), 1e-12);
+  }
+}
+
+// Strength blends in world space, as Cycles' Normal Map and Bump nodes do after the transform.
+TEST(WorldShading, StrengthBlendsTheWorldNormals) {
+  RampTexture ramp(0.4);
+  const WorldSpace space = spaceOf(Mat3::diagonal({3, 1, 0.4}));
+  SurfacePoint object;
+  object.numUvSets = 1;
+  object.uv[0] = {{0.1, 0.2}, {0.8, 0.1, 0}, {-0.1, 1.1, 0}};
+  const SurfacePoint world = toWorld(object, space);
+  UvHeightSource full{&ramp, 0, 1.0};
+  UvHeightSource half = full;
+  half.strength = 0.5;
+  const Vec3d n = world.normal;
+  const Vec3d bumped =
+      shadeLayersInWorld(std::vector<Layer>{{full, 1.0, {}}}, object, world, n, space).normal;
+  const Vec3d blended =
+      shadeLayersInWorld(std::vector<Layer>{{half, 1.0, {}}}, object, world, n, space).normal;
+  EXPECT_LT(maxAbsDiff(blended, normalizeOr(0.5 * bumped + 0.5 * n, {})), 1e-15);
+}
+
+TEST(WorldShading, SingularOrNonFiniteTransformsAreRejected) {
+  EXPECT_FALSE(WorldSpace::of({Mat3::diagonal({1, 0, 1}), {}}).ok());
+  EXPECT_FALSE(WorldSpace::of({Mat3::diagonal({1, NAN, 1}), {}}).ok());
+  EXPECT_FALSE(WorldSpace::of({Mat3::identity(), {0, INFINITY, 0}}).ok());
+  EXPECT_FALSE(WorldSpace::of({Mat3::diagonal({1e-200, 1e-200, 1e-200}), {}}).ok());
+  EXPECT_TRUE(WorldSpace::of({Mat3::diagonal({-1, 1, 1}), {}}).ok());  // a mirror is fine
+  const ObjectTransform moved{Mat3::identity(), {1, 2, 3}};
+  const ObjectTransform mirrored{Mat3::diagonal({1, 1, -1}), {}};
+  EXPECT_TRUE(moved.shadesAsObjectSpace());
+  EXPECT_FALSE(mirrored.shadesAsObjectSpace());
+}
+
+}  // namespace
+}  // namespace sgbake
