@@ -3,6 +3,7 @@
 #include "sgbake/bake/convert.hpp"
 
 #include <new>
+#include <optional>
 #include <string>
 
 #include "bake/limit_shader.hpp"
@@ -35,6 +36,9 @@ struct ConvertShader {
   NormalMapGreen green = NormalMapGreen::kOpenGL;
   int uvSet = 0;
   ShadingTriangle tri;
+  /// With a transform (ConvertSettings::transform): the object-space side's texels to object
+  /// normals, M^T M, and back, M^{-1} M^{-T}.
+  std::optional<Mat3> objectMapToNormal, normalToObjectMap;
 
   void beginTriangle(std::uint32_t, const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
@@ -52,9 +56,12 @@ struct ConvertShader {
     if (from == to) {
       result = normalizeOr(n, to == NormalSpace::kTangent ? Vec3d{0, 0, 1} : unitNormal(tri, f));
     } else if (to == NormalSpace::kTangent) {
-      result = objectToTangent(f, n);
+      result = objectToTangent(f, objectMapToNormal ? *objectMapToNormal * n : n);
     } else {
       result = tangentToObject(tri, f, n);
+      if (normalToObjectMap) {
+        result = normalizeOr(*normalToObjectMap * result, unitNormal(tri, f));
+      }
     }
     if (to == NormalSpace::kTangent && green == NormalMapGreen::kDirectX) result.y = -result.y;
     const Vec3d e = encodeNormal(result);
@@ -118,6 +125,11 @@ Status validateConvert(const Mesh& mesh, const CornerTangents& tangents, const F
     return Error::badInput(where + ": the mesh is not a tessellation of the limit surface "
                                    "(tessellateLimitSurface)");
   }
+  if (settings.transform != nullptr) {
+    if (Result<WorldSpace> space = WorldSpace::of(*settings.transform); !space) {
+      return Error::badInput(where + ": " + space.error().message);
+    }
+  }
   return Ok{};
 }
 
@@ -133,6 +145,11 @@ bake_detail::ConvertShader convertShader(const Mesh& mesh, const CornerTangents&
   shader.to = to;
   shader.green = settings.green;
   shader.uvSet = settings.uvSet;
+  if (settings.transform != nullptr && !settings.transform->shadesAsObjectSpace()) {
+    const WorldSpace space = WorldSpace::of(*settings.transform).value();  // validateConvert
+    shader.objectMapToNormal = space.normalToObject * space.toWorld;
+    shader.normalToObjectMap = space.directionToObject * space.normalToWorld;
+  }
   return shader;
 }
 

@@ -59,6 +59,7 @@ struct BakeArguments {
   std::optional<std::string> range;  ///< a number, or "auto"
   SubdivisionOptions subdivision;  ///< level 0: none
   bool limitSurface = false;       ///< --subdivide limit
+  std::string transform;           ///< --transform: matrix_world, row by row
 };
 
 constexpr const char* kFooter =
@@ -71,6 +72,7 @@ constexpr const char* kFooter =
     "                    \"quality\": 3, \"use_limit_surface\": true, \"type\": "
     "\"catmull-clark\", \"auto_smooth\": 30,\n"
     "                    \"sharp_edges\": [[A, B], ...]},\n"
+    "    \"transform\": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],\n"
     "    \"layers\": [\n"
     "      {\"type\": \"height\", \"image\": \"h.png\", \"scale\": 0.1, \"filter\": \"bicubic\"},\n"
     "      {\"type\": \"normal\", \"image\": \"n.png\", \"space\": \"tangent\", \"green\": "
@@ -116,6 +118,11 @@ constexpr const char* kFooter =
     "    alpha = false (coverage as alpha), range = 1 (derivative and surface-gradient maps\n"
     "    in PNG/TIFF integers store v / (2 range) + 0.5; EXR and float TIFF store v;\n"
     "    \"auto\": the largest |v| of the map, rounded up, found by a first pass).\n"
+    "  transform: the object's matrix_world (4 rows of 4, or 3 of 3). Unless its 3 x 3 part is\n"
+    "    the identity, maps of normals and gradients are shaded in world space as Cycles\n"
+    "    shades the placed object: height scales are world distances (a Bump node's\n"
+    "    Distance), normal maps are carried to world space as normals, and the result comes\n"
+    "    back as Blender's baker brings it (object-space maps through the inverse matrix).\n"
     "  Unknown keys are errors; keys starting with '_' are comments.\n"
     "\n"
     "Incremental:\n"
@@ -135,13 +142,36 @@ constexpr const char* kFooter =
     "\n";
 
 /// Options of the one-map form: any of them set means the one-map form.
-const char* const kOneMapOptions[] = {
-    "--mesh",    "--output",       "--map",          "--size",      "--margin",       "--padding",
-    "--samples", "--uv",           "--green",        "--height",    "--height-scale", "--filter",
-    "--normal",  "--normal-space", "--normal-green", "--bit-depth", "--alpha",
-    "--range",   "--subdivide",    "--uv-smooth",    "--boundary-smooth",
-    "--edge-crease", "--vertex-crease", "--no-creases", "--subdivision-quality",
-    "--no-limit-surface", "--subdivision-type", "--auto-smooth", "--sharp-edge"};
+const char* const kOneMapOptions[] = {"--mesh",
+                                      "--output",
+                                      "--map",
+                                      "--size",
+                                      "--margin",
+                                      "--padding",
+                                      "--samples",
+                                      "--uv",
+                                      "--green",
+                                      "--height",
+                                      "--height-scale",
+                                      "--filter",
+                                      "--normal",
+                                      "--normal-space",
+                                      "--normal-green",
+                                      "--bit-depth",
+                                      "--alpha",
+                                      "--range",
+                                      "--subdivide",
+                                      "--uv-smooth",
+                                      "--boundary-smooth",
+                                      "--edge-crease",
+                                      "--vertex-crease",
+                                      "--no-creases",
+                                      "--subdivision-quality",
+                                      "--no-limit-surface",
+                                      "--subdivision-type",
+                                      "--auto-smooth",
+                                      "--sharp-edge",
+                                      "--transform"};
 
 // ---- Progress bar ------------------------------------------------------------------------------
 
@@ -364,6 +394,9 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     }
   }
   scene.outputs.push_back(output);
+  Result<std::optional<ObjectTransform>> transform = parseTransformOption("bake", args.transform);
+  if (!transform) return transform.error();
+  scene.transform = *transform;
   if (Status valid = validateScene(scene); !valid) {
     return Error::badInput("bake: " + valid.error().message);
   }
@@ -549,6 +582,7 @@ CommandAction defineBakeCommand(CLI::App& app) {
       ->type_name("FILE")
       ->group(oneMap);
   addSubdivisionOptions(app, args->subdivision, oneMap, &args->limitSurface);
+  addTransformOption(app, args->transform, oneMap);
   app.add_option("--map", args->map,
                  "tangent-normal, object-normal, height, derivative, surface-gradient, tangent, "
                  "bitangent, mask or corners")

@@ -18,6 +18,7 @@
 #include <tbb/global_control.h>
 
 #include "sgbake/core/result.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/io/atomic_file.hpp"
 #include "sgbake/subdiv/subdivide.hpp"
 
@@ -83,6 +84,18 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options,
 /// --subdivision-quality or --no-creases given on @p app without a --subdivide option.
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,
                                bool limit, const CLI::App& app);
+
+/// @brief Adds --transform M (the object's matrix_world, see parseTransformOption) bound to
+/// @p text, filed under @p group of --help when non-empty.
+void addTransformOption(CLI::App& app, std::string& text, const std::string& group = {});
+
+/// @brief The object transform --transform gave @p command: 16, 12 or 9 numbers separated by
+/// commas (or spaces), row by row (Blender's matrix_world: 4 rows of 4, the last 0 0 0 1; or 3
+/// rows of 4 without it; or the 3 × 3 linear part). Empty @p text: none.
+/// @return kBadInput naming the option and what is wrong (count, a non-number, the last row,
+///         a singular matrix)
+Result<std::optional<ObjectTransform>> parseTransformOption(const std::string& command,
+                                                            const std::string& text);
 
 /// @brief Measures wall-clock seconds since construction or the last lap().
 class Stopwatch {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -289,6 +290,56 @@ void addSubdivisionOptions(CLI::App& app, SubdivisionOptions& options, const std
       option->group(group);
     }
   }
+}
+
+void addTransformOption(CLI::App& app, std::string& text, const std::string& group) {
+  CLI::Option* option = app.add_option(
+      "--transform", text,
+      "The object's matrix_world, row by row (16 numbers, or 12 without the last row 0 0 0 1, "
+      "or the 3 x 3 part): shade in world space as Cycles does, heights in world units");
+  if (!group.empty()) option->group(group);
+}
+
+Result<std::optional<ObjectTransform>> parseTransformOption(const std::string& command,
+                                                            const std::string& text) {
+  if (text.empty()) return std::optional<ObjectTransform>{};
+  const std::string where = command + ": --transform: ";
+  std::vector<double> numbers;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == ',' || text[i] == ' ') {
+      ++i;
+      continue;
+    }
+    const std::size_t end = text.find_first_of(", ", i);
+    const std::string word = text.substr(i, end == std::string::npos ? end : end - i);
+    char* stop = nullptr;
+    const double value = std::strtod(word.c_str(), &stop);
+    if (*stop != '\0' || !std::isfinite(value)) {
+      return Error::badInput(where + "'" + word + "' is not a finite number");
+    }
+    numbers.push_back(value);
+    i = end == std::string::npos ? text.size() : end;
+  }
+  const std::size_t n = numbers.size();
+  if (n != 16 && n != 12 && n != 9) {
+    return Error::badInput(where + "expected 16, 12 or 9 numbers (matrix_world row by row), not " +
+                           std::to_string(n));
+  }
+  const std::size_t columns = n == 9 ? 3 : 4;
+  const auto at = [&](std::size_t r, std::size_t c) { return numbers[r * columns + c]; };
+  if (n == 16 && (at(3, 0) != 0 || at(3, 1) != 0 || at(3, 2) != 0 || at(3, 3) != 1)) {
+    return Error::badInput(where + "the last row must be 0 0 0 1 (an affine transform)");
+  }
+  ObjectTransform transform;
+  transform.linear =
+      Mat3::fromColumns({at(0, 0), at(1, 0), at(2, 0)}, {at(0, 1), at(1, 1), at(2, 1)},
+                        {at(0, 2), at(1, 2), at(2, 2)});
+  if (columns == 4) transform.translation = {at(0, 3), at(1, 3), at(2, 3)};
+  if (Result<WorldSpace> space = WorldSpace::of(transform); !space) {
+    return Error::badInput(where + space.error().message);
+  }
+  return std::optional<ObjectTransform>{transform};
 }
 
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,

@@ -48,6 +48,7 @@ struct ConvertArguments {
   bool stats = false;
   SubdivisionOptions subdivision;  ///< level 0: none
   bool limitSurface = false;       ///< --subdivide limit: convert on the exact limit surface
+  std::string transform;           ///< --transform: matrix_world, row by row
 };
 
 constexpr const char* kFooter =
@@ -65,6 +66,9 @@ constexpr const char* kFooter =
     "  replaced only once complete.\n"
     "  With --subdivide limit, the frame is the exact limit surface's at each sample, as\n"
     "  `sgbake bake` uses from \"level\": \"limit\" (T = dP/du made orthogonal to N).\n"
+    "  With --transform (the object's matrix_world), the object-space side is the map Blender\n"
+    "  bakes for the placed object, whose normals it brings back from world space through the\n"
+    "  inverse matrix: n stands for the object normal M^T M n.\n"
     "\n"
     "Examples:\n"
     "  sgbake convert --mesh suzanne.obj --from object --to tangent n_os.exr -o n_ts.exr\n"
@@ -114,6 +118,10 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
     return Error::badInput("convert: --from and --to are both " + args.from +
                            ": there is nothing to convert");
   }
+  Result<std::optional<ObjectTransform>> parsedTransform =
+      parseTransformOption("convert", args.transform);
+  if (!parsedTransform) return parsedTransform.error();
+  const std::optional<ObjectTransform> transform = *parsedTransform;
   std::optional<PaddingMode> padding;  // none: keep the input's values
   if (args.padding != "keep") {
     Result<PaddingMode> mode = parsePaddingMode(args.padding);
@@ -248,6 +256,7 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
     settings.limit = &limit->surface;
     settings.limitParameters = &limit->parameters;
   }
+  if (transform) settings.transform = &*transform;
 
   // Converted band by band; each band's rows go to the writer's thread, which compresses and
   // writes them while the next band is converted. The output image never exists whole.
@@ -367,6 +376,7 @@ CommandAction defineConvertCommand(CLI::App& app) {
       ->required()
       ->type_name("FILE");
   addSubdivisionOptions(app, args->subdivision, {}, &args->limitSurface);
+  addTransformOption(app, args->transform);
   app.add_option("-o,--output", args->output, "Output file (.png, .exr, .tif); same size as IN")
       ->required()
       ->type_name("FILE");

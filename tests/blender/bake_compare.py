@@ -18,6 +18,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                      object bakes
   ours_nmap_flags.exr  the same tangent-normal bake from --normal flags (Strength 1 cases)
   ours_nmap_weak.exr   the scene's tangent-normal bake at 0.9 x Strength (negative control)
+  ours_bake_object_space.exr, ours_nmap_object_space.exr   a transformed case's bake
+                       without its transform (in object space: a negative control)
   ours_nmap_sum.exr    a chain case's bake with the bump added to the normal map's surface
                        gradient instead of stacked on its normal (negative control)
 
@@ -102,7 +104,8 @@ def compare_case(entry):
 
     bake = None
     for key, name in (("bake", "ours_bake.exr"), ("bake_json", "ours_bake_json.exr"),
-                      ("bake_x2", "ours_bake_x2.exr")):
+                      ("bake_x2", "ours_bake_x2.exr"),
+                      ("bake_object_space", "ours_bake_object_space.exr")):
         img = load_if(os.path.join(d, name))
         if img is None:
             continue
@@ -123,7 +126,8 @@ def compare_case(entry):
                              ("nmap_object", "ours_nmap_object.exr", "object"),
                              ("nmap_flags", "ours_nmap_flags.exr", "tangent"),
                              ("nmap_weak", "ours_nmap_weak.exr", "tangent"),
-                             ("nmap_sum", "ours_nmap_sum.exr", "tangent")):
+                             ("nmap_sum", "ours_nmap_sum.exr", "tangent"),
+                             ("nmap_object_space", "ours_nmap_object_space.exr", "tangent")):
         img = load_if(os.path.join(d, name))
         if img is None:
             continue

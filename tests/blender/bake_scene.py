@@ -7,7 +7,8 @@
 
 Used by bake_oracle.py (the BlenderBakeOracle test) and, as a module, by
 bench/bake_vs_cycles.py. For every case it builds one object at the origin (identity
-transform, so object space = world space), gives it the material
+transform, so object space = world space; the stretch_* cases move, turn and scale it, see
+TRANSFORMS, and list its matrix_world as "transform"), gives it the material
 
     Image Texture (height.exr, Non-Color, Linear, Repeat) --Color--> Bump.Height
     Bump (Strength 1, Distance = the case's scale S, not inverted) --Normal--> Diffuse BSDF.Normal
@@ -128,10 +129,11 @@ def normal_map_case(name, mesh_case, size, space, strength, tilt_deg, bump=None)
 TRANSFORMS = {}
 
 
-def transformed_case(name, of_case, location, rotation, scale):
-    """Registers case `name`: case `of_case` (its mesh, material and bake size) with the object
-    moved, turned and scaled by (location, rotation, scale)."""
-    CASES[name] = CASES[of_case]
+def transformed_case(name, of_case, location, rotation, scale, size=None):
+    """Registers case `name`: case `of_case` (its mesh, material and bake size, or `size`) with
+    the object moved, turned and scaled by (location, rotation, scale)."""
+    builder, case_size, distance = CASES[of_case]
+    CASES[name] = (builder, size or case_size, distance)
     SUBDIVISION[name] = SUBDIVISION[of_case]
     if of_case in NORMAL_MAPS:
         NORMAL_MAPS[name] = dict(NORMAL_MAPS[of_case])
@@ -248,8 +250,11 @@ normal_map_case("chain_suzanne", "suzanne", 512, "TANGENT", 1.0, 40.0, bump=0.1)
 # Unevenly scaled objects (a cube scaled without Apply Scale is the everyday example): Cycles
 # bumps in world space (Distance in world units), decodes normal maps in object space and
 # carries them to world space as normals, guards in world space, and the baker brings the
-# result back to object space.
-transformed_case("stretch_sphere", "sphere", (0.5, -1.0, 2.0), (0.4, 0.2, 0.7), (2.0, 1.0, 0.5))
+# result back to object space. The stretched sphere bakes at 512^2: its bump's finite
+# difference spans more of the height image where the object is squeezed (0.91 deg median
+# at 256^2, 0.18 at 1024^2).
+transformed_case("stretch_sphere", "sphere", (0.5, -1.0, 2.0), (0.4, 0.2, 0.7), (2.0, 1.0, 0.5),
+                 size=512)
 transformed_case("stretch_nmap_sphere", "nmap_sphere", (0.5, -1.0, 2.0), (0.4, 0.2, 0.7),
                  (2.0, 1.0, 0.5))
 transformed_case("stretch_nmap_sphere_object", "nmap_sphere_object", (0.5, -1.0, 2.0),

@@ -1285,6 +1285,98 @@ TEST_F(BakeCliTest, ConvertErrors) {
   EXPECT_EQ(listDirectory(dir_), before);
 }
 
+// --transform (the object's matrix_world) shades the one-map bake in world space, as the
+// scene's "transform" does; a translation alone changes nothing; convert's object-space side is
+// then Blender's map of the placed object, and object -> tangent -> object comes back.
+TEST_F(BakeCliTest, TransformFlagForBakeAndConvert) {
+  const std::string mesh = (dir_ / "plane.obj").string();
+  const auto bakeWith = [&](const std::string& name, const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"bake",
+                                  "--mesh",
+                                  mesh,
+                                  "--height",
+                                  (dir_ / "h.png").string(),
+                                  "--height-scale",
+                                  "0.1",
+                                  "--map",
+                                  "tangent-normal",
+                                  "--size",
+                                  "16",
+                                  "--margin",
+                                  "0",
+                                  "--bit-depth",
+                                  "32",
+                                  "-o",
+                                  (dir_ / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return readPixels(dir_ / name);
+  };
+  const std::vector<float> plain = bakeWith("plain.exr", {});
+  EXPECT_EQ(bakeWith("moved.exr", {"--transform", "1,0,0,5, 0,1,0,6, 0,0,1,7"}), plain);
+  const std::vector<float> squeezed =
+      bakeWith("squeezed.exr", {"--transform", "1 0 0 0 1 0 0 0 0.5"});
+  ASSERT_EQ(squeezed.size(), plain.size());
+  EXPECT_NE(squeezed, plain);
+  // Squeezed across the plane, the same world bump tilts the object-space normal twice as much:
+  // the texels' slopes (x/z) double.
+  int compared = 0;
+  for (std::size_t i = 0; i + 2 < plain.size(); i += 3) {
+    const double px = 2.0 * plain[i] - 1, pz = 2.0 * plain[i + 2] - 1;
+    const double sx = 2.0 * squeezed[i] - 1, sz = 2.0 * squeezed[i + 2] - 1;
+    if (std::abs(px / pz) < 1e-3) continue;
+    EXPECT_NEAR((sx / sz) / (px / pz), 2.0, 1e-4) << i;
+    ++compared;
+  }
+  EXPECT_GT(compared, 50);
+
+  writeTestImage(dir_ / "os.exr", 8, {0.8f, 0.5f, 0.9f}, false);  // n = (0.6, 0, 0.8)
+  const std::string transform = "2,0,0,0, 0,1,0,0, 0,0,0.5,0, 0,0,0,1";
+  const auto convert = [&](const std::string& from, const std::string& to, const fs::path& in,
+                           const fs::path& out, bool transformed) {
+    std::vector<std::string> args{"convert",     "--mesh", mesh, "--from",
+                                  from,          "--to",   to,   in.string(),
+                                  "--bit-depth", "32",     "-o", out.string()};
+    if (transformed) args.insert(args.end(), {"--transform", transform});
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+  };
+  convert("object", "tangent", dir_ / "os.exr", dir_ / "ts_t.exr", true);
+  convert("object", "tangent", dir_ / "os.exr", dir_ / "ts.exr", false);
+  convert("tangent", "object", dir_ / "ts_t.exr", dir_ / "os_back.exr", true);
+  EXPECT_NE(readPixels(dir_ / "ts_t.exr"), readPixels(dir_ / "ts.exr"));
+  const std::vector<float> input = readPixels(dir_ / "os.exr");  // as stored (half floats)
+  const std::vector<float> back = readPixels(dir_ / "os_back.exr");
+  ASSERT_EQ(back.size(), 8u * 8u * 3u);
+  ASSERT_EQ(input.size(), back.size());
+  const std::size_t at = (4 * 8 + 4) * 3;
+  const double x = 2.0 * input[at] - 1, z = 2.0 * input[at + 2] - 1, length = std::hypot(x, z);
+  EXPECT_NEAR(back[at], 0.5 * x / length + 0.5, 1e-6);  // the input's normal, normalized
+  EXPECT_NEAR(back[at + 2], 0.5 * z / length + 0.5, 1e-6);
+
+  const std::set<std::string> before = listDirectory(dir_);
+  for (const std::string bad :
+       {"1,2,3", "1,0,0,0,0,0,0,0,1", "1,0,0,x,1,0,0,0,1", "1,0,0,0,0,1,0,0,0,0,1,0,1,0,0,1"}) {
+    for (const std::string command : {"bake", "convert"}) {
+      std::vector<std::string> args =
+          command == "bake"
+              ? std::vector<std::string>{"bake", "--mesh", mesh, "-o", (dir_ / "t.png").string()}
+              : std::vector<std::string>{"convert", "--mesh",
+                                         mesh,      "--from",
+                                         "object",  "--to",
+                                         "tangent", (dir_ / "os.exr").string(),
+                                         "-o",      (dir_ / "t.exr").string()};
+      args.insert(args.end(), {"--transform", bad});
+      const ProcessResult r = run(args);
+      EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.err;
+      expectOneErrorLine(r);
+      EXPECT_NE(r.err.find("--transform"), std::string::npos) << r.err;
+    }
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
 TEST_F(BakeCliTest, HelpTexts) {
   const ProcessResult bake = run({"bake", "--help"});
   EXPECT_EQ(bake.exitCode, 0);

@@ -41,6 +41,13 @@ struct ConvertSettings {
   /// the conversion.
   const LimitSurface* limit = nullptr;
   const SurfaceParameters* limitParameters = nullptr;
+  /// Optional: the object's placement in the world (BakeInput::transform), whose object-space
+  /// side is then the map Blender bakes for the placed object. Blender's baker brings the world
+  /// normal n_w back to object space as a direction for object-space maps (M^{-1} n_w) and as a
+  /// normal for tangent-space maps (M^T n_w), so a Blender object-space texel n stands for the
+  /// object normal M^T M n (object → tangent), and a tangent-space one decoded to n_o is written
+  /// as M^{-1} M^{-T} n_o (tangent → object); both normalized. Must outlive the conversion.
+  const ObjectTransform* transform = nullptr;
 };
 
 /// @brief Converts the normal map @p input from space @p from to space @p to.
