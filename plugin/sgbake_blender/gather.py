@@ -115,26 +115,39 @@ def limit_modifier(ob):
     return modifier
 
 
-def world_scale(ob, layers):
-    """The factor height layers' Scale (world units, as Cycles' Bump Distance) is divided by
-    to become object units for the bake, and notes for the report: the object's scale, or the
-    geometric mean of its axes' when they differ (with a note: Cycles' bumps then differ by
-    direction, which a height in object units cannot follow)."""
-    if not any(layer.type == "height" for layer in layers):
-        return 1.0, []
-    linear = ob.matrix_world.to_3x3()
-    axes = [column.length for column in linear.col]
-    volume = abs(linear.determinant())
-    if not volume > 0:
-        return 1.0, [f"object '{ob.name}' has a zero scale: its heights are taken in object "
-                     "units"]
-    mean = volume ** (1.0 / 3.0)
-    if max(axes) > min(axes) * (1 + 1e-5):
-        scales = ", ".join(f"{a:.4g}" for a in axes)
-        return mean, [f"object '{ob.name}' is scaled unevenly ({scales}): its heights are "
-                      f"divided by {mean:.4g}, but Cycles' bumps in world units differ by "
-                      "direction (apply the scale for an exact match)"]
-    return mean, []
+def world_transform(ob, map_name):
+    """The scene's "transform" for the evaluated object `ob` and notes for the report.
+
+    Cycles shades an object in world space: a Bump node's Distance is a world distance and its
+    bump is taken on the world surface, normal maps are carried to world space as normals, and
+    Blender's baker brings the result back to object space. libsgbake does the same given the
+    object's matrix_world (4 rows of 4 Python floats), so heights are sent as they are, in
+    world units, and any scale, even, uneven or mirrored, is matched. None for the identity
+    (nothing to carry; a translation alone is sent, it changes nothing).
+
+    A matrix with a zero scale (determinant 0, or an inverse beyond floats) has no world normals
+    to carry: libsgbake would refuse it, and Cycles has nothing sensible to bake. The object is
+    then baked in object space, as if it were unscaled, with a note when `map_name` is one the
+    transform shades (scene.WORLD_SHADED_MAPS; the others come out the same either way)."""
+    rows = [[float(value) for value in row] for row in ob.matrix_world]
+    if rows == [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0],
+                [0.0, 0.0, 0.0, 1.0]]:
+        return None, []
+    linear = np.array(rows, np.float64)[:3, :3]
+    with np.errstate(all="ignore"):
+        determinant = float(np.linalg.det(linear))
+        # M^-T = cof(M) / det(M), what libsgbake carries normals with; the columns of cof(M)
+        # are those of M crossed in turn (b x c, c x a, a x b).
+        cofactor = np.cross(linear[:, [1, 2, 0]], linear[:, [2, 0, 1]], axis=0)
+        carried = cofactor / determinant
+    if determinant != 0 and np.isfinite(determinant) and np.isfinite(carried).all():
+        return rows, []
+    if map_name not in scene.WORLD_SHADED_MAPS:
+        return None, []
+    scales = ", ".join(f"{column.length:.4g}" for column in ob.matrix_world.to_3x3().col)
+    return None, [f"object '{ob.name}' has a zero scale (its matrix_world is singular; axes "
+                  f"scaled {scales}): it is baked in object space, as if unscaled, heights in "
+                  "object units (give every axis a scale to bake it as Cycles shades it)"]
 
 
 @contextlib.contextmanager

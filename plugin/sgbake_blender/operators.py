@@ -49,6 +49,9 @@ class BakeJob:
         # surface's own modifier hidden.
         with gather.render_settings(ob, hidden=modifier):
             ob_eval = ob.evaluated_get(context.evaluated_depsgraph_get())
+            # Cycles shades the object in world space: the mesh goes in object space, with the
+            # matrix that places it (heights then in world units, as the Bump Distance is).
+            transform, self.notes = gather.world_transform(ob_eval, settings.map)
             mesh = ob_eval.to_mesh()
             try:
                 try:
@@ -81,10 +84,8 @@ class BakeJob:
             gather.check_target(image)
         gather.check_memory(self.width, self.height, settings.padding)
         self.tiles = gather.image_tiles(image)
-        # Cycles' Bump Distance is in world units, the mesh here in object units.
-        world_scale, self.notes = gather.world_scale(ob, layers)
         self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
-                                              subdivision, world_scale, render_uv)
+                                              subdivision, transform, render_uv)
                        for tile in self.tiles}
         self.scene = self.scenes[self.tiles[0]]
         self.uv_tiles = gather.uv_tiles(self.arrays[4][bake_uv], self.arrays[1])

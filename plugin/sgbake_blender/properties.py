@@ -76,8 +76,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     scale: FloatProperty(
         name="Scale", default=1.0, precision=4, step=1,
         description="Height layers: world units per unit of image value, the Bump node's "
-                    "Distance (divided by the object's scale for the bake). Normal layers: "
-                    "strength. Projections: object units, or strength")
+                    "Distance. Normal layers: strength. Projections: world units per unit of "
+                    "value (Kind Height), or strength")
     strength: FloatProperty(
         name="Strength", default=1.0, min=0.0, soft_max=1.0, precision=3,
         description="Height layers: the Bump node's Strength, which blends the bumped normal "
@@ -114,7 +114,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                                           "(their plane is not sampled)")
     function: EnumProperty(name="Function", items=FUNCTIONS, default="sine")
     amplitude: FloatProperty(name="Amplitude", default=1.0, precision=4,
-                             description="Height amplitude, object units")
+                             description="Height amplitude, world units (as a Bump node's "
+                                         "Distance)")
     frequency: FloatProperty(name="Frequency", default=1.0, precision=4,
                              description="Cycles (sine) or noise features per object unit")
     direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0),

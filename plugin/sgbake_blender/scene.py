@@ -15,7 +15,7 @@ function, amplitude, frequency, direction, phase, seed, octaves, gradient and st
 MAPS = (
     ("tangent-normal", "Tangent Normal", "Normal map in tangent space (n/2 + 0.5)"),
     ("object-normal", "Object Normal", "Normal map in object space (n/2 + 0.5)"),
-    ("height", "Height", "The layers' heights (object units)"),
+    ("height", "Height", "The layers' heights (world units, as the Bump node's Distance)"),
     ("derivative", "Derivative", "Height derivatives along u and v (signed, 2 channels)"),
     ("surface-gradient", "Surface Gradient", "Object-space surface gradient (signed)"),
     ("tangent", "Tangent", "MikkTSpace tangent (n/2 + 0.5)"),
@@ -24,6 +24,9 @@ MAPS = (
 )
 # Maps that read no layer: their bakes send none, so an unfinished layer cannot stop them.
 LAYERLESS_MAPS = {"tangent", "bitangent", "mask"}
+# Maps whose values the object's transform changes (libsgbake's shadedThroughTransform): the
+# shaded normal and the surface gradient. Heights, tangents and the mask are the same either way.
+WORLD_SHADED_MAPS = {"tangent-normal", "object-normal", "derivative", "surface-gradient"}
 
 LAYER_TYPES = (
     ("height", "Height", "Height image on a UV map"),
@@ -101,11 +104,11 @@ def reads_tangent_normals(layer):
     return False
 
 
-def layer_json(layer, uv_index, world_scale=1.0, default_uv=None):
+def layer_json(layer, uv_index, default_uv=None):
     """One entry of "layers". uv_index(name) gives the UV set of a UV map name (for height and
     normal layers: the layer's own UV map, else `default_uv`, the render UV map, else the
-    scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance: it is
-    divided by `world_scale`, the object's scale."""
+    scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance, and is
+    sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
     if layer.type in IMAGE_LAYER_TYPES:
         entry.update(image=image_key(layer.image), filter=layer.filter, wrap=layer.wrap,
@@ -115,7 +118,7 @@ def layer_json(layer, uv_index, world_scale=1.0, default_uv=None):
     if layer.type in UV_LAYER_TYPES and (layer.uv_map or default_uv):
         entry["uv"] = uv_index(layer.uv_map or default_uv)
     if layer.type == "height":
-        entry["scale"] = _number(layer.scale / world_scale)
+        entry["scale"] = _number(layer.scale)
         if layer.strength != 1.0:  # the Bump node's blend of normals (1: none)
             entry["strength"] = _number(layer.strength)
         if layer.channel != "luminance":
@@ -183,15 +186,18 @@ def limit_subdivision_json(modifier, edge_creases, vertex_creases):
 
 
 def scene_json(settings, layers, bake_uv_set, uv_index, tile=1001, subdivision=None,
-               world_scale=1.0, default_uv=None):
+               transform=None, default_uv=None):
     """The scene for sgbake_bake_map: the bake's UV set as the default of the layers and the
-    output ("uv"), the layers (baked_layers; height scales divided by `world_scale`, their UV
-    map by default `default_uv`) and one output, of UDIM tile `tile`, and the "subdivision"
-    block when one is given (limit_subdivision_json)."""
+    output ("uv"), the layers (baked_layers; their UV map by default `default_uv`) and one
+    output, of UDIM tile `tile`, the "subdivision" block when one is given
+    (limit_subdivision_json) and the "transform" when one is given: the object's matrix_world
+    as rows (gather.world_transform), with which libsgbake shades the object in world space as
+    Cycles does (heights in world units, as the Bump node's Distance)."""
     result = {"uv": bake_uv_set,
-              "layers": [layer_json(layer, uv_index, world_scale, default_uv)
-                         for layer in layers],
+              "layers": [layer_json(layer, uv_index, default_uv) for layer in layers],
               "outputs": [output_json(settings, tile)]}
     if subdivision is not None:
         result["subdivision"] = subdivision
+    if transform is not None:
+        result["transform"] = transform
     return result

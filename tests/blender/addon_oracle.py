@@ -44,6 +44,14 @@
    Surface (addon_limit.npy) and Evaluated Mesh (addon_limit_mesh.npy); mesh_limit.obj is the
    coarse mesh. The modifier must be shown again afterwards, and a Displace modifier after it
    must make the add-on refuse the bake.
+   Transformed object (world_case): Suzanne moved, turned and scaled unevenly (WORLD_*) is
+   baked in tangent and object space by the add-on, whose scene must carry "transform" = the
+   object's matrix_world and the height's Scale = the Bump Distance, with no note; by the
+   add-on's job with the "transform" taken out (the negative control: the add-on before it
+   sent one); and by Cycles (tangent, object and an EMIT mask, 256^2). Besides: an object
+   scaled 2x or unevenly sends its matrix_world and the Scale as it is, a zero scale falls back
+   to object space with a note naming the object (none for a height map), and a translated
+   object bakes as at the origin.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -72,6 +80,11 @@
    options_no_*.json by more than that. The limit surface bake must equal the CLI's within
    1e-5 (it comes out bit-identical), and differ by more than that from the CLI's negative
    controls and from the add-on's own bake of Blender's level-1 mesh.
+   The transformed object's bakes against Cycles' (angles between the decoded normals over
+   Cycles' mask less one texel at island borders, as bake_compare.py): median <=
+   WORLD_MEDIAN_DEG (1 deg, Cycles' Bump being a finite difference; measured 0.61 tangent,
+   0.23 object), and the negative control at least WORLD_CONTROL_FACTOR (3) times worse
+   (measured medians 3.0 and 33 deg).
 
 --sabotage bakes the add-on's tangent-normal cases with green DirectX: the test must FAIL.
 Prints per case the largest difference, where it is, and the texels compared.
@@ -79,7 +92,7 @@ Prints per case the largest difference, where it is, and the texels compared.
 Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed or
 the library is built with AddressSanitizer (SGBAKE_SANITIZE: ASan's runtime must come first
 in a process, and Blender does not start with it; CTest: SKIP_RETURN_CODE 77).
-Takes ~9 s (Blender starts twice; twenty CLI bakes).
+Takes ~9 s (Blender starts twice; twenty CLI bakes; three Cycles bakes at 256^2).
 """
 
 import argparse
@@ -112,6 +125,20 @@ UDIM_TILES = [1001, 1002, 1011]
 UDIM_TOLERANCE = 1e-6
 OPTIONS_MAP = "tangent-normal"
 LIMIT_MAP = "tangent-normal"
+# The transformed object against Cycles (world_case): Suzanne moved, turned and scaled unevenly
+# (the scales' geometric mean is 1, so the bake without "transform" is exactly the add-on's
+# before it sent one: heights divided by the mean scale), tangent- and object-space maps.
+WORLD_LOCATION = (0.5, -1.0, 2.0)
+WORLD_ROTATION = (0.4, 0.2, 0.7)
+WORLD_SCALE = (2.0, 1.0, 0.5)
+WORLD_MAPS = {"tangent-normal": "tangent", "object-normal": "object"}  # -> Cycles' normal_space
+# Cycles' Bump is a finite difference of the height over half a bake texel: the bar of
+# BlenderBakeOracle's height bakes (BAKE_MEDIAN_DEG). Measured at 256^2: median 0.61 (tangent)
+# and 0.23 deg (object); the object unmoved 0.31 deg. Without the transform the median is 3.0
+# (tangent) and 33 deg (object: Blender's baker brings the normal back as a direction, M^-1):
+# the control must be WORLD_CONTROL_FACTOR times worse.
+WORLD_MEDIAN_DEG = 1.0
+WORLD_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -321,9 +348,10 @@ def error_reports(settings, prefs, height, work, library_path):
 
 def material_checks(settings, ob, distance):
     """Layers from Material on chains and strays, the UV map textures are read on, and what a
-    bake takes from the object (its scale, a Subdivision Surface's render levels). Returns
+    bake takes from the object (its transform, a Subdivision Surface's render levels). Returns
     check records like expect_error's."""
     import bpy
+    import numpy as np
     from sgbake_blender import operators
     tree = ob.active_material.node_tree
     tex = next(node for node in tree.nodes if node.type == "TEX_IMAGE" and node.image)
@@ -391,20 +419,58 @@ def material_checks(settings, ob, distance):
           len(render_uv) == 1 and render_uv[0].get("uv_map") == "UVMap",
           "uv_map 'UVMap'", str(render_uv))
 
-    # The bake divides a height's Scale (world units) by the object's scale.
+    # A transformed object: the scene carries its matrix_world ("transform", with which
+    # libsgbake shades it in world space as Cycles does) and the height's Scale as it is (world
+    # units, the Bump Distance), for an even scale as for an uneven one, without a note.
     settings.map = "tangent-normal"
-    ob.scale = (2.0, 2.0, 2.0)
+    layer_scale = float(settings.layers[0].scale)
+    for what, scale in (("scaled 2x", (2.0, 2.0, 2.0)), ("scaled unevenly", (1.0, 2.0, 1.0))):
+        ob.scale = scale
+        bpy.context.view_layer.update()
+        job = operators.BakeJob(bpy.context)
+        rows = [[float(v) for v in row] for row in ob.matrix_world]
+        sent = job.scene.get("transform")
+        scale_sent = job.scene["layers"][0]["scale"]
+        check(f"bake: an object {what} sends its matrix_world and the height's Scale as it is",
+              sent == rows and scale_sent == layer_scale and abs(scale_sent - distance) < 1e-7
+              and not job.notes,
+              f"transform {rows}, scale {layer_scale}, no note",
+              f"transform {sent}, scale {scale_sent}, notes {job.notes}")
+    # A zero scale has no world normals: the bake falls back to object space, with a note
+    # naming the object (the maps the transform does not change get none).
+    ob.scale = (1.0, 0.0, 1.0)
     bpy.context.view_layer.update()
     job = operators.BakeJob(bpy.context)
-    scale = job.scene["layers"][0]["scale"]
-    check("bake: a height's Scale on an object scaled 2x", abs(scale - distance / 2) < 1e-6
-          and not job.notes, f"scale {distance / 2}, no note", f"scale {scale}, {job.notes}")
-    ob.scale = (1.0, 2.0, 1.0)
-    bpy.context.view_layer.update()
+    check("bake: an object of zero scale is baked in object space, with a note",
+          "transform" not in job.scene and job.scene["layers"][0]["scale"] == layer_scale
+          and any(f"object '{ob.name}' has a zero scale" in n for n in job.notes),
+          "no transform, the Scale as it is, a note", f"{sorted(job.scene)}, {job.notes}")
+    settings.map = "height"
     job = operators.BakeJob(bpy.context)
-    check("bake: an unevenly scaled object", any("unevenly" in n for n in job.notes),
-          "a note", str(job.notes))
+    check("bake: no zero-scale note for a map the transform does not change",
+          not job.notes, "no note", str(job.notes))
+    settings.map = "tangent-normal"
+    # A translation alone changes nothing: the pixels at the origin (within TOLERANCE: each
+    # to_mesh() may move a normal by an ulp, see the module docstring).
     ob.scale = (1.0, 1.0, 1.0)
+    settings.width = settings.height = 64
+    bpy.context.view_layer.update()
+    at_origin = operators.BakeJob(bpy.context)
+    ob.location = (0.5, -2.0, 3.0)
+    bpy.context.view_layer.update()
+    moved = operators.BakeJob(bpy.context)
+    at_origin.run()
+    moved.run()
+    apart = (float(np.abs(at_origin.rgba[1001] - moved.rgba[1001]).max())
+             if at_origin.error is None and moved.error is None else None)
+    check("bake: a translated object bakes as at the origin",
+          apart is not None and apart <= TOLERANCE and "transform" not in at_origin.scene,
+          f"pixels within {TOLERANCE:g}, no transform at the origin",
+          f"errors {at_origin.error} / {moved.error}, max difference {apart}, origin's "
+          f"scene keys {sorted(at_origin.scene)}")
+    ob.location = (0.0, 0.0, 0.0)
+    settings.width = settings.height = SIZE
+    bpy.context.view_layer.update()
     # A Subdivision Surface at other render levels than viewport levels bakes its render
     # levels (as Cycles does), and its viewport levels are set back; one hidden for rendering
     # is left out.
@@ -813,6 +879,70 @@ def limit_case(settings, ob, work, scale):
             "creases": [len(edge_creases), len(vertex_creases)]}
 
 
+def world_case(settings, ob, work, sabotage):
+    """The bump material's Suzanne moved, turned and scaled unevenly (WORLD_*), baked in
+    WORLD_MAPS by the add-on (addon_world_MAP.npy), by the add-on's job without the scene's
+    "transform" (addon_world_MAP_control.npy, the negative control: the add-on before it sent
+    one) and by Cycles (cycles_world_SPACE.npy, and its EMIT mask cycles_world_mask.npy). The
+    object is put back afterwards. Returns the manifest entry: checks (the scene carries the
+    transform, heights as they are, no note)."""
+    import bpy
+    import numpy as np
+    import bake_scene
+    from sgbake_blender import operators
+    ob.location, ob.rotation_euler, ob.scale = WORLD_LOCATION, WORLD_ROTATION, WORLD_SCALE
+    bpy.context.view_layer.update()
+    settings.target_image = None
+    settings.width = settings.height = SIZE
+    settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+    settings.padding, settings.surface = "extend", "mesh"
+    settings.green = "directx" if sabotage else "opengl"
+    entry = {"location": WORLD_LOCATION, "rotation": WORLD_ROTATION, "scale": WORLD_SCALE,
+             "maps": WORLD_MAPS, "result": {}, "checks": []}
+    rows = [[float(v) for v in row] for row in ob.matrix_world]
+    for kind in WORLD_MAPS:
+        settings.map = kind
+        job = operators.BakeJob(bpy.context)
+        entry["checks"].append({
+            "name": f"world: the {kind} scene carries matrix_world and the Bump Distance",
+            "ok": (job.scene.get("transform") == rows and not job.notes
+                   and job.scene["layers"][0]["scale"] == float(settings.layers[0].scale)),
+            "expected": f"transform {rows}, scale {float(settings.layers[0].scale)}, no note",
+            "message": f"transform {job.scene.get('transform')}, scale "
+                       f"{job.scene['layers'][0]['scale']}, notes {job.notes}"})
+        try:
+            entry["result"][kind] = sorted(bpy.ops.object.sgbake_bake())
+        except RuntimeError as exc:
+            entry["result"][kind] = ["ERROR", str(exc).strip()]
+            continue
+        image = bpy.data.images[f"{ob.name}_{kind}"]
+        np.save(os.path.join(work, f"addon_world_{kind}.npy"), bc.image_array(image))
+        # The negative control: the same job without the transform, into the same image.
+        for scene_of_tile in job.scenes.values():
+            scene_of_tile.pop("transform", None)
+        job.run()
+        if job.error is None:
+            image, _ = job.finish()
+            np.save(os.path.join(work, f"addon_world_{kind}_control.npy"),
+                    bc.image_array(image))
+    # Cycles' bakes of the same object and material.
+    scene = bpy.context.scene
+    engine = scene.render.engine
+    bc.setup_cycles(scene)
+    mat = ob.active_material
+    target = mat.node_tree.nodes["bake_target"]
+    for space in list(WORLD_MAPS.values()) + ["mask"]:
+        image = bc.new_float_image(f"cycles_world_{space}", SIZE, SIZE)
+        bake_scene.bake_pass(ob, mat, target, image, space, 0)
+        np.save(os.path.join(work, f"cycles_world_{space}.npy"), bc.image_array(image))
+        bpy.data.images.remove(image)
+    target.image = None
+    scene.render.engine = engine
+    ob.location, ob.rotation_euler, ob.scale = (0, 0, 0), (0, 0, 0), (1, 1, 1)
+    bpy.context.view_layer.update()
+    return entry
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -832,6 +962,7 @@ def blender_make(work, library_path, sabotage):
     manifest["options"] = options_case(settings, height, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["limit"] = limit_case(settings, ob, work, manifest["scale"])
+    manifest["world"] = world_case(settings, ob, work, sabotage)
     manifest["errors"] = (material_checks(settings, ob, distance)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
@@ -874,6 +1005,7 @@ def blender_compare(work):
             "covered": covered,
         }
     results["extra"] = extra_comparisons(work, manifest)
+    results["world"] = world_comparisons(work, manifest)
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -934,6 +1066,32 @@ def extra_comparisons(work, manifest):
         else:
             record.update(difference(ours, theirs, 3))
         records.append(record)
+    return records
+
+
+def world_comparisons(work, manifest):
+    """The transformed object's bakes (world_case) against Cycles': angle statistics between
+    the decoded normals over the texels Cycles' mask covers, less one texel at island borders
+    (as bake_compare.py), for the add-on's bake and for the negative control. Returns
+    {map: {"addon": stats, "control": stats}} ({"error": ...} for a missing file)."""
+    import numpy as np
+    records = {}
+    mask_path = os.path.join(work, "cycles_world_mask.npy")
+    if not os.path.exists(mask_path):
+        return {kind: {"error": "no Cycles mask"} for kind in manifest["world"]["maps"]}
+    inner = bc.erode(np.load(mask_path)[..., 0] > 0.5, 1)
+    for kind, space in manifest["world"]["maps"].items():
+        files = {"addon": f"addon_world_{kind}.npy", "control": f"addon_world_{kind}_control.npy",
+                 "cycles": f"cycles_world_{space}.npy"}
+        missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
+        if missing:
+            records[kind] = {"error": f"missing {', '.join(missing)}"}
+            continue
+        cycles = bc.decode_normals(np.load(os.path.join(work, files["cycles"])))
+        records[kind] = {}
+        for which in ("addon", "control"):
+            ours = bc.decode_normals(np.load(os.path.join(work, files[which])))
+            records[kind][which] = bc.angle_stats(bc.angle_deg(ours, cycles)[inner])
     return records
 
 
@@ -1032,13 +1190,49 @@ def evaluate(manifest, results):
             failures.append(f"{r['name']}: max {r['max_abs']:.3g} at (x, row) "
                             f"{r['worst_at']}, expected to "
                             f"{'be within' if equal else 'exceed'} {tolerance:g}")
+    failures += evaluate_world(manifest["world"], results["world"])
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
-                  + manifest["limit"]["checks"] + manifest["errors"]):
+                  + manifest["limit"]["checks"] + manifest["world"]["checks"]
+                  + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
             failures.append(f"{check['name']}: expected an error report containing "
                             f"{check['expected']!r}, got {check['message']!r}")
+    return failures
+
+
+def evaluate_world(entry, results):
+    """Prints the transformed object's angles to Cycles; returns failures: a median over
+    WORLD_MEDIAN_DEG, or a negative control (no "transform") less than WORLD_CONTROL_FACTOR
+    times worse."""
+    failures = []
+    print(f"  transformed Suzanne (scale {entry['scale']}, rotation {entry['rotation']}) vs "
+          "Cycles:")
+    for kind, result in entry["result"].items():
+        if result != ["FINISHED"]:
+            failures.append(f"world, {kind}: the add-on's bake returned {result}")
+    for kind, r in results.items():
+        if "error" in r:
+            print(f"    {kind}: {r['error']}")
+            failures.append(f"world, {kind}: {r['error']}")
+            continue
+        ours, control = r["addon"], r["control"]
+        ok = ours["median_deg"] <= WORLD_MEDIAN_DEG
+        worse = control["median_deg"] >= WORLD_CONTROL_FACTOR * ours["median_deg"]
+        print(f"    {kind:15s} median {ours['median_deg']:.3f}, p90 {ours['p90_deg']:.3f}, p99 "
+              f"{ours['p99_deg']:.3f}, max {ours['max_deg']:.1f} deg over {ours['texels']} "
+              f"texels -> {'ok' if ok else 'FAIL'} (median <= {WORLD_MEDIAN_DEG}); without "
+              f"the transform: median {control['median_deg']:.3f}, p90 {control['p90_deg']:.3f}"
+              f", p99 {control['p99_deg']:.3f} deg -> {'ok' if worse else 'FAIL'} (must be "
+              f">= {WORLD_CONTROL_FACTOR:g} x)")
+        if not ok:
+            failures.append(f"world, {kind}: median {ours['median_deg']:.3f} deg from Cycles "
+                            f"(bar {WORLD_MEDIAN_DEG})")
+        if not worse:
+            failures.append(f"world, {kind} negative control: without the transform the median "
+                            f"is {control['median_deg']:.3f} deg, not {WORLD_CONTROL_FACTOR:g} "
+                            f"x the add-on's {ours['median_deg']:.3f}")
     return failures
 
 
