@@ -35,8 +35,11 @@
 /// 0.2.0 re-bake). 0.4.0 changes none either: the scene gains a height layer's "base"
 /// ("above": it bumps the normal of the layers before it, as chained Bump nodes do) and
 /// "channel" (one channel of a packed map), a tangent-space normal layer's "tangent_uv", and
-/// the corners table decodes tangent-space layers with the loop triangles' frames.
-#define SGBAKE_VERSION_STRING "0.4.0"
+/// the corners table decodes tangent-space layers with the loop triangles' frames. 0.5.0
+/// changes none: the scene gains "transform" (the object's matrix_world), with which normal
+/// maps, derivative, surface-gradient and corners outputs are shaded in world space as Cycles
+/// shades the placed object (height scales then in world units; docs/baker.md).
+#define SGBAKE_VERSION_STRING "0.5.0"
 
 #ifdef __cplusplus
 extern "C" {
