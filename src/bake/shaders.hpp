@@ -16,6 +16,7 @@
 #include "bake/raster.hpp"
 #include "bake/texel_frame.hpp"
 #include "gradient/prepared_uv_frame.hpp"
+#include "gradient/world_shading_detail.hpp"
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/layers.hpp"
@@ -48,6 +49,7 @@ struct BakeShaderBase {
   const WorldSpace* world = nullptr;
   ShadingTriangle worldTri;  ///< tri in world space (worldTriangle), when `world`
   SurfacePoint worldPoint;   ///< constant fields set per triangle, the rest per sample
+  std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedWorldUv{};  ///< of worldTri
 
   void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
@@ -71,16 +73,25 @@ struct BakeShaderBase {
     if (world != nullptr) {
       worldTriangle(tri, *world, worldTri);
       beginSurfacePoint(worldTri, worldPoint);
+      for (std::size_t s = 0; s < static_cast<std::size_t>(worldTri.numUvSets); ++s)
+        preparedWorldUv[s] = gradient_detail::prepareUvFrame(worldPoint.uv[s]);
     }
   }
 
   /// The object's shading in world space at barycentrics @p b (`world` non-null): the guarded
-  /// world normal (the unperturbed one without layers) and the object-space Γ.
+  /// world normal (the unperturbed one without layers) and the unguarded one. (`point` is then
+  /// the object-space point, for worldGradient.)
   WorldShadedNormal shadeInWorld(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& objectPoint = pointAt(b, f);
     const SurfacePoint& w = surfacePointAt(worldTri, b, texelFrame(worldTri, b), worldPoint);
-    if (layers.empty()) return {w.normal, {}};
-    return shadeLayersInWorld(layers, objectPoint, w, worldTri.faceNormal, *world);
+    if (layers.empty()) return {w.normal, w.normal};
+    return gradient_detail::shadeLayersInWorld(layers, objectPoint, w, worldTri.faceNormal, *world,
+                                               preparedWorldUv.data());
+  }
+  /// The object-space Γ of the world shading at @p b (objectSpaceGradient).
+  Vec3d worldGradient(const Vec3d& b, const TexelFrame& f) {
+    const WorldShadedNormal shaded = shadeInWorld(b, f);
+    return objectSpaceGradient(shaded, point, *world);
   }
   /// shade() of every sample of @p s, for the shaders whose lane-parallel path is object-space.
   template <class Shader>
@@ -527,7 +538,7 @@ struct DerivativeShader : BakeShaderBase {
   static constexpr int kChannels = 2;
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
-    const Vec3d gamma = world != nullptr ? shadeInWorld(b, f).gradient : gradient(pointAt(b, f));
+    const Vec3d gamma = world != nullptr ? worldGradient(b, f) : gradient(pointAt(b, f));
     out[0] = dot(gamma, tri.bakeDPdu);
     out[1] = dot(gamma, tri.bakeDPdv);
   }
@@ -553,7 +564,7 @@ struct SurfaceGradientShader : BakeShaderBase {
   static constexpr int kChannels = 3;
   void shade(const Vec3d& b, int, int, double* out) {
     const TexelFrame f = texelFrame(tri, b);
-    put(world != nullptr ? shadeInWorld(b, f).gradient : gradient(pointAt(b, f)), out);
+    put(world != nullptr ? worldGradient(b, f) : gradient(pointAt(b, f)), out);
   }
 
   /// shade() of every sample of @p s, lane-parallel (batchGradients).

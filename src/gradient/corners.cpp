@@ -189,8 +189,9 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
               if (options.world != nullptr) {
                 // A corner has no triangle: its own normal is its Ng, as compositeGradient's.
                 const SurfacePoint world = worldCornerPoint(point, *options.world);
-                s.gradient =
-                    shadeLayersInWorld(layers, point, world, world.normal, *options.world).gradient;
+                s.gradient = objectSpaceGradient(
+                    shadeLayersInWorld(layers, point, world, world.normal, *options.world), point,
+                    *options.world);
                 s.perturbed = resolveNormal(point.normal, s.gradient);
               } else {
                 s.gradient = compositeGradient(layers, point);

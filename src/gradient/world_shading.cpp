@@ -3,12 +3,16 @@
 #include <cmath>
 #include <variant>
 
+#include "gradient/prepared_uv_frame.hpp"
 #include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
+#include "gradient/world_shading_detail.hpp"
 #include "sgbake/core/math.hpp"
 
 namespace sgbake {
 namespace {
+
+using gradient_detail::PreparedUvFrame;
 
 Mat3 transpose(const Mat3& m) {
   return Mat3::fromColumns({m(0, 0), m(0, 1), m(0, 2)}, {m(1, 0), m(1, 1), m(1, 2)},
@@ -30,13 +34,24 @@ struct WorldGradient {
 class WorldLayerEvaluator {
  public:
   WorldLayerEvaluator(const SurfacePoint& objectPoint, const SurfacePoint& worldPoint,
-                      const WorldSpace& space)
-      : object_(objectPoint), world_(worldPoint), space_(space) {}
+                      const WorldSpace& space, const gradient_detail::PreparedUvFrame* prepared)
+      : object_(objectPoint), world_(worldPoint), space_(space), prepared_(prepared) {}
 
+  /// Eq. 31 on the world triangle; Strength blends in world space (withNormalMapStrength).
   WorldGradient operator()(const UvHeightSource& s) const {
-    UvHeightSource unblended = s;  // Strength blends in world space (withNormalMapStrength)
-    unblended.strength = 1;
-    return {layerGradient(unblended, world_), s.strength};
+    if (s.texture == nullptr || s.uvSet < 0 || s.uvSet >= world_.numUvSets ||
+        s.uvSet >= kMaxUvSets) {
+      return {Vec3d{}, s.strength};
+    }
+    const std::size_t set = static_cast<std::size_t>(s.uvSet);
+    const ScalarSample h =
+        s.texture->sample(textureCoordinates(world_.uv[set].uv, s.tiling, s.offset));
+    const gradient_detail::PreparedUvFrame frame =
+        prepared_ != nullptr ? prepared_[set] : gradient_detail::prepareUvFrame(world_.uv[set]);
+    return {
+        gradient_detail::gradientFromPreparedUvFrame(
+            frame, world_.normal, uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine),
+        s.strength};
   }
   WorldGradient operator()(const TangentNormalSource& s) const {
     TangentNormalSource unblended = s;
@@ -77,6 +92,7 @@ class WorldLayerEvaluator {
   const SurfacePoint& object_;
   const SurfacePoint& world_;
   const WorldSpace& space_;
+  const gradient_detail::PreparedUvFrame* prepared_;  ///< per UV set of world_, or null
 };
 
 }  // namespace
@@ -115,8 +131,18 @@ Result<WorldSpace> WorldSpace::of(const ObjectTransform& transform) {
 WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
                                      const SurfacePoint& worldPoint,
                                      const Vec3d& worldGeometricNormal, const WorldSpace& space) {
+  return gradient_detail::shadeLayersInWorld(layers, objectPoint, worldPoint, worldGeometricNormal,
+                                             space, nullptr);
+}
+
+namespace gradient_detail {
+
+WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
+                                     const SurfacePoint& worldPoint,
+                                     const Vec3d& worldGeometricNormal, const WorldSpace& space,
+                                     const PreparedUvFrame* preparedWorldUv) {
   const Vec3d& n = worldPoint.normal;
-  const WorldLayerEvaluator evaluate(objectPoint, worldPoint, space);
+  const WorldLayerEvaluator evaluate(objectPoint, worldPoint, space, preparedWorldUv);
   Vec3d gamma{};
   for (const Layer& layer : layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
@@ -134,13 +160,20 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
   if (!isFinite(gamma)) gamma = {};  // overflow of absurd weights/scales: unperturbed
 
   WorldShadedNormal result;
-  const Vec3d unguarded = normalizeOr(n - gamma, n);
-  result.normal = layers.empty()
-                      ? n
-                      : gradient_detail::validReflectionNormal(unguarded, worldGeometricNormal, n);
-  const Vec3d back = gradientFromObjectNormal(space.normalToObject * unguarded, objectPoint.normal);
-  result.gradient = isFinite(back) ? back : Vec3d{};
+  result.unguarded = normalizeOr(n - gamma, n);
+  result.normal = layers.empty() ? n
+                                 : gradient_detail::validReflectionNormal(result.unguarded,
+                                                                          worldGeometricNormal, n);
   return result;
+}
+
+}  // namespace gradient_detail
+
+Vec3d objectSpaceGradient(const WorldShadedNormal& shaded, const SurfacePoint& objectPoint,
+                          const WorldSpace& space) {
+  const Vec3d gamma =
+      gradientFromObjectNormal(space.normalToObject * shaded.unguarded, objectPoint.normal);
+  return isFinite(gamma) ? gamma : Vec3d{};
 }
 
 }  // namespace sgbake

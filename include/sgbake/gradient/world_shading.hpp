@@ -65,11 +65,17 @@ struct WorldSpace {
 struct WorldShadedNormal {
   /// The perturbed world normal after Cycles' guard (unit): what the baker converts back.
   Vec3d normal{0, 0, 1};
-  /// Γ in object space that resolves (N − Γ, normalized) to the unguarded perturbed normal
-  /// brought back to object space as a normal: the surface-gradient and derivative maps'
-  /// value, consistent with the tangent-space map where the guard does not act.
-  Vec3d gradient{};
+  /// The same before the guard (unit): what objectSpaceGradient reads.
+  Vec3d unguarded{0, 0, 1};
 };
+
+/// @brief The Γ in object space that resolves (N − Γ, normalized) to @p shaded's unguarded
+/// normal brought back to object space as a normal (M^T): the surface-gradient and derivative
+/// maps' value, consistent with the tangent-space map where the guard does not act. Zero when
+/// not finite.
+/// @param[in] objectPoint the point shadeLayersInWorld shaded, in object space
+Vec3d objectSpaceGradient(const WorldShadedNormal& shaded, const SurfacePoint& objectPoint,
+                          const WorldSpace& space);
 
 /// @brief The layers at a point of an object shaded in world space (see the file comment).
 ///
