@@ -577,7 +577,12 @@ ObjectTransform parseTransform(const json& value) {
   double m[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
   for (std::size_t r = 0; r < n; ++r) {
     const json& row = value[r];
-    if (!row.is_array() || row.size() != n) shape();
+    if (!row.is_array() || row.size() != n) {
+      fail("",
+           "transform[" + std::to_string(r) + "] must be a row of " + std::to_string(n) +
+               " numbers (" + std::to_string(n) + " rows of " + std::to_string(n) + "), not " +
+               (row.is_array() ? "an array of " + std::to_string(row.size()) : describeType(row)));
+    }
     for (std::size_t c = 0; c < n; ++c) {
       const std::string where = "transform[" + std::to_string(r) + "][" + std::to_string(c) + "]";
       if (!row[c].is_number()) fail("", where + " must be a number, not " + describeType(row[c]));

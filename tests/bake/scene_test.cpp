@@ -331,12 +331,13 @@ TEST(Scene, TransformIsBlendersMatrixWorld) {
   EXPECT_FALSE(parseScene(withOutput(R"({"map": "mask", "file": "m.png"})"), options())
                    ->transform.has_value());
 
-  EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 1, 0]]")),
-            "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 "
-            "rows of 3, not an array of 2");
+  const std::string shape =
+      "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 rows "
+      "of 3, not ";
+  EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 1, 0]]")), shape + "an array of 2");
+  EXPECT_EQ(parseError(withTransform("{}")), shape + "an object");
   EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 1, 0], [0, 0]]")),
-            "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 "
-            "rows of 3, not an array of 3");
+            "scene.json: transform[2] must be a row of 3 numbers (3 rows of 3), not an array of 2");
   EXPECT_EQ(parseError(withTransform(R"([[1, 0, 0], [0, "a", 0], [0, 0, 1]])")),
             "scene.json: transform[1][1] must be a number, not a string");
   EXPECT_EQ(parseError(withTransform("[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]")),
@@ -345,9 +346,6 @@ TEST(Scene, TransformIsBlendersMatrixWorld) {
   EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 0, 0], [0, 0, 1]]")),
             "scene.json: 'transform' is singular (its 3 x 3 part has determinant 0): no normal "
             "can be carried through it");
-  EXPECT_EQ(parseError(withTransform("{}")),
-            "scene.json: 'transform' must be 4 rows of 4 numbers (Blender's matrix_world) or 3 "
-            "rows of 3, not an object");
 }
 
 TEST(Scene, MissingAndEmpty) {

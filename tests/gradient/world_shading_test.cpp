@@ -12,12 +12,14 @@
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/world_shading.hpp"
 #include "support/analytic_textures.hpp"
+#include "support/surface_points.hpp"
 
 namespace sgbake {
 namespace {
 
 using test::AnalyticHeight;
 using test::maxAbsDiff;
+using test::samplePoint;
 
 /// h = slope · s (a ramp along the first texture coordinate).
 class RampTexture final : public ScalarTexture {
@@ -60,22 +62,6 @@ SurfacePoint toWorld(const SurfacePoint& object, const WorldSpace& space) {
   return world;
 }
 
-/// A point on a flat sheared triangle (the geometric normal is the shading normal), with a
-/// MikkTSpace-like frame.
-SurfacePoint flatPoint(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  SurfacePoint p;
-  p.position = {u(rng), u(rng), u(rng)};
-  const Vec3d dPdu{1 + 0.3 * u(rng), 0.2 * u(rng), 0.3 * u(rng)};
-  const Vec3d dPdv{0.2 * u(rng), 1 + 0.3 * u(rng), 0.3 * u(rng)};
-  p.normal = normalizeOr(cross(dPdu, dPdv), Vec3d{0, 0, 1});
-  p.numUvSets = 1;
-  p.uv[0] = {{u(rng), u(rng)}, dPdu, dPdv};
-  p.tangent = normalizeOr(dPdu - dot(dPdu, p.normal) * p.normal, Vec3d{1, 0, 0});
-  p.hasTangentFrame = true;
-  return p;
-}
-
 WorldSpace spaceOf(const Mat3& m) {
   const Result<WorldSpace> space = WorldSpace::of({m, {0.5, -2, 3}});
   EXPECT_TRUE(space.ok());
@@ -110,7 +96,7 @@ TEST(WorldShading, ASimilarityIsObjectSpaceWithHeightsDividedByTheScale) {
   for (const double s : {0.25, 1.0, 3.0}) {
     const WorldSpace space = spaceOf(rotation(0.7, -0.4) * Mat3::diagonal({s, s, s}));
     for (int i = 0; i < 100; ++i) {
-      const SurfacePoint object = flatPoint(rng);
+      const SurfacePoint object = samplePoint(rng);
       const SurfacePoint world = toWorld(object, space);
       const std::vector<Layer> inWorld{{UvHeightSource{&h, 0, 0.2}, 1.0, {}}};
       const std::vector<Layer> inObject{{UvHeightSource{&h, 0, 0.2 / s}, 1.0, {}}};
@@ -138,7 +124,7 @@ TEST(WorldShading, ANormalMapComesBackUnchangedThroughAnyTransform) {
     Mat3 m = rotation(3 * u(rng), u(rng)) * Mat3::diagonal({2 + u(rng), 1, 0.6 + 0.3 * u(rng)});
     m.col[1] += 0.3 * u(rng) * m.col[0];  // a shear as well
     const WorldSpace space = spaceOf(m);
-    const SurfacePoint object = flatPoint(rng);
+    const SurfacePoint object = samplePoint(rng);
     const SurfacePoint world = toWorld(object, space);
     const std::vector<Layer> layers{{TangentNormalSource{&map, 0, {}}, 1.0, {}}};
     const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
