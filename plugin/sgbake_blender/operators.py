@@ -294,24 +294,32 @@ def _notes(skipped):
     return f" (skipped: {'; '.join(skipped)})" if skipped else ""
 
 
-def _linked_image_node(socket):
-    """The Image Texture node (with an image) linked directly into `socket`, or None."""
-    if not socket.is_linked:
-        return None
-    node = socket.links[0].from_node
-    return node if node.type == "TEX_IMAGE" and node.image is not None else None
-
-
-def _source_node(socket):
-    """The node linked into `socket` through any Reroute nodes, or None."""
+def _source_link(socket):
+    """The link that feeds `socket` from a node other than a Reroute (followed back through any
+    Reroute nodes), or None: nothing linked, or a muted link on the way (Cycles then takes the
+    socket's own value)."""
     while socket.is_linked:
         link = socket.links[0]
         if link.is_muted:
             return None
         if link.from_node.type != "REROUTE":
-            return link.from_node
+            return link
         socket = link.from_node.inputs[0]
     return None
+
+
+def _linked_image_node(socket):
+    """The Image Texture node (with an image) that feeds `socket` (_source_link), or None."""
+    link = _source_link(socket)
+    node = link.from_node if link else None
+    return node if node is not None and node.type == "TEX_IMAGE" and node.image is not None \
+        else None
+
+
+def _source_node(socket):
+    """The node that feeds `socket` (_source_link), or None."""
+    link = _source_link(socket)
+    return link.from_node if link else None
 
 
 def _surface_nodes(node_tree):
@@ -334,8 +342,11 @@ def _surface_nodes(node_tree):
 
 def _not_image(socket):
     """Why `socket` gave no layer: what is linked into it instead of an Image Texture node."""
-    if socket.is_linked and socket.links[0].from_node.type == "TEX_IMAGE":
+    link = _source_link(socket)
+    if link is not None and link.from_node.type == "TEX_IMAGE":
         return f"{socket.name}'s Image Texture node has no image"
+    if socket.is_linked and link is None:
+        return f"{socket.name}'s link is muted"
     return f"{socket.name} is not an Image Texture node"
 
 
@@ -346,14 +357,13 @@ def _ignored(node, tex, inputs, socket):
     other than Flat, Closest interpolation (read bilinear), and node-driven `inputs` (of which
     the layer takes the unconnected value)."""
     notes = []
-    if node.type != "BUMP" and node.inputs[socket].links[0].from_socket.name == "Alpha":
+    if node.type != "BUMP" and _source_link(node.inputs[socket]).from_socket.name == "Alpha":
         notes.append(f"'{node.name}' {socket} from '{tex.name}' Alpha (the layer reads its "
                      "colour)")
     if tex.interpolation == "Closest":
         notes.append(f"'{tex.name}' Closest interpolation (read bilinear)")
-    vector = tex.inputs["Vector"]
-    if vector.is_linked:
-        link = vector.links[0]
+    link = _source_link(tex.inputs["Vector"])
+    if link is not None:
         uv = link.from_node.type == "UVMAP" or (link.from_node.type == "TEX_COORD"
                                                  and link.from_socket.name == "UV")
         if not uv:
@@ -374,10 +384,9 @@ def _texture_settings(node, render_uv=None):
     values = {"image": node.image, "name": node.image.name,
               "filter": INTERPOLATION_FILTERS.get(node.interpolation, "bilinear"),
               "wrap": "clamp" if node.extension == "EXTEND" else "repeat"}
-    vector = node.inputs["Vector"]
-    if vector.is_linked and vector.links[0].from_node.type == "UVMAP" \
-            and vector.links[0].from_node.uv_map:
-        values["uv_map"] = vector.links[0].from_node.uv_map
+    vector = _source_node(node.inputs["Vector"])
+    if vector is not None and vector.type == "UVMAP" and vector.uv_map:
+        values["uv_map"] = vector.uv_map
     elif render_uv:
         values["uv_map"] = render_uv
     return values
@@ -415,7 +424,7 @@ def material_layers(node_tree, render_uv=None):
             values = _texture_settings(tex, render_uv)
             values.update(type="height", scale=-scale if node.invert else scale,
                           strength=max(node.inputs["Strength"].default_value, 0.0))
-            if node.inputs["Height"].links[0].from_socket.name == "Alpha":
+            if _source_link(node.inputs["Height"]).from_socket.name == "Alpha":
                 values["channel"] = "a"
         else:
             tex = _linked_image_node(node.inputs["Color"])

@@ -413,6 +413,26 @@ def material_checks(settings, ob, distance):
     tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     check("Layers from Material: a Height from the Alpha output",
           len(alpha) == 1 and alpha[0].get("channel") == "a", "channel 'a'", str(alpha))
+    # Reroute nodes between the image and the Bump's Height are followed (the Alpha output
+    # still told apart); a muted link feeds nothing (Cycles takes the socket's own value).
+    first = tree.nodes.new("NodeReroute")
+    second = tree.nodes.new("NodeReroute")
+    tree.links.new(tex.outputs["Alpha"], first.inputs[0])
+    tree.links.new(first.outputs[0], second.inputs[0])
+    tree.links.new(second.outputs[0], bump.inputs["Height"])
+    rerouted, _, _ = operators.material_layers(tree)
+    check("Layers from Material: a Height through two Reroute nodes",
+          len(rerouted) == 1 and rerouted[0].get("image") == tex.image
+          and rerouted[0].get("channel") == "a", f"one layer of '{tex.image.name}', channel 'a'",
+          str(rerouted))
+    second.inputs[0].links[0].is_muted = True
+    muted, muted_skipped, _ = operators.material_layers(tree)
+    check("Layers from Material: a muted link into the Height",
+          not muted and any("muted" in note for note in muted_skipped),
+          "no layer, skipped as muted", f"{muted}; skipped {muted_skipped}")
+    tree.nodes.remove(first)
+    tree.nodes.remove(second)
+    tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     # An Image Texture without a UV Map node is read on the UV map active for rendering.
     render_uv, _, _ = operators.material_layers(tree, "UVMap")
     check("Layers from Material: the render UV map",
