@@ -125,9 +125,11 @@ CHAIN_P99_DEG = 3.0
 # A normal map on an unevenly scaled object (stretch_nmap_*): median and p90 as above
 # (measured 0.002-0.004 / 0.004-0.007 deg), but where Cycles' guard bends the normal near the
 # sphere's UV seam, in stripes that follow its triangles, ~1 % of the texels differ by up to
-# 3 deg (p99 0.30 tangent, 0.62 object; 0.03-0.04 for the object-space map). Those texels'
-# Cycles normals lie outside the plane of sgbake's unguarded normal and Ng, so Cycles' guard
-# saw another normal or Ng there; not found yet. Without the transform: p90 11-17 deg.
+# 3 deg (p99 0.26 tangent, 0.52 object; 0.03-0.04 for the object-space map). Those texels'
+# Cycles normals lie outside the plane of sgbake's unguarded normal and Ng, the plane the guard
+# turns in, while Cycles' Ng, N and I there (baked through a Geometry node) are sgbake's: the
+# normal Cycles' guard turned is another; not found yet (docs/baker.md). Without the
+# transform: p90 11-17 deg.
 STRETCH_NMAP_P99_DEG = 1.0
 # The chain on Suzanne scaled (0.6, 1.5, 1) and turned (stretch_chain_suzanne, 512^2): median and
 # p90 within the chain bars (measured 0.40 / 1.36 tangent, 0.25 / 1.18 object), but the same
