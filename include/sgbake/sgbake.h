@@ -38,8 +38,9 @@
 /// the corners table decodes tangent-space layers with the loop triangles' frames. 0.5.0
 /// changes none: the scene gains "transform" (the object's matrix_world), with which normal
 /// maps, derivative, surface-gradient and corners outputs are shaded in world space as Cycles
-/// shades the placed object (height scales then in world units; docs/baker.md).
-#define SGBAKE_VERSION_STRING "0.5.0"
+/// shades the placed object (height scales then in world units; docs/baker.md). 0.6.0
+/// appends sgbake_mesh::face_material (rebuild, and set it or NULL) for a layer's "material".
+#define SGBAKE_VERSION_STRING "0.6.0"
 
 #ifdef __cplusplus
 extern "C" {
@@ -125,6 +126,9 @@ typedef struct sgbake_mesh {
   /// Nonzero when Blender's Auto Smooth is on (`mesh.use_auto_smooth`; custom normals need it):
   /// Cycles then shades every face, flat ones included, with its corner normals.
   int auto_smooth;
+  /// #F material indices (Blender: `polygons.foreach_get("material_index")`), or NULL: every
+  /// face material 0. A scene layer's "material": N applies to the faces of material N only.
+  const uint32_t* face_material;
 } sgbake_mesh;
 
 /// @brief An image in memory, laid out as Blender's `Image.pixels`: width × height × channels

@@ -67,7 +67,14 @@ class Mesh(ctypes.Structure):
         ("num_corners", ctypes.c_size_t),
         ("face_flat", ctypes.POINTER(ctypes.c_uint8)),
         ("auto_smooth", ctypes.c_int),
+        ("face_material", _uint32_p),
     ]
+
+
+# The oldest library whose struct sgbake_mesh is Mesh above (0.6.0 appended face_material): an
+# older one would read a shorter struct, a newer one with the same major and minor version the
+# same.
+MIN_LIBRARY_VERSION = (0, 6)
 
 
 class Image(ctypes.Structure):
@@ -145,7 +152,18 @@ def load_library(path=None, path_source="the given path"):
         if not hasattr(lib, "sgbake_bake_map"):
             raise SgbakeError(f"{candidate} ({where}) has no sgbake_bake_map: "
                               "it is an older libsgbake or another library")
-        return _declare(lib)
+        lib = _declare(lib)
+        found = version(lib)
+        try:
+            numbers = tuple(int(part) for part in found.split(".")[:2])
+        except ValueError:
+            numbers = (0, 0)
+        if numbers < MIN_LIBRARY_VERSION:
+            wanted = ".".join(str(n) for n in MIN_LIBRARY_VERSION)
+            raise SgbakeError(f"{candidate} ({where}) is libsgbake {found}, older than the "
+                              f"{wanted} this add-on passes meshes to (install the libsgbake "
+                              "built with this add-on)")
+        return lib
     raise SgbakeError("cannot find libsgbake: set the library path in the add-on's preferences "
                       f"or ${LIBRARY_ENV}, or put {LIBRARY_FILE} beside the add-on (tried "
                       f"{', '.join(tried) or 'nothing'} and the system library path)")
@@ -203,7 +221,8 @@ def _image_entry(name, image):
 
 
 def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, uv_sets,
-             images=None, threads=0, progress=None, face_flat=None, auto_smooth=False):
+             images=None, threads=0, progress=None, face_flat=None, auto_smooth=False,
+             face_material=None):
     """Bakes one map with sgbake_bake_map and returns its pixels.
 
     scene           dict: a scene as for `sgbake bake SCENE.json` without "mesh", with one
@@ -224,6 +243,8 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
                     unless auto_smooth.
     auto_smooth     Blender's Auto Smooth (mesh.use_auto_smooth): every face, flat ones
                     included, is shaded with its corner normals.
+    face_material   #F material indices (Blender: polygons' material_index), or None: every
+                    face material 0. A layer's "material": N applies to material N's faces.
 
     Returns a float32 array of width * height * 4 values (RGBA, rows bottom first: the layout
     of Blender's Image.pixels). Raises SgbakeError on any failure, SgbakeCancelled when
@@ -247,6 +268,11 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
         face_flat = _array(face_flat, np.uint8, "face_flat")
         if face_flat.size != num_faces:
             raise SgbakeError(f"face_flat has {face_flat.size} flags for {num_faces} faces")
+    if face_material is not None:
+        face_material = _array(face_material, np.uint32, "face_material")
+        if face_material.size != num_faces:
+            raise SgbakeError(f"face_material has {face_material.size} indices for {num_faces} "
+                              "faces")
     uv_arrays = [_array(uv, np.float32, f"uv set {i}", 2) for i, uv in enumerate(uv_sets)]
     for i, uv in enumerate(uv_arrays):
         if uv.size != 2 * num_corners:
@@ -262,7 +288,9 @@ def bake_map(lib, scene, positions, face_start, corner_vertex, corner_normals, u
                 corner_uvs=uv_pointers, num_uv_sets=len(uv_arrays), num_corners=num_corners,
                 face_flat=(_pointer(face_flat, ctypes.POINTER(ctypes.c_uint8))
                            if face_flat is not None else None),
-                auto_smooth=1 if auto_smooth else 0)
+                auto_smooth=1 if auto_smooth else 0,
+                face_material=(_pointer(face_material, _uint32_p)
+                               if face_material is not None else None))
 
     entries = [(name.encode("utf-8"),) + _image_entry(name, image)
                for name, image in (images or {}).items()]

@@ -54,12 +54,6 @@ const MapInfo& info(MapKind kind) {
   return kMaps[0];  // unreachable for valid enumerators
 }
 
-/// The face whose corners include @p corner (faceStart is ascending).
-std::size_t faceOfCorner(const Mesh& mesh, std::uint32_t corner) {
-  const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), corner);
-  return static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1;
-}
-
 }  // namespace
 
 Result<MapKind> parseMapKind(std::string_view name) {
@@ -263,6 +257,9 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   base.tangents = input.tangents;
   base.triangleTangents = input.triangleTangents;
   base.layers = input.layers;
+  // Layers of one material: each triangle takes its face's.
+  const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(input.layers);
+  base.layersByMaterial = byMaterial;
   base.uvSet = settings.uvSet;
   base.green = settings.green;
   WorldSpace world;
@@ -344,8 +341,8 @@ Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
     faceStart[t + 1] = static_cast<std::uint32_t>(3 * (t + 1));
     const std::array<std::uint32_t, 3>& c = triangles[t];
     // Cycles shades a flat face without Auto Smooth, and gives MikkTSpace, its triangle's normal.
-    const bool triangleNormal =
-        !mesh.faceFlat.empty() && !mesh.autoSmooth && mesh.isFlat(faceOfCorner(mesh, c[0]));
+    const bool triangleNormal = !mesh.faceFlat.empty() && !mesh.autoSmooth &&
+                                mesh.isFlat(bake_detail::faceOfCorner(mesh, c[0]));
     const Vec3f p0 = mesh.positions[mesh.cornerVertex[c[0]]];
     const Vec3f flat =
         cast<float>(normalizeOr(cast<double>(cross(mesh.positions[mesh.cornerVertex[c[1]]] - p0,

@@ -1376,9 +1376,13 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   progress.finishOne();
   if (!textures) return textures.error();
   // Layers, and tangent frames if the plan needs them (timed apart from the loading).
+  const std::size_t loadWarnings = loaded.warnings.size();
   if (Status ok = plan_detail::prepareLayers(plan, options.threads, loaded, progress, report); !ok) {
     return ok.error();
   }
+  report.warnings.insert(report.warnings.end(),
+                         loaded.warnings.begin() + static_cast<std::ptrdiff_t>(loadWarnings),
+                         loaded.warnings.end());  // about the layers (layerMaterial)
   report.loadSeconds = secondsSince(start) - report.tangentsSeconds;
 
   // 2. The tiles of every output to bake (known now that the mesh is loaded).

@@ -249,6 +249,37 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
   return std::unique_ptr<HeightVolume>(std::make_unique<GradientNoise>(std::move(*noise)));
 }
 
+/// The material index of scene layer @p index (Layer::material: −1 for every face): its
+/// "material" index, or the index of its OBJ `usemtl` name in the mesh. A name the mesh does
+/// not have is bad input; an index no face has, a warning (the layer bakes nothing).
+Result<int> layerMaterial(const Scene& scene, std::size_t index, Loaded& loaded) {
+  const SceneLayer& layer = scene.layers[index];
+  const Mesh& mesh = loaded.mesh;
+  const std::string where = scenePrefix(scene) + layerLabel(index) + ": ";
+  if (layer.materialName) {
+    const std::vector<std::string>& names = mesh.materialNames;
+    const auto found = std::find(names.begin(), names.end(), *layer.materialName);
+    if (found != names.end()) return static_cast<int>(found - names.begin());
+    std::string known;
+    for (const std::string& name : names) known += (known.empty() ? "'" : ", '") + name + "'";
+    return Error::badInput(where + "material '" + *layer.materialName + "' is not in " +
+                           scene.mesh.string() +
+                           (names.empty() ? " (it names no material: no usemtl; give an index)"
+                                          : " (its materials: " + known + ")"));
+  }
+  if (!layer.material) return -1;
+  const std::uint32_t material = static_cast<std::uint32_t>(*layer.material);
+  const bool used = mesh.faceMaterial.empty()
+                        ? material == 0
+                        : std::find(mesh.faceMaterial.begin(), mesh.faceMaterial.end(), material) !=
+                              mesh.faceMaterial.end();
+  if (!used) {
+    loaded.warnings.push_back(where + "no face of " + scene.mesh.string() + " has material " +
+                              std::to_string(material) + ": the layer bakes nothing");
+  }
+  return *layer.material;
+}
+
 /// The library Layer of a planned layer (textures and volumes must be loaded).
 Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& loaded,
                         double objectSize) {
@@ -264,6 +295,9 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
     result.mask.offset = layer.mask->offset;
   }
   result.base = layer.base;
+  Result<int> material = layerMaterial(plan.scene, planned.sceneLayer, loaded);
+  if (!material) return material.error();
+  result.material = *material;
   ProjectedNormalOptions projected;
   projected.green = layer.green;
   switch (layer.type) {

@@ -357,7 +357,7 @@ const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",  
                                                    "type",        "auto_smooth",
                                                    "sharp_edges"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
-const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask"};
+const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask", "material"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
 
 /// The keys of a layer of @p type beyond kLayerCommonKeys.
@@ -683,6 +683,14 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   layer.uvSet = defaultUv;
   if (reader.has("name")) layer.name = reader.string("name");
   if (reader.has("weight")) layer.weight = reader.number("weight");
+  if (reader.has("material")) {
+    const json& material = reader.at("material");
+    if (material.is_string()) {
+      layer.materialName = material.get<std::string>();
+    } else {
+      layer.material = static_cast<int>(reader.integer("material", 0, kMaxMaterialIndex));
+    }
+  }
 
   if (layer.hasImage()) {
     reader.require("image");
@@ -1285,6 +1293,8 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   j["type"] = sceneLayerTypeName(layer.type);
   j["weight"] = layer.weight;
   if (layer.base != LayerBase::kSurface) j["base"] = nameIn(kBases, layer.base);
+  if (layer.material) j["material"] = *layer.material;
+  if (layer.materialName) j["material"] = *layer.materialName;
   if (layer.mask) {
     j["mask"] = {{"image", name(layer.mask->image)},
                  {"uv", layer.mask->uvSet},

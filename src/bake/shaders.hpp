@@ -34,7 +34,10 @@ struct BakeShaderBase {
   const Mesh* mesh = nullptr;
   const CornerTangents* tangents = nullptr;
   std::array<const CornerTangents*, kMaxUvSets> triangleTangents{};  ///< BakeInput's
-  std::span<const Layer> layers;
+  std::span<const Layer> layers;  ///< the current triangle's (layersByMaterial)
+  /// When some layer applies to one material only: the layers of each material index
+  /// (layersOfMaterial), the last entry for every higher index; `layers` is set per triangle.
+  std::span<const std::vector<Layer>> layersByMaterial;
   int uvSet = 0;
   NormalMapGreen green = NormalMapGreen::kOpenGL;
   ShadingTriangle tri;
@@ -52,6 +55,10 @@ struct BakeShaderBase {
   std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedWorldUv{};  ///< of worldTri
 
   void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
+    if (!layersByMaterial.empty()) {
+      const std::size_t material = mesh->material(faceOfCorner(*mesh, corners[0]));
+      layers = layersByMaterial[std::min(material, layersByMaterial.size() - 1)];
+    }
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
     for (std::size_t s = 0; s < kMaxUvSets; ++s) {
       const CornerTangents* frames = triangleTangents[s];

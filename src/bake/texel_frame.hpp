@@ -4,6 +4,7 @@
 /// convertNormalMap so that the two agree bit for bit.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -60,6 +61,12 @@ struct ShadingTriangle {
 /// UV triangle is degenerate (see kMinUvTriangleSine).
 void triangleDerivatives(const std::array<Vec3d, 3>& p, const std::array<Vec2d, 3>& uv,
                          Vec3d& dPdu, Vec3d& dPdv);
+
+/// @brief The face whose corners include @p corner (faceStart is ascending).
+inline std::size_t faceOfCorner(const Mesh& mesh, std::uint32_t corner) {
+  const auto next = std::upper_bound(mesh.faceStart.begin(), mesh.faceStart.end(), corner);
+  return static_cast<std::size_t>(next - mesh.faceStart.begin()) - 1;
+}
 
 /// @brief Loads triangle @p corners of @p mesh.
 /// @param[in] tangents per-corner MikkTSpace frames (UV set 0), or nullptr

@@ -88,6 +88,7 @@ struct MeshArrays {
   bool normalsOptional = false;
   const std::uint8_t* faceFlat = nullptr;  ///< #F, or NULL: every face smooth
   bool autoSmooth = false;
+  const std::uint32_t* faceMaterial = nullptr;  ///< #F, or NULL: every face material 0
   std::vector<const float*> uvSets;  ///< each #C × 2
   std::vector<std::string> uvNames;  ///< how messages name each UV array
   std::size_t numCorners = 0;
@@ -244,6 +245,10 @@ Mesh toMesh(const MeshArrays& a) {
     for (std::size_t f = 0; f < a.numFaces; ++f) mesh.faceFlat[f] = a.faceFlat[f] != 0 ? 1 : 0;
   }
   mesh.autoSmooth = a.autoSmooth;
+  if (a.faceMaterial != nullptr && std::any_of(a.faceMaterial, a.faceMaterial + a.numFaces,
+                                               [](std::uint32_t m) { return m != 0; })) {
+    mesh.faceMaterial.assign(a.faceMaterial, a.faceMaterial + a.numFaces);
+  }
   if (a.cornerNormals == nullptr) {
     computeSmoothNormals(mesh);
     return mesh;
@@ -338,17 +343,9 @@ Status bakeMapFromArrays(const BakeArguments& a) {
   }
 
   const sgbake_mesh& m = *a.mesh;
-  MeshArrays arrays{m.positions,
-                    m.num_vertices,
-                    m.face_start,
-                    m.num_faces,
-                    m.corner_vertex,
-                    m.corner_normals,
-                    true,
-                    m.face_flat,
-                    m.auto_smooth != 0,
-                    {},
-                    {},
+  MeshArrays arrays{m.positions,        m.num_vertices,   m.face_start, m.num_faces,
+                    m.corner_vertex,    m.corner_normals, true,         m.face_flat,
+                    m.auto_smooth != 0, m.face_material,  {},           {},
                     m.num_corners};
   if (m.num_uv_sets < 1 || m.num_uv_sets > static_cast<std::size_t>(kMaxUvSets)) {
     return Error::badInput(where + "num_uv_sets = " + std::to_string(m.num_uv_sets) +
@@ -453,9 +450,9 @@ int sgbake_compute_tangents(const float* positions, size_t num_vertices,
                             float* out_tangents, float* out_signs, char* error_buf,
                             size_t error_buf_size) {
   return sgbake::guarded("sgbake_compute_tangents", error_buf, error_buf_size, [&] {
-    const sgbake::MeshArrays arrays{positions,     num_vertices,   face_start,     num_faces,
-                                    corner_vertex, corner_normals, false,          nullptr,
-                                    false,         {corner_uvs},   {"corner_uvs"}, num_corners};
+    const sgbake::MeshArrays arrays{
+        positions, num_vertices, face_start, num_faces,    corner_vertex,  corner_normals, false,
+        nullptr,   false,        nullptr,    {corner_uvs}, {"corner_uvs"}, num_corners};
     return sgbake::computeTangentsFromArrays(arrays, threads, out_tangents, out_signs);
   });
 }

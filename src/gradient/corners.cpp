@@ -168,12 +168,20 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
     tangents = std::move(computed).value();
   }
 
+  // Layers of one material: each face takes its material's.
+  const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(layers);
+  const auto faceLayers = [&](std::size_t f) -> std::span<const Layer> {
+    if (byMaterial.empty()) return layers;
+    return byMaterial[std::min<std::size_t>(mesh.material(f), byMaterial.size() - 1)];
+  };
+
   std::vector<CornerSample> samples(mesh.numCorners());
   auto work = [&] {
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, mesh.numFaces()),
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t f = range.begin(); f != range.end(); ++f) {
+            const std::span<const Layer> shading = faceLayers(f);
             for (std::uint32_t c = mesh.faceStart[f]; c < mesh.faceStart[f + 1]; ++c) {
               SurfacePoint point = cornerSurfacePoint(mesh, haveTangents ? &tangents : nullptr, f,
                                                       c, options.minCornerSine);
@@ -190,11 +198,11 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
                 // A corner has no triangle: its own normal is its Ng, as compositeGradient's.
                 const SurfacePoint world = worldCornerPoint(point, *options.world);
                 s.gradient = objectSpaceGradient(
-                    shadeLayersInWorld(layers, point, world, world.normal, *options.world), point,
+                    shadeLayersInWorld(shading, point, world, world.normal, *options.world), point,
                     *options.world);
                 s.perturbed = resolveNormal(point.normal, s.gradient);
               } else {
-                s.gradient = compositeGradient(layers, point);
+                s.gradient = compositeGradient(shading, point);
                 s.perturbed = resolveNormal(point.normal, s.gradient, options.objectScaleCofactor);
               }
             }

@@ -173,6 +173,25 @@ const char* kindName(const LayerSource& source) {
 
 }  // namespace
 
+std::vector<Layer> layersOfMaterial(std::span<const Layer> layers, std::uint32_t material) {
+  std::vector<Layer> chosen;
+  for (const Layer& layer : layers) {
+    if (layer.material < 0 || static_cast<std::uint32_t>(layer.material) == material)
+      chosen.push_back(layer);
+  }
+  return chosen;
+}
+
+std::vector<std::vector<Layer>> layersByMaterial(std::span<const Layer> layers) {
+  int highest = -1;
+  for (const Layer& layer : layers) highest = std::max(highest, layer.material);
+  std::vector<std::vector<Layer>> byMaterial;
+  if (highest < 0) return byMaterial;
+  for (int m = 0; m <= highest + 1; ++m)
+    byMaterial.push_back(layersOfMaterial(layers, static_cast<std::uint32_t>(m)));
+  return byMaterial;
+}
+
 Vec3d layerGradient(const LayerSource& source, const SurfacePoint& point) {
   return std::visit([&](const auto& s) { return evaluate(s, point); }, source);
 }

@@ -164,6 +164,8 @@ Result<Mesh> readWithOpenMesh(const ValidatedFile& file, std::string_view name) 
 
   mesh.faceStart = parsed.faceStart;
   mesh.faceFlat = parsed.faceFlat;
+  mesh.faceMaterial = parsed.faceMaterial;
+  mesh.materialNames = parsed.materialNames;
   mesh.cornerVertex.resize(parsed.cornerVertex.size());
   const bool hasUvs = parsed.uvBinding != Binding::kNone;
   std::vector<Vec2f> uvs(hasUvs ? parsed.cornerVertex.size() : 0);

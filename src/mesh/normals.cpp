@@ -271,6 +271,10 @@ Status validate(const Mesh& mesh) {
     return fail("faceFlat has " + std::to_string(mesh.faceFlat.size()) + " entries for " +
                 std::to_string(mesh.numFaces()) + " faces");
   }
+  if (!mesh.faceMaterial.empty() && mesh.faceMaterial.size() != mesh.numFaces()) {
+    return fail("faceMaterial has " + std::to_string(mesh.faceMaterial.size()) + " entries for " +
+                std::to_string(mesh.numFaces()) + " faces");
+  }
   for (std::size_t c = 0; c < numCorners; ++c) {
     if (mesh.cornerVertex[c] >= numVertices) {
       return fail("corner " + std::to_string(c) + " refers to vertex " +

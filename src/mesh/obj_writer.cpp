@@ -1,5 +1,6 @@
 /// @file obj_writer.cpp
 /// @brief formatObj: a Mesh as OBJ text that reads back bit for bit.
+#include <algorithm>
 #include <array>
 #include <charconv>
 
@@ -35,7 +36,24 @@ std::string formatObj(const Mesh& mesh, std::size_t uvSet) {
   // Flat faces as Blender's exporter marks them: `s 0` before a run of flat faces, `s 1`
   // before a run of smooth ones (nothing when the mesh does not say: every face smooth).
   int smoothing = -1;
+  // Materials as `usemtl` before each run of faces of one material (names: the file's, else
+  // "material_N"). A reader numbers them in order of first appearance, so every one is named
+  // once first, in index order: the indices read back are these.
+  const auto materialName = [&mesh](std::size_t m) {
+    const bool named = m < mesh.materialNames.size() && !mesh.materialNames[m].empty();
+    return named ? mesh.materialNames[m] : "material_" + std::to_string(m);
+  };
+  if (!mesh.faceMaterial.empty()) {
+    const std::uint32_t highest =
+        *std::max_element(mesh.faceMaterial.begin(), mesh.faceMaterial.end());
+    for (std::size_t m = 0; m <= highest; ++m) out += "usemtl " + materialName(m) + "\n";
+  }
+  std::size_t material = static_cast<std::size_t>(-1);
   for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    if (!mesh.faceMaterial.empty() && material != mesh.material(f)) {
+      material = mesh.material(f);
+      out += "usemtl " + materialName(material) + "\n";
+    }
     if (!mesh.faceFlat.empty() && smoothing != (mesh.isFlat(f) ? 0 : 1)) {
       smoothing = mesh.isFlat(f) ? 0 : 1;
       out += smoothing == 0 ? "s 0\n" : "s 1\n";

@@ -63,6 +63,10 @@ struct ParsedMesh {
   /// #F, 1 for a flat-shaded face (OBJ: Blender's reading of `s` statements), or empty when the
   /// file does not say (no `s` statement at all; PLY, OFF): every face smooth.
   std::vector<std::uint8_t> faceFlat;
+  /// #F material indices (OBJ: `usemtl` names numbered in order of first use, faces before the
+  /// first `usemtl` 0 with the name ""), or empty when the file names none.
+  std::vector<std::uint32_t> faceMaterial;
+  std::vector<std::string> materialNames;  ///< per material index (faceMaterial)
 
   std::size_t numFaces() const { return faceStart.size() - 1; }
 };
@@ -199,6 +203,14 @@ class Tokenizer {
     token = rest_.substr(b, e - b);
     rest_.remove_prefix(e);
     return true;
+  }
+
+  /// The rest of the line without its leading and trailing blanks (a name with spaces).
+  std::string_view rest() const {
+    std::size_t b = 0, e = rest_.size();
+    while (b < e && (rest_[b] == ' ' || rest_[b] == '\t')) ++b;
+    while (e > b && (rest_[e - 1] == ' ' || rest_[e - 1] == '\t')) --e;
+    return rest_.substr(b, e - b);
   }
 
  private:

@@ -66,6 +66,9 @@ class ObjChecker {
   Status texcoord(Tokenizer& tokens, std::size_t line);
   Status normal(Tokenizer& tokens, std::size_t line);
   Status face(Tokenizer& tokens, std::size_t line);
+  Status useMaterial(Tokenizer& tokens, std::size_t line);
+  /// The index of material @p name, numbered in order of first use.
+  std::uint32_t materialIndex(std::string_view name);
   /// Resolves one index of a corner: OBJ's 1-based or negative relative index → 0-based.
   /// Positive indices are checked against the final count at the end (forward references are
   /// legal OBJ); negative ones against the count defined so far.
@@ -81,6 +84,11 @@ class ObjChecker {
   bool everyCornerWithNormal_ = true;
   bool anySmoothing_ = false;  ///< the file has an `s` statement
   bool smooth_ = false;        ///< the state `s` statements set: Blender's importer starts flat
+  bool anyMaterial_ = false;   ///< the file has a `usemtl` statement
+  /// The state `usemtl` statements set (index into materialNames); before the first, kNoMaterial
+  /// (faces there get the name "").
+  static constexpr std::uint32_t kNoMaterial = 0xffffffffu;
+  std::uint32_t material_ = kNoMaterial;
 };
 
 /// Whether the argument of an `s` statement makes the faces that follow smooth, as Blender 3.4's
@@ -148,6 +156,10 @@ Result<ValidatedFile> ObjChecker::run() {
     mesh.uvs.clear();
   }
   if (!anySmoothing_) mesh.faceFlat.clear();  // the file does not say: smooth, as before
+  if (!anyMaterial_) {
+    mesh.faceMaterial.clear();
+    mesh.materialNames.clear();
+  }
   if (everyCornerWithNormal_) {
     mesh.normalBinding = Binding::kPerCorner;
   } else {
@@ -156,6 +168,22 @@ Result<ValidatedFile> ObjChecker::run() {
   }
   out_.openMeshExtension = ".obj";
   return std::move(out_);
+}
+
+Status ObjChecker::useMaterial(Tokenizer& tokens, std::size_t line) {
+  const std::string_view name = tokens.rest();  // as Blender's importer, spaces and all
+  if (name.empty()) return errorAt(name_, line, "usemtl without a material name");
+  anyMaterial_ = true;
+  material_ = materialIndex(name);
+  return Ok{};
+}
+
+std::uint32_t ObjChecker::materialIndex(std::string_view name) {
+  std::vector<std::string>& names = out_.parsed.materialNames;
+  const auto found = std::find(names.begin(), names.end(), name);
+  if (found != names.end()) return static_cast<std::uint32_t>(found - names.begin());
+  names.emplace_back(name);
+  return static_cast<std::uint32_t>(names.size() - 1);
 }
 
 Status ObjChecker::statement(std::string_view keyword, Tokenizer& tokens, std::size_t line) {
@@ -168,6 +196,7 @@ Status ObjChecker::statement(std::string_view keyword, Tokenizer& tokens, std::s
     smooth_ = smoothingGroupIsSmooth(tokens);
     return Ok{};
   }
+  if (keyword == "usemtl") return useMaterial(tokens, line);
   if (isIgnoredStatement(keyword)) return Ok{};
   return errorAt(name_, line, "unknown OBJ statement " + quoted(keyword));
 }
@@ -333,6 +362,7 @@ Status ObjChecker::face(Tokenizer& tokens, std::size_t line) {
   }
   mesh.faceStart.push_back(static_cast<std::uint32_t>(mesh.cornerVertex.size()));
   mesh.faceFlat.push_back(smooth_ ? 0 : 1);
+  mesh.faceMaterial.push_back(material_ != kNoMaterial ? material_ : materialIndex(""));
   faceLine_.push_back(line);
   return Ok{};
 }

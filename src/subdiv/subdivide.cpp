@@ -608,6 +608,16 @@ Mesh subdivideGrids(const Mesh& coarse, ControlMesh& control, const SubdivisionO
                 coarse.isFlat(f) ? 1 : 0);
     }
   }
+  // Each new face keeps its coarse face's material, as the modifier does.
+  fine.materialNames = coarse.materialNames;
+  if (!coarse.faceMaterial.empty()) {
+    fine.faceMaterial.resize(fineFaces);
+    for (std::size_t f = 0; f < nf; ++f) {
+      std::fill(fine.faceMaterial.begin() + static_cast<std::ptrdiff_t>(cellStart[f]),
+                fine.faceMaterial.begin() + static_cast<std::ptrdiff_t>(cellStart[f + 1]),
+                coarse.material(f));
+    }
+  }
   if (options.autoSmoothDegrees) {
     shadeAutoSmooth(fine, options,
                     sharpAlongMarkedEdges(fine, *refiner, numbering, options.sharpEdges));

@@ -226,6 +226,51 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
   EXPECT_NE(refused.error().message.find("singular"), std::string::npos) << refused.error().message;
 }
 
+// A layer of one material bumps that material's faces only, as a multi-material object's Bump
+// node bumps its material's faces: the plane's quads alternately of materials 0 and 1, the
+// ramp on material 1: its faces bake the analytic bump, the others the flat normal; the height
+// map too holds material 1's height only.
+TEST(Maps, ALayerOfOneMaterialBumpsItsFacesOnly) {
+  const double lx = 2, ly = 0.5, a = 0.3, b = -0.2, scale = 0.7;
+  Mesh mesh = scaledPlane(lx, ly);
+  mesh.faceMaterial.resize(mesh.numFaces());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) mesh.faceMaterial[f] = f % 2 == 0 ? 1 : 0;
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::LinearHeight height(a, b);
+  Layer ramp{UvHeightSource{&height, 0, scale}, 1.0, {}};
+  ramp.material = 1;
+  const std::vector<Layer> layers{ramp};
+  const Vec3d bumped = normalizeOr(Vec3d{-scale * a / lx, -scale * b / ly, 1}, Vec3d{});
+  const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal);
+  const auto ht = bake(mesh, &*tangents, layers, MapKind::kHeight);
+  ASSERT_TRUE(tn.ok() && ht.ok());
+  // Which face covers a texel centre: the grid's quads are 4 x 3 over UV [0.1, 0.9]².
+  const auto faceAt = [](double u, double v) {
+    const int i = std::min(3, static_cast<int>((u - 0.1) / 0.8 * 4));
+    const int j = std::min(2, static_cast<int>((v - 0.1) / 0.8 * 3));
+    return static_cast<std::size_t>(j * 4 + i);
+  };
+  int onOne = 0, onZero = 0;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      if (test::coverageUp(*tn, x, y) != 1.0f) continue;
+      const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+      // Texels within half a texel of a quad's edge could belong to either neighbour.
+      const double gu = (u - 0.1) / 0.8 * 4, gv = (v - 0.1) / 0.8 * 3;
+      if (std::abs(gu - std::round(gu)) < 0.1 || std::abs(gv - std::round(gv)) < 0.1) continue;
+      const bool one = mesh.material(faceAt(u, v)) == 1;
+      const std::string at = std::to_string(x) + "," + std::to_string(y);
+      expectNear(test::pixelUp(*tn, x, y), encode(one ? bumped : Vec3d{0, 0, 1}), kFloatTol,
+                 (one ? "material 1 " : "material 0 ") + at);
+      EXPECT_NEAR(ht->at(x, 31 - y, 0), one ? scale * (a * u + b * v) : 0.0, 1e-6) << at;
+      ++(one ? onOne : onZero);
+    }
+  }
+  EXPECT_GT(onOne, 100);
+  EXPECT_GT(onZero, 100);
+}
+
 // Cycles bends a bumped normal whose reflection of the incoming direction (at a bake, the
 // shading normal: ẑ on this plane) would go below the surface: on a flat plane no normal leans
 // more than acos(0.01)/2 = 44.71° from ẑ. A steep linear height (60°) bakes that tilt, in the

@@ -608,6 +608,44 @@ TEST_F(PlannerTest, TheTransformReBakesWhatItShades) {
   EXPECT_EQ(plan(stretched).outputsToBake(), 0u);
 }
 
+// A layer's "material" names a material of the mesh by index or by its OBJ `usemtl` name: a
+// name the mesh lacks is bad input listing the names; an index no face has, a warning; the
+// material is a parameter of the manifest.
+TEST_F(PlannerTest, LayerMaterialsByIndexOrName) {
+  writeFile(dir_ / "split.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+            "usemtl Skin\nf 1/1 2/2 3/3\nusemtl Cloth\nf 1/1 3/3 4/4\n");
+  const auto withMaterial = [](const std::string& material) {
+    return R"({"type": "height", "image": "h.png", "scale": 0.1, "material": )" + material + "}";
+  };
+  const std::string output = R"({"map": "height", "file": "h.exr", "size": 8})";
+  const ExecuteReport byName = bake(planeScene(withMaterial(R"("Cloth")"), output, "split.obj"));
+  EXPECT_TRUE(byName.warnings.empty());
+  const std::vector<float> cloth = readPixels(dir_ / "h.exr");
+  bake(planeScene(withMaterial("1"), output, "split.obj"), {.force = true});
+  EXPECT_EQ(readPixels(dir_ / "h.exr"), cloth) << "Cloth is material 1";
+  bake(planeScene(withMaterial("0"), output, "split.obj"), {.force = true});
+  EXPECT_NE(readPixels(dir_ / "h.exr"), cloth);
+  EXPECT_EQ(plan(planeScene(withMaterial("1"), output, "split.obj")).outputs[0].whyBake,
+            "its parameters changed: \"layers\"");
+
+  Result<Plan> unknown = makePlan(scene(planeScene(withMaterial(R"("Skn")"), output, "split.obj")));
+  ASSERT_TRUE(unknown);
+  Result<ExecuteReport> refused = executePlan(*unknown);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("layers[0]: material 'Skn' is not in"), std::string::npos)
+      << refused.error().message;
+  EXPECT_NE(refused.error().message.find("(its materials: 'Skin', 'Cloth')"), std::string::npos)
+      << refused.error().message;
+  const ExecuteReport nobody =
+      bake(planeScene(withMaterial("4"), output, "split.obj"), {.force = true});
+  ASSERT_EQ(nobody.warnings.size(), 1u);
+  EXPECT_NE(nobody.warnings[0].find("layers[0]: no face of"), std::string::npos)
+      << nobody.warnings[0];
+  EXPECT_NE(nobody.warnings[0].find("has material 4: the layer bakes nothing"), std::string::npos)
+      << nobody.warnings[0];
+}
+
 TEST_F(PlannerTest, ValuesAFileCannotStoreAreAWarningNamingTheFileAndTheRemedy) {
   // h.png rises by 0.5 across the plane: with scale 4, ∂h/∂u = 2 and heights reach 2.
   const std::string layer = R"({"type": "height", "image": "h.png", "scale": 4})";

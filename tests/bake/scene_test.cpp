@@ -348,6 +348,26 @@ TEST(Scene, TransformIsBlendersMatrixWorld) {
             "can be carried through it");
 }
 
+TEST(Scene, LayerMaterialIsAnIndexOrAName) {
+  Result<Scene> index =
+      parseScene(withLayer(R"({"type": "height", "image": "h.png", "material": 2})"), options());
+  ASSERT_TRUE(index.ok()) << index.error().message;
+  EXPECT_EQ(index->layers[0].material, 2);
+  EXPECT_FALSE(index->layers[0].materialName.has_value());
+  Result<Scene> name = parseScene(
+      withLayer(R"({"type": "volume", "function": "noise", "material": "Skin"})"), options());
+  ASSERT_TRUE(name.ok()) << name.error().message;
+  EXPECT_EQ(name->layers[0].materialName, "Skin");
+  EXPECT_FALSE(name->layers[0].material.has_value());
+  EXPECT_FALSE(parseScene(withLayer(R"({"type": "height", "image": "h.png"})"), options())
+                   ->layers[0]
+                   .material.has_value());
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "material": -1})")),
+            "scene.json: layers[0]: material -1 is out of range 0..32766");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "material": 1.5})")),
+            "scene.json: layers[0]: 'material' must be an integer, not 1.5");
+}
+
 TEST(Scene, MissingAndEmpty) {
   EXPECT_EQ(parseError(R"({"outputs": [{"map": "mask", "file": "m.png"}]})"),
             "scene.json: missing key 'mesh' in the scene");

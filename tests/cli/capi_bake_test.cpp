@@ -111,13 +111,16 @@ class CApiBake : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
+  fs::path meshFile_ = fs::path(SGBAKE_MESHES) / "suzanne.obj";  ///< what fileBake reads
+  std::string layers_ = kLayers;             ///< the scene's layers (%BUMPS%, %NORMALS%)
+  std::vector<std::uint32_t> faceMaterial_;  ///< memoryBake's face_material, or none
+
   /// The output @p output baked by executePlan into a float EXR and read back (rows top first).
   Image fileBake(const std::string& output) {
-    const std::string scene = R"({"mesh": ")" + (fs::path(SGBAKE_MESHES) / "suzanne.obj").string() +
-                              R"(", "layers": )" +
-                              replaceAll(replaceAll(kLayers, "%BUMPS%", "bumps.exr"), "%NORMALS%",
-                                         "normals.exr") +
-                              R"(, "outputs": [)" + output + "]}";
+    const std::string scene =
+        R"({"mesh": ")" + meshFile_.string() + R"(", "layers": )" +
+        replaceAll(replaceAll(layers_, "%BUMPS%", "bumps.exr"), "%NORMALS%", "normals.exr") +
+        R"(, "outputs": [)" + output + "]}";
     test::writeFile(dir_ / "scene.json", scene);
     Result<Scene> parsed = loadScene(dir_ / "scene.json");
     EXPECT_TRUE(parsed) << parsed.error().message;
@@ -141,7 +144,7 @@ class CApiBake : public ::testing::Test {
     const sgbake_image images[] = {bumps.view(), normals.view()};
     const std::string scene =
         R"({"layers": )" +
-        replaceAll(replaceAll(kLayers, "%BUMPS%", bumpsKey), "%NORMALS%", "Normal Map.001") +
+        replaceAll(replaceAll(layers_, "%BUMPS%", bumpsKey), "%NORMALS%", "Normal Map.001") +
         R"(, "outputs": [)" + output + "]}";
     std::vector<float> positions, normalsArray, uvs;
     for (const Vec3f& p : mesh_.positions) positions.insert(positions.end(), {p.x, p.y, p.z});
@@ -158,7 +161,8 @@ class CApiBake : public ::testing::Test {
                            1,
                            mesh_.numCorners(),
                            nullptr,
-                           0};
+                           0,
+                           faceMaterial_.empty() ? nullptr : faceMaterial_.data()};
     rgba.assign(static_cast<std::size_t>(size) * size * 4, -1.0f);
     char error[512] = "";
     const int status = sgbake_bake_map(scene.c_str(), &mesh, images, 2, 0, nullptr,
@@ -229,6 +233,39 @@ TEST_F(CApiBake, TangentNormalWithExtendMarginIsTheFileBake) {
   expectSameAsFile(R"({"map": "tangent-normal", "size": 96, "margin": 3})", 96, 3, false);
 }
 
+// A layer of one material applies to that material's faces: Suzanne's faces in two materials,
+// the bump on material 1 and the normal map on material 0 (OBJ `usemtl` for the file bake,
+// face_material in memory), the volume on every face. Same texels both ways, and not those of
+// the bake with every layer on every face.
+TEST_F(CApiBake, LayersOfOneMaterialAreTheFileBake) {
+  std::vector<float> everywhere;
+  std::string message;
+  ASSERT_EQ(memoryBake(R"({"map": "tangent-normal", "size": 64})", 64, everywhere, message),
+            SGBAKE_OK)
+      << message;
+  faceMaterial_.resize(mesh_.numFaces());
+  for (std::size_t f = 0; f < faceMaterial_.size(); ++f) faceMaterial_[f] = f % 3 == 0 ? 1 : 0;
+  Mesh split = mesh_;
+  split.faceMaterial = faceMaterial_;
+  meshFile_ = dir_ / "split.obj";
+  test::writeFile(meshFile_, formatObj(split));
+  layers_ = replaceAll(replaceAll(kLayers, R"("scale": 0.05,)", R"("scale": 0.05, "material": 1,)"),
+                       R"("weight": 0.5})", R"("weight": 0.5, "material": 0})");
+  ASSERT_NE(layers_, kLayers);
+  {
+    Result<Mesh> reread = loadMesh(meshFile_);
+    ASSERT_TRUE(reread) << reread.error().message;
+    EXPECT_EQ(reread->faceMaterial, faceMaterial_) << "the OBJ's usemtl statements";
+    EXPECT_EQ(reread->cornerNormals.size(), mesh_.cornerNormals.size());
+    EXPECT_EQ(reread->faceFlat, mesh_.faceFlat);
+  }
+  expectSameAsFile(R"({"map": "tangent-normal", "size": 64})", 64, 3, false);
+  std::vector<float> split64;
+  ASSERT_EQ(memoryBake(R"({"map": "tangent-normal", "size": 64})", 64, split64, message), SGBAKE_OK)
+      << message;
+  EXPECT_NE(split64, everywhere);
+}
+
 TEST_F(CApiBake, DirectXObjectNormalAndPushPullAreTheFileBake) {
   expectSameAsFile(R"({"map": "object-normal", "size": 64, "padding": "push-pull"})", 64, 3,
                    false);
@@ -271,8 +308,9 @@ TEST_F(CApiBake, FlatFacesAreShadedPerTriangle) {
        {std::pair{true, false}, std::pair{false, false}, std::pair{true, true}}) {
     const bool flat = flagged && !autoSmooth;
     const std::uint8_t faceFlat[] = {static_cast<std::uint8_t>(flagged ? 1 : 0)};
-    const sgbake_mesh mesh{positions, 4, faceStart, 1,        corners,           normals.data(),
-                           uvSets,    1, 4,         faceFlat, autoSmooth ? 1 : 0};
+    const sgbake_mesh mesh{positions,          4,      faceStart, 1, corners,
+                           normals.data(),     uvSets, 1,         4, faceFlat,
+                           autoSmooth ? 1 : 0, nullptr};
     std::vector<float> out(16 * 16 * 4);
     char error[256] = "";
     ASSERT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "object-normal", "size": 16}]})", &mesh,
@@ -307,7 +345,8 @@ TEST_F(CApiBake, NamesAMissingImageAndAWrongBufferSize) {
   const float* uvSets[] = {uv};
   const float positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const std::uint32_t faceStart[] = {0, 3}, corners[] = {0, 1, 2};
-  const sgbake_mesh mesh{positions, 3, faceStart, 1, corners, nullptr, uvSets, 1, 3, nullptr, 0};
+  const sgbake_mesh mesh{positions, 3, faceStart, 1,       corners, nullptr,
+                         uvSets,    1, 3,         nullptr, 0,       nullptr};
   std::vector<float> out(16 * 16 * 4);
   char error[256] = "";
   EXPECT_EQ(sgbake_bake_map(R"({"outputs": [{"map": "height", "size": 16}],

@@ -127,7 +127,8 @@ sgbake_mesh meshOf(const FlatMesh& m, const float* const* uvSets) {
           1,
           m.numCorners(),
           nullptr,
-          0};
+          0,
+          nullptr};
 }
 
 TEST(CApi, BakeMapFromArraysDoesNotLoadOpenImageIO) {

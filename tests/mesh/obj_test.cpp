@@ -87,6 +87,30 @@ TEST(MeshObj, SmoothingStatementsMarkFlatFacesAsBlendersImporterDoes) {
   EXPECT_EQ(formatObj(unmarked).find("\ns "), std::string::npos);
 }
 
+// `usemtl` gives each face the index of its material name, numbered in order of first
+// appearance (faces before any `usemtl` get the name ""); a file without `usemtl` has none.
+// The writer names every material first, in index order, so indices survive a round trip
+// whatever order the faces come in.
+TEST(MeshObj, UsemtlNumbersMaterialsInOrderOfFirstAppearance) {
+  const std::string vertices = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  const Mesh named = loadObjText(vertices +
+                                 "f 1 2 3\nusemtl Skin\nf 1 3 4\nusemtl Cloth Fine\nf 1 2 4\n"
+                                 "usemtl Skin\nf 2 3 4\n");
+  EXPECT_EQ(named.faceMaterial, (std::vector<std::uint32_t>{0, 1, 2, 1}));
+  EXPECT_EQ(named.materialNames, (std::vector<std::string>{"", "Skin", "Cloth Fine"}));
+  EXPECT_EQ(named.material(2), 2u);
+  const Mesh none = loadObjText(vertices + "f 1 2 3\nf 1 3 4\n");
+  EXPECT_TRUE(none.faceMaterial.empty());
+  EXPECT_EQ(none.material(1), 0u);
+  Mesh reordered = named;
+  reordered.faceMaterial = {2, 0, 1, 2};
+  EXPECT_EQ(loadObjText(formatObj(reordered)).faceMaterial, reordered.faceMaterial);
+  Result<Mesh> bad = loadMeshFromMemory(vertices + "usemtl\nf 1 2 3\n", "obj", "bad.obj");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("usemtl without a material name"), std::string::npos)
+      << bad.error().message;
+}
+
 TEST(MeshObj, NormalsThatOnlyAutoSmoothMakesSayItIsOn) {
   // Two triangles of a square, z up. Without Blender's Auto Smooth a flat face's corners carry
   // its polygon normal and a vertex's smooth corners share one normal; anything else in the

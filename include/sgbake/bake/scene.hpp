@@ -156,6 +156,11 @@ struct SceneLayer {
   /// "base" (heights): "surface" (N, the default) or "above" (the normal the layers above make,
   /// as a Bump node whose Normal input is linked to them; LayerBase::kLayersAbove)
   LayerBase base = LayerBase::kSurface;
+  /// "material": the faces the layer applies to, those of one material: an index (Blender's
+  /// material slot; Mesh::faceMaterial) or an OBJ `usemtl` name (materialName). Neither: every
+  /// face.
+  std::optional<int> material;
+  std::optional<std::string> materialName;
 
   // Volume layers.
   VolumeFunction function = VolumeFunction::kSine;      ///< "function"

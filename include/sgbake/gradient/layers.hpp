@@ -17,8 +17,10 @@
 /// layers as an Error for the caller to show.
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <variant>
+#include <vector>
 
 #include "sgbake/core/result.hpp"
 #include "sgbake/core/vec.hpp"
@@ -136,7 +138,24 @@ struct Layer {
   double weight = 1;  ///< any finite value (negative inverts the bumps); 0 disables
   LayerMask mask{};
   LayerBase base = LayerBase::kSurface;
+  /// The material whose faces the layer applies to (Mesh::faceMaterial: Blender's material
+  /// slot), as a multi-material object's Bump and Normal Map nodes apply to their material's
+  /// faces only; −1: every face. The engine's functions of a point do not read it: the baker
+  /// and the corner table pick each face's layers (layersOfMaterial).
+  int material = -1;
 };
+
+/// Largest material index a layer may name (Blender allows 32767 material slots).
+inline constexpr int kMaxMaterialIndex = 32766;
+
+/// @brief The layers of @p layers that apply to faces of material @p material (Layer::material
+/// −1 or equal to it), in order.
+std::vector<Layer> layersOfMaterial(std::span<const Layer> layers, std::uint32_t material);
+
+/// @brief layersOfMaterial for every material index 0 … K + 1, K the highest a layer names
+/// (entry K + 1 serves every material above K); empty when every layer applies to every face.
+/// What a face of material m shades with: entry min(m, K + 1).
+std::vector<std::vector<Layer>> layersByMaterial(std::span<const Layer> layers);
 
 /// @brief Γ of a layer's source alone (no weight, no mask), object space, at @p point.
 ///

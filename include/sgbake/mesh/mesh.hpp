@@ -61,6 +61,17 @@ struct Mesh {
   std::vector<std::uint8_t> faceFlat;
   /// @brief Whether face @p f is flat-shaded (faceFlat says so).
   bool isFlat(std::size_t f) const { return f < faceFlat.size() && faceFlat[f] != 0; }
+  /// #F material indices (Blender's material slot of each face; OBJ: `usemtl` names numbered
+  /// in order of first use), or empty: every face material 0. A layer with a material
+  /// (Layer::material) applies to that material's faces only; subdivision keeps each face's.
+  std::vector<std::uint32_t> faceMaterial;
+  /// The material names of an OBJ (per index of faceMaterial; faces before the first `usemtl`
+  /// have the name ""), or empty.
+  std::vector<std::string> materialNames;
+  /// @brief The material index of face @p f (0 without faceMaterial).
+  std::uint32_t material(std::size_t f) const {
+    return f < faceMaterial.size() ? faceMaterial[f] : 0;
+  }
   /// Blender's Auto Smooth is on (split or custom normals; computeSplitNormals sets it): Cycles
   /// then shades every face, flat ones included, with its corner normals. Off (an OBJ does not
   /// say; Blender's default), a flat face is shaded with each of its triangles' own normal. A
