@@ -85,7 +85,7 @@ constexpr const char* kFooter =
     "      {\"map\": \"tangent-normal\", \"file\": \"out/n.png\", \"size\": 2048, \"margin\": 16}] "
     "}\n"
     "  Layer keys (all layers: type, name, weight = 1, mask = IMAGE or {image, uv, tiling,\n"
-    "  offset, filter}):\n"
+    "  offset, filter}, material = INDEX or OBJ usemtl NAME: that material's faces only):\n"
     "    height     image, uv, scale = 1, strength = 1 (Blender's Bump Strength: a blend of\n"
     "               normals), channel = luminance|r|g|b|a (one channel: a packed height),\n"
     "               filter = bilinear|bicubic|hermite, wrap = repeat|clamp,\n"
