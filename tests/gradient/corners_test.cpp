@@ -297,6 +297,32 @@ TEST(Corners, ObjectScaleCofactorAppliesToThePerturbedNormalOnly) {
   }
 }
 
+// Shaded through a transform (CornerOptions::world) and by material, as the bake shades texels:
+// the plane z = 0 of an object scaled (2, 0.5, 1.5) with a ramp h = 0.3·u on material 1 only.
+// Material 1's corners get the world bump brought back to object space, Γ = (0.3/1.5, 0, 0)
+// (only the scale across the plane matters; the maps test has the derivation), material 0's
+// none.
+TEST(Corners, WorldShadingAndMaterialsAsTheBakeDoes) {
+  Mesh mesh = test::gridMesh(test::plane, 4, 2);
+  mesh.faceMaterial.resize(mesh.numFaces());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) mesh.faceMaterial[f] = f % 2 == 0 ? 1 : 0;
+  const AnalyticHeight ramp(0.3, 0, 0);  // h = 0.3·s
+  Layer layer{UvHeightSource{&ramp, 0}, 1, {}};
+  layer.material = 1;
+  const Result<WorldSpace> space = WorldSpace::of({Mat3::diagonal({2, 0.5, 1.5}), {1, 2, 3}});
+  ASSERT_TRUE(space.ok());
+  CornerOptions options;
+  options.world = &*space;
+  const auto corners = evaluate(mesh, {layer}, options);
+  ASSERT_EQ(corners.size(), mesh.numCorners());
+  for (const CornerSample& s : corners) {
+    const bool bumped = mesh.material(s.face) == 1;
+    const Vec3d expected = bumped ? Vec3d{0.3 / 1.5, 0, 0} : Vec3d{};
+    EXPECT_LT(maxAbsDiff(s.gradient, expected), 1e-12) << "corner " << s.corner;
+    EXPECT_LT(maxAbsDiff(s.perturbed, resolveNormal(s.normal, expected)), 1e-12);
+  }
+}
+
 // Every source kind on curved meshes with seams and poles: finite, unit perturbed normals.
 TEST(Corners, CurvedMeshesWithEverySourceAreFinite) {
   AnalyticHeight h(0.1, 0.2, 0.05);
