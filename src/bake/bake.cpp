@@ -257,16 +257,28 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   base.tangents = input.tangents;
   base.triangleTangents = input.triangleTangents;
   base.layers = input.layers;
-  // Layers of one material: each triangle takes its face's.
-  const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(input.layers);
-  base.layersByMaterial = byMaterial;
   base.uvSet = settings.uvSet;
   base.green = settings.green;
+  // The object's transform (not for height maps, whose heights it does not change): a rotation
+  // (or mirror) with a uniform scale s shades as object space with heights divided by s
+  // (ObjectTransform::uniformScale), on the lane-parallel paths; any other is shaded in world
+  // space, sample by sample.
+  std::vector<Layer> scaledLayers;
   WorldSpace world;
-  if (input.transform != nullptr && !input.transform->shadesAsObjectSpace()) {
-    world = WorldSpace::of(*input.transform).value();  // validateSettings checked it
-    base.world = &world;
+  if (input.transform != nullptr && !input.transform->shadesAsObjectSpace() &&
+      settings.map != MapKind::kHeight) {
+    if (const std::optional<double> s = input.transform->uniformScale()) {
+      for (const Layer& layer : input.layers)
+        scaledLayers.push_back(withHeightsScaled(layer, 1 / *s));
+      base.layers = scaledLayers;
+    } else {
+      world = WorldSpace::of(*input.transform).value();  // validateSettings checked it
+      base.world = &world;
+    }
   }
+  // Layers of one material: each triangle takes its face's.
+  const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(base.layers);
+  base.layersByMaterial = byMaterial;
 
   static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
   static constexpr float kZero[3] = {0, 0, 0};

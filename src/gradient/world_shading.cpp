@@ -1,6 +1,7 @@
 #include "sgbake/gradient/world_shading.hpp"
 
 #include <cmath>
+#include <type_traits>
 #include <variant>
 
 #include "gradient/prepared_uv_frame.hpp"
@@ -103,6 +104,37 @@ bool ObjectTransform::shadesAsObjectSpace() const {
     for (int r = 0; r < 3; ++r)
       if (linear(r, c) != identity(r, c)) return false;
   return true;
+}
+
+std::optional<double> ObjectTransform::uniformScale(double tolerance) const {
+  // MᵀM = s²·I for M = s·Q, Q orthogonal.
+  const Mat3 gram = transpose(linear) * linear;
+  const double s2 = (gram(0, 0) + gram(1, 1) + gram(2, 2)) / 3;
+  if (!(s2 > 0) || !std::isfinite(s2)) return std::nullopt;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      const double expected = r == c ? s2 : 0.0;
+      if (!(std::abs(gram(r, c) - expected) <= tolerance * s2)) return std::nullopt;
+    }
+  }
+  return std::sqrt(s2);
+}
+
+Layer withHeightsScaled(Layer layer, double factor) {
+  std::visit(
+      [factor](auto& source) {
+        using Source = std::decay_t<decltype(source)>;
+        if constexpr (std::is_same_v<Source, UvHeightSource> ||
+                      std::is_same_v<Source, VolumeSource>) {
+          source.scale *= factor;
+        } else if constexpr (std::is_same_v<Source, PlanarSource>) {
+          if (source.kind == ProjectedKind::kHeight) source.scale *= factor;
+        } else if constexpr (std::is_same_v<Source, TriplanarSource>) {
+          if (source.kind == ProjectedKind::kHeight) source.options.scale *= factor;
+        }
+      },
+      layer.source);
+  return layer;
 }
 
 Result<WorldSpace> WorldSpace::of(const ObjectTransform& transform) {

@@ -218,6 +218,22 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
   for (const MapKind kind : {MapKind::kTangentNormal, MapKind::kObjectNormal}) {
     EXPECT_EQ(bakeWith(&moved, kind).pixels, bakeWith(nullptr, kind).pixels) << mapKindName(kind);
   }
+  // A rotation with a uniform scale 2 (shaded as object space with heights halved, on the
+  // lane-parallel paths): the world bump is half as steep in both maps; heights unchanged.
+  const ObjectTransform similar{turn * Mat3::diagonal({2, 2, 2}), {}};
+  ASSERT_TRUE(similar.uniformScale().has_value());
+  const Vec3d halved = normalizeOr(Vec3d{-scale * a / (2 * lx), -scale * b / (2 * ly), 1}, {});
+  const FloatImage tnSimilar = bakeWith(&similar, MapKind::kTangentNormal);
+  const FloatImage onSimilar = bakeWith(&similar, MapKind::kObjectNormal);
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      if (test::coverageUp(tnSimilar, x, y) != 1.0f) continue;
+      expectNear(test::pixelUp(tnSimilar, x, y), encode(halved), kFloatTol, "similar tangent");
+      expectNear(test::pixelUp(onSimilar, x, y), encode(halved), kFloatTol, "similar object");
+    }
+  }
+  EXPECT_EQ(bakeWith(&similar, MapKind::kHeight).pixels,
+            bakeWith(nullptr, MapKind::kHeight).pixels);
   const ObjectTransform singular{Mat3::diagonal({1, 1, 0}), {}};
   BakeInput bad{&mesh, &*tangents, layers};
   bad.transform = &singular;

@@ -29,6 +29,7 @@
 /// shadeLayersInWorld computes the first four; the bake's shaders do the last.
 #pragma once
 
+#include <optional>
 #include <span>
 
 #include "sgbake/core/vec.hpp"
@@ -46,7 +47,17 @@ struct ObjectTransform {
 
   /// Whether it changes no normal and no height: the identity linear part (any translation).
   bool shadesAsObjectSpace() const;
+  /// @brief s when the linear part is a rotation (or a mirror) times a uniform scale s, to
+  /// within @p tolerance (relative; Blender's float matrices are orthogonal to ~1e-7), else
+  /// nothing. Such an object shades in world space exactly as in object space with every
+  /// height divided by s (the normals carried there and back are the object's own, and the
+  /// guard does not change under a rotation or a mirror): withHeightsScaled.
+  std::optional<double> uniformScale(double tolerance = 1e-6) const;
 };
+
+/// @brief @p layer with its height (UV height maps, volumes, height projections) multiplied by
+/// @p factor; normal maps unchanged.
+Layer withHeightsScaled(Layer layer, double factor);
 
 /// @brief The matrices shading under an ObjectTransform uses, computed once.
 struct WorldSpace {
