@@ -285,10 +285,13 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   RasterOutput output{kZero, false};
   output.blank = blank;
   // On a limit surface every sample is shaded from the surface under it (LimitShader).
+  // In world space, sample by sample (PerSampleShader).
   const auto run = [&](auto shader) {
     if (input.limit != nullptr) {
       rasterize(job, LimitShader<decltype(shader)>(shader, input.limit, input.limitParameters),
                 output, target);
+    } else if (base.world != nullptr) {
+      rasterize(job, PerSampleShader<decltype(shader)>{shader}, output, target);
     } else {
       rasterize(job, shader, output, target);
     }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <variant>
 
@@ -48,17 +49,35 @@ struct BakeShaderBase {
   std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};
 
   /// Non-null: the object is shaded in world space through this transform, as Cycles shades
-  /// it (world_shading.hpp), sample by sample (the lane-parallel paths stay object-space).
+  /// it (world_shading.hpp), by shade() only (the lane-parallel paths are object-space: runBake
+  /// wraps the shader in PerSampleShader).
   const WorldSpace* world = nullptr;
-  ShadingTriangle worldTri;  ///< tri in world space (worldTriangle), when `world`
-  SurfacePoint worldPoint;   ///< constant fields set per triangle, the rest per sample
-  std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedWorldUv{};  ///< of worldTri
+  /// What shading in world space keeps per triangle and per sample.
+  struct WorldScratch {
+    ShadingTriangle tri;  ///< `tri` in world space (worldTriangle)
+    SurfacePoint point;   ///< constant fields set per triangle, the rest per sample
+    std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};  ///< of `tri`
+  };
+  /// Made on first use, one per copy of the shader (a copy starts without one): kept off the
+  /// shader itself, which every row block copies onto its stack (2 KB more there made the
+  /// lane-parallel paths 10 % slower).
+  class WorldScratchHolder {
+   public:
+    WorldScratchHolder() = default;
+    WorldScratchHolder(const WorldScratchHolder&) {}
+    WorldScratchHolder& operator=(const WorldScratchHolder&) { return *this; }
+    WorldScratch& get() {
+      if (!scratch_) scratch_ = std::make_unique<WorldScratch>();
+      return *scratch_;
+    }
+
+   private:
+    std::unique_ptr<WorldScratch> scratch_;
+  };
+  WorldScratchHolder worldScratch;
 
   void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
-    if (!layersByMaterial.empty()) {
-      const std::size_t material = mesh->material(faceOfCorner(*mesh, corners[0]));
-      layers = layersByMaterial[std::min(material, layersByMaterial.size() - 1)];
-    }
+    if (!layersByMaterial.empty()) selectLayersOfFace(corners[0]);
     loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
     for (std::size_t s = 0; s < kMaxUvSets; ++s) {
       const CornerTangents* frames = triangleTangents[s];
@@ -77,34 +96,41 @@ struct BakeShaderBase {
     beginSurfacePoint(tri, point);
     for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s)
       preparedUv[s] = gradient_detail::prepareUvFrame(point.uv[s]);
-    if (world != nullptr) {
-      worldTriangle(tri, *world, worldTri);
-      beginSurfacePoint(worldTri, worldPoint);
-      for (std::size_t s = 0; s < static_cast<std::size_t>(worldTri.numUvSets); ++s)
-        preparedWorldUv[s] = gradient_detail::prepareUvFrame(worldPoint.uv[s]);
-    }
+    if (world != nullptr) beginWorldTriangle();
+  }
+  // The world and material cases are out of line (noinline), as the rare cases they are:
+  // inlined into shade(), and shade() into the lane-parallel paths' slow lanes, they made the
+  // compiler stop inlining batchTexelFrames there (10 % of a one-thread bake).
+  /// `layers` = those of the material of the face of @p corner (layersByMaterial).
+  [[gnu::noinline]] void selectLayersOfFace(std::uint32_t corner) {
+    const std::size_t material = mesh->material(faceOfCorner(*mesh, corner));
+    layers = layersByMaterial[std::min(material, layersByMaterial.size() - 1)];
+  }
+  /// The world scratch of `tri` (`world` non-null).
+  [[gnu::noinline]] void beginWorldTriangle() {
+    WorldScratch& w = worldScratch.get();
+    worldTriangle(tri, *world, w.tri);
+    beginSurfacePoint(w.tri, w.point);
+    for (std::size_t s = 0; s < static_cast<std::size_t>(w.tri.numUvSets); ++s)
+      w.preparedUv[s] = gradient_detail::prepareUvFrame(w.point.uv[s]);
   }
 
   /// The object's shading in world space at barycentrics @p b (`world` non-null): the guarded
   /// world normal (the unperturbed one without layers) and the unguarded one. (`point` is then
   /// the object-space point, for worldGradient.)
-  WorldShadedNormal shadeInWorld(const Vec3d& b, const TexelFrame& f) {
+  [[gnu::noinline]] WorldShadedNormal shadeInWorld(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& objectPoint = pointAt(b, f);
-    const SurfacePoint& w = surfacePointAt(worldTri, b, texelFrame(worldTri, b), worldPoint);
+    WorldScratch& scratch = worldScratch.get();
+    const SurfacePoint& w =
+        surfacePointAt(scratch.tri, b, texelFrame(scratch.tri, b), scratch.point);
     if (layers.empty()) return {w.normal, w.normal};
-    return gradient_detail::shadeLayersInWorld(layers, objectPoint, w, worldTri.faceNormal, *world,
-                                               preparedWorldUv.data());
+    return gradient_detail::shadeLayersInWorld(layers, objectPoint, w, scratch.tri.faceNormal,
+                                               *world, scratch.preparedUv.data());
   }
   /// The object-space Γ of the world shading at @p b (objectSpaceGradient).
-  Vec3d worldGradient(const Vec3d& b, const TexelFrame& f) {
+  [[gnu::noinline]] Vec3d worldGradient(const Vec3d& b, const TexelFrame& f) {
     const WorldShadedNormal shaded = shadeInWorld(b, f);
     return objectSpaceGradient(shaded, point, *world);
-  }
-  /// shade() of every sample of @p s, for the shaders whose lane-parallel path is object-space.
-  template <class Shader>
-  static void shadeEachSample(Shader& shader, const SampleBatch& s, double* out) {
-    for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i)
-      shader.shade({s.b0[i], s.b1[i], s.b2[i]}, s.x[i], s.y[i], out + Shader::kChannels * i);
   }
   const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
     return surfacePointAt(tri, b, f, point);
@@ -407,7 +433,6 @@ struct TangentNormalShader : BakeShaderBase {
 
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames).
   void shadeBatch(const SampleBatch& s, double* out) {
-    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -464,7 +489,6 @@ struct ObjectNormalShader : BakeShaderBase {
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames): N̂, or N̂ − Γ
   /// normalized as perturbed() normalizes it, encoded.
   void shadeBatch(const SampleBatch& s, double* out) {
-    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -552,7 +576,6 @@ struct DerivativeShader : BakeShaderBase {
 
   /// shade() of every sample of @p s, lane-parallel (batchGradients).
   void shadeBatch(const SampleBatch& s, double* out) {
-    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -576,7 +599,6 @@ struct SurfaceGradientShader : BakeShaderBase {
 
   /// shade() of every sample of @p s, lane-parallel (batchGradients).
   void shadeBatch(const SampleBatch& s, double* out) {
-    if (world != nullptr) return shadeEachSample(*this, s, out);
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
@@ -603,6 +625,18 @@ struct BitangentShader : BakeShaderBase {
   void shade(const Vec3d& b, int, int, double* out) {
     put(encodeNormal(normalizeOr(texelFrame(tri, b).bitangent, Vec3d{})), out);
   }
+};
+
+/// A bake shader shading sample by sample: without its lane-parallel shadeBatch, which is
+/// object-space (a bake in world space, BakeShaderBase::world, goes through this).
+template <class Inner>
+struct PerSampleShader {
+  static constexpr int kChannels = Inner::kChannels;
+  Inner inner;
+  void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
+    inner.beginTriangle(triangle, corners);
+  }
+  void shade(const Vec3d& b, int x, int y, double* out) { inner.shade(b, x, y, out); }
 };
 
 struct MaskShader {
