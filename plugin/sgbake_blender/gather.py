@@ -56,11 +56,16 @@ def uv_sets(mesh, bake_uv_name, layers):
     return names, names.index(bake_uv_name)
 
 
-def mesh_arrays(mesh, uv_names):
+def mesh_arrays(mesh, uv_names, material_slots=1):
     """The mesh as sgbake_mesh arrays: positions (#V x 3), face_start (#F + 1), corner_vertex
     (#C), corner normals (#C x 3, Blender's split normals: calc_normals_split must have run),
-    one (#C x 2) array per UV map name, face_flat (#F, 1 where the face is flat-shaded) and
-    whether Auto Smooth is on.
+    one (#C x 2) array per UV map name, face_flat (#F, 1 where the face is flat-shaded),
+    whether Auto Smooth is on, and face_material (#F material slot indices).
+
+    face_material is each face's material_index clamped to the object's `material_slots` slots,
+    as Cycles clamps it: a face whose index has no slot is shaded with the last slot's material
+    (with no slot, every face with the default one, index 0). A layer's "material" then applies
+    to the faces Cycles shades with that slot's node tree.
 
     sgbake wants each face's corners contiguous and in face order. Blender's meshes almost
     always store them so; when loop_start says otherwise, the corner arrays are reordered."""
@@ -80,6 +85,9 @@ def mesh_arrays(mesh, uv_names):
     face_flat = (~smooth).astype(np.uint8)
     # Auto Smooth on (custom normals need it): Cycles shades flat faces with their split normals.
     auto_smooth = bool(mesh.use_auto_smooth)
+    material_index = np.empty(nf, np.int64)
+    mesh.polygons.foreach_get("material_index", material_index)
+    face_material = np.clip(material_index, 0, max(material_slots - 1, 0)).astype(np.uint32)
     uvs = []
     for name in uv_names:
         uv = np.empty(nc * 2, np.float32)
@@ -95,7 +103,7 @@ def mesh_arrays(mesh, uv_names):
         normals = normals.reshape(-1, 3)[order].reshape(-1)
         uvs = [uv.reshape(-1, 2)[order].reshape(-1) for uv in uvs]
     return (positions, face_start.astype(np.uint32), corner_vertex, normals, uvs, face_flat,
-            auto_smooth)
+            auto_smooth, face_material)
 
 
 def limit_modifier(ob):

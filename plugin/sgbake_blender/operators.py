@@ -1,4 +1,4 @@
-"""The operators: bake, layers from the active material, and the layer list's buttons.
+"""The operators: bake, layers from the object's materials, and the layer list's buttons.
 
 Bad input (no active mesh, no UV map, a layer without an image, a library that cannot be
 loaded, a scene libsgbake refuses) is reported with self.report({'ERROR'}, message) and the
@@ -62,7 +62,9 @@ class BakeJob:
                 if len(mesh.polygons) == 0:
                     raise gather.BakeInputError(f"object '{ob.name}' has no faces")
                 mesh.calc_normals_split()
-                self.arrays = gather.mesh_arrays(mesh, uv_names)
+                # Each face's material slot: layers made from a slot's material apply to its
+                # faces (Cycles shades each face with its own material's node tree).
+                self.arrays = gather.mesh_arrays(mesh, uv_names, len(ob_eval.material_slots))
                 if modifier is not None:
                     subdivision = scene.limit_subdivision_json(modifier, *gather.creases(mesh))
             finally:
@@ -105,8 +107,8 @@ class BakeJob:
         in self.error."""
         start = time.perf_counter()
         try:
-            positions, face_start, corner_vertex, normals, uvs, face_flat, auto_smooth = \
-                self.arrays
+            (positions, face_start, corner_vertex, normals, uvs, face_flat, auto_smooth,
+             face_material) = self.arrays
             rgba = {}
             for index, tile in enumerate(self.tiles):
                 self.progress.fraction = 0.0
@@ -114,7 +116,8 @@ class BakeJob:
                 rgba[tile] = capi.bake_map(self.lib, self.scenes[tile], positions, face_start,
                                            corner_vertex, normals, uvs, self.images,
                                            threads=self.threads, progress=self.progress,
-                                           face_flat=face_flat, auto_smooth=auto_smooth)
+                                           face_flat=face_flat, auto_smooth=auto_smooth,
+                                           face_material=face_material)
             self.rgba = rgba
         except capi.SgbakeError as exc:
             self.error = exc
@@ -248,8 +251,9 @@ def _tile_list(tiles):
 
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
-    """Add sgbake layers for the Bump and Normal Map nodes of the active material that are fed
-    directly by an Image Texture node"""
+    """Add sgbake layers for the Bump and Normal Map nodes fed by an Image Texture node in the
+    active object's materials (with several material slots, each layer applies to its slot's
+    faces)"""
     bl_idname = "object.sgbake_layers_from_material"
     bl_label = "Layers from Material"
     bl_options = {"REGISTER", "UNDO"}
@@ -259,18 +263,23 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
 
     def execute(self, context):
         ob = context.active_object
-        material = ob.active_material if ob is not None else None
-        if material is None or not material.use_nodes:
-            self.report({"ERROR"}, "the active object has no active node material")
+        sources, skipped = material_sources(ob) if ob is not None else ([], [])
+        if not sources:
+            self.report({"ERROR"}, "the active object has no active node material"
+                        if ob is None or len(ob.material_slots) <= 1 else
+                        f"no material slot of object '{ob.name}' holds a node material"
+                        + _notes(skipped))
             return {"CANCELLED"}
-        render_uv = gather.render_uv_name(ob.data) if ob.data.uv_layers else None
-        found, skipped, ignored = material_layers(material.node_tree, render_uv)
-        if len({slot.material for slot in ob.material_slots if slot.material}) > 1:
-            ignored.append(f"object '{ob.name}' has other materials: the layers bump every "
-                           "face, also those of the other materials")
+        render_uv = (gather.render_uv_name(ob.data)
+                     if ob.type == "MESH" and ob.data.uv_layers else None)
+        found, more_skipped, ignored = object_layers(sources, render_uv)
+        skipped += more_skipped
+        single = sources[0][0] is None  # one material for every face
         if not found:
-            self.report({"ERROR"}, f"material '{material.name}' has no Bump or Normal Map node "
-                                   "fed by an Image Texture node" + _notes(skipped))
+            what = (f"material '{sources[0][1].name}' has no" if single
+                    else f"no material of object '{ob.name}' has a")
+            self.report({"ERROR"}, f"{what} Bump or Normal Map node fed by an Image Texture "
+                                   "node" + _notes(skipped))
             return {"CANCELLED"}
         settings = context.scene.sgbake
         if self.replace:
@@ -280,14 +289,69 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             for key, value in values.items():
                 setattr(layer, key, value)
         settings.active_layer_index = len(settings.layers) - 1
-        added = ", ".join(f"{v['type']} '{v['image'].name}' x {v['scale']:.4g}" for v in found)
+        added = ", ".join(f"{v['type']} '{v['image'].name}' x {v['scale']:.4g}"
+                          + (f" on slot {v['material_index']}" if "material_index" in v else "")
+                          for v in found)
+        origin = f"'{sources[0][1].name}'" if single else f"the materials of '{ob.name}'"
         # What the layers could not take over is a warning: the bake will differ from Cycles'.
         self.report({"WARNING" if ignored else "INFO"},
-                    f"added {len(found)} layer(s) from '{material.name}': {added}"
+                    f"added {len(found)} layer(s) from {origin}: {added}"
                     + _notes(skipped)
                     + (f" (ignored, the layers read their UV maps as they are: "
                        f"{'; '.join(ignored)})" if ignored else ""))
         return {"FINISHED"}
+
+
+def material_sources(ob):
+    """The materials Layers from Material reads on object `ob`, as (slot, material) pairs, and
+    notes on the slots it cannot read.
+
+    Cycles shades each face with the material of its slot, so with several material slots every
+    slot whose material uses nodes is read, with its index (the layers made from it apply to
+    that slot's faces only; the same material in two slots is read twice, once per slot). An
+    empty slot or a material without nodes makes no layer: its faces bake unperturbed, as
+    Cycles shades them without a bump. With one slot or none, the active material alone, with
+    slot None: its layers apply to every face (there are no other faces to spare)."""
+    if len(ob.material_slots) <= 1:
+        material = ob.active_material
+        if material is None or not material.use_nodes:
+            return [], []
+        return [(None, material)], []
+    sources, skipped = [], []
+    for slot, material in enumerate(slot.material for slot in ob.material_slots):
+        if material is None:
+            skipped.append(f"slot {slot}: empty (its faces are not bumped)")
+        elif not material.use_nodes or material.node_tree is None:
+            skipped.append(f"material '{material.name}' (slot {slot}): uses no nodes (its "
+                           "faces are not bumped)")
+        else:
+            sources.append((slot, material))
+    return sources, skipped
+
+
+def object_layers(sources, render_uv=None):
+    """material_layers of every (slot, material) of `sources` (material_sources), in slot
+    order: (layer settings, skipped, ignored). With several slots each layer gets its slot as
+    material_index (libsgbake applies it to that slot's faces only) and each note names its
+    material. A Bump's chain ("base" "above") stays within its own material's layers, as a
+    Bump node's Normal input comes from its own node tree: material_layers orders and chains
+    each tree's layers on their own, and libsgbake stacks a chain on the layers of the face's
+    material only."""
+    found, skipped, ignored = [], [], []
+    for slot, material in sources:
+        values, slot_skipped, slot_ignored = material_layers(material.node_tree, render_uv)
+        if slot is not None:
+            where = f"material '{material.name}' (slot {slot})"
+            for entry in values:
+                entry["material_index"] = slot
+            if not values and not slot_skipped:
+                slot_skipped.append("no Bump or Normal Map node fed by an Image Texture node")
+            slot_skipped = [f"{where}: {note}" for note in slot_skipped]
+            slot_ignored = [f"{where}: {note}" for note in slot_ignored]
+        found += values
+        skipped += slot_skipped
+        ignored += slot_ignored
+    return found, skipped, ignored
 
 
 def _notes(skipped):

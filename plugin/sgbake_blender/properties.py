@@ -71,6 +71,11 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     type: EnumProperty(name="Type", items=scene.LAYER_TYPES, default="height")
     weight: FloatProperty(name="Weight", default=1.0, soft_min=0.0, soft_max=1.0,
                           description="Multiplies the layer's bump; 0 disables it")
+    material_index: IntProperty(
+        name="Material Slot", default=-1, min=-1, max=32766,
+        description="The material slot (counted from 0) whose faces the layer applies to, as a "
+                    "Bump or Normal Map node of that slot's material applies to its faces; "
+                    "-1: every face")
     image: PointerProperty(name="Image", type=bpy.types.Image,
                            description="The layer's image (heights, or encoded normals)")
     scale: FloatProperty(

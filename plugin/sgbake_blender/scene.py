@@ -6,8 +6,8 @@ PropertyGroups of properties.py, or anything with the same attributes).
 The scene parser refuses keys that do not apply (a "green" on an object-space normal map, a
 "phase" on a noise volume, an "image" on a volume), so every key below is sent only for the
 layer types, spaces and maps it applies to (scene.cpp's layerKeys and kMapOutputKeys).
-Every per-layer key of the scene format is covered: the common ones (name, weight, mask with
-its image, uv, tiling, offset and filter), the image ones (image, filter, wrap, tiling,
+Every per-layer key of the scene format is covered: the common ones (name, weight, material,
+mask with its image, uv, tiling, offset and filter), the image ones (image, filter, wrap, tiling,
 offset), uv, scale/strength, space, green, kind, axis, sharpness, min_weight and the volume's
 function, amplitude, frequency, direction, phase, seed, octaves, gradient and step.
 """
@@ -108,8 +108,12 @@ def layer_json(layer, uv_index, default_uv=None):
     """One entry of "layers". uv_index(name) gives the UV set of a UV map name (for height and
     normal layers: the layer's own UV map, else `default_uv`, the render UV map, else the
     scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance, and is
-    sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json)."""
+    sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json).
+    A layer of one material slot (material_index >= 0) sends it as "material": libsgbake then
+    applies it to the faces of that slot only (the mesh's face_material)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
+    if layer.material_index >= 0:  # the faces of one material slot (-1: every face)
+        entry["material"] = int(layer.material_index)
     if layer.type in IMAGE_LAYER_TYPES:
         entry.update(image=image_key(layer.image), filter=layer.filter, wrap=layer.wrap,
                      tiling=_pair(layer.tiling), offset=_pair(layer.offset))

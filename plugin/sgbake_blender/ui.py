@@ -7,7 +7,8 @@ from . import library, scene
 
 
 class SGBAKE_UL_layers(bpy.types.UIList):
-    """One row per layer: name, type, image (or volume function) and weight."""
+    """One row per layer: name, type, image (or volume function), material slot (when it
+    applies to one slot's faces) and weight."""
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         row = layout.row(align=True)
@@ -19,6 +20,8 @@ class SGBAKE_UL_layers(bpy.types.UIList):
                       icon="IMAGE_DATA" if item.image else "ERROR")
         else:
             row.label(text=item.function)
+        if item.material_index >= 0:
+            row.label(text=f"slot {item.material_index}", icon="MATERIAL")
         row.prop(item, "weight", text="", emboss=False)
 
 
@@ -100,6 +103,9 @@ class SGBAKE_PT_layers(bpy.types.Panel):
         col = layout.column()
         col.prop(layer, "type")
         col.prop(layer, "weight")
+        col.prop(layer, "material_index")
+        if layer.material_index >= 0:
+            col.label(text=_slot_text(context.active_object, layer.material_index))
         if layer.type in scene.IMAGE_LAYER_TYPES:
             col.template_ID(layer, "image", open="image.open")
             if layer.type in ("planar", "triplanar"):
@@ -159,6 +165,20 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "mask_tiling", text="Tiling")
             col.prop(layer, "mask_offset", text="Offset")
             col.prop(layer, "mask_filter", text="Filter")
+
+
+def _slot_text(ob, index):
+    """What material slot `index` of the active object `ob` holds, under a layer's Material
+    Slot: the layer bumps the faces of that slot only."""
+    if ob is None or ob.type != "MESH":
+        return f"the faces of material slot {index}"
+    if index >= max(len(ob.material_slots), 1):  # no slot: every face is in slot 0
+        return f"'{ob.name}' has no slot {index}: no face"
+    if len(ob.material_slots) == 0:
+        return f"every face ('{ob.name}' has no material slot)"
+    material = ob.material_slots[index].material
+    return (f"the faces of slot {index} ('{material.name}')" if material
+            else f"the faces of empty slot {index}")
 
 
 CLASSES = (SGBAKE_UL_layers, SGBAKE_PT_bake, SGBAKE_PT_layers)

@@ -52,6 +52,16 @@
    scaled 2x or unevenly sends its matrix_world and the Scale as it is, a zero scale falls back
    to object space with a note naming the object (none for a height map), and a translated
    object bakes as at the origin.
+   Two materials (materials_case): a copy of Suzanne with the bump material in slot 0 and, on
+   its faces of even index, a material chaining a Bump on a tangent-space Normal Map in slot 1
+   (MATERIALS_*). Layers from Material must tag the height layer with slot 0 and the normal
+   layer and the height "above" it with slot 1, the bake send those as "material" and the
+   faces' slots as face_material (clamped to the slots, as Cycles clamps them); a note about
+   one material names it; the same material in a second slot makes its own layers and an
+   empty slot none. It is baked by the add-on, by the add-on's job without the "material" keys
+   (every layer on every face: the negative control) and by Cycles (the bake target active in
+   both materials; tangent and an EMIT mask, 256^2). Back on the one-material Suzanne, the
+   layers must have no slot (-1) and send no "material"; a hand-made layer's slot is -1.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -84,7 +94,9 @@
    Cycles' mask less one texel at island borders, as bake_compare.py): median <=
    WORLD_MEDIAN_DEG (1 deg, Cycles' Bump being a finite difference; measured 0.61 tangent,
    0.23 object), and the negative control at least WORLD_CONTROL_FACTOR (3) times worse
-   (measured medians 3.0 and 33 deg).
+   (measured medians 3.0 and 33 deg). The two-material object likewise: median <=
+   MATERIALS_MEDIAN_DEG (measured 0.22 deg), every layer on every face at least
+   MATERIALS_CONTROL_FACTOR times worse (measured 11 deg).
 
 --sabotage bakes the add-on's tangent-normal cases with green DirectX: the test must FAIL.
 Prints per case the largest difference, where it is, and the texels compared.
@@ -92,7 +104,7 @@ Prints per case the largest difference, where it is, and the texels compared.
 Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not installed or
 the library is built with AddressSanitizer (SGBAKE_SANITIZE: ASan's runtime must come first
 in a process, and Blender does not start with it; CTest: SKIP_RETURN_CODE 77).
-Takes ~9 s (Blender starts twice; twenty CLI bakes; three Cycles bakes at 256^2).
+Takes ~8 s (Blender starts twice; twenty CLI bakes; five Cycles bakes at 256^2).
 """
 
 import argparse
@@ -139,6 +151,18 @@ WORLD_MAPS = {"tangent-normal": "tangent", "object-normal": "object"}  # -> Cycl
 # the control must be WORLD_CONTROL_FACTOR times worse.
 WORLD_MEDIAN_DEG = 1.0
 WORLD_CONTROL_FACTOR = 3.0
+# The object of two materials against Cycles (materials_case): a copy of Suzanne whose faces of
+# even index are in slot 1, whose material chains a Bump (MATERIALS_CHAIN_DISTANCE, the height
+# image) on a tangent-space Normal Map (normal_field leaning up to MATERIALS_TILT_DEG); the
+# others keep slot 0, the bump material. Same bar as the transformed object: Cycles' Bump is a
+# finite difference (the chain alone: 0.40 deg median in BlenderBakeOracle, the normal map
+# alone ~0.005 deg). The negative control, every layer on every face (the add-on before it
+# sent "material"), must be MATERIALS_CONTROL_FACTOR times worse.
+MATERIALS_TILT_DEG = 40.0
+MATERIALS_CHAIN_DISTANCE = 0.05
+MATERIALS_MAP = "tangent-normal"
+MATERIALS_MEDIAN_DEG = 1.0
+MATERIALS_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -963,6 +987,147 @@ def world_case(settings, ob, work, sabotage):
     return entry
 
 
+def materials_case(settings, ob, height, work, sabotage):
+    """An object of two materials (MATERIALS_*): a copy of Suzanne with the bump material in
+    slot 0 and, on its faces of even index, a material chaining a Bump on a Normal Map in slot
+    1. Layers from Material must make a height layer of slot 0 and a normal layer and a height
+    layer "above" it of slot 1, and the bake send them with "material" and the faces' slots as
+    face_material. It is baked (MATERIALS_MAP) by the add-on (addon_materials.npy), by the
+    add-on's job without the "material" keys (addon_materials_control.npy, every layer on every
+    face: the negative control) and by Cycles with the bake target active in both materials
+    (cycles_materials.npy and its EMIT mask cycles_materials_mask.npy). Then the object is
+    removed, the layers are the bump material's again, and a single-slot object must send no
+    "material". Returns the manifest entry: results and checks."""
+    import bpy
+    import numpy as np
+    import bake_scene
+    from sgbake_blender import gather, operators
+    checks = []
+
+    def check(name, ok, expected, message):
+        checks.append({"name": f"materials: {name}", "ok": bool(ok), "expected": expected,
+                       "message": message})
+
+    multi = ob.copy()
+    multi.data = ob.data.copy()
+    multi.name = multi.data.name = "SuzanneMaterials"
+    bpy.context.scene.collection.objects.link(multi)
+    bump_mat = multi.material_slots[0].material
+    side = bake_scene.HEIGHT_SIZE
+    normal = bc.new_float_image("materials_normal", side, side,
+                                bake_scene.normal_field(side, MATERIALS_TILT_DEG))
+    chain_mat, _ = bake_scene.make_normal_material(
+        normal, "TANGENT", 1.0, multi.data.uv_layers.active.name, height_image=height,
+        bump=MATERIALS_CHAIN_DISTANCE)
+    chain_mat.name = "chain"
+    multi.data.materials.append(chain_mat)
+    slots = (np.arange(len(multi.data.polygons)) % 2 == 0).astype(np.int64)
+    multi.data.polygons.foreach_set("material_index", slots)
+    multi.data.update()
+    bpy.context.view_layer.objects.active = multi
+    settings.target_image = None
+    settings.map, settings.surface = MATERIALS_MAP, "mesh"
+    settings.width = settings.height = SIZE
+    settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+    settings.padding = "extend"
+    settings.green = "directx" if sabotage else "opengl"
+
+    # Layers from Material reads both slots; each layer is its slot's, the chain within slot 1.
+    try:
+        made = sorted(bpy.ops.object.sgbake_layers_from_material())
+    except RuntimeError as exc:
+        made = ["ERROR", str(exc).strip()]
+    layers = [(layer.type, layer.material_index, layer.base) for layer in settings.layers]
+    expected = [("height", 0, "surface"), ("normal", 1, "surface"), ("height", 1, "above")]
+    check("Layers from Material tags each layer with its slot", made == ["FINISHED"]
+          and layers == expected, f"FINISHED, (type, slot, base) {expected}",
+          f"{made}, {layers}")
+    job = operators.BakeJob(bpy.context)
+    sent = [layer.get("material") for layer in job.scene["layers"]]
+    face_material = job.arrays[7]
+    check("the bake sends \"material\" and the faces' slots", sent == [0, 1, 1]
+          and face_material.dtype == np.uint32 and np.array_equal(face_material, slots),
+          "material [0, 1, 1], face_material = the polygons' material_index",
+          f"material {sent}, face_material {face_material.dtype} {face_material[:6]}...")
+    # Cycles clamps a face's index to the slots: with one slot every face is slot 0's.
+    clamped = gather.mesh_arrays(multi.data, [multi.data.uv_layers.active.name], 1)[7]
+    check("face_material clamped to the object's slots", not clamped.any(),
+          "all 0 with one slot", f"{np.unique(clamped).tolist()}")
+    # A note about one material names it.
+    tex = next(node for node in chain_mat.node_tree.nodes
+               if node.type == "TEX_IMAGE" and node.image == normal)
+    mapping = chain_mat.node_tree.nodes.new("ShaderNodeMapping")
+    chain_mat.node_tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    _, _, ignored = operators.object_layers(operators.material_sources(multi)[0])
+    chain_mat.node_tree.nodes.remove(mapping)
+    check("a note names its material",
+          any(note.startswith("material 'chain' (slot 1): ") and "Mapping" in note
+              for note in ignored), "a note on 'chain' (slot 1)", str(ignored))
+    # The same material in a second slot makes its own layers; an empty slot none.
+    multi.data.materials.append(bump_mat)
+    multi.data.materials.append(None)
+    sources, skipped = operators.material_sources(multi)
+    found, _, _ = operators.object_layers(sources)
+    multi.data.materials.pop()
+    multi.data.materials.pop()
+    check("the same material in two slots, and an empty slot",
+          [v["material_index"] for v in found] == [0, 1, 1, 2]
+          and any("slot 3: empty" in note for note in skipped),
+          "layers of slots [0, 1, 1, 2], slot 3 noted empty",
+          f"{[v['material_index'] for v in found]}, skipped {skipped}")
+
+    entry = {"map": MATERIALS_MAP, "faces": [int((slots == 0).sum()), int(slots.sum())],
+             "checks": checks}
+    try:
+        entry["result"] = sorted(bpy.ops.object.sgbake_bake())
+    except RuntimeError as exc:
+        entry["result"] = ["ERROR", str(exc).strip()]
+    if entry["result"] == ["FINISHED"]:
+        image = bpy.data.images[f"{multi.name}_{MATERIALS_MAP}"]
+        np.save(os.path.join(work, "addon_materials.npy"), bc.image_array(image))
+        # The negative control: the same job with every layer on every face.
+        for scene_of_tile in job.scenes.values():
+            for layer in scene_of_tile["layers"]:
+                layer.pop("material", None)
+        job.run()
+        if job.error is None:
+            image, _ = job.finish()
+            np.save(os.path.join(work, "addon_materials_control.npy"), bc.image_array(image))
+
+    # Cycles: each face with its material; the target node active in both.
+    scene = bpy.context.scene
+    engine = scene.render.engine
+    bc.setup_cycles(scene)
+    targets = [mat.node_tree.nodes["bake_target"] for mat in (bump_mat, chain_mat)]
+    space = "tangent" if MATERIALS_MAP == "tangent-normal" else "object"
+    for kind, name in ((space, "cycles_materials"), ("mask", "cycles_materials_mask")):
+        image = bc.new_float_image(name, SIZE, SIZE)
+        targets[0].image = image
+        bump_mat.node_tree.nodes.active = targets[0]
+        bake_scene.bake_pass(multi, chain_mat, targets[1], image, kind, 0)
+        np.save(os.path.join(work, f"{name}.npy"), bc.image_array(image))
+        bpy.data.images.remove(image)
+    for target in targets:
+        target.image = None
+    scene.render.engine = engine
+
+    bpy.data.objects.remove(multi)
+    bpy.context.view_layer.objects.active = ob
+    # One slot: the layers apply to every face, as before; no "material" is sent.
+    bpy.ops.object.sgbake_layers_from_material()
+    job = operators.BakeJob(bpy.context)
+    check("one slot: no \"material\"",
+          [layer.material_index for layer in settings.layers] == [-1]
+          and not any("material" in layer for layer in job.scene["layers"]),
+          "material_index -1, no \"material\" key",
+          f"{[layer.material_index for layer in settings.layers]}, {job.scene['layers']}")
+    settings.layers.add()
+    check("a hand-made layer applies to every face", settings.layers[-1].material_index == -1,
+          "material_index -1", str(settings.layers[-1].material_index))
+    settings.layers.remove(len(settings.layers) - 1)
+    return entry
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -983,6 +1148,7 @@ def blender_make(work, library_path, sabotage):
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["limit"] = limit_case(settings, ob, work, manifest["scale"])
     manifest["world"] = world_case(settings, ob, work, sabotage)
+    manifest["materials"] = materials_case(settings, ob, height, work, sabotage)
     manifest["errors"] = (material_checks(settings, ob, distance)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
@@ -1026,6 +1192,7 @@ def blender_compare(work):
         }
     results["extra"] = extra_comparisons(work, manifest)
     results["world"] = world_comparisons(work, manifest)
+    results["materials"] = materials_comparisons(work)
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -1113,6 +1280,22 @@ def world_comparisons(work, manifest):
             ours = bc.decode_normals(np.load(os.path.join(work, files[which])))
             records[kind][which] = bc.angle_stats(bc.angle_deg(ours, cycles)[inner])
     return records
+
+
+def materials_comparisons(work):
+    """The two-material object's bakes (materials_case) against Cycles', as world_comparisons:
+    {"addon": stats, "control": stats}, or {"error": ...} for a missing file."""
+    import numpy as np
+    files = {"addon": "addon_materials.npy", "control": "addon_materials_control.npy",
+             "cycles": "cycles_materials.npy", "mask": "cycles_materials_mask.npy"}
+    missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
+    if missing:
+        return {"error": f"missing {', '.join(missing)}"}
+    inner = bc.erode(np.load(os.path.join(work, files["mask"]))[..., 0] > 0.5, 1)
+    cycles = bc.decode_normals(np.load(os.path.join(work, files["cycles"])))
+    return {which: bc.angle_stats(bc.angle_deg(
+        bc.decode_normals(np.load(os.path.join(work, files[which]))), cycles)[inner])
+        for which in ("addon", "control")}
 
 
 def blender_main(argv):
@@ -1211,9 +1394,10 @@ def evaluate(manifest, results):
                             f"{r['worst_at']}, expected to "
                             f"{'be within' if equal else 'exceed'} {tolerance:g}")
     failures += evaluate_world(manifest["world"], results["world"])
+    failures += evaluate_materials(manifest["materials"], results["materials"])
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
-                  + manifest["errors"]):
+                  + manifest["materials"]["checks"] + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
@@ -1253,6 +1437,37 @@ def evaluate_world(entry, results):
             failures.append(f"world, {kind} negative control: without the transform the median "
                             f"is {control['median_deg']:.3f} deg, not {WORLD_CONTROL_FACTOR:g} "
                             f"x the add-on's {ours['median_deg']:.3f}")
+    return failures
+
+
+def evaluate_materials(entry, r):
+    """Prints the two-material object's angles to Cycles; returns failures: a median over
+    MATERIALS_MEDIAN_DEG, or a negative control (every layer on every face) less than
+    MATERIALS_CONTROL_FACTOR times worse."""
+    failures = []
+    print(f"  Suzanne of two materials ({entry['faces'][0]} faces bumped, {entry['faces'][1]} "
+          f"a Bump on a Normal Map), {entry['map']} vs Cycles:")
+    if entry["result"] != ["FINISHED"]:
+        failures.append(f"materials: the add-on's bake returned {entry['result']}")
+    if "error" in r:
+        print(f"    {r['error']}")
+        return failures + [f"materials: {r['error']}"]
+    ours, control = r["addon"], r["control"]
+    ok = ours["median_deg"] <= MATERIALS_MEDIAN_DEG
+    worse = control["median_deg"] >= MATERIALS_CONTROL_FACTOR * ours["median_deg"]
+    print(f"    median {ours['median_deg']:.3f}, p90 {ours['p90_deg']:.3f}, p99 "
+          f"{ours['p99_deg']:.3f}, max {ours['max_deg']:.1f} deg over {ours['texels']} texels "
+          f"-> {'ok' if ok else 'FAIL'} (median <= {MATERIALS_MEDIAN_DEG}); every layer on "
+          f"every face: median {control['median_deg']:.3f}, p90 {control['p90_deg']:.3f}, "
+          f"p99 {control['p99_deg']:.3f} deg -> {'ok' if worse else 'FAIL'} (must be >= "
+          f"{MATERIALS_CONTROL_FACTOR:g} x)")
+    if not ok:
+        failures.append(f"materials: median {ours['median_deg']:.3f} deg from Cycles (bar "
+                        f"{MATERIALS_MEDIAN_DEG})")
+    if not worse:
+        failures.append(f"materials negative control: with every layer on every face the "
+                        f"median is {control['median_deg']:.3f} deg, not "
+                        f"{MATERIALS_CONTROL_FACTOR:g} x the add-on's {ours['median_deg']:.3f}")
     return failures
 
 
