@@ -1421,22 +1421,31 @@ def evaluate_world(entry, results):
             print(f"    {kind}: {r['error']}")
             failures.append(f"world, {kind}: {r['error']}")
             continue
-        ours, control = r["addon"], r["control"]
-        ok = ours["median_deg"] <= WORLD_MEDIAN_DEG
-        worse = control["median_deg"] >= WORLD_CONTROL_FACTOR * ours["median_deg"]
-        print(f"    {kind:15s} median {ours['median_deg']:.3f}, p90 {ours['p90_deg']:.3f}, p99 "
-              f"{ours['p99_deg']:.3f}, max {ours['max_deg']:.1f} deg over {ours['texels']} "
-              f"texels -> {'ok' if ok else 'FAIL'} (median <= {WORLD_MEDIAN_DEG}); without "
-              f"the transform: median {control['median_deg']:.3f}, p90 {control['p90_deg']:.3f}"
-              f", p99 {control['p99_deg']:.3f} deg -> {'ok' if worse else 'FAIL'} (must be "
-              f">= {WORLD_CONTROL_FACTOR:g} x)")
-        if not ok:
-            failures.append(f"world, {kind}: median {ours['median_deg']:.3f} deg from Cycles "
-                            f"(bar {WORLD_MEDIAN_DEG})")
-        if not worse:
-            failures.append(f"world, {kind} negative control: without the transform the median "
-                            f"is {control['median_deg']:.3f} deg, not {WORLD_CONTROL_FACTOR:g} "
-                            f"x the add-on's {ours['median_deg']:.3f}")
+        failures += judge_against_cycles(f"world, {kind}", f"{kind:15s} ", r["addon"],
+                                         r["control"], "without the transform",
+                                         WORLD_MEDIAN_DEG, WORLD_CONTROL_FACTOR)
+    return failures
+
+
+def judge_against_cycles(name, label, ours, control, control_what, bar, factor):
+    """Prints the add-on's angles to Cycles (`ours`) and its negative control's; returns
+    failures: a median over `bar`, or a control (`control_what`) less than `factor` times
+    worse."""
+    ok = ours["median_deg"] <= bar
+    worse = control["median_deg"] >= factor * ours["median_deg"]
+    print(f"    {label}median {ours['median_deg']:.3f}, p90 {ours['p90_deg']:.3f}, p99 "
+          f"{ours['p99_deg']:.3f}, max {ours['max_deg']:.1f} deg over {ours['texels']} texels "
+          f"-> {'ok' if ok else 'FAIL'} (median <= {bar}); {control_what}: median "
+          f"{control['median_deg']:.3f}, p90 {control['p90_deg']:.3f}, p99 "
+          f"{control['p99_deg']:.3f} deg -> {'ok' if worse else 'FAIL'} (must be >= "
+          f"{factor:g} x)")
+    failures = []
+    if not ok:
+        failures.append(f"{name}: median {ours['median_deg']:.3f} deg from Cycles (bar {bar})")
+    if not worse:
+        failures.append(f"{name} negative control: {control_what} the median is "
+                        f"{control['median_deg']:.3f} deg, not {factor:g} x the add-on's "
+                        f"{ours['median_deg']:.3f}")
     return failures
 
 
@@ -1452,22 +1461,9 @@ def evaluate_materials(entry, r):
     if "error" in r:
         print(f"    {r['error']}")
         return failures + [f"materials: {r['error']}"]
-    ours, control = r["addon"], r["control"]
-    ok = ours["median_deg"] <= MATERIALS_MEDIAN_DEG
-    worse = control["median_deg"] >= MATERIALS_CONTROL_FACTOR * ours["median_deg"]
-    print(f"    median {ours['median_deg']:.3f}, p90 {ours['p90_deg']:.3f}, p99 "
-          f"{ours['p99_deg']:.3f}, max {ours['max_deg']:.1f} deg over {ours['texels']} texels "
-          f"-> {'ok' if ok else 'FAIL'} (median <= {MATERIALS_MEDIAN_DEG}); every layer on "
-          f"every face: median {control['median_deg']:.3f}, p90 {control['p90_deg']:.3f}, "
-          f"p99 {control['p99_deg']:.3f} deg -> {'ok' if worse else 'FAIL'} (must be >= "
-          f"{MATERIALS_CONTROL_FACTOR:g} x)")
-    if not ok:
-        failures.append(f"materials: median {ours['median_deg']:.3f} deg from Cycles (bar "
-                        f"{MATERIALS_MEDIAN_DEG})")
-    if not worse:
-        failures.append(f"materials negative control: with every layer on every face the "
-                        f"median is {control['median_deg']:.3f} deg, not "
-                        f"{MATERIALS_CONTROL_FACTOR:g} x the add-on's {ours['median_deg']:.3f}")
+    failures += judge_against_cycles("materials", "", r["addon"], r["control"],
+                                     "with every layer on every face", MATERIALS_MEDIAN_DEG,
+                                     MATERIALS_CONTROL_FACTOR)
     return failures
 
 
