@@ -123,18 +123,6 @@ void useLayerTangents(const std::array<const CornerTangents*, kMaxUvSets>& layer
   }
 }
 
-/// @p point in world space: the normal carried as a normal, ∂P/∂u and ∂P/∂v as directions.
-SurfacePoint worldCornerPoint(const SurfacePoint& point, const WorldSpace& space) {
-  SurfacePoint world = point;
-  world.position = space.toWorld * point.position + space.translation;
-  world.normal = normalizeOr(space.normalToWorld * point.normal, point.normal);
-  for (std::size_t set = 0; set < static_cast<std::size_t>(point.numUvSets); ++set) {
-    world.uv[set].dPdu = space.toWorld * point.uv[set].dPdu;
-    world.uv[set].dPdv = space.toWorld * point.uv[set].dPdv;
-  }
-  return world;
-}
-
 }  // namespace
 
 SurfacePoint cornerSurfacePoint(const Mesh& mesh, const CornerTangents* tangents, std::size_t face,
@@ -196,7 +184,7 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
               s.uv = point.numUvSets > 0 ? point.uv[0].uv : Vec2d{};
               if (options.world != nullptr) {
                 // A corner has no triangle: its own normal is its Ng, as compositeGradient's.
-                const SurfacePoint world = worldCornerPoint(point, *options.world);
+                const SurfacePoint world = worldSurfacePoint(point, *options.world);
                 s.gradient = objectSpaceGradient(
                     shadeLayersInWorld(shading, point, world, world.normal, *options.world), point,
                     *options.world);

@@ -201,6 +201,17 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
 
 }  // namespace gradient_detail
 
+SurfacePoint worldSurfacePoint(const SurfacePoint& point, const WorldSpace& space) {
+  SurfacePoint world = point;
+  world.position = space.toWorld * point.position + space.translation;
+  world.normal = normalizeOr(space.normalToWorld * point.normal, point.normal);
+  for (std::size_t set = 0; set < static_cast<std::size_t>(point.numUvSets); ++set) {
+    world.uv[set].dPdu = space.toWorld * point.uv[set].dPdu;
+    world.uv[set].dPdv = space.toWorld * point.uv[set].dPdv;
+  }
+  return world;
+}
+
 Vec3d objectSpaceGradient(const WorldShadedNormal& shaded, const SurfacePoint& objectPoint,
                           const WorldSpace& space) {
   const Vec3d gamma =

@@ -47,21 +47,6 @@ Mat3 rotation(double yaw, double pitch) {
   return z * x;
 }
 
-/// @p object as seen through @p space: the normal carried as a normal, ∂P/∂u, ∂P/∂v as
-/// directions (what the baker's world triangle gives at a point of a flat triangle).
-SurfacePoint toWorld(const SurfacePoint& object, const WorldSpace& space) {
-  SurfacePoint world = object;
-  world.position = space.toWorld * object.position;
-  world.normal = normalizeOr(space.normalToWorld * object.normal, object.normal);
-  for (int s = 0; s < object.numUvSets; ++s) {
-    world.uv[static_cast<std::size_t>(s)].dPdu =
-        space.toWorld * object.uv[static_cast<std::size_t>(s)].dPdu;
-    world.uv[static_cast<std::size_t>(s)].dPdv =
-        space.toWorld * object.uv[static_cast<std::size_t>(s)].dPdv;
-  }
-  return world;
-}
-
 WorldSpace spaceOf(const Mat3& m) {
   const Result<WorldSpace> space = WorldSpace::of({m, {0.5, -2, 3}});
   EXPECT_TRUE(space.ok());
@@ -79,7 +64,7 @@ TEST(WorldShading, RampOnAStretchedPlaneFollowsTheWorldSlope) {
   SurfacePoint object;
   object.numUvSets = 1;
   object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
-  const SurfacePoint world = toWorld(object, space);
+  const SurfacePoint world = worldSurfacePoint(object, space);
   const std::vector<Layer> layers{{UvHeightSource{&ramp, 0, 1.0}, 1.0, {}}};
   const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
   EXPECT_LT(maxAbsDiff(objectSpaceGradient(shaded, object, space), Vec3d{2 * a, 0, 0}), 1e-15);
@@ -97,7 +82,7 @@ TEST(WorldShading, ASimilarityIsObjectSpaceWithHeightsDividedByTheScale) {
     const WorldSpace space = spaceOf(rotation(0.7, -0.4) * Mat3::diagonal({s, s, s}));
     for (int i = 0; i < 100; ++i) {
       const SurfacePoint object = samplePoint(rng);
-      const SurfacePoint world = toWorld(object, space);
+      const SurfacePoint world = worldSurfacePoint(object, space);
       const std::vector<Layer> inWorld{{UvHeightSource{&h, 0, 0.2}, 1.0, {}}};
       const std::vector<Layer> inObject{{UvHeightSource{&h, 0, 0.2 / s}, 1.0, {}}};
       const WorldShadedNormal shaded =
@@ -125,7 +110,7 @@ TEST(WorldShading, ANormalMapComesBackUnchangedThroughAnyTransform) {
     m.col[1] += 0.3 * u(rng) * m.col[0];  // a shear as well
     const WorldSpace space = spaceOf(m);
     const SurfacePoint object = samplePoint(rng);
-    const SurfacePoint world = toWorld(object, space);
+    const SurfacePoint world = worldSurfacePoint(object, space);
     const std::vector<Layer> layers{{TangentNormalSource{&map, 0, {}}, 1.0, {}}};
     const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
     EXPECT_LT(maxAbsDiff(normalizeOr(space.normalToObject * shaded.normal, {}),
@@ -144,7 +129,7 @@ TEST(WorldShading, StrengthBlendsTheWorldNormals) {
   SurfacePoint object;
   object.numUvSets = 1;
   object.uv[0] = {{0.1, 0.2}, {0.8, 0.1, 0}, {-0.1, 1.1, 0}};
-  const SurfacePoint world = toWorld(object, space);
+  const SurfacePoint world = worldSurfacePoint(object, space);
   UvHeightSource full{&ramp, 0, 1.0};
   UvHeightSource half = full;
   half.strength = 0.5;

@@ -72,6 +72,11 @@ struct WorldSpace {
   static Result<WorldSpace> of(const ObjectTransform& transform);
 };
 
+/// @brief @p point as the world sees it through @p space: the position moved, the normal carried
+/// as a normal (normalized), ∂P/∂u and ∂P/∂v as directions; UVs and tangent frames kept (what
+/// shadeLayersInWorld's worldPoint needs where there is no triangle, e.g. at a corner).
+SurfacePoint worldSurfacePoint(const SurfacePoint& point, const WorldSpace& space);
+
 /// @brief What shadeLayersInWorld computes at one point.
 struct WorldShadedNormal {
   /// The perturbed world normal after Cycles' guard (unit): what the baker converts back.
