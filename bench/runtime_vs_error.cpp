@@ -190,12 +190,14 @@ std::unique_ptr<ImageScalarTexture> waveTexture(int r, Filter filter) {
 }
 
 void heightFilters(const Settings& settings) {
-  Table table("Height-map filters",
-              "A plane, UV = (x, y), the height map of A·sin(2π·3s)·sin(2π·2t) (A = 0.01; steepest "
-              "slope 21°) sampled at R² texel centres, baked to " +
-                  std::to_string(settings.size) + "² object-space normals, 1 sample per texel. "
-                  "Error: against the exact normal of the continuous height at each texel centre.",
-              "filter, R");
+  Table table(
+      "Height-map filters",
+      "A plane, UV = (x, y), the height map of A·sin(2π·3s)·sin(2π·2t) (A = 0.01; steepest "
+      "slope 21°) sampled at R² texel centres, baked to " +
+          std::to_string(settings.size) +
+          "² object-space normals, 1 sample per texel. "
+          "Error: against the exact normal of the continuous height where each texel is sampled.",
+      "filter, R");
   const Mesh plane = test::gridMesh(test::plane, 4, 4);
   const std::vector<int> resolutions =
       settings.quick ? std::vector<int>{64, 256} : std::vector<int>{32, 64, 128, 256, 512};
@@ -208,7 +210,8 @@ void heightFilters(const Settings& settings) {
         image = bake({&plane, nullptr, layers}, objectNormals(settings));
       });
       const ErrorStats error = compare(image, [&](int x, int y) {
-        return waveNormal((x + 0.5) / settings.size, (y + 0.5) / settings.size);
+        const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, settings.size, settings.size);
+        return waveNormal(uv.x, uv.y);
       });
       table.row(std::string(filterName(filter)) + ", " + std::to_string(r), seconds, error);
     }
@@ -234,7 +237,8 @@ void supersampling(const Settings& settings) {
     Vec3d sum{0, 0, 0};
     for (int j = 0; j < kPoints; ++j) {
       for (int i = 0; i < kPoints; ++i) {
-        sum = sum + waveNormal((x + (i + 0.5) / kPoints) / size, (y + (j + 0.5) / kPoints) / size);
+        const Vec2d uv = bakeSampleUv(x + (i + 0.5) / kPoints, y + (j + 0.5) / kPoints, size, size);
+        sum = sum + waveNormal(uv.x, uv.y);
       }
     }
     return normalizeOr(sum, Vec3d{0, 0, 1});  // the mean encoded colour decodes to this direction
@@ -299,7 +303,8 @@ void subdivision(const Settings& settings) {
   const Mesh coarse = test::torusGridWithUvs(kNu, kNv);
   const int size = settings.size;
   const auto exact = [&](int x, int y) {
-    const double u = (x + 0.5) / size * kNu, v = (y + 0.5) / size * kNv;
+    const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, size, size);
+    const double u = uv.x * kNu, v = uv.y * kNv;
     const int i = std::min(kNu - 1, static_cast<int>(u)), j = std::min(kNv - 1, static_cast<int>(v));
     Vec3d P, Ps, Pt;
     test::torusGridLimit(coarse, kNu, kNv, i, j, u - i, v - j, P, Ps, Pt);

@@ -69,8 +69,7 @@ std::vector<std::uint32_t> texelFaces(std::span<const Vec2f> uvs,
                                       std::span<const std::uint32_t> cornerFace, int width,
                                       int height, int samples, int udimTile, int threads) {
   std::vector<std::uint32_t> face(static_cast<std::size_t>(width) * height, kNoFace);
-  std::vector<double> offsets(static_cast<std::size_t>(samples));
-  for (int i = 0; i < samples; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / samples;
+  const bake_detail::SampleOffsets offsets(samples);
   bake_detail::RasterJob job;
   job.triangles = triangles;
   job.uvs = uvs;
@@ -99,9 +98,9 @@ std::vector<std::uint32_t> texelFaces(std::span<const Vec2f> uvs,
             bake_detail::rowSpan(tri, y, offsets, first, last);
             for (int x = first; x <= last; ++x) {
               bool inside = false;
-              for (std::size_t j = 0; j < offsets.size() && !inside; ++j) {
-                for (std::size_t i = 0; i < offsets.size() && !inside; ++i) {
-                  const double px = x + offsets[i], py = y + offsets[j];
+              for (std::size_t j = 0; j < offsets.y.size() && !inside; ++j) {
+                for (std::size_t i = 0; i < offsets.x.size() && !inside; ++i) {
+                  const double px = x + offsets.x[i], py = y + offsets.y[j];
                   inside = tri.edge[0].inside(tri.edge[0](px, py)) &&
                            tri.edge[1].inside(tri.edge[1](px, py)) &&
                            tri.edge[2].inside(tri.edge[2](px, py));

@@ -1,5 +1,6 @@
-// The texel raster: Blender's looptris, edge functions with the nudge tie rule, row-block bins,
-// and the UDIM tiles a UV set touches. See bake.hpp and raster.hpp for the conventions.
+// The texel raster: Blender's looptris and nudged samples, edge functions with a tie rule,
+// row-block bins, and the UDIM tiles a UV set touches. See bake.hpp and raster.hpp for the
+// conventions.
 #include "bake/raster.hpp"
 
 #include <algorithm>
@@ -16,9 +17,9 @@ namespace sgbake {
 namespace bake_detail {
 namespace {
 
-/// Nudge direction (texels, y up) deciding samples exactly on an edge: Blender's (0.001, 0.002)
-/// texel shift of every sample, taken to the limit; kTieDirection2 breaks the tie of an edge
-/// parallel to it.
+/// Direction (texels, y up) deciding samples exactly on an edge, rare now that samples are
+/// nudged (kBakeSampleNudge): the nudge once more, taken to the limit; kTieDirection2 breaks the
+/// tie of an edge parallel to it.
 constexpr Vec2d kTieDirection{1, 2};
 constexpr Vec2d kTieDirection2{1, 0};
 
@@ -82,16 +83,23 @@ bool setupRasterTriangle(const std::array<Vec2d, 3>& texel, int width, int heigh
   return triangle.x0 <= triangle.x1 && triangle.y0 <= triangle.y1;
 }
 
-void rowSpan(const RasterTriangle& tri, int y, std::span<const double> offsets, int& first,
+SampleOffsets::SampleOffsets(int samples) {
+  for (int i = 0; i < samples; ++i) {
+    x.push_back((i + 0.5) / samples + kBakeSampleNudge.x);
+    y.push_back((i + 0.5) / samples + kBakeSampleNudge.y);
+  }
+}
+
+void rowSpan(const RasterTriangle& tri, int y, const SampleOffsets& offsets, int& first,
              int& last) {
   first = tri.x0;
   last = tri.x1;
-  if (offsets.empty()) return;
+  if (offsets.x.empty()) return;
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-  const double maxPx = tri.x1 + 1.0;
+  const double maxPx = tri.x1 + 2.0;  // beyond every sample of the box (offsets < 1.002)
   // Union over the sample rows of the px interval where every edge may be ≥ 0.
   double unionLo = INFINITY, unionHi = -INFINITY;
-  for (const double offsetY : offsets) {
+  for (const double offsetY : offsets.y) {
     const double py = y + offsetY;
     double lo = -INFINITY, hi = INFINITY;
     bool empty = false;
@@ -118,8 +126,8 @@ void rowSpan(const RasterTriangle& tri, int y, std::span<const double> offsets, 
     return;
   }
   // px = x + offset ∈ [x + offsets.front(), x + offsets.back()] meets [unionLo, unionHi].
-  const double xLo = std::floor(unionLo - offsets.back());
-  const double xHi = std::floor(unionHi - offsets.front()) + 1;
+  const double xLo = std::floor(unionLo - offsets.x.back());
+  const double xHi = std::floor(unionHi - offsets.x.front()) + 1;
   if (xLo > first) first = xLo > last ? last + 1 : static_cast<int>(xLo);
   if (xHi < last) last = xHi < first ? first - 1 : static_cast<int>(xHi);
 }

@@ -76,13 +76,21 @@ struct RasterTriangle {
 bool setupRasterTriangle(const std::array<Vec2d, 3>& texel, int width, int height,
                          RasterTriangle& triangle);
 
+/// @brief Where the samples of a texel sit, as offsets from its lower-left corner: sample
+/// (i, j) of an N × N bake is at (x[i], y[j]), ((i + 0.5)/N, (j + 0.5)/N) + kBakeSampleNudge
+/// (bake.hpp, "Where a texel is sampled").
+struct SampleOffsets {
+  std::vector<double> x, y;
+  explicit SampleOffsets(int samples);
+};
+
 /// @brief The texels [first, last] of row @p y (within the triangle's bounding box) that may
-/// hold a sample inside @p tri, samples being at x + offsets[i], y + offsets[j]: rasterize()
-/// still tests every sample exactly, this only skips texels where no sample can be inside. The
-/// bounds come from solving E(px) = 0 per edge, widened by a texel plus the rounding error of
-/// evaluating E, so no sample the exact test would accept is ever skipped.
-void rowSpan(const RasterTriangle& tri, int y, std::span<const double> offsets, int& first,
-             int& last);
+/// hold a sample inside @p tri, the samples being at x + offsets.x[i], y + offsets.y[j]:
+/// rasterize() still tests every sample exactly, this only skips texels
+/// where no sample can be inside. The bounds come from solving E(px) = 0 per edge, widened by a
+/// texel plus the rounding error of evaluating E, so no sample the exact test would accept is
+/// ever skipped.
+void rowSpan(const RasterTriangle& tri, int y, const SampleOffsets& offsets, int& first, int& last);
 
 /// @brief Texel-space position of UV @p uv in a width × height bake of tile @p udimTile.
 inline Vec2d uvToTexel(Vec2f uv, int udimTile, int width, int height) {
@@ -243,8 +251,7 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
       !output.keepUncovered &&
       std::all_of(output.background.begin(), output.background.begin() + kC,
                   [](float v) { return v == 0 && !std::signbit(v); });
-  std::vector<double> offsets(static_cast<std::size_t>(N));
-  for (int i = 0; i < N; ++i) offsets[static_cast<std::size_t>(i)] = (i + 0.5) / N;
+  const SampleOffsets offsets(N);
   // A row of background texels, copied whole into each row to reset when the shader fills
   // every channel (texel by texel, channel by channel, the reset cost a sixth of the raster).
   std::vector<float> backgroundRow;
@@ -361,9 +368,9 @@ void rasterize(const RasterJob& job, const Shader& prototype, const RasterOutput
         rowSpan(tri, y, offsets, xFirst, xLast);
         for (int x = xFirst; x <= xLast; ++x) {
           for (int j = 0; j < N; ++j) {
-            const double py = y + offsets[static_cast<std::size_t>(j)];
+            const double py = y + offsets.y[static_cast<std::size_t>(j)];
             for (int i = 0; i < N; ++i) {
-              const double px = x + offsets[static_cast<std::size_t>(i)];
+              const double px = x + offsets.x[static_cast<std::size_t>(i)];
               const double e0 = tri.edge[0](px, py);
               if (!tri.edge[0].inside(e0)) continue;
               const double e1 = tri.edge[1](px, py);

@@ -32,7 +32,8 @@ double worstNormalError(const FloatImage& image, const Mesh& coarse, int& covere
       if (image.coverage[static_cast<std::size_t>(row) * image.width + x] != 1.0f) continue;
       ++covered;
       // UVs are (i + s, j + t) / (nu, nv) on face (i, j): linear ("uv_smooth": "none").
-      const double u = (x + 0.5) / image.width * kNu, v = (1 - (row + 0.5) / image.height) * kNv;
+      const Vec2d uv = bakeSampleUv(x + 0.5, image.height - row - 0.5, image.width, image.height);
+      const double u = uv.x * kNu, v = uv.y * kNv;
       const int i = std::min(kNu - 1, static_cast<int>(u)), j = std::min(kNv - 1, static_cast<int>(v));
       Vec3d P, Ps, Pt;
       test::torusGridLimit(coarse, kNu, kNv, i, j, u - i, v - j, P, Ps, Pt);

@@ -78,7 +78,8 @@ TEST(Maps, FlatPlaneWithoutLayersBakesTheFlatNormal) {
     int covered = 0;
     for (int y = 0; y < 32; ++y) {
       for (int x = 0; x < 32; ++x) {
-        const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+        const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, 32, 32);
+        const double u = uv.x, v = uv.y;
         const bool inside = u > 0.1 && u < 0.9 && v > 0.1 && v < 0.9;
         ASSERT_EQ(test::coverageUp(*image, x, y), inside ? 1.0f : 0.0f);
         const Vec3d c = test::pixelUp(*image, x, y);
@@ -151,7 +152,8 @@ TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
         EXPECT_NEAR(dv->at(x, row, 0), scale * a, 1e-6) << at;
         EXPECT_NEAR(dv->at(x, row, 1), scale * b, 1e-6) << at;
         if (samples == 1) {  // the mean of a linear function over the samples is its centre value
-          const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+          const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, 32, 32);
+          const double u = uv.x, v = uv.y;
           EXPECT_NEAR(ht->at(x, row, 0), scale * (a * u + b * v), 1e-6) << at;
         }
       }
@@ -271,7 +273,8 @@ TEST(Maps, ALayerOfOneMaterialBumpsItsFacesOnly) {
   for (int y = 0; y < 32; ++y) {
     for (int x = 0; x < 32; ++x) {
       if (test::coverageUp(*tn, x, y) != 1.0f) continue;
-      const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+      const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, 32, 32);
+      const double u = uv.x, v = uv.y;
       // Texels within half a texel of a quad's edge could belong to either neighbour.
       const double gu = (u - 0.1) / 0.8 * 4, gv = (v - 0.1) / 0.8 * 3;
       if (std::abs(gu - std::round(gu)) < 0.1 || std::abs(gv - std::round(gv)) < 0.1) continue;
@@ -558,7 +561,8 @@ TEST(Maps, HeightStrengthBlendsNormalsAsTheBumpNodeDoes) {
             std::to_string(strength) + " " + std::to_string(x) + "," + std::to_string(y);
         expectNear(test::pixelUp(*on, x, y), encode(expected), kFloatTol, "object-normal " + at);
         expectNear(test::pixelUp(*tn, x, y), encode(expected), kFloatTol, "tangent-normal " + at);
-        const double u = (x + 0.5) / 16, v = (y + 0.5) / 16;
+        const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, 16, 16);
+        const double u = uv.x, v = uv.y;
         EXPECT_NEAR(ht->at(x, 15 - y, 0), scale * (0.6 * u - 0.3 * v), 1e-6) << at;
       }
     }
@@ -600,7 +604,8 @@ TEST(Maps, HeightSumsWeightedMaskedHeightLayers) {
   for (int y = 0; y < 32; ++y) {
     for (int x = 0; x < 32; ++x) {
       if (test::coverageUp(*ht, x, y) != 1.0f) continue;
-      const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+      const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, 32, 32);
+      const double u = uv.x, v = uv.y;
       const Vec3d p{2 * u, 0.5 * v, 0};
       const double volume = 2.0 * 0.1 * std::sin(2 * kPi * 0.75 * p.x + 0.3);
       const double planarH = 0.2 * (0.4 * 2 * p.x - 0.3 * 3 * p.y);
@@ -709,7 +714,8 @@ TEST(Maps, PerTexelFrameMatchesTheClosedForm) {
   double transposeError = 0;
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
-      const Vec3d b = barycentrics(h.uv, (x + 0.5) / size, (y + 0.5) / size);
+      const Vec2d uv = bakeSampleUv(x + 0.5, y + 0.5, size, size);
+      const Vec3d b = barycentrics(h.uv, uv.x, uv.y);
       const bool inside = b.x > 1e-9 && b.y > 1e-9 && b.z > 1e-9;
       const bool outside = b.x < -1e-9 || b.y < -1e-9 || b.z < -1e-9;
       if (!inside && !outside) continue;  // on an edge: either is right
@@ -751,7 +757,8 @@ TEST(Maps, SupersampledNormalsAreTheMeanOfEncodedSamples) {
       bool all = true;
       for (int j = 0; j < 2; ++j)
         for (int i = 0; i < 2; ++i) {
-          const Vec3d b = barycentrics(h.uv, (x + (i + 0.5) / 2) / size, (y + (j + 0.5) / 2) / size);
+          const Vec2d uv = bakeSampleUv(x + (i + 0.5) / 2, y + (j + 0.5) / 2, size, size);
+          const Vec3d b = barycentrics(h.uv, uv.x, uv.y);
           all = all && b.x > 1e-9 && b.y > 1e-9 && b.z > 1e-9;
           sum += encode(normalizeOr(b.x * h.tangent[0] + b.y * h.tangent[1] + b.z * h.tangent[2], Vec3d{}));
         }

@@ -161,6 +161,35 @@ TEST(Raster, EdgeThroughTexelCentresGoesToTheNudgedSide) {
   for (int y = 0; y < 6; ++y) EXPECT_EQ(test::coverageUp(*c, 0, y), y < 2 ? 1.0f : 0.0f) << y;
 }
 
+TEST(Raster, TexelsNextToAnEdgeGoWhereTheNudgedSampleIs) {
+  // Blender samples texel (x, y) at (x + 0.501, y + 0.502) texels, not at its centre: an edge
+  // 0.0005 texel right of column 4's centre gives the column to the right quad, one 0.0015
+  // texel right leaves it to the left quad. Likewise in y with a nudge of 0.002.
+  for (const double offset : {0.0005, 0.0015}) {
+    const float m = static_cast<float>((4.5 + offset) / 8);
+    const Mesh left = test::uvPlaneMesh({{{0, 0}, {m, 0}, {m, 1}, {0, 1}}});
+    const Mesh right = test::uvPlaneMesh({{{m, 0}, {1, 0}, {1, 1}, {m, 1}}});
+    const Result<FloatImage> a = bakeMask(left, 8, 3), b = bakeMask(right, 8, 3);
+    ASSERT_TRUE(a.ok() && b.ok());
+    const int firstRight = offset < kBakeSampleNudge.x ? 4 : 5;
+    for (int x = 0; x < 8; ++x) {
+      EXPECT_EQ(a->coverage[static_cast<std::size_t>(x)], x < firstRight ? 1.0f : 0.0f)
+          << offset << " " << x;
+      EXPECT_EQ(b->coverage[static_cast<std::size_t>(x)], x >= firstRight ? 1.0f : 0.0f)
+          << offset << " " << x;
+    }
+  }
+  for (const double offset : {0.0015, 0.0025}) {
+    const float mv = static_cast<float>((2.5 + offset) / 6);
+    const Mesh low = test::uvPlaneMesh({{{0, 0}, {1, 0}, {1, mv}, {0, mv}}});
+    const Result<FloatImage> c = bakeMask(low, 2, 6);
+    ASSERT_TRUE(c.ok());
+    const int rowsBelow = offset < kBakeSampleNudge.y ? 2 : 3;
+    for (int y = 0; y < 6; ++y)
+      EXPECT_EQ(test::coverageUp(*c, 0, y), y < rowsBelow ? 1.0f : 0.0f) << offset << " " << y;
+  }
+}
+
 TEST(Raster, MirroredAndDegenerateUvTriangles) {
   // Clockwise UVs (a mirrored island) cover like counter-clockwise ones; zero-area UV triangles
   // cover nothing.
@@ -327,8 +356,7 @@ TEST(Raster, RowSpansKeepEverySampleTheExactTestAccepts) {
     bake_detail::RasterTriangle tri;
     if (!bake_detail::setupRasterTriangle(p, 64, 64, tri)) continue;
     for (const int n : {1, 3}) {
-      std::vector<double> offsets;
-      for (int i = 0; i < n; ++i) offsets.push_back((i + 0.5) / n);
+      const bake_detail::SampleOffsets offsets(n);
       for (int y = tri.y0; y <= tri.y1; ++y) {
         int first = 0, last = -1;
         bake_detail::rowSpan(tri, y, offsets, first, last);
@@ -339,8 +367,8 @@ TEST(Raster, RowSpansKeepEverySampleTheExactTestAccepts) {
           boxTexels += static_cast<std::size_t>(tri.x1 - tri.x0 + 1);
         }
         for (int x = tri.x0; x <= tri.x1; ++x) {
-          for (const double oy : offsets) {
-            for (const double ox : offsets) {
+          for (const double oy : offsets.y) {
+            for (const double ox : offsets.x) {
               const double px = x + ox, py = y + oy;
               bool inside = true;
               for (const bake_detail::EdgeFunction& e : tri.edge) inside = inside && e.inside(e(px, py));
