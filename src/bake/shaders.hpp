@@ -17,6 +17,7 @@
 #include "bake/raster.hpp"
 #include "bake/texel_frame.hpp"
 #include "gradient/prepared_uv_frame.hpp"
+#include "gradient/stacking.hpp"
 #include "gradient/world_shading_detail.hpp"
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/filters.hpp"
@@ -181,10 +182,16 @@ struct BakeShaderBase {
   /// identity cofactor). Equal to resolveNormal(N, Γ) up to the sign of zero components, without
   /// its identity matrix products and its fallback normalization (computed for every texel);
   /// then Cycles' validReflectionNormal with the triangle's geometric normal, as Blender bakes.
+  /// Where N̂ faces away from the triangle, what Cycles bakes there (backFacingNormal).
   Vec3d perturbed(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& p = pointAt(b, f);
+    if (gradient_detail::backFacing(p.normal, tri.faceNormal)) return backFacingNormal(p);
     return validReflectionNormal(unitOr(p.normal - gradient(p), p.normal), tri.faceNormal,
                                  p.normal);
+  }
+  /// gradient_detail::backFacingNormal with the triangle's layers and Ng (out of line: rare).
+  [[gnu::noinline]] Vec3d backFacingNormal(const SurfacePoint& p) const {
+    return gradient_detail::backFacingNormal(layers, p, tri.faceNormal);
   }
   static void put(const Vec3d& v, double* out) {
     out[0] = v.x;
@@ -379,7 +386,8 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
 
 /// v = N̂ − Γ of every sample (batchGradients), not normalized; slow[i] also when |v|² is not a
 /// normal positive number (zero, subnormal, overflowing), whose normalization takes a fallback,
-/// and when v fails reflectsAboveSurface (validReflectionNormal turns it: the scalar path).
+/// and when v fails reflectsAboveSurface (validReflectionNormal turns it: the scalar path) or
+/// N̂ faces away from the triangle (backFacing: the scalar path shades it as Cycles does).
 inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
                                      Lanes3& v, LaneFlags& slow) {
   Lanes3 gamma;
@@ -399,7 +407,8 @@ inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& 
     const double vn = vx * ng.x + vy * ng.y + vz * ng.z;
     const double threshold = std::min(0.9 * iz, 0.01);
     const bool above = 2 * vi * vn - iz * len2 >= threshold * len2;
-    slow[i] = slow[i] | !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2) & above);
+    slow[i] = slow[i] | (iz < 0) |
+              !((len2 >= std::numeric_limits<double>::min()) & finiteLane(len2) & above);
   }
 }
 
@@ -412,6 +421,7 @@ struct TangentNormalShader : BakeShaderBase {
   /// fallback is kept.
   Vec3d unnormalizedPerturbed(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& p = pointAt(b, f);
+    if (gradient_detail::backFacing(p.normal, tri.faceNormal)) return backFacingNormal(p);
     const Vec3d v = p.normal - gradient(p);
     const double len2 = lengthSquared(v);
     if (len2 >= std::numeric_limits<double>::min() && std::isfinite(len2) &&

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <variant>
 
 #include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
@@ -206,13 +207,31 @@ double layerMask(const LayerMask& mask, const SurfacePoint& point) {
   return m > 0 ? std::min(m, 1.0) : 0.0;  // NaN → 0
 }
 
-Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point,
-                        const Vec3d& geometricNormal) {
+namespace {
+
+/// stackLayerGradient with the guards seeing @p incoming.
+Vec3d stackLayerGradientSeen(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
+                             const Vec3d& gammaAbove, const Vec3d& incoming) {
+  const double factor = layer.weight * layerMask(layer.mask, point);
+  if (factor == 0) return gammaAbove;  // masked out: the source is not sampled
+  const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+  const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
+  if (!(strength > 0)) return gammaAbove;  // Blender clamps Strength at 0 (and NaN is no bump)
+  const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
+                                                    : layerGradient(layer.source, point));
+  return gradient_detail::stackGradient(gamma, strength, point.normal, ng, gammaAbove, incoming);
+}
+
+/// compositeGradient, its stacked layers' guards seeing the incoming direction N, or −N at a
+/// back-facing point (backFacingNormal).
+Vec3d compositeSeen(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng,
+                    bool back) {
+  const Vec3d incoming = back ? -point.normal : point.normal;
   Vec3d gamma{};
   for (const Layer& layer : layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
     if (layer.base == LayerBase::kLayersAbove) {
-      gamma = stackLayerGradient(layer, point, geometricNormal, gamma);
+      gamma = stackLayerGradientSeen(layer, point, ng, gamma, incoming);
       continue;
     }
     const double factor = layer.weight * layerMask(layer.mask, point);
@@ -222,35 +241,41 @@ Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point
   return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
 }
 
+}  // namespace
+
+Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point,
+                        const Vec3d& geometricNormal) {
+  return compositeSeen(layers, point, geometricNormal, false);
+}
+
 Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point) {
   return compositeGradient(layers, point, point.normal);
 }
 
 Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
                          const Vec3d& geometricNormal, const Vec3d& gammaAbove) {
-  const double factor = layer.weight * layerMask(layer.mask, point);
-  if (factor == 0) return gammaAbove;  // masked out: the source is not sampled
-  const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-  const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
-  if (!(strength > 0)) return gammaAbove;  // Blender clamps Strength at 0 (and NaN is no bump)
-  const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
-                                                    : layerGradient(layer.source, point));
-  return gradient_detail::stackGradient(gamma, strength, point.normal, geometricNormal, gammaAbove);
+  return stackLayerGradientSeen(layer, point, geometricNormal, gammaAbove, point.normal);
 }
 
 namespace gradient_detail {
 
+Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng) {
+  const Vec3d& n = point.normal;
+  const Vec3d gamma = compositeSeen(layers, point, ng, true);
+  return -validReflectionNormal(normalizeOr(n - gamma, n), ng, -n);
+}
+
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
-                    const Vec3d& gammaAbove) {
+                    const Vec3d& gammaAbove, const Vec3d& incoming) {
   if (!isFinite(gamma) || !isFinite(gammaAbove)) return gammaAbove;
   // The normal the layers above hand on, guarded as the node that made it guards it.
-  const Vec3d above = validReflectionNormal(normalizeOr(n - gammaAbove, n), ng, n);
+  const Vec3d above = validReflectionNormal(normalizeOr(n - gammaAbove, n), ng, incoming);
   // The same derivatives along the plane of Ng, perpendicular to that normal.
   const double across = dot(ng, above);
   const Vec3d sigma = std::abs(across) > 0 ? gamma - (dot(gamma, above) / across) * ng : gamma;
   Vec3d bumped = normalizeOr(above - sigma, above);
   if (strength != 1) bumped = normalizeOr(strength * bumped + (1 - strength) * above, above);
-  bumped = validReflectionNormal(bumped, ng, n);
+  bumped = validReflectionNormal(bumped, ng, incoming);
   // The Γ that resolves to it: N − Γ = n₂ / ⟨n₂, N⟩.
   const double height = dot(bumped, n);
   if (!(height > 0)) return gammaAbove;  // only when the guard had nothing to turn to

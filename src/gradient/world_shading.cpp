@@ -174,28 +174,36 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const Vec3d& worldGeometricNormal, const WorldSpace& space,
                                      const PreparedUvFrame* preparedWorldUv) {
   const Vec3d& n = worldPoint.normal;
+  const Vec3d& ng = worldGeometricNormal;
   const WorldLayerEvaluator evaluate(objectPoint, worldPoint, space, preparedWorldUv);
-  Vec3d gamma{};
-  for (const Layer& layer : layers) {
-    if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-    const double factor = layer.weight * layerMask(layer.mask, objectPoint);
-    if (factor == 0) continue;  // masked out: the source is not sampled
-    const WorldGradient g = std::visit(evaluate, layer.source);
-    if (layer.base == LayerBase::kLayersAbove) {
-      if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
-        gamma = gradient_detail::stackGradient(factor * g.gamma, g.strength, n,
-                                               worldGeometricNormal, gamma);
-      continue;
+  // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point.
+  auto composite = [&](bool back) {
+    const Vec3d incoming = back ? -n : n;
+    Vec3d gamma{};
+    for (const Layer& layer : layers) {
+      if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+      const double factor = layer.weight * layerMask(layer.mask, objectPoint);
+      if (factor == 0) continue;  // masked out: the source is not sampled
+      const WorldGradient g = std::visit(evaluate, layer.source);
+      if (layer.base == LayerBase::kLayersAbove) {
+        if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
+          gamma = stackGradient(factor * g.gamma, g.strength, n, ng, gamma, incoming);
+        continue;
+      }
+      gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
     }
-    gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
-  }
-  if (!isFinite(gamma)) gamma = {};  // overflow of absurd weights/scales: unperturbed
+    return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
+  };
 
   WorldShadedNormal result;
-  result.unguarded = normalizeOr(n - gamma, n);
-  result.normal = layers.empty() ? n
-                                 : gradient_detail::validReflectionNormal(result.unguarded,
-                                                                          worldGeometricNormal, n);
+  result.unguarded = normalizeOr(n - composite(false), n);
+  if (layers.empty()) {
+    result.normal = n;
+  } else if (backFacing(n, ng)) {  // backFacingNormal, in world space
+    result.normal = -validReflectionNormal(normalizeOr(n - composite(true), n), ng, -n);
+  } else {
+    result.normal = validReflectionNormal(result.unguarded, ng, n);
+  }
   return result;
 }
 

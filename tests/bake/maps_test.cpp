@@ -122,6 +122,51 @@ TEST(Maps, AFlatNonPlanarQuadShowsEachTrianglesNormal) {
   }
 }
 
+TEST(Maps, BackFacingTexelsBakeWhatCyclesShadesFromBehind) {
+  // A plane z = 0 (Ng = +z) whose corner normals all lean past it, N = (0.8, 0, −0.6): every
+  // texel is back-facing (⟨N, Ng⟩ < 0). Cycles shades it from behind, and the bumped normal it
+  // bakes is the front one, normalize(N − Γ), negated (BlenderBakeOracle sphere_backfacing);
+  // derivative maps keep the front Γ. Without layers the unbumped N is baked as it is.
+  const Vec3d n{0.8, 0, -0.6};
+  Mesh mesh = test::uvPlaneMesh({{{0, 0}, {1, 0}, {1, 1}, {0, 1}}});
+  mesh.cornerNormals.assign(mesh.cornerVertex.size(), cast<float>(n));
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const double a = 0.3, b = -0.2, scale = 0.5;
+  const test::LinearHeight height(a, b);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, scale}, 1.0, {}}};
+  // Γ ⊥ N with ⟨Γ, ∂P/∂u⟩ = ∂h/∂u, ⟨Γ, ∂P/∂v⟩ = ∂h/∂v (∂P/∂u = x̂, ∂P/∂v = ŷ): eq. 31.
+  const Vec3d t{1, 0, 0}, bt{0, 1, 0};
+  const Vec3d gamma =
+      (1 / dot(cross(t, bt), n)) * (scale * a * cross(bt, n) + scale * b * cross(n, t));
+  const Vec3d front = normalizeOr(n - gamma, Vec3d{});
+  // Cycles' guard, with the incoming direction and Ng it sees from behind, leaves it alone here.
+  const Vec3d incoming = -n, ng{0, 0, 1};
+  ASSERT_GE(2 * dot(front, incoming) * dot(front, ng) - dot(incoming, ng),
+            std::min(0.9 * dot(incoming, ng), 0.01));
+
+  const auto on = bake(mesh, &*tangents, layers, MapKind::kObjectNormal, 16);
+  const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal, 16);
+  const auto dv = bake(mesh, &*tangents, layers, MapKind::kDerivative, 16);
+  const auto plain = bake(mesh, &*tangents, {}, MapKind::kObjectNormal, 16);
+  ASSERT_TRUE(on.ok() && tn.ok() && dv.ok() && plain.ok());
+  int covered = 0;
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      if (test::coverageUp(*on, x, y) != 1.0f) continue;
+      ++covered;
+      const std::string at = std::to_string(x) + "," + std::to_string(y);
+      expectNear(test::pixelUp(*on, x, y), encode(-front), kFloatTol, "object-normal " + at);
+      expectNear(test::pixelUp(*plain, x, y), encode(n), kFloatTol, "unbumped " + at);
+      // In the tangent frame (T ⊥ N, N): the reversed normal points into the surface.
+      EXPECT_LT(2 * test::pixelUp(*tn, x, y).z - 1, -0.9) << at;
+      EXPECT_NEAR(dv->at(x, 15 - y, 0), scale * a, 1e-6) << at;
+      EXPECT_NEAR(dv->at(x, 15 - y, 1), scale * b, 1e-6) << at;
+    }
+  }
+  EXPECT_EQ(covered, 256);
+}
+
 TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
   // h = scale·(a·u + b·v) on P = (Lx u, Ly v, 0): Γ = scale·(a/Lx, b/Ly, 0), N' = normalize(−Γ + ẑ),
   // MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself.

@@ -6,7 +6,7 @@
                  nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
                  nmap_cube_s2,nmap_suzanne,chain_sphere,chain_suzanne,stretch_sphere,
                  stretch_cube,stretch_nmap_sphere,stretch_nmap_sphere_object,
-                 stretch_chain_suzanne]
+                 stretch_chain_suzanne,sphere_backfacing,nmap_sphere_backfacing]
         [--sabotage green|scale|input|strength|normal-green]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
@@ -98,6 +98,7 @@ Exit status: 0 pass, 1 fail (or a tool failed), 2 usage error, 77 Blender is not
 """
 
 import json
+import math
 import os
 import sys
 
@@ -110,6 +111,11 @@ import objio  # noqa: E402
 CONVERT_MEDIAN_DEG = 0.05
 CONVERT_P99_DEG = 0.5
 BAKE_MEDIAN_DEG = 1.0
+# Per-case p99 bars on (b), where the median alone cannot see what the case is about.
+# sphere_backfacing: custom normals facing away from their triangles on 27 % of the texels,
+# where Cycles shades from behind (gradient_detail::backFacingNormal): measured p99 5.4 deg,
+# 176 deg shaded from the front.
+BAKE_P99_DEG = {"sphere_backfacing": 10.0}
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
@@ -148,7 +154,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
                  "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne",
                  "chain_sphere", "chain_suzanne", "stretch_sphere", "stretch_cube",
-                 "stretch_nmap_sphere", "stretch_nmap_sphere_object", "stretch_chain_suzanne")
+                 "stretch_nmap_sphere", "stretch_nmap_sphere_object", "stretch_chain_suzanne",
+                 "sphere_backfacing", "nmap_sphere_backfacing")
 
 
 def run_blender_script(blender, script, args):
@@ -327,8 +334,9 @@ def passes_convert(s):
     return s["median_deg"] <= CONVERT_MEDIAN_DEG and s["p99_deg"] <= CONVERT_P99_DEG
 
 
-def passes_bake(s):
-    return s["median_deg"] <= BAKE_MEDIAN_DEG
+def passes_bake(s, case=None):
+    return (s["median_deg"] <= BAKE_MEDIAN_DEG
+            and s["p99_deg"] <= BAKE_P99_DEG.get(case, math.inf))
 
 
 def passes_nmap(s, chain=False, stretched=False):
@@ -442,22 +450,23 @@ def evaluate(name, r):
                          f"({fmt(s['flipped_green'])})")
     if not missing("bake", "bake"):
         s = r["bake"]
-        ok = passes_bake(s)
+        ok = passes_bake(s, name)
+        p99_bar = f", p99 <= {BAKE_P99_DEG[name]}" if name in BAKE_P99_DEG else ""
         print(f"  (b) bake vs Blender tangent:    {fmt(s)} worst at (x, row) {s.get('worst_at')}"
-              f" -> {'ok' if ok else 'FAIL'} (median <= {BAKE_MEDIAN_DEG})")
+              f" -> {'ok' if ok else 'FAIL'} (median <= {BAKE_MEDIAN_DEG}{p99_bar})")
         if not ok:
             fails.append(f"{name}: bake differs from Blender's tangent bake: {fmt(s)}")
         if s["outside_max_abs"] > BACKGROUND_ABS:
             fails.append(f"{name}: bake background is not (0.5, 0.5, 1) outside the islands "
                          f"(max |diff| {s['outside_max_abs']:.3g})")
         print(f"      control, green flipped:     {fmt(s['flipped_green'])}")
-        if passes_bake(s["flipped_green"]):
+        if passes_bake(s["flipped_green"], name):
             fails.append(f"{name}: negative control: bake with green flipped still passes")
     if not missing("bake_json", "JSON-scene bake"):
         s = r["bake_json"]
         same = s.get("json_vs_flags_max_abs")
         print(f"  (b) JSON scene bake:            {fmt(s)}; max |JSON - flags| = {same}")
-        if not passes_bake(s):
+        if not passes_bake(s, name):
             fails.append(f"{name}: JSON-scene bake differs from Blender's: {fmt(s)}")
         if same is None or same > SAME_IMAGE_ABS:
             fails.append(f"{name}: the JSON scene and the flags give different images "

@@ -221,6 +221,36 @@ def build_cylinder_twist():
     return ob
 
 
+@case("sphere_backfacing", 256, 0.1)
+def build_sphere_backfacing():
+    """The UV sphere of case sphere with custom normals leaning north by up to
+    BACKFACING_LEAN_DEG, the lean a function of longitude (sin^2 2*lon): in two bands its
+    interpolated normals face away from their triangles (N . Ng < 0), where Cycles shades the
+    point from behind (gradient_detail::backFacingNormal)."""
+    from mathutils import Vector
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=1.0, calc_uvs=True)
+    ob = bpy.context.object
+    bake_common.set_smooth(ob, True)
+    me = ob.data
+    me.use_auto_smooth = True
+    me.auto_smooth_angle = math.pi
+    normals = []
+    for v in me.vertices:
+        p = v.co.normalized()
+        north = Vector((-p.x * p.z, -p.y * p.z, 1.0 - p.z * p.z))
+        if north.length < 1e-6:  # a pole: no north, keep the sphere's normal
+            normals.append(p)
+            continue
+        north.normalize()
+        lean = math.radians(BACKFACING_LEAN_DEG) * math.sin(2 * math.atan2(p.y, p.x)) ** 2
+        normals.append(math.cos(lean) * p + math.sin(lean) * north)
+    me.normals_split_custom_set_from_vertices(normals)
+    return ob
+
+
+BACKFACING_LEAN_DEG = 110.0
+
+
 @case("cube_flat", 512, 0.25)
 def build_cube_flat():
     """Default cube (size 2) with its cross-shaped UV layout, FLAT shading: the per-texel frame
@@ -244,6 +274,7 @@ normal_map_case("nmap_cube_s2", "cube_flat", 256, "TANGENT", 2.0, 40.0)
 # Suzanne's quads (UVs no parallelograms): Cycles' Normal Map node decodes in MikkTSpace of its
 # triangulated mesh, which the polygon mesh's frames miss by a median 0.32 deg here.
 normal_map_case("nmap_suzanne", "suzanne", 256, "TANGENT", 1.0, 40.0)
+normal_map_case("nmap_sphere_backfacing", "sphere_backfacing", 256, "TANGENT", 1.0, 40.0)
 # A Bump node on the normal map's output (its Normal input linked): sgbake's "base": "above".
 normal_map_case("chain_sphere", "sphere", 512, "TANGENT", 1.0, 40.0, bump=0.1)
 normal_map_case("chain_suzanne", "suzanne", 512, "TANGENT", 1.0, 40.0, bump=0.1)
