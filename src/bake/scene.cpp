@@ -590,20 +590,10 @@ ObjectTransform parseTransform(const json& value) {
       if (!std::isfinite(m[r][c])) fail("", where + " is not finite");
     }
   }
-  if (m[3][0] != 0 || m[3][1] != 0 || m[3][2] != 0 || m[3][3] != 1) {
-    fail("",
-         "'transform' row 3 must be [0, 0, 0, 1] (an affine transform), not " + value[3].dump());
-  }
-  ObjectTransform transform;
-  transform.linear = Mat3::fromColumns({m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
-                                       {m[0][2], m[1][2], m[2][2]});
-  transform.translation = {m[0][3], m[1][3], m[2][3]};
-  if (!WorldSpace::of(transform)) {
-    fail("",
-         "'transform' is singular (its 3 x 3 part has determinant 0): no normal can be "
-         "carried through it");
-  }
-  return transform;
+  const Result<ObjectTransform> transform =
+      objectTransformFromRows({&m[0][0], 16}, static_cast<int>(n) == 3 ? 3 : 4, 4);
+  if (!transform) fail("", "'transform' " + transform.error().message);
+  return *transform;
 }
 
 SceneSubdivision parseSubdivision(const json& value) {

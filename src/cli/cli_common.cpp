@@ -326,20 +326,11 @@ Result<std::optional<ObjectTransform>> parseTransformOption(const std::string& c
     return Error::badInput(where + "expected 16, 12 or 9 numbers (matrix_world row by row), not " +
                            std::to_string(n));
   }
-  const std::size_t columns = n == 9 ? 3 : 4;
-  const auto at = [&](std::size_t r, std::size_t c) { return numbers[r * columns + c]; };
-  if (n == 16 && (at(3, 0) != 0 || at(3, 1) != 0 || at(3, 2) != 0 || at(3, 3) != 1)) {
-    return Error::badInput(where + "the last row must be 0 0 0 1 (an affine transform)");
-  }
-  ObjectTransform transform;
-  transform.linear =
-      Mat3::fromColumns({at(0, 0), at(1, 0), at(2, 0)}, {at(0, 1), at(1, 1), at(2, 1)},
-                        {at(0, 2), at(1, 2), at(2, 2)});
-  if (columns == 4) transform.translation = {at(0, 3), at(1, 3), at(2, 3)};
-  if (Result<WorldSpace> space = WorldSpace::of(transform); !space) {
-    return Error::badInput(where + space.error().message);
-  }
-  return std::optional<ObjectTransform>{transform};
+  const int columns = n == 9 ? 3 : 4;
+  Result<ObjectTransform> transform =
+      objectTransformFromRows(numbers, static_cast<int>(n) / columns, columns);
+  if (!transform) return Error::badInput(where + "the matrix " + transform.error().message);
+  return std::optional<ObjectTransform>{*transform};
 }
 
 Status checkSubdivisionOptions(const std::string& command, const SubdivisionOptions& options,

@@ -1,6 +1,7 @@
 #include "sgbake/gradient/world_shading.hpp"
 
 #include <cmath>
+#include <sstream>
 #include <type_traits>
 #include <variant>
 
@@ -104,6 +105,32 @@ bool ObjectTransform::shadesAsObjectSpace() const {
     for (int r = 0; r < 3; ++r)
       if (linear(r, c) != identity(r, c)) return false;
   return true;
+}
+
+Result<ObjectTransform> objectTransformFromRows(std::span<const double> rowMajor, int rows,
+                                                int columns) {
+  const auto at = [&](int r, int c) {
+    return rowMajor[static_cast<std::size_t>(r) * static_cast<std::size_t>(columns) +
+                    static_cast<std::size_t>(c)];
+  };
+  if (rows == 4 && (at(3, 0) != 0 || at(3, 1) != 0 || at(3, 2) != 0 || at(3, 3) != 1)) {
+    std::ostringstream row;
+    row << "[" << at(3, 0) << ", " << at(3, 1) << ", " << at(3, 2) << ", " << at(3, 3) << "]";
+    return Error::badInput("row 3 must be [0, 0, 0, 1] (an affine transform), not " + row.str());
+  }
+  ObjectTransform transform;
+  transform.linear =
+      Mat3::fromColumns({at(0, 0), at(1, 0), at(2, 0)}, {at(0, 1), at(1, 1), at(2, 1)},
+                        {at(0, 2), at(1, 2), at(2, 2)});
+  if (columns == 4) transform.translation = {at(0, 3), at(1, 3), at(2, 3)};
+  if (determinant(transform.linear) == 0) {
+    return Error::badInput(
+        "is singular (its 3 x 3 part has determinant 0): no normal can be carried through it");
+  }
+  if (!WorldSpace::of(transform)) {
+    return Error::badInput("is too close to singular: its normals overflow");
+  }
+  return transform;
 }
 
 std::optional<double> ObjectTransform::uniformScale(double tolerance) const {

@@ -342,7 +342,7 @@ TEST(Scene, TransformIsBlendersMatrixWorld) {
             "scene.json: transform[1][1] must be a number, not a string");
   EXPECT_EQ(parseError(withTransform("[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]")),
             "scene.json: 'transform' row 3 must be [0, 0, 0, 1] (an affine transform), not "
-            "[0,0,1,1]");
+            "[0, 0, 1, 1]");
   EXPECT_EQ(parseError(withTransform("[[1, 0, 0], [0, 0, 0], [0, 0, 1]]")),
             "scene.json: 'transform' is singular (its 3 x 3 part has determinant 0): no normal "
             "can be carried through it");

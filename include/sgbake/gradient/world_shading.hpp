@@ -55,6 +55,14 @@ struct ObjectTransform {
   std::optional<double> uniformScale(double tolerance = 1e-6) const;
 };
 
+/// @brief The ObjectTransform of a matrix_world given row by row (Blender's Object.matrix_world):
+/// @p rowMajor holds @p rows rows of @p columns finite numbers, 4 × 4, 3 × 4 (without the last
+/// row) or 3 × 3 (the linear part alone). Bad input, with a message to follow the name of what
+/// was read: a 4 × 4 whose last row is not 0 0 0 1 ("row 3 must be [0, 0, 0, 1] (an affine
+/// transform), not [...]"), or a singular linear part ("is singular (...)").
+Result<ObjectTransform> objectTransformFromRows(std::span<const double> rowMajor, int rows,
+                                                int columns);
+
 /// @brief @p layer with its height (UV height maps, volumes, height projections) multiplied by
 /// @p factor; normal maps unchanged.
 Layer withHeightsScaled(Layer layer, double factor);
