@@ -141,6 +141,31 @@ TEST(WorldShading, StrengthBlendsTheWorldNormals) {
   EXPECT_LT(maxAbsDiff(blended, normalizeOr(0.5 * bumped + 0.5 * n, {})), 1e-15);
 }
 
+// Where the world normal points behind the world triangle, Cycles shades from behind and bakes
+// the front normal reversed (gradient_detail::backFacingNormal); in front, and for the Γ the
+// derivative maps read, nothing changes. The ramp of the stretched plane, with N leaning past
+// the plane: a small slope, so that no guard acts, either side.
+TEST(WorldShading, BackFacingPointsBakeTheFrontNormalReversed) {
+  RampTexture ramp(0.05);
+  const WorldSpace space = spaceOf(Mat3::diagonal({2, 1, 0.5}));
+  const std::vector<Layer> layers{{UvHeightSource{&ramp, 0, 1.0}, 1.0, {}}};
+  const Vec3d ng = normalizeOr(space.normalToWorld * Vec3d{0, 0, 1}, {});
+  for (const double lean : {0.3, 2.0}) {  // radians from Ng: in front, then behind
+    SurfacePoint object;
+    object.normal = Vec3d{std::sin(lean), 0, std::cos(lean)};
+    object.numUvSets = 1;
+    object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
+    const SurfacePoint world = worldSurfacePoint(object, space);
+    const bool back = dot(world.normal, ng) < 0;
+    EXPECT_EQ(back, lean > 1.6) << lean;
+    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, ng, space);
+    const Vec3d expected = back ? -shaded.unguarded : shaded.unguarded;
+    EXPECT_LT(maxAbsDiff(shaded.normal, expected), 1e-15) << lean;
+    // The unguarded normal is the front one either way: N − Γ with the world ramp's Γ ⊥ N.
+    EXPECT_GT(dot(shaded.unguarded, world.normal), 0.99) << lean;
+  }
+}
+
 TEST(WorldShading, SingularOrNonFiniteTransformsAreRejected) {
   EXPECT_FALSE(WorldSpace::of({Mat3::diagonal({1, 0, 1}), {}}).ok());
   EXPECT_FALSE(WorldSpace::of({Mat3::diagonal({1, NAN, 1}), {}}).ok());
