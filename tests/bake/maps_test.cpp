@@ -40,6 +40,21 @@ Mesh scaledPlane(double lx, double ly) {
       4, 3, [](double s, double t) { return Vec2d{0.1 + 0.8 * s, 0.1 + 0.8 * t}; });
 }
 
+/// Calls check(x, y, at) for every fully covered texel of @p image (x right, y up; `at` names
+/// it for messages); returns how many there were.
+template <class Check>
+int forEachCoveredTexel(const FloatImage& image, const Check& check) {
+  int covered = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (test::coverageUp(image, x, y) != 1.0f) continue;
+      ++covered;
+      check(x, y, std::to_string(x) + "," + std::to_string(y));
+    }
+  }
+  return covered;
+}
+
 Result<FloatImage> bake(const Mesh& mesh, const CornerTangents* tangents, std::span<const Layer> layers,
                         MapKind kind, int size = 32, int samples = 1) {
   BakeSettings s;
@@ -150,20 +165,14 @@ TEST(Maps, BackFacingTexelsBakeWhatCyclesShadesFromBehind) {
   const auto dv = bake(mesh, &*tangents, layers, MapKind::kDerivative, 16);
   const auto plain = bake(mesh, &*tangents, {}, MapKind::kObjectNormal, 16);
   ASSERT_TRUE(on.ok() && tn.ok() && dv.ok() && plain.ok());
-  int covered = 0;
-  for (int y = 0; y < 16; ++y) {
-    for (int x = 0; x < 16; ++x) {
-      if (test::coverageUp(*on, x, y) != 1.0f) continue;
-      ++covered;
-      const std::string at = std::to_string(x) + "," + std::to_string(y);
-      expectNear(test::pixelUp(*on, x, y), encode(-front), kFloatTol, "object-normal " + at);
-      expectNear(test::pixelUp(*plain, x, y), encode(n), kFloatTol, "unbumped " + at);
-      // In the tangent frame (T ⊥ N, N): the reversed normal points into the surface.
-      EXPECT_LT(2 * test::pixelUp(*tn, x, y).z - 1, -0.9) << at;
-      EXPECT_NEAR(dv->at(x, 15 - y, 0), scale * a, 1e-6) << at;
-      EXPECT_NEAR(dv->at(x, 15 - y, 1), scale * b, 1e-6) << at;
-    }
-  }
+  const int covered = forEachCoveredTexel(*on, [&](int x, int y, const std::string& at) {
+    expectNear(test::pixelUp(*on, x, y), encode(-front), kFloatTol, "object-normal " + at);
+    expectNear(test::pixelUp(*plain, x, y), encode(n), kFloatTol, "unbumped " + at);
+    // In the tangent frame (T ⊥ N, N): the reversed normal points into the surface.
+    EXPECT_LT(2 * test::pixelUp(*tn, x, y).z - 1, -0.9) << at;
+    EXPECT_NEAR(dv->at(x, 15 - y, 0), scale * a, 1e-6) << at;
+    EXPECT_NEAR(dv->at(x, 15 - y, 1), scale * b, 1e-6) << at;
+  });
   EXPECT_EQ(covered, 256);
 }
 
@@ -352,18 +361,12 @@ TEST(Maps, SteepBumpsAreBentToCyclesValidReflection) {
   const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal, 16, 1);
   const auto sg = bake(mesh, &*tangents, layers, MapKind::kSurfaceGradient, 16, 1);
   ASSERT_TRUE(on.ok() && tn.ok() && sg.ok());
-  int covered = 0;
-  for (int y = 0; y < 16; ++y) {
-    for (int x = 0; x < 16; ++x) {
-      if (test::coverageUp(*on, x, y) != 1.0f) continue;
-      ++covered;
-      const std::string at = std::to_string(x) + "," + std::to_string(y);
-      expectNear(test::pixelUp(*on, x, y), encode(bent), kFloatTol, "object-normal " + at);
-      expectNear(test::pixelUp(*tn, x, y), encode(bent), kFloatTol, "tangent-normal " + at);
-      expectNear(test::pixelUp(*sg, x, y), Vec3d{0.6 * slope, 0.8 * slope, 0}, 1e-6,
-                 "surface gradient " + at);
-    }
-  }
+  const int covered = forEachCoveredTexel(*on, [&](int x, int y, const std::string& at) {
+    expectNear(test::pixelUp(*on, x, y), encode(bent), kFloatTol, "object-normal " + at);
+    expectNear(test::pixelUp(*tn, x, y), encode(bent), kFloatTol, "tangent-normal " + at);
+    expectNear(test::pixelUp(*sg, x, y), Vec3d{0.6 * slope, 0.8 * slope, 0}, 1e-6,
+               "surface gradient " + at);
+  });
   EXPECT_GT(covered, 100);
 }
 
