@@ -411,6 +411,100 @@ std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::p
   return {};
 }
 
+/// The file of tile @p tile of @p output (a corners table is one file).
+fs::path tileFile(const SceneOutput& output, int tile) {
+  return output.kind == OutputKind::kCorners
+             ? output.file
+             : fs::path(expandUdimToken(output.file.string(), tile));
+}
+
+/// Whether every layer @p layers (scene indices) that reads a UDIM image or mask reads, at a
+/// texel of tile t of @p output, the image's tile t only: one sampled on the output's UV set
+/// (UDIM images are on UV layers, untiled and unshifted: validateScene; a UDIM texture samples
+/// the tile its coordinates lie in, and a texel's sample lies inside its tile).
+bool readsUdimTileByTile(const Scene& s, const std::vector<std::size_t>& layers,
+                         const SceneOutput& output) {
+  for (const std::size_t l : layers) {
+    const SceneLayer& layer = s.layers[l];
+    if (layer.hasImage() && hasUdimToken(layer.image.string()) && layer.uvSet != output.uvSet)
+      return false;
+    if (layer.mask && hasUdimToken(layer.mask->image.string()) &&
+        layer.mask->uvSet != output.uvSet) {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The tiles of a UDIM output to bake again and those to keep.
+struct TilesToKeep {
+  std::set<int> rebaked;  ///< their inputs or their files changed
+  std::vector<int> kept;
+  std::vector<std::pair<std::string, std::string>> keptFiles;  ///< manifest name → hash
+};
+
+/// For a UDIM output that must be baked (whyBake) because some of its tiles changed only: which
+/// tiles those are, and the tiles whose files stay (their UDIM image tiles and their files are
+/// as the manifest @p entry recorded them, and every layer reads tile by tile). Nothing when
+/// the whole output must be baked: its parameters, mesh or a plain image changed, a tile file
+/// of an input is gone (which tile is not known here), its "range" is "auto" (one range for
+/// every tile), or the tile number is in a directory name.
+std::optional<TilesToKeep> udimTilesToKeep(const json* entry, const PlannedOutput& planned,
+                                           const Scene& s, const SceneOutput& output) {
+  if (entry == nullptr || !entry->is_object() || output.kind != OutputKind::kMap ||
+      !hasUdimToken(output.file.filename().string()) ||
+      (output.rangeAuto && output.storesSignedRange()) ||
+      !readsUdimTileByTile(s, planned.layers, output)) {
+    return {};
+  }
+  const auto parameters = entry->find("parameters");
+  const auto inputs = entry->find("inputs");
+  const auto files = entry->find("files");
+  if (parameters == entry->end() || parameters->dump() != planned.parameters ||
+      inputs == entry->end() || !inputs->is_object() || files == entry->end() ||
+      !files->is_object()) {
+    return {};
+  }
+  const auto reached = entry->find("udim_reached");
+  std::set<int> reachedTiles;
+  if (reached != entry->end()) reachedTiles = reached->get<std::set<int>>();
+  TilesToKeep result;
+  std::set<std::string> compared;
+  for (const auto& [path, hash] : planned.inputHashes) {
+    const auto tile = planned.udimTileInputs.find(path);
+    if (reached != entry->end() && tile != planned.udimTileInputs.end() &&
+        !reachedTiles.contains(tile->second)) {
+      continue;  // as whyBake: a tile no UV reaches changes no texel
+    }
+    compared.insert(path);
+    const auto recorded = inputs->find(path);
+    if (recorded != inputs->end() && *recorded == hash) continue;
+    if (tile == planned.udimTileInputs.end()) return {};  // the mesh or a plain image
+    result.rebaked.insert(tile->second);
+  }
+  for (const auto& [path, hash] : inputs->items()) {
+    if (!compared.contains(path)) return {};
+  }
+  std::map<std::string, int> tileOfName;
+  for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
+    tileOfName.emplace(manifestText(tileFile(output, tile).filename().string()), tile);
+  }
+  for (const auto& [name, hash] : files->items()) {
+    const auto tile = tileOfName.find(name);
+    if (tile == tileOfName.end() || !hash.is_string()) return {};
+    if (result.rebaked.contains(tile->second)) continue;
+    const Result<std::string> now = hashFile(directoryOf(output.file) / fileNameBytes(name));
+    if (!now || *now != hash.get<std::string>()) {
+      result.rebaked.insert(tile->second);
+      continue;
+    }
+    result.kept.push_back(tile->second);
+    result.keptFiles.emplace_back(name, hash.get<std::string>());
+  }
+  if (result.rebaked.empty() || result.kept.empty()) return {};
+  return result;
+}
+
 // ---- Planning ----------------------------------------------------------------------------------
 
 /// Checks that an input file exists and is a regular file.
@@ -701,8 +795,9 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
              std::to_string(output.width) + "x" + std::to_string(output.height) + ", " +
              std::to_string(output.samples) + "x" + std::to_string(output.samples) +
              " samples per texel, UV set " + std::to_string(output.uvSet) + ", " +
-             (udim ? "every UDIM tile the UV set touches"
-                   : "UDIM tile " + std::to_string(output.tile)),
+             (!udim                       ? "UDIM tile " + std::to_string(output.tile)
+              : planned.keptTiles.empty() ? "every UDIM tile the UV set touches"
+                                          : "the UDIM tiles the UV set touches but those kept"),
          "because " + planned.whyBake + "; " + reads + memory});
     if (padding.mode == PaddingMode::kPushPull) {  // (masks are never padded: outputPadding)
       plan.steps.push_back({"pad " + output.file.string() + " by push-pull",
@@ -968,6 +1063,17 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
       const json* entry = manifests.entry(output.file);  // read with --force too, for warnings
       planned.whyBake = options.force ? "of --force" : whyBake(entry, planned, output.file);
       planned.upToDate = planned.whyBake.empty();
+      if (!planned.upToDate && !options.force) {
+        if (std::optional<TilesToKeep> keep = udimTilesToKeep(entry, planned, s, output)) {
+          std::vector<std::string> rebaked, kept;
+          for (const int tile : keep->rebaked) rebaked.push_back(std::to_string(tile));
+          for (const int tile : keep->kept) kept.push_back(std::to_string(tile));
+          planned.whyBake = "tile(s) " + joinLabels(rebaked) + " changed (" + planned.whyBake +
+                            "); tile(s) " + joinLabels(kept) + " are kept as they are";
+          planned.keptTiles = std::move(keep->kept);
+          planned.keptFiles = std::move(keep->keptFiles);
+        }
+      }
     } else {
       planned.whyBake =
           s.inMemory ? "it is baked in memory" : "the manifest is off (--no-manifest)";
@@ -1240,13 +1346,6 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
   return Ok{};
 }
 
-/// The file of tile @p tile of @p output (a corners table is one file).
-fs::path tileFile(const SceneOutput& output, int tile) {
-  return output.kind == OutputKind::kCorners
-             ? output.file
-             : fs::path(expandUdimToken(output.file.string(), tile));
-}
-
 /// Creates the directory of @p file when it is missing.
 Status ensureDirectory(const fs::path& file) {
   const fs::path dir = file.parent_path();
@@ -1267,7 +1366,9 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   const Scene& s = plan.scene;
   ExecuteReport report;
   for (const PlannedOutput& output : plan.outputs) {
-    report.outputs.push_back({s.outputs[output.sceneOutput].file, false, {}});
+    OutputReport entry;
+    entry.file = s.outputs[output.sceneOutput].file;
+    report.outputs.push_back(std::move(entry));
   }
   if (plan.outputsToBake() == 0) return report;
 
@@ -1427,6 +1528,13 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
                                     " of an earlier bake are left as they were (no triangle of " +
                                     uvSet + " lies there now)");
         }
+        // Tiles whose inputs and files are unchanged (PlannedOutput::keptTiles) stay.
+        std::erase_if(tiles[o], [&](int tile) {
+          const bool kept = std::find(planned.keptTiles.begin(), planned.keptTiles.end(), tile) !=
+                            planned.keptTiles.end();
+          if (kept) report.outputs[o].kept.push_back(tileFile(output, tile));
+          return kept;
+        });
       } else {
         tiles[o] = {output.tile};
         if (std::find(touched.begin(), touched.end(), output.tile) == touched.end()) {
@@ -1468,6 +1576,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     const std::vector<Layer> layers = plan_detail::outputLayers(planned, loaded);
     OutputReport& outputReport = report.outputs[o];
     json files = json::object();
+    for (const auto& [name, hash] : planned.keptFiles) files[name] = hash;
     // A "range": "auto" output is stored with one range for all its tiles, found first.
     SceneOutput stored = output;
     if (output.rangeAuto && output.storesSignedRange()) {

@@ -421,6 +421,9 @@ Status printOutcome(const ExecuteReport& report) {
     for (const std::filesystem::path& file : output.files) {
       text += "wrote " + file.string() + range + "\n";
     }
+    for (const std::filesystem::path& file : output.kept) {
+      text += "up to date: " + file.string() + "\n";
+    }
   }
   return writeStandardOutput(text);
 }

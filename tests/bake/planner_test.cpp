@@ -789,6 +789,66 @@ TEST_F(PlannerTest, UdimHeightImagesAreReadTileByTile) {
             (dir_ / "h_1002.png").string() + " is gone");
 }
 
+TEST_F(PlannerTest, UdimOutputsBakeAgainOnlyTheTilesThatChanged) {
+  // One square in tile 1001, one in 1002, a UDIM height image of both tiles and a UDIM output.
+  writeFile(dir_ / "two_tiles.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 3 1 0\nv 2 1 0\n"
+            "vt 0.25 0.25\nvt 0.75 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
+            "vt 1.25 0.25\nvt 1.75 0.25\nvt 1.75 0.75\nvt 1.25 0.75\n"
+            "f 1/1 2/2 3/3 4/4\nf 5/5 6/6 7/7 8/8\n");
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1001.png");
+  fs::copy_file(dir_ / "h.png", dir_ / "h_1002.png");
+  const auto scene = [&](const std::string& layerExtra) {
+    return planeScene(
+        R"({"type": "height", "image": "h_<UDIM>.png", "scale": 0.1)" + layerExtra + "}",
+        R"({"map": "object-normal", "file": "n_<UDIM>.exr", "size": 16})", "two_tiles.obj");
+  };
+  const ExecuteReport first = bake(scene(""));
+  ASSERT_EQ(first.outputs[0].files.size(), 2u);
+  const auto written1001 = fs::last_write_time(dir_ / "n_1001.exr");
+  const std::string bytes1001 = readFile(dir_ / "n_1001.exr");
+  const std::string bytes1002 = readFile(dir_ / "n_1002.exr");
+
+  // Tile 1002 of the image changes: tile 1002 of the output is baked again, 1001 stays.
+  FloatImage steeper = heightImage(16);
+  for (float& v : steeper.pixels) v *= 1.5f;
+  ASSERT_TRUE(writeImage(steeper, dir_ / "h_1002.png"));
+  const Plan changed = plan(scene(""));
+  ASSERT_EQ(changed.outputsToBake(), 1u);
+  EXPECT_EQ(changed.outputs[0].keptTiles, std::vector<int>{1001});
+  EXPECT_EQ(changed.outputs[0].whyBake, "tile(s) 1002 changed (" +
+                                            fs::canonical(dir_ / "h_1002.png").string() +
+                                            " changed); tile(s) 1001 are kept as they are");
+  const ExecuteReport second = bake(scene(""));
+  EXPECT_EQ(second.outputs[0].files, std::vector<fs::path>{dir_ / "n_1002.exr"});
+  EXPECT_EQ(second.outputs[0].kept, std::vector<fs::path>{dir_ / "n_1001.exr"});
+  EXPECT_EQ(second.tilesBaked, 1u);
+  EXPECT_EQ(fs::last_write_time(dir_ / "n_1001.exr"), written1001);
+  EXPECT_EQ(readFile(dir_ / "n_1001.exr"), bytes1001);
+  EXPECT_NE(readFile(dir_ / "n_1002.exr"), bytes1002) << "the new height bumps tile 1002";
+  // The manifest keeps both tiles: nothing to do now, and the same files as a full bake.
+  EXPECT_EQ(plan(scene("")).outputsToBake(), 0u);
+  const std::string partial1002 = readFile(dir_ / "n_1002.exr");
+  PlanOptions force;
+  force.force = true;
+  bake(scene(""), force);
+  EXPECT_EQ(readFile(dir_ / "n_1001.exr"), bytes1001);
+  EXPECT_EQ(readFile(dir_ / "n_1002.exr"), partial1002);
+
+  // A tile file edited by hand is baked again, alone.
+  writeFile(dir_ / "n_1001.exr", "not an image");
+  EXPECT_EQ(plan(scene("")).outputs[0].keptTiles, std::vector<int>{1002});
+  bake(scene(""));
+  EXPECT_EQ(readFile(dir_ / "n_1001.exr"), bytes1001);
+
+  // The mesh changes (or the parameters, or a plain image): every tile is baked again.
+  writeFile(dir_ / "two_tiles.obj", readFile(dir_ / "two_tiles.obj") + "# edited\n");
+  const Plan edited = plan(scene(""));
+  EXPECT_EQ(edited.outputsToBake(), 1u);
+  EXPECT_TRUE(edited.outputs[0].keptTiles.empty());
+  EXPECT_EQ(bake(scene("")).outputs[0].files.size(), 2u);
+}
+
 TEST_F(PlannerTest, UdimNormalMapsAreFlatWhereNoTileIs) {
   // A square tilted 36.87° about x (normal (0, −0.6, 0.8)), its UVs in tile 1002; the normal
   // maps have only tile 1001, which holds +Z: unread, so both spaces leave the normal as it is.

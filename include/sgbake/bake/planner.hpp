@@ -113,6 +113,13 @@ struct PlannedOutput {
   /// records, and compares, only the tiles the mesh's UVs reach ("udim_reached"), so that a
   /// tile no UV reaches can be added, changed or removed without a re-bake.
   std::map<std::string, int> udimTileInputs;
+  /// A UDIM output of which only some tiles changed (their UDIM image tiles, or their files
+  /// since they were baked): the tiles baked before whose files stay as they are. Only when
+  /// every layer reads the output's tile of its UDIM images (the same UV set, untiled,
+  /// unshifted); empty: every tile the UV set touches is baked.
+  std::vector<int> keptTiles;
+  /// The manifest's records (file name → hash) of the kept tiles' files, carried over.
+  std::vector<std::pair<std::string, std::string>> keptFiles;
 };
 
 /// @brief One line of the plan: what is done and why.
@@ -183,6 +190,8 @@ struct OutputReport {
   std::filesystem::path file;                ///< the scene's file name (may contain `<UDIM>`)
   bool baked = false;                        ///< false: up to date, not touched
   std::vector<std::filesystem::path> files;  ///< files written (one per UDIM tile)
+  /// UDIM tile files left as they were, their inputs unchanged (PlannedOutput::keptTiles)
+  std::vector<std::filesystem::path> kept;
   /// The range a `"range": "auto"` output was stored with (0: none was chosen)
   double autoRange = 0;
 };
