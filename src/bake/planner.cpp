@@ -1440,7 +1440,18 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     reached = plan_detail::reachedUdimTiles(
         loaded.mesh, [&](int uvSet) -> const std::vector<int>& { return uvSetTiles(uvSet).tiles; },
         cornerTable);
-    load = plan_detail::imagesToLoad(plan, reached);
+    // A tile every output to bake keeps (PlannedOutput::keptTiles) is not read: its image
+    // tiles are not loaded.
+    std::vector<bool> read = reached;
+    for (std::size_t tile = 0; tile < read.size(); ++tile) {
+      read[tile] =
+          read[tile] &&
+          std::any_of(plan.outputs.begin(), plan.outputs.end(), [&](const PlannedOutput& o) {
+            return !o.upToDate && std::find(o.keptTiles.begin(), o.keptTiles.end(),
+                                            static_cast<int>(tile)) == o.keptTiles.end();
+          });
+    }
+    load = plan_detail::imagesToLoad(plan, read);
     // A tile the UVs reach without a file is read as no bump (documented), but is more often a
     // file forgotten or misnamed: said once per UDIM image and UV set.
     std::set<std::pair<std::size_t, int>> told;

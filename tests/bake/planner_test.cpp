@@ -823,6 +823,7 @@ TEST_F(PlannerTest, UdimOutputsBakeAgainOnlyTheTilesThatChanged) {
   EXPECT_EQ(second.outputs[0].files, std::vector<fs::path>{dir_ / "n_1002.exr"});
   EXPECT_EQ(second.outputs[0].kept, std::vector<fs::path>{dir_ / "n_1001.exr"});
   EXPECT_EQ(second.tilesBaked, 1u);
+  EXPECT_EQ(second.imagesLoaded, 1u) << "h_1001.png is not read";
   EXPECT_EQ(fs::last_write_time(dir_ / "n_1001.exr"), written1001);
   EXPECT_EQ(readFile(dir_ / "n_1001.exr"), bytes1001);
   EXPECT_NE(readFile(dir_ / "n_1002.exr"), bytes1002) << "the new height bumps tile 1002";
