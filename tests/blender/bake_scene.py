@@ -293,6 +293,12 @@ transformed_case("stretch_nmap_sphere_object", "nmap_sphere_object", (0.5, -1.0,
 transformed_case("stretch_chain_suzanne", "chain_suzanne", (0.0, 0.0, 0.0), (0.0, 0.0, 0.3),
                  (0.6, 1.5, 1.0))
 transformed_case("stretch_cube", "cube_flat", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (3.0, 1.0, 0.4))
+# Back-facing texels of a stretched object: whether N faces away from Ng is decided in world
+# space, where the scale changes both.
+transformed_case("stretch_sphere_backfacing", "sphere_backfacing", (0.5, -1.0, 2.0),
+                 (0.4, 0.2, 0.7), (2.0, 1.0, 0.5), size=512)
+transformed_case("stretch_nmap_sphere_backfacing", "nmap_sphere_backfacing", (0.5, -1.0, 2.0),
+                 (0.4, 0.2, 0.7), (2.0, 1.0, 0.5))
 
 
 def tilt_field(size, tilt_deg):
