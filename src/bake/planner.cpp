@@ -1138,7 +1138,15 @@ std::string explainPlan(const Plan& plan) {
       "plan for " +
       (scene.source.empty() ? std::string("the command line") : scene.source.string()) + ": " +
       std::to_string(plan.outputsToBake()) + " of " + std::to_string(scene.outputs.size()) +
-      " output" + (scene.outputs.size() == 1 ? "" : "s") + " to bake\n";
+      " output" + (scene.outputs.size() == 1 ? "" : "s") + " to bake";
+  // Images are loaded once however many layers read them (and UDIM tiles the UVs do not
+  // reach not at all, once the mesh is read).
+  std::size_t uses = 0;
+  for (const PlannedImage& image : plan.images) uses += image.users.size();
+  text += ", " + std::to_string(plan.images.size()) + " image" +
+          (plan.images.size() == 1 ? "" : "s") + " to load";
+  if (uses > plan.images.size()) text += " for " + std::to_string(uses) + " layer inputs";
+  text += "\n";
   if (plan.steps.empty())
     text += "steps: none\n";
   else

@@ -267,7 +267,9 @@ TEST_F(PlannerTest, ExplainListsStepsAndSkippedWork) {
          {"map": "mask", "file": "m.png", "size": 64})"));
   const std::string text = explainPlan(p);
   EXPECT_TRUE(text.starts_with("plan for ")) << text;
-  EXPECT_NE(text.find("2 of 2 outputs to bake"), std::string::npos) << text;
+  EXPECT_NE(text.find("2 of 2 outputs to bake, 1 image to load for 2 layer inputs\n"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("1. load mesh "), std::string::npos) << text;
   EXPECT_NE(text.find("load image "), std::string::npos) << text;
   EXPECT_NE(text.find("compute MikkTSpace tangent frames (the tangent-normal map "),
