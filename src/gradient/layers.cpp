@@ -260,9 +260,7 @@ Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
 namespace gradient_detail {
 
 Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng) {
-  const Vec3d& n = point.normal;
-  const Vec3d gamma = compositeSeen(layers, point, ng, true);
-  return -validReflectionNormal(normalizeOr(n - gamma, n), ng, -n);
+  return backFacingGuarded(point.normal, compositeSeen(layers, point, ng, true), ng);
 }
 
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,

@@ -7,6 +7,7 @@
 
 #include <span>
 
+#include "gradient/valid_reflection.hpp"
 #include "sgbake/core/vec.hpp"
 #include "sgbake/gradient/layers.hpp"
 
@@ -21,10 +22,16 @@ Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const V
                     const Vec3d& gammaAbove, const Vec3d& incoming);
 
 /// @brief Whether Cycles shades @p n as back-facing: a unit shading normal that points behind
-/// its triangle's unit geometric normal @p ng (smooth normals of a strongly curved or folded
-/// mesh; Suzanne: 0.45 % of texels). Cycles' bake looks at the surface along −N, finds I = N on
-/// the triangle's back and flips N and Ng before any node runs.
+/// its triangle's unit geometric normal @p ng (custom normals, smooth normals of a folded mesh,
+/// or a stretched object's, in world space). Cycles' bake looks at the surface along −N, finds
+/// I = N on the triangle's back and flips N and Ng before any node runs.
 inline bool backFacing(const Vec3d& n, const Vec3d& ng) { return dot(n, ng) < 0; }
+
+/// @brief backFacingNormal from the layers' Γ @p gamma summed with the stacked layers' guards
+/// seeing −n: normalize(n − Γ), guarded from behind, negated.
+inline Vec3d backFacingGuarded(const Vec3d& n, const Vec3d& gamma, const Vec3d& ng) {
+  return -validReflectionNormal(normalizeOr(n - gamma, n), ng, -n);
+}
 
 /// @brief The normal Cycles bakes at a back-facing point (backFacing(point.normal, ng)), unit.
 /// Cycles shades it from behind: N, Ng and ∂P/∂u, ∂P/∂v flipped, I = N, and the baked normal

@@ -227,7 +227,7 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
   if (layers.empty()) {
     result.normal = n;
   } else if (backFacing(n, ng)) {  // backFacingNormal, in world space
-    result.normal = -validReflectionNormal(normalizeOr(n - composite(true), n), ng, -n);
+    result.normal = backFacingGuarded(n, composite(true), ng);
   } else {
     result.normal = validReflectionNormal(result.unguarded, ng, n);
   }
