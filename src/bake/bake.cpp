@@ -279,6 +279,14 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   // Layers of one material: each triangle takes its face's.
   const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(base.layers);
   base.layersByMaterial = byMaterial;
+  // The maps of Cycles' normals are shaded on the triangles Cycles reads the texels on.
+  std::vector<std::array<std::uint32_t, 3>> shadingCorners;
+  if ((settings.map == MapKind::kTangentNormal || settings.map == MapKind::kObjectNormal) &&
+      input.limit == nullptr) {
+    shadingCorners = cyclesShadingTriangles(*input.mesh, job.triangles);
+    base.shadingCorners = shadingCorners;
+    base.loopTriangles = job.triangles;
+  }
 
   static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
   static constexpr float kZero[3] = {0, 0, 0};

@@ -187,6 +187,33 @@ TriangleBins binTriangles(const RasterJob& job) {
   return bins;
 }
 
+std::vector<std::array<std::uint32_t, 3>> cyclesShadingTriangles(
+    const Mesh& mesh, std::span<const std::array<std::uint32_t, 3>> triangles) {
+  std::vector<std::array<std::uint32_t, 3>> shading;
+  std::size_t t = 0;  // the first loop triangle of face f (faces are cut in order)
+  for (std::size_t f = 0; f < mesh.numFaces(); t += mesh.faceSize(f) - 2, ++f) {
+    if (mesh.faceSize(f) != 4 || t + 1 >= triangles.size()) continue;
+    const std::uint32_t first = mesh.faceStart[f];
+    const bool bakerFlips = triangles[t][2] == first + 3;  // loopTriangles' 1–3 diagonal
+    // Blender's is_quad_flip_v3_first_third_fast_with_normal with the quad's normal
+    // (normal_quad_v3, the cross product of its diagonals), in float as Blender computes it.
+    const Vec3f v1 = mesh.positions[mesh.cornerVertex[first]];
+    const Vec3f v2 = mesh.positions[mesh.cornerVertex[first + 1]];
+    const Vec3f v3 = mesh.positions[mesh.cornerVertex[first + 2]];
+    const Vec3f v4 = mesh.positions[mesh.cornerVertex[first + 3]];
+    const Vec3f tangent = cross(v3 - v1, cross(v1 - v3, v2 - v4));
+    const float d = dot(v1, tangent);
+    const bool cyclesFlips = dot(v4, tangent) >= d || dot(v2, tangent) <= d;
+    if (bakerFlips == cyclesFlips) continue;
+    if (shading.empty()) shading.assign(triangles.begin(), triangles.end());
+    shading[t] = cyclesFlips ? std::array<std::uint32_t, 3>{first, first + 1, first + 3}
+                             : std::array<std::uint32_t, 3>{first, first + 1, first + 2};
+    shading[t + 1] = cyclesFlips ? std::array<std::uint32_t, 3>{first + 1, first + 2, first + 3}
+                                 : std::array<std::uint32_t, 3>{first, first + 2, first + 3};
+  }
+  return shading;
+}
+
 }  // namespace bake_detail
 
 std::vector<std::array<std::uint32_t, 3>> loopTriangles(const Mesh& mesh) {

@@ -92,6 +92,19 @@ struct SampleOffsets {
 /// ever skipped.
 void rowSpan(const RasterTriangle& tri, int y, const SampleOffsets& offsets, int& first, int& last);
 
+/// @brief The corners Cycles shades each loop triangle of @p triangles (loopTriangles(mesh))
+/// with; empty when those are the triangles' own everywhere.
+///
+/// Blender's baker splits a quad by its fast test (the one loopTriangles reproduces), and
+/// Cycles its own copy of the mesh by the test that uses the polygon normal; on a near-tie
+/// (Suzanne's concave quads 162 and 163) they choose different diagonals, and the baker hands
+/// Cycles its triangle k with barycentrics that Cycles reads on its own triangle k of the
+/// other split: a texel there shows the other triangle's normal and point (measured: all 48
+/// texels of flat Suzanne's two quads, 28–115° off before). The texel's frame stays the
+/// baker's.
+std::vector<std::array<std::uint32_t, 3>> cyclesShadingTriangles(
+    const Mesh& mesh, std::span<const std::array<std::uint32_t, 3>> triangles);
+
 /// @brief Texel-space position of UV @p uv in a width × height bake of tile @p udimTile.
 inline Vec2d uvToTexel(Vec2f uv, int udimTile, int width, int height) {
   const int index = udimTile - kFirstUdimTile;

@@ -59,39 +59,89 @@ struct BakeShaderBase {
     SurfacePoint point;   ///< constant fields set per triangle, the rest per sample
     std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};  ///< of `tri`
   };
-  /// Made on first use, one per copy of the shader (a copy starts without one): kept off the
-  /// shader itself, which every row block copies onto its stack (2 KB more there made the
+  /// A T made on first use, one per copy of the shader (a copy starts without one): kept off
+  /// the shader itself, which every row block copies onto its stack (2 KB more there made the
   /// lane-parallel paths 10 % slower).
-  class WorldScratchHolder {
+  template <class T>
+  class LazyScratch {
    public:
-    WorldScratchHolder() = default;
-    WorldScratchHolder(const WorldScratchHolder&) {}
-    WorldScratchHolder& operator=(const WorldScratchHolder&) { return *this; }
-    WorldScratch& get() {
-      if (!scratch_) scratch_ = std::make_unique<WorldScratch>();
+    LazyScratch() = default;
+    LazyScratch(const LazyScratch&) {}
+    LazyScratch& operator=(const LazyScratch&) { return *this; }
+    T& get() {
+      if (!scratch_) scratch_ = std::make_unique<T>();
       return *scratch_;
     }
 
    private:
-    std::unique_ptr<WorldScratch> scratch_;
+    std::unique_ptr<T> scratch_;
   };
-  WorldScratchHolder worldScratch;
+  LazyScratch<WorldScratch> worldScratch;
+
+  /// Non-empty (maps of Cycles' normals): the corners Cycles shades each loop triangle with
+  /// (cyclesShadingTriangles), and the loop triangles; the texel's frame stays its own
+  /// triangle's.
+  std::span<const std::array<std::uint32_t, 3>> shadingCorners, loopTriangles;
+  /// The current triangle is shaded with other corners (`tri`) than its own (ownTriangle).
+  bool shadedElsewhere = false;
+  LazyScratch<ShadingTriangle> ownTriangle;
 
   void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
     if (!layersByMaterial.empty()) selectLayersOfFace(corners[0]);
-    loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+    shadedElsewhere = !shadingCorners.empty() && shadingCorners[triangle] != corners;
+    if (shadedElsewhere) [[unlikely]] {
+      beginShadingElsewhere(triangle, corners);
+    } else {
+      loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
+      for (std::size_t s = 0; s < kMaxUvSets; ++s) {
+        const CornerTangents* frames = triangleTangents[s];
+        tri.hasLayerTangents[s] = frames != nullptr;
+        if (frames == nullptr) continue;
+        for (std::size_t i = 0; i < 3; ++i) {
+          const std::size_t k = 3 * static_cast<std::size_t>(triangle) + i;
+          tri.layerTangent[s][i] = cast<double>(frames->tangent[k]);
+          tri.layerSign[s][i] = frames->sign[k];
+        }
+      }
+    }
+    triangleChanged();
+  }
+  /// beginTriangle's `tri` from the corners Cycles shades (shadingCorners), and ownTriangle
+  /// from the triangle's own. A tangent-space layer's frame at a corner is the one the loop
+  /// triangles of the quad (this one and its neighbour) give it (Cycles' MikkTSpace on its own
+  /// split is not reproduced).
+  [[gnu::noinline]] void beginShadingElsewhere(std::uint32_t triangle,
+                                               const std::array<std::uint32_t, 3>& corners) {
+    const std::array<std::uint32_t, 3>& shading = shadingCorners[triangle];
+    loadShadingTriangle(*mesh, tangents, corners, uvSet, ownTriangle.get());
+    loadShadingTriangle(*mesh, tangents, shading, uvSet, tri);
+    // Where corner c sits among the loop triangles of the quad: 3·t + i.
+    const auto frameIndex = [&](std::uint32_t c) {
+      for (const std::size_t t :
+           {std::size_t{triangle}, std::size_t{triangle} + 1, std::size_t{triangle} - 1}) {
+        if (t >= loopTriangles.size()) continue;
+        for (std::size_t i = 0; i < 3; ++i)
+          if (loopTriangles[t][i] == c) return 3 * t + i;
+      }
+      return 3 * std::size_t{triangle};  // (every corner of the quad is in one of them)
+    };
     for (std::size_t s = 0; s < kMaxUvSets; ++s) {
       const CornerTangents* frames = triangleTangents[s];
       tri.hasLayerTangents[s] = frames != nullptr;
       if (frames == nullptr) continue;
       for (std::size_t i = 0; i < 3; ++i) {
-        const std::size_t k = 3 * static_cast<std::size_t>(triangle) + i;
+        const std::size_t k = frameIndex(shading[i]);
         tri.layerTangent[s][i] = cast<double>(frames->tangent[k]);
         tri.layerSign[s][i] = frames->sign[k];
       }
     }
-    triangleChanged();
   }
+  /// The frame Blender's baker expresses the texel's normal in: its own triangle's at @p b,
+  /// which is @p f unless Cycles shades the texel elsewhere.
+  TexelFrame outputFrame(const Vec3d& b, const TexelFrame& f) {
+    return shadedElsewhere ? ownFrame(b) : f;
+  }
+  [[gnu::noinline]] TexelFrame ownFrame(const Vec3d& b) { return texelFrame(ownTriangle.get(), b); }
   /// Updates what is derived from `tri` (after beginTriangle, or after LimitShader rewrote it).
   void triangleChanged() {
     beginSurfacePoint(tri, point);
@@ -440,7 +490,7 @@ struct TangentNormalShader : BakeShaderBase {
     const Vec3d normal = world != nullptr ? world->normalToObject * shadeInWorld(b, f).normal
                          : layers.empty() ? unitNormal(tri, f)
                                           : unnormalizedPerturbed(b, f);
-    Vec3d n = objectToTangent(f, normal);
+    Vec3d n = objectToTangent(outputFrame(b, f), normal);
     if (green == NormalMapGreen::kDirectX) n.y = -n.y;
     put(encodeNormal(n), out);
   }
@@ -450,6 +500,8 @@ struct TangentNormalShader : BakeShaderBase {
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
+    if (shadedElsewhere) [[unlikely]]
+      f.slow.fill(1);  // shade() takes the own frame
 
     // The normal to express in tangent space: N̂, or N̂ − Γ (unnormalizedPerturbed).
     Lanes3 perturbedDirections;

@@ -50,6 +50,69 @@ TEST(LoopTriangles, QuadReflexAtCorner1Or3FlipsToDiagonal13) {
             (std::vector<Tri>{{0, 1, 3}, {1, 2, 3}}));
 }
 
+// Suzanne's concave quad 162 (its positions and UVs, the UVs stretched to fill the image): the
+// baker's fast test flips it to the 1–3 diagonal, Cycles' test with the polygon normal keeps
+// 0–2, and Cycles shades the baker's triangle k on its own triangle k (measured on flat
+// Suzanne: all 48 texels of quads 162 and 163 show the 0–2 triangles' normals).
+TEST(LoopTriangles, CyclesShadesANearTieQuadOnItsOtherSplit) {
+  const std::vector<Vec3f> p{{0.1015625f, -0.7421875f, -0.1484375f},
+                             {0.125f, -0.75f, -0.2265625f},
+                             {0.1640625f, -0.7109375f, -0.2421875f},
+                             {0.125f, -0.8125f, -0.1015625f}};
+  const std::vector<Vec2f> suzanneUv{{0.544281006f, 0.193366006f},
+                                     {0.548362017f, 0.173559994f},
+                                     {0.561572015f, 0.167778999f},
+                                     {0.55311799f, 0.209599003f}};
+  std::vector<Vec2f> uv;
+  for (const Vec2f t : suzanneUv) uv.push_back({(t.x - 0.54f) / 0.025f, (t.y - 0.16f) / 0.055f});
+  Mesh mesh = test::polygonMesh(p, {{0, 1, 2, 3}}, uv);
+  mesh.faceFlat = {1};
+  const std::vector<Tri> baker = loopTriangles(mesh);
+  ASSERT_EQ(baker, (std::vector<Tri>{{0, 1, 3}, {1, 2, 3}}));
+  const std::vector<Tri> cycles{{0, 1, 2}, {0, 2, 3}};
+  EXPECT_EQ(bake_detail::cyclesShadingTriangles(mesh, baker), cycles);
+  // A quad both tests flip, and one neither flips: shaded on the baker's own triangles.
+  const Mesh concave = quadMesh({{0, 0, 0}, {0.3f, 0.6f, 0}, {1, 1, 0}, {0, 1, 0}});
+  EXPECT_TRUE(bake_detail::cyclesShadingTriangles(concave, loopTriangles(concave)).empty());
+  const Mesh square = quadMesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+  EXPECT_TRUE(bake_detail::cyclesShadingTriangles(square, loopTriangles(square)).empty());
+
+  // A flat face's object-space normal is the normal of the triangle Cycles shades.
+  BakeSettings s;
+  s.map = MapKind::kObjectNormal;
+  s.width = s.height = 32;
+  const Result<FloatImage> image = bakeMap({&mesh, nullptr, {}}, s);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  const auto normalOf = [&](const Tri& t) {
+    return normalizeOr(cross(cast<double>(p[t[1]] - p[t[0]]), cast<double>(p[t[2]] - p[t[0]])),
+                       Vec3d{});
+  };
+  int covered = 0, other = 0;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      if (test::coverageUp(*image, x, y) != 1.0f) continue;
+      ++covered;
+      const Vec2d q = bakeSampleUv(x + 0.5, y + 0.5, 32, 32);
+      // The baker's triangle k holding the sample.
+      std::size_t k = 0;
+      for (std::size_t t = 0; t < 2; ++t) {
+        const Vec2d a = cast<double>(uv[baker[t][0]]), b = cast<double>(uv[baker[t][1]]),
+                    c = cast<double>(uv[baker[t][2]]);
+        const double area = (b - a).x * (c - a).y - (b - a).y * (c - a).x;
+        const double l1 = ((q - a).x * (c - a).y - (q - a).y * (c - a).x) / area;
+        const double l2 = ((b - a).x * (q - a).y - (b - a).y * (q - a).x) / area;
+        if (l1 >= 0 && l2 >= 0 && l1 + l2 <= 1) k = t;
+      }
+      const Vec3d expected = normalOf(cycles[k]);
+      const Vec3d got = 2.0 * test::pixelUp(*image, x, y) - Vec3d{1, 1, 1};
+      EXPECT_LT(length(got - expected), 1e-5) << x << "," << y;
+      other += length(expected - normalOf(baker[k])) > 0.5;
+    }
+  }
+  EXPECT_GT(covered, 100);
+  EXPECT_EQ(other, covered) << "every triangle of the other split has another normal here";
+}
+
 TEST(LoopTriangles, ReflexAt0Or2AndTiesKeepDiagonal02) {
   const std::vector<Tri> keep{{0, 1, 2}, {0, 2, 3}};
   EXPECT_EQ(loopTriangles(quadMesh({{0.7f, 0.7f, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}})), keep);

@@ -120,6 +120,10 @@ BAKE_MEDIAN_DEG = 1.0
 # back-facing is decided in world space: measured p99 8.9 deg (median 0.57), 179.7 deg (median
 # 1.5) shaded from the front.
 BAKE_P99_DEG = {"sphere_backfacing": 10.0, "stretch_sphere_backfacing": 15.0}
+# Per-case bars on the worst texel of (b). suzanne_flat: its concave quads 162 and 163, which
+# Cycles shades on the other diagonal's triangles (bake_detail::cyclesShadingTriangles):
+# measured 2.3 deg, 117 deg on 48 texels when shaded on the baker's own triangles.
+BAKE_MAX_DEG = {"suzanne_flat": 10.0}
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
@@ -341,7 +345,8 @@ def passes_convert(s):
 
 def passes_bake(s, case=None):
     return (s["median_deg"] <= BAKE_MEDIAN_DEG
-            and s["p99_deg"] <= BAKE_P99_DEG.get(case, math.inf))
+            and s["p99_deg"] <= BAKE_P99_DEG.get(case, math.inf)
+            and s["max_deg"] <= BAKE_MAX_DEG.get(case, math.inf))
 
 
 def passes_nmap(s, chain=False, stretched=False):
@@ -457,6 +462,7 @@ def evaluate(name, r):
         s = r["bake"]
         ok = passes_bake(s, name)
         p99_bar = f", p99 <= {BAKE_P99_DEG[name]}" if name in BAKE_P99_DEG else ""
+        p99_bar += f", max <= {BAKE_MAX_DEG[name]}" if name in BAKE_MAX_DEG else ""
         print(f"  (b) bake vs Blender tangent:    {fmt(s)} worst at (x, row) {s.get('worst_at')}"
               f" -> {'ok' if ok else 'FAIL'} (median <= {BAKE_MEDIAN_DEG}{p99_bar})")
         if not ok:
