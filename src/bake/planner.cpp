@@ -114,7 +114,8 @@ bool nestsDeeperThan(const json& value, int limit) {
 
 /// Whether @p entry is an output's entry as recordInManifests writes it: "parameters" (an
 /// object, a few levels deep), "inputs" and "files" (objects of strings), and "udim_reached"
-/// (tile numbers) when the output reads a UDIM image.
+/// (tile numbers) and "input_tiles" (input name → tile number) when the output reads a UDIM
+/// image.
 bool isManifestEntry(const json& entry) {
   if (!entry.is_object()) return false;
   const auto parameters = entry.find("parameters");
@@ -131,6 +132,12 @@ bool isManifestEntry(const json& entry) {
   if (const auto reached = entry.find("udim_reached"); reached != entry.end()) {
     if (!reached->is_array()) return false;
     for (const json& tile : *reached) {
+      if (!tile.is_number_integer()) return false;
+    }
+  }
+  if (const auto tiles = entry.find("input_tiles"); tiles != entry.end()) {
+    if (!tiles->is_object()) return false;
+    for (const json& tile : *tiles) {
       if (!tile.is_number_integer()) return false;
     }
   }
@@ -352,15 +359,51 @@ std::string transformParametersJson(const Scene& scene, const SceneOutput& outpu
   return ",\"transform\":" + rows.dump();
 }
 
+/// An input of an output that differs from what its manifest entry recorded.
+struct InputDifference {
+  enum class Kind { kNew, kChanged, kGone };
+  Kind kind;
+  std::string name;             ///< as the manifest names it
+  std::optional<int> udimTile;  ///< the UDIM tile it is a file of; none: the mesh or a plain image
+};
+
+/// The inputs of @p planned that differ from those its manifest entry @p entry records ("inputs",
+/// an object): new or changed ones in the planned order, then gone ones. UDIM tiles the mesh's UVs
+/// did not reach when it was baked ("udim_reached") are left out: the same mesh (its hash is an
+/// input) reaches the same tiles, and a tile no UV reaches changes no texel. The tile of a gone
+/// input is the one the entry recorded for it ("input_tiles").
+std::vector<InputDifference> inputDifferences(const json& entry, const json& inputs,
+                                              const PlannedOutput& planned) {
+  using Kind = InputDifference::Kind;
+  const auto reached = entry.find("udim_reached");
+  std::set<int> reachedTiles;
+  if (reached != entry.end()) reachedTiles = reached->get<std::set<int>>();
+  std::vector<InputDifference> differences;
+  std::set<std::string> compared;
+  for (const auto& [path, hash] : planned.inputHashes) {
+    const auto tile = planned.udimTileInputs.find(path);
+    const bool isTile = tile != planned.udimTileInputs.end();
+    if (reached != entry.end() && isTile && !reachedTiles.contains(tile->second)) continue;
+    compared.insert(path);
+    const auto recorded = inputs.find(path);
+    if (recorded != inputs.end() && *recorded == hash) continue;
+    differences.push_back({recorded == inputs.end() ? Kind::kNew : Kind::kChanged, path,
+                           isTile ? std::optional<int>(tile->second) : std::nullopt});
+  }
+  const auto tiles = entry.find("input_tiles");
+  for (const auto& [path, hash] : inputs.items()) {
+    if (compared.contains(path)) continue;
+    std::optional<int> tile;
+    if (tiles != entry.end() && tiles->contains(path)) tile = (*tiles)[path].get<int>();
+    differences.push_back({Kind::kGone, path, tile});
+  }
+  return differences;
+}
+
 /// Why @p planned must be baked, as the manifest entry @p entry of its @p file says (one
 /// phrase for explainPlan: the first difference found); empty when nothing changed.
 std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::path& file) {
   const std::string manifest = (directoryOf(file) / kManifestName).string();
-  // Inputs are named relative to the manifest's directory: said as full paths.
-  const fs::path dir = canonicalPath(directoryOf(file));
-  const auto full = [&dir](const std::string& name) {
-    return (dir / fileNameBytes(name)).lexically_normal().string();
-  };
   if (entry == nullptr || !entry->is_object()) return "it is not in " + manifest + " yet";
   const auto parameters = entry->find("parameters");
   if (parameters == entry->end() || parameters->dump() != planned.parameters) {
@@ -376,25 +419,15 @@ std::string whyBake(const json* entry, const PlannedOutput& planned, const fs::p
   }
   const auto inputs = entry->find("inputs");
   if (inputs == entry->end() || !inputs->is_object()) return "its inputs are not in " + manifest;
-  // The UDIM tiles the mesh's UVs reached when it was baked: the same mesh (its hash is an
-  // input) reaches the same tiles, and tiles it does not reach do not count.
-  const auto reached = entry->find("udim_reached");
-  std::set<int> reachedTiles;
-  if (reached != entry->end()) reachedTiles = reached->get<std::set<int>>();
-  std::set<std::string> compared;
-  for (const auto& [path, hash] : planned.inputHashes) {
-    const auto tile = planned.udimTileInputs.find(path);
-    if (reached != entry->end() && tile != planned.udimTileInputs.end() &&
-        !reachedTiles.contains(tile->second)) {
-      continue;
-    }
-    compared.insert(path);
-    const auto recorded = inputs->find(path);
-    if (recorded == inputs->end()) return full(path) + " is new";
-    if (*recorded != hash) return full(path) + " changed";
-  }
-  for (const auto& [path, hash] : inputs->items()) {
-    if (!compared.contains(path)) return full(path) + " is gone";
+  if (const std::vector<InputDifference> differences = inputDifferences(*entry, *inputs, planned);
+      !differences.empty()) {
+    // Inputs are named relative to the manifest's directory: said as full paths.
+    const InputDifference& first = differences.front();
+    const fs::path full = (canonicalPath(directoryOf(file)) / fileNameBytes(first.name));
+    using Kind = InputDifference::Kind;
+    return full.lexically_normal().string() + (first.kind == Kind::kNew       ? " is new"
+                                               : first.kind == Kind::kChanged ? " changed"
+                                                                              : " is gone");
   }
   const auto files = entry->find("files");
   if (files == entry->end() || !files->is_object() || files->empty()) {
@@ -447,8 +480,8 @@ struct TilesToKeep {
 /// tiles those are, and the tiles whose files stay (their UDIM image tiles and their files are
 /// as the manifest @p entry recorded them, and every layer reads tile by tile). Nothing when
 /// the whole output must be baked: its parameters, mesh or a plain image changed, a tile file
-/// of an input is gone (which tile is not known here), its "range" is "auto" (one range for
-/// every tile), or the tile number is in a directory name.
+/// of an input is gone from a manifest that did not record its tile number, its "range" is
+/// "auto" (one range for every tile), or the tile number is in a directory name.
 std::optional<TilesToKeep> udimTilesToKeep(const json* entry, const PlannedOutput& planned,
                                            const Scene& s, const SceneOutput& output) {
   if (entry == nullptr || !entry->is_object() || output.kind != OutputKind::kMap ||
@@ -465,25 +498,10 @@ std::optional<TilesToKeep> udimTilesToKeep(const json* entry, const PlannedOutpu
       !files->is_object()) {
     return {};
   }
-  const auto reached = entry->find("udim_reached");
-  std::set<int> reachedTiles;
-  if (reached != entry->end()) reachedTiles = reached->get<std::set<int>>();
   TilesToKeep result;
-  std::set<std::string> compared;
-  for (const auto& [path, hash] : planned.inputHashes) {
-    const auto tile = planned.udimTileInputs.find(path);
-    if (reached != entry->end() && tile != planned.udimTileInputs.end() &&
-        !reachedTiles.contains(tile->second)) {
-      continue;  // as whyBake: a tile no UV reaches changes no texel
-    }
-    compared.insert(path);
-    const auto recorded = inputs->find(path);
-    if (recorded != inputs->end() && *recorded == hash) continue;
-    if (tile == planned.udimTileInputs.end()) return {};  // the mesh or a plain image
-    result.rebaked.insert(tile->second);
-  }
-  for (const auto& [path, hash] : inputs->items()) {
-    if (!compared.contains(path)) return {};
+  for (const InputDifference& difference : inputDifferences(*entry, *inputs, planned)) {
+    if (!difference.udimTile) return {};  // the mesh, a plain image, or a tile of unknown number
+    result.rebaked.insert(*difference.udimTile);
   }
   std::map<std::string, int> tileOfName;
   for (int tile = kFirstUdimTile; tile <= kLastUdimTile; ++tile) {
@@ -1668,17 +1686,25 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     if (plan.options.useManifest) {
       start = Clock::now();
       // UDIM tiles no UV reaches are left out (whyBake): changing them changes no texel.
+      // A UDIM tile's number is recorded too, for the day its file is gone (udimTilesToKeep).
       json inputs = json::object();
+      json inputTiles = json::object();
       for (const auto& [path, hash] : planned.inputHashes) {
         const auto tile = planned.udimTileInputs.find(path);
-        if (tile == planned.udimTileInputs.end() || reachedTiles.contains(tile->second)) {
+        if (tile == planned.udimTileInputs.end()) {
           inputs[path] = hash;
+        } else if (reachedTiles.contains(tile->second)) {
+          inputs[path] = hash;
+          inputTiles[path] = tile->second;
         }
       }
       json entry = {{"parameters", json::parse(planned.parameters)},
                     {"inputs", std::move(inputs)},
                     {"files", std::move(files)}};
-      if (!planned.udimTileInputs.empty()) entry["udim_reached"] = reachedTiles;
+      if (!planned.udimTileInputs.empty()) {
+        entry["udim_reached"] = reachedTiles;
+        entry["input_tiles"] = std::move(inputTiles);
+      }
       manifestEntries.emplace_back(output.file, std::move(entry));
       report.writeSeconds += secondsSince(start);
     }

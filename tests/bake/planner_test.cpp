@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -845,6 +846,31 @@ TEST_F(PlannerTest, UdimOutputsBakeAgainOnlyTheTilesThatChanged) {
   EXPECT_EQ(plan(scene("")).outputs[0].keptTiles, std::vector<int>{1002});
   bake(scene(""));
   EXPECT_EQ(readPixels(dir_ / "n_1001.exr"), pixels1001);
+
+  // A tile file of the image removed: its tile is baked again, without the bump, alone.
+  const std::vector<float> bumped1001 = readPixels(dir_ / "n_1001.exr");
+  ASSERT_TRUE(fs::remove(dir_ / "h_1002.png"));
+  const Plan removed = plan(scene(""));
+  EXPECT_EQ(removed.outputs[0].keptTiles, std::vector<int>{1001});
+  EXPECT_EQ(removed.outputs[0].whyBake, "tile(s) 1002 changed (" +
+                                            (fs::canonical(dir_) / "h_1002.png").string() +
+                                            " is gone); tile(s) 1001 are kept as they are");
+  const ExecuteReport third = bake(scene(""));
+  EXPECT_EQ(third.outputs[0].files, std::vector<fs::path>{dir_ / "n_1002.exr"});
+  EXPECT_EQ(readPixels(dir_ / "n_1001.exr"), bumped1001);
+  const std::vector<float> flat1002 = readPixels(dir_ / "n_1002.exr");
+  for (std::size_t i = 0; i + 2 < flat1002.size(); i += 3) {
+    if (flat1002[i] == 0 && flat1002[i + 1] == 0 && flat1002[i + 2] == 0) continue;  // uncovered
+    EXPECT_NEAR(flat1002[i + 2], 1.0f, 1e-3f) << "no tile file: no bump (texel " << i / 3 << ")";
+  }
+  // A manifest of before the tiles' numbers were recorded: the whole output is baked again.
+  ASSERT_TRUE(writeImage(steeper, dir_ / "h_1002.png"));
+  bake(scene(""));
+  nlohmann::json manifest = nlohmann::json::parse(readFile(dir_ / kManifestName));
+  for (auto& [name, entry] : manifest["outputs"].items()) entry.erase("input_tiles");
+  writeFile(dir_ / kManifestName, manifest.dump());
+  ASSERT_TRUE(fs::remove(dir_ / "h_1002.png"));
+  EXPECT_TRUE(plan(scene("")).outputs[0].keptTiles.empty());
 
   // The mesh changes (or the parameters, or a plain image): every tile is baked again.
   writeFile(dir_ / "two_tiles.obj", readFile(dir_ / "two_tiles.obj") + "# edited\n");
