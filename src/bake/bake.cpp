@@ -279,14 +279,18 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   // Layers of one material: each triangle takes its face's.
   const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(base.layers);
   base.layersByMaterial = byMaterial;
-  // The maps of Cycles' normals are shaded on the triangles Cycles reads the texels on.
+  // The maps of Cycles' normals are shaded on the triangles Cycles reads the texels on; the
+  // layers' loop-triangle frames are of Cycles' triangles.
+  const bool normalMap =
+      settings.map == MapKind::kTangentNormal || settings.map == MapKind::kObjectNormal;
+  const bool layerFrames =
+      std::ranges::any_of(input.triangleTangents, [](const auto* t) { return t != nullptr; });
   std::vector<std::array<std::uint32_t, 3>> shadingCorners;
-  if ((settings.map == MapKind::kTangentNormal || settings.map == MapKind::kObjectNormal) &&
-      input.limit == nullptr) {
+  if ((normalMap || layerFrames) && input.limit == nullptr) {
     shadingCorners = cyclesShadingTriangles(*input.mesh, job.triangles);
-    base.shadingCorners = shadingCorners;
-    base.loopTriangles = job.triangles;
   }
+  if (normalMap) base.shadingCorners = shadingCorners;
+  if (layerFrames) base.frameTriangles = shadingCorners.empty() ? job.triangles : shadingCorners;
 
   static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
   static constexpr float kZero[3] = {0, 0, 0};
@@ -348,13 +352,28 @@ void bake_detail::worldTriangle(const bake_detail::ShadingTriangle& tri, const W
   world.hasLayerTangents = {};
 }
 
+namespace {
+
+/// The unit normal of triangle (p0, p1, p2) as Cycles computes it (Mesh::Triangle::compute_normal,
+/// in float, the cross product scaled by the reciprocal of its length): MikkTSpace welds the
+/// corners of a flat quad's two triangles where their normals are equal to the bit, so a normal
+/// that rounds otherwise gives some flat quads other tangents.
+Vec3f cyclesTriangleNormal(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2) {
+  const Vec3f n = cross(p1 - p0, p2 - p0);
+  const float length = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+  if (length == 0.0f) return {1.0f, 0.0f, 0.0f};
+  return {n.x / length, n.y / length, n.z / length};
+}
+
+}  // namespace
+
 Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
                                                    const TangentOptions& options) {
   if (uvSet < 0 || !mesh.hasUvSet(static_cast<std::size_t>(uvSet))) {
     return Error::badInput("loop-triangle tangents: the mesh has no UV set " +
                            std::to_string(uvSet));
   }
-  const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  const std::vector<std::array<std::uint32_t, 3>> triangles = bake_detail::cyclesTriangles(mesh);
   const std::size_t n = 3 * triangles.size();
   std::vector<std::uint32_t> faceStart(triangles.size() + 1), cornerVertex(n);
   std::vector<Vec3f> normals(n);
@@ -366,11 +385,9 @@ Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet,
     // Cycles shades a flat face without Auto Smooth, and gives MikkTSpace, its triangle's normal.
     const bool triangleNormal = !mesh.faceFlat.empty() && !mesh.autoSmooth &&
                                 mesh.isFlat(bake_detail::faceOfCorner(mesh, c[0]));
-    const Vec3f p0 = mesh.positions[mesh.cornerVertex[c[0]]];
-    const Vec3f flat =
-        cast<float>(normalizeOr(cast<double>(cross(mesh.positions[mesh.cornerVertex[c[1]]] - p0,
-                                                   mesh.positions[mesh.cornerVertex[c[2]]] - p0)),
-                                Vec3d{0, 0, 1}));
+    const Vec3f flat = cyclesTriangleNormal(mesh.positions[mesh.cornerVertex[c[0]]],
+                                            mesh.positions[mesh.cornerVertex[c[1]]],
+                                            mesh.positions[mesh.cornerVertex[c[2]]]);
     for (std::size_t i = 0; i < 3; ++i) {
       cornerVertex[3 * t + i] = mesh.cornerVertex[c[i]];
       normals[3 * t + i] = triangleNormal ? flat : mesh.cornerNormals[c[i]];
@@ -386,7 +403,7 @@ CornerTangents loopTriangleFramesAtCorners(const Mesh& mesh, const CornerTangent
   frames.tangent.assign(mesh.numCorners(), Vec3f{});
   frames.sign.assign(mesh.numCorners(), 1.0f);
   std::vector<bool> found(mesh.numCorners(), false);
-  const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  const std::vector<std::array<std::uint32_t, 3>> triangles = bake_detail::cyclesTriangles(mesh);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     for (std::size_t i = 0; i < 3; ++i) {
       const std::uint32_t c = triangles[t][i];

@@ -214,6 +214,12 @@ std::vector<std::array<std::uint32_t, 3>> cyclesShadingTriangles(
   return shading;
 }
 
+std::vector<std::array<std::uint32_t, 3>> cyclesTriangles(const Mesh& mesh) {
+  std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  std::vector<std::array<std::uint32_t, 3>> cycles = cyclesShadingTriangles(mesh, triangles);
+  return cycles.empty() ? triangles : cycles;
+}
+
 }  // namespace bake_detail
 
 std::vector<std::array<std::uint32_t, 3>> loopTriangles(const Mesh& mesh) {

@@ -105,6 +105,11 @@ void rowSpan(const RasterTriangle& tri, int y, const SampleOffsets& offsets, int
 std::vector<std::array<std::uint32_t, 3>> cyclesShadingTriangles(
     const Mesh& mesh, std::span<const std::array<std::uint32_t, 3>> triangles);
 
+/// @brief Cycles' triangles of @p mesh, in loop-triangle order: loopTriangles(mesh) with the
+/// quads Cycles splits on the other diagonal cut as Cycles cuts them (cyclesShadingTriangles).
+/// Cycles' MikkTSpace, which its Normal Map node decodes in, runs on these.
+std::vector<std::array<std::uint32_t, 3>> cyclesTriangles(const Mesh& mesh);
+
 /// @brief Texel-space position of UV @p uv in a width × height bake of tile @p udimTile.
 inline Vec2d uvToTexel(Vec2f uv, int udimTile, int width, int height) {
   const int index = udimTile - kFirstUdimTile;

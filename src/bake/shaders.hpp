@@ -79,9 +79,12 @@ struct BakeShaderBase {
   LazyScratch<WorldScratch> worldScratch;
 
   /// Non-empty (maps of Cycles' normals): the corners Cycles shades each loop triangle with
-  /// (cyclesShadingTriangles), and the loop triangles; the texel's frame stays its own
-  /// triangle's.
-  std::span<const std::array<std::uint32_t, 3>> shadingCorners, loopTriangles;
+  /// (cyclesShadingTriangles); the texel's frame stays its own triangle's.
+  std::span<const std::array<std::uint32_t, 3>> shadingCorners;
+  /// The triangles triangleTangents' frames are of (3 per triangle), given with them: Cycles'
+  /// own (cyclesTriangles), the loop triangles but on the quads Blender's baker and Cycles split
+  /// on different diagonals.
+  std::span<const std::array<std::uint32_t, 3>> frameTriangles;
   /// The current triangle is shaded with other corners (`tri`) than its own (ownTriangle).
   bool shadedElsewhere = false;
   LazyScratch<ShadingTriangle> ownTriangle;
@@ -90,51 +93,43 @@ struct BakeShaderBase {
     if (!layersByMaterial.empty()) selectLayersOfFace(corners[0]);
     shadedElsewhere = !shadingCorners.empty() && shadingCorners[triangle] != corners;
     if (shadedElsewhere) [[unlikely]] {
-      beginShadingElsewhere(triangle, corners);
+      loadShadingTriangle(*mesh, tangents, corners, uvSet, ownTriangle.get());
+      loadShadingTriangle(*mesh, tangents, shadingCorners[triangle], uvSet, tri);
     } else {
       loadShadingTriangle(*mesh, tangents, corners, uvSet, tri);
-      for (std::size_t s = 0; s < kMaxUvSets; ++s) {
-        const CornerTangents* frames = triangleTangents[s];
-        tri.hasLayerTangents[s] = frames != nullptr;
-        if (frames == nullptr) continue;
-        for (std::size_t i = 0; i < 3; ++i) {
-          const std::size_t k = 3 * static_cast<std::size_t>(triangle) + i;
-          tri.layerTangent[s][i] = cast<double>(frames->tangent[k]);
-          tri.layerSign[s][i] = frames->sign[k];
-        }
-      }
     }
+    loadLayerTangents(triangle, shadedElsewhere ? shadingCorners[triangle] : corners);
     triangleChanged();
   }
-  /// beginTriangle's `tri` from the corners Cycles shades (shadingCorners), and ownTriangle
-  /// from the triangle's own. A tangent-space layer's frame at a corner is the one the loop
-  /// triangles of the quad (this one and its neighbour) give it (Cycles' MikkTSpace on its own
-  /// split is not reproduced).
-  [[gnu::noinline]] void beginShadingElsewhere(std::uint32_t triangle,
-                                               const std::array<std::uint32_t, 3>& corners) {
-    const std::array<std::uint32_t, 3>& shading = shadingCorners[triangle];
-    loadShadingTriangle(*mesh, tangents, corners, uvSet, ownTriangle.get());
-    loadShadingTriangle(*mesh, tangents, shading, uvSet, tri);
-    // Where corner c sits among the loop triangles of the quad: 3·t + i.
-    const auto frameIndex = [&](std::uint32_t c) {
-      for (const std::size_t t :
-           {std::size_t{triangle}, std::size_t{triangle} + 1, std::size_t{triangle} - 1}) {
-        if (t >= loopTriangles.size()) continue;
-        for (std::size_t i = 0; i < 3; ++i)
-          if (loopTriangles[t][i] == c) return 3 * t + i;
-      }
-      return 3 * std::size_t{triangle};  // (every corner of the quad is in one of them)
-    };
+  /// `tri`'s frames for tangent-space layers (triangleTangents) at @p shaded, the corners loop
+  /// triangle @p triangle is shaded with: Cycles' triangle of the same number, or on a quad
+  /// split two ways each corner's frame in the first of the quad's Cycles triangles through it.
+  void loadLayerTangents(std::uint32_t triangle, const std::array<std::uint32_t, 3>& shaded) {
+    tri.hasLayerTangents.fill(false);
+    if (frameTriangles.empty()) return;  // no triangleTangents
+    const bool ownFrames = frameTriangles[triangle] == shaded;
     for (std::size_t s = 0; s < kMaxUvSets; ++s) {
       const CornerTangents* frames = triangleTangents[s];
       tri.hasLayerTangents[s] = frames != nullptr;
       if (frames == nullptr) continue;
       for (std::size_t i = 0; i < 3; ++i) {
-        const std::size_t k = frameIndex(shading[i]);
+        const std::size_t k =
+            ownFrames ? 3 * std::size_t{triangle} + i : frameIndexElsewhere(triangle, shaded[i]);
         tri.layerTangent[s][i] = cast<double>(frames->tangent[k]);
         tri.layerSign[s][i] = frames->sign[k];
       }
     }
+  }
+  /// Where corner @p c sits among Cycles' triangles of loop triangle @p triangle's quad (it and
+  /// its neighbour): 3·t + i.
+  [[gnu::noinline]] std::size_t frameIndexElsewhere(std::uint32_t triangle, std::uint32_t c) const {
+    for (const std::size_t t :
+         {std::size_t{triangle}, std::size_t{triangle} + 1, std::size_t{triangle} - 1}) {
+      if (t >= frameTriangles.size()) continue;
+      for (std::size_t i = 0; i < 3; ++i)
+        if (frameTriangles[t][i] == c) return 3 * t + i;
+    }
+    return 3 * std::size_t{triangle};  // (every corner of the quad is in one of them)
   }
   /// The frame Blender's baker expresses the texel's normal in: its own triangle's at @p b,
   /// which is @p f unless Cycles shades the texel elsewhere.

@@ -4,7 +4,8 @@
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
         [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist,
                  nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
-                 nmap_cube_s2,nmap_suzanne,chain_sphere,chain_suzanne,stretch_sphere,
+                 nmap_cube_s2,nmap_suzanne,nmap_suzanne_flat,chain_sphere,chain_suzanne,
+                 stretch_sphere,
                  stretch_cube,stretch_nmap_sphere,stretch_nmap_sphere_object,
                  stretch_chain_suzanne,sphere_backfacing,nmap_sphere_backfacing,
                  stretch_sphere_backfacing,stretch_nmap_sphere_backfacing]
@@ -129,6 +130,11 @@ BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
 NMAP_P90_DEG = 0.1
 NMAP_P99_DEG = 0.3
+# Per-case bars on the worst texel of (d). nmap_suzanne_flat: flat Suzanne, where Cycles'
+# MikkTSpace runs on its own split of quads 162 and 163 and welds a flat quad's two triangles
+# where its float triangle normals are equal to the bit (computeLoopTriangleTangents): measured
+# 0.002 deg; 5.3 deg with the baker's split, 0.76 with normals rounded otherwise.
+NMAP_MAX_DEG = {"nmap_suzanne_flat": 0.05}
 # A Bump node stacked on the Normal Map's output: Cycles' bump is a finite difference (see (b)),
 # so the bars are the plain bump's noise at 512^2 (UV sphere: median 0.22, p90 0.91, p99 1.79
 # deg) with room; adding the bump's gradient to the normal map's instead is off by medians
@@ -161,7 +167,7 @@ SGBAKE_TIMEOUT = 120
 DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
                  "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
                  "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne",
-                 "chain_sphere", "chain_suzanne", "stretch_sphere", "stretch_cube",
+                 "nmap_suzanne_flat",                 "chain_sphere", "chain_suzanne", "stretch_sphere", "stretch_cube",
                  "stretch_nmap_sphere", "stretch_nmap_sphere_object", "stretch_chain_suzanne",
                  "sphere_backfacing", "nmap_sphere_backfacing", "stretch_sphere_backfacing",
                  "stretch_nmap_sphere_backfacing")
@@ -349,7 +355,9 @@ def passes_bake(s, case=None):
             and s["max_deg"] <= BAKE_MAX_DEG.get(case, math.inf))
 
 
-def passes_nmap(s, chain=False, stretched=False):
+def passes_nmap(s, chain=False, stretched=False, case=None):
+    if s["max_deg"] > NMAP_MAX_DEG.get(case, math.inf):
+        return False
     if chain:
         return (s["median_deg"] <= CHAIN_MEDIAN_DEG and s["p90_deg"] <= CHAIN_P90_DEG
                 and s["p99_deg"] <= (STRETCH_CHAIN_P99_DEG if stretched else CHAIN_P99_DEG))
@@ -371,7 +379,8 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
             f"{STRETCH_CHAIN_P99_DEG if stretched else CHAIN_P99_DEG})"
             if chain else
             f"(median <= {NMAP_MEDIAN_DEG}, p90 <= {NMAP_P90_DEG}, p99 <= "
-            f"{STRETCH_NMAP_P99_DEG if stretched else NMAP_P99_DEG})")
+            f"{STRETCH_NMAP_P99_DEG if stretched else NMAP_P99_DEG}"
+            + (f", max <= {NMAP_MAX_DEG[name]}" if name in NMAP_MAX_DEG else "") + ")")
     for key, what in (("nmap_tangent", "tangent-normal vs Blender tangent"),
                       ("nmap_object", "object-normal vs Blender object ")):
         if key not in r or "error" in r[key]:
@@ -379,7 +388,7 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
                                                          else "no output to compare"))
             continue
         s = r[key]
-        ok = passes_nmap(s, chain, stretched)
+        ok = passes_nmap(s, chain, stretched, name)
         print(f"  (d) {what}: {fmt_nmap(s)} worst at (x, row) {s.get('worst_at')} -> "
               f"{'ok' if ok else 'FAIL'} {bars}")
         if not ok:

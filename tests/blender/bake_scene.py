@@ -274,6 +274,9 @@ normal_map_case("nmap_cube_s2", "cube_flat", 256, "TANGENT", 2.0, 40.0)
 # Suzanne's quads (UVs no parallelograms): Cycles' Normal Map node decodes in MikkTSpace of its
 # triangulated mesh, which the polygon mesh's frames miss by a median 0.32 deg here.
 normal_map_case("nmap_suzanne", "suzanne", 256, "TANGENT", 1.0, 40.0)
+# Flat Suzanne: Cycles' MikkTSpace runs on its own split of the quads it cuts on the other
+# diagonal, and welds a flat quad's triangles where their float normals are equal.
+normal_map_case("nmap_suzanne_flat", "suzanne_flat", 256, "TANGENT", 1.0, 40.0)
 normal_map_case("nmap_sphere_backfacing", "sphere_backfacing", 256, "TANGENT", 1.0, 40.0)
 # A Bump node on the normal map's output (its Normal input linked): sgbake's "base": "above".
 normal_map_case("chain_sphere", "sphere", 512, "TANGENT", 1.0, 40.0, bump=0.1)

@@ -229,17 +229,19 @@ struct BakeInput {
   const ObjectTransform* transform = nullptr;
 };
 
-/// @brief MikkTSpace frames of @p mesh's loop triangles (Blender's looptris, the triangles the
-/// raster walks), each handed to MikkTSpace as a face of its own: the tangents Cycles computes
-/// for its Normal Map node (on its triangulated mesh), which differ from the polygon mesh's
-/// (computeTangents) inside quads and n-gons. Normals as Cycles gives them: a flat face without
-/// Auto Smooth its triangle's normal, every other face its corner normals. UV set @p uvSet.
-/// @return 3 frames per triangle, in loop-triangle order; kBadInput without UV set @p uvSet
+/// @brief MikkTSpace frames of Cycles' triangles of @p mesh (Blender's looptris, the triangles
+/// the raster walks, but for the near-tie quads Cycles splits on the other diagonal), each
+/// handed to MikkTSpace as a face of its own: the tangents Cycles computes for its Normal Map
+/// node (on its triangulated mesh), which differ from the polygon mesh's (computeTangents)
+/// inside quads and n-gons. Normals as Cycles gives them: a flat face without Auto Smooth its
+/// triangle's normal, every other face its corner normals. UV set @p uvSet.
+/// @return 3 frames per triangle, in loop-triangle order (triangle k of a quad split two ways
+///         is Cycles' triangle k); kBadInput without UV set @p uvSet
 Result<CornerTangents> computeLoopTriangleTangents(const Mesh& mesh, int uvSet = 0,
                                                    const TangentOptions& options = {});
 
 /// @brief The loop-triangle frames of @p triangleFrames (computeLoopTriangleTangents of @p mesh)
-/// per corner of @p mesh: each corner takes its frame in the first loop triangle through it.
+/// per corner of @p mesh: each corner takes its frame in the first of those triangles through it.
 /// (MikkTSpace gives a corner the same frame in every triangle of its face that it shares with
 /// the same normal and UV, so which triangle is not a choice.) For per-corner evaluation
 /// (CornerOptions::layerTangents) that decodes as the bake does.
