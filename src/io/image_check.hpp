@@ -12,6 +12,17 @@
 ///   markers and segments from SOI, skips each scan's entropy-coded data (where 0xFF is
 ///   followed by 0x00 or a restart marker), and wants the EOI marker before the file ends.
 ///   Stray bytes between segments are skipped, as libjpeg skips them.
+/// - SGI (IRIS): OpenImageIO's reader aborts the process (an assertion kept in Debian's build)
+///   on RLE data that overruns its scanline, and says "Read error" once per row of a truncated
+///   file. The check wants every RLE scanline inside the file and decoding to exactly xsize
+///   values in exactly its recorded length, and a verbatim file long enough for its pixels.
+/// - Cineon, DPX: a Cineon file cut short is decoded with its missing pixels zero or garbage,
+///   a DPX one refused with no reason given. The check compares the file's size with the size
+///   its header records, with where its pixels start, and with their least possible size.
+/// - OpenEXR: a chunk whose size field says 0 comes back as rows of zeros or of another chunk.
+///   In single-part scanline and tiled files (one level or mipmapped), every chunk the offset
+///   table points to inside the file must hold data, all of it inside the file (entries pointing
+///   elsewhere are left to OpenEXR, which rebuilds the table from the chunks).
 #pragma once
 
 #include <cstddef>
@@ -26,8 +37,9 @@ namespace sgbake::io_detail {
 std::uint32_t crc32(std::uint32_t crc, const unsigned char* data, std::size_t size);
 
 /// @brief Why the image file @p path cannot be decoded whole ("truncated PNG: ...", "corrupt
-/// PNG: ...", "truncated JPEG: ..."), or "" when its structure is whole, it cannot be opened
-/// (the decoder says why), or it is neither PNG nor JPEG (by its signature, not its name).
+/// PNG: ...", "truncated JPEG: ...", "corrupt SGI image: ...", "corrupt EXR: ..."), or "" when
+/// its structure is whole, it cannot be opened (the decoder says why), or it is of a format not
+/// checked here (by its signature, not its name).
 std::string imageDamage(const std::filesystem::path& path);
 
 }  // namespace sgbake::io_detail

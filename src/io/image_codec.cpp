@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
@@ -11,6 +12,7 @@
 #include <string>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include "sgbake/io/image_io.hpp"
 
@@ -82,16 +84,24 @@ std::string oneLineReason(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) {
     text.pop_back();
   }
+  // Lines joined by "; ", each said once (a decoder may repeat "Read error" for every row).
   std::string line;
-  line.reserve(text.size());
-  for (const char c : text) {
-    if (c == '\n') {
-      line += "; ";
-    } else if (c == '\r') {
-      continue;
-    } else {
-      line += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
+  std::vector<std::string> said;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string part;
+    for (std::size_t i = start; i < end; ++i) {
+      const char c = text[i];
+      if (c == '\r') continue;
+      part += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
     }
+    start = end + 1;
+    if (part.empty() || std::find(said.begin(), said.end(), part) != said.end()) continue;
+    if (!line.empty()) line += "; ";
+    line += part;
+    said.push_back(std::move(part));
   }
   return line.empty() ? std::string("no reason given: the file may be truncated or damaged") : line;
 }

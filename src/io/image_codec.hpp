@@ -125,8 +125,9 @@ Result<const ImageCodec*> imageCodec();
 /// Waits for a load startLoading began (finishImageIoPreload, sgbake/io/image_io.hpp).
 void finishLoading();
 
-/// A codec error as one line: line breaks become "; ", control characters '?', trailing blanks
-/// go; when empty, that no reason was given and the file may be truncated or damaged.
+/// A codec error as one line: its lines joined by "; ", each said once, control characters '?',
+/// trailing blanks gone; when empty, that no reason was given and the file may be truncated or
+/// damaged.
 std::string oneLineReason(std::string text);
 
 }  // namespace sgbake::io_detail

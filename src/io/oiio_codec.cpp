@@ -36,12 +36,9 @@ OIIO::TypeDesc oiioType(PixelType type) {
 
 class OiioReader final : public ImageReader {
  public:
-  explicit OiioReader(std::unique_ptr<OIIO::ImageInput> in) : in_(std::move(in)) {
-    // How many subimages there are (EXR parts, TIFF pages): seeking past the last fails.
-    while (subimages_ < 64 && in_->seek_subimage(subimages_, 0)) ++subimages_;
-    in_->seek_subimage(0, 0);
-    (void)in_->geterror();  // the failed seek's text
-  }
+  /// @p subimages: how many the file has (countSubimages), @p in at the first.
+  OiioReader(std::unique_ptr<OIIO::ImageInput> in, int subimages)
+      : in_(std::move(in)), subimages_(subimages) {}
   ~OiioReader() override { in_->close(); }
 
   ImageHeader header() const override {
@@ -217,7 +214,22 @@ class OiioCodec final : public ImageCodec {
       error = OIIO::geterror();
       return nullptr;
     }
-    return std::make_unique<OiioReader>(std::move(in));
+    // How many subimages there are (EXR parts, TIFF pages): seeking past the last fails.
+    int subimages = 1;
+    while (subimages < 64 && in->seek_subimage(subimages, 0)) ++subimages;
+    (void)in->geterror();  // the failed seek's text
+    if (subimages > 1) {
+      in->seek_subimage(0, 0);
+    } else {
+      // A reader may not read again after a failed seek (WebP's says "Couldn't decode
+      // subimage 0"): a file of one image is opened afresh.
+      in = OIIO::ImageInput::open(path.string(), &config);
+      if (!in) {
+        error = OIIO::geterror();
+        return nullptr;
+      }
+    }
+    return std::make_unique<OiioReader>(std::move(in), subimages);
   }
 
   std::unique_ptr<ImageWriter> openWriter(const std::filesystem::path& path,

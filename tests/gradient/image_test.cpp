@@ -412,6 +412,197 @@ TEST(LoadImage, TruncatedTiffIsRefused) {
   }
 }
 
+// A WebP file was refused ("Couldn't decode subimage 0"): OpenImageIO's WebP reader cannot read
+// after the failed seek that counts subimages, so a file of one image is opened afresh.
+TEST(LoadImage, WebpIsRead) {
+  const fs::path path = testDir() / "ramp.webp";
+  std::vector<unsigned char> pixels(16 * 8 * 3);
+  for (std::size_t i = 0; i < pixels.size(); ++i)
+    pixels[i] = static_cast<unsigned char>(8 * (i % 24));
+  {
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path.string());
+    ASSERT_TRUE(out) << OIIO::geterror();
+    OIIO::ImageSpec spec(16, 8, 3, OIIO::TypeDesc::UINT8);
+    ASSERT_TRUE(out->open(path.string(), spec)) << out->geterror();
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    ASSERT_TRUE(out->close());
+  }
+  const Result<Image> image = loadImage(path);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(image->width(), 16);
+  EXPECT_NEAR(image->at(1, 0, 0), 24.0f / 255.0f, 0.03f) << "lossy, but the same ramp";
+}
+
+// SGI (IRIS) files: OpenImageIO's reader aborts the process on RLE data that overruns its
+// scanline (an assertion Debian's build keeps), and reports a truncated file as "Read error"
+// once per row. The structure is checked first: every RLE scanline must decode to the width.
+TEST(LoadImage, DamagedSgiIsRefused) {
+  const fs::path dir = testDir();
+  // OpenImageIO writes SGI files verbatim: a 16 x 8 grey RLE file made here. Header: magic
+  // 474, RLE, 1 byte per channel, 2 dimensions, 16 x 8 x 1; then the tables of the scanlines'
+  // offsets and lengths; each scanline a literal run of its 16 values and the end count 0.
+  std::string file(512, '\0');
+  const auto put16 = [&](std::size_t at, unsigned v) {
+    file[at] = static_cast<char>(v >> 8);
+    file[at + 1] = static_cast<char>(v & 0xFFu);
+  };
+  const auto put32 = [&](std::size_t at, std::uint32_t v) {
+    for (std::size_t i = 0; i < 4; ++i) file[at + i] = static_cast<char>(v >> (24 - 8 * i));
+  };
+  put16(0, 474);
+  file[2] = 1;
+  file[3] = 1;
+  put16(4, 2);
+  put16(6, 16);
+  put16(8, 8);
+  put16(10, 1);
+  put32(108, 255);  // pixmax
+  file.resize(512 + 2 * 8 * 4);
+  for (std::uint32_t row = 0; row < 8; ++row) {
+    put32(512 + 4 * row, static_cast<std::uint32_t>(file.size()));
+    put32(512 + 32 + 4 * row, 18);
+    file += static_cast<char>(0x80 | 16);
+    for (int x = 0; x < 16; ++x) file += static_cast<char>(16 * x + row);
+    file += '\0';
+  }
+  const fs::path full = dir / "full.sgi";
+  writeBytes(full, file);
+  const Result<Image> image = loadImage(full);
+  ASSERT_TRUE(image.ok()) << image.error().message;
+  EXPECT_EQ(std::lround(image->at(3, 2, 0) * 255.0f) / 16, 3) << "column 3 holds 48 + row";
+  const std::string& bytes = file;
+  // Scanline 0's first count, made a run of 127 values: more than the 16 of its row.
+  const auto loadBig32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+  };
+  std::string overrun = bytes;
+  overrun[loadBig32(512)] = static_cast<char>(0x7F);
+  const fs::path corrupt = dir / "overrun.sgi";
+  writeBytes(corrupt, overrun);
+  expectFileError(loadImage(corrupt), corrupt,
+                  "cannot read image (corrupt SGI image: RLE scanline 0 (at byte " +
+                      std::to_string(loadBig32(512)) + ") does not decode to 16 values)");
+  const fs::path cut = dir / "cut.sgi";
+  writeBytes(cut, bytes.substr(0, bytes.size() - 10));
+  expectFileError(loadImage(cut), cut,
+                  "cannot read image (truncated SGI image: the file ends "
+                  "inside RLE scanline ");
+}
+
+// A Cineon or DPX file cut short was decoded with its missing pixels zero or garbage (Cineon),
+// or refused with no reason given (DPX): their headers' sizes are checked first.
+TEST(LoadImage, TruncatedCineonAndDpxAreRefused) {
+  const fs::path dir = testDir();
+  // An 8 x 8 RGB ramp Blender 3.4 wrote (10 bits, 2048-byte header).
+  const fs::path cineon = fs::path(SGBAKE_TEST_DATA) / "corpus" / "images" / "ramp_8x8.cin";
+  ASSERT_TRUE(loadImage(cineon).ok());
+  const std::string cineonBytes = readBytes(cineon);
+  ASSERT_EQ(cineonBytes.size(), 2304u);
+  const fs::path cutCineon = dir / "cut.cin";
+  writeBytes(cutCineon, cineonBytes.substr(0, 2200));
+  expectFileError(loadImage(cutCineon), cutCineon,
+                  "cannot read image (truncated Cineon image: the file is 2200 bytes, its "
+                  "header says 2304)");
+  const fs::path headerOnly = dir / "header.cin";
+  writeBytes(headerOnly, cineonBytes.substr(0, 2048));
+  expectFileError(loadImage(headerOnly), headerOnly,
+                  "cannot read image (truncated Cineon image: the file is 2048 bytes, its "
+                  "pixels would start at byte 2048)");
+
+  const fs::path dpx = dir / "full.dpx";
+  std::vector<float> ramp(32 * 16 * 3);
+  for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<float>(i % 29) / 29.0f;
+  writeImage(dpx, 32, 16, 3, OIIO::TypeDesc::UINT16, ramp);
+  ASSERT_TRUE(loadImage(dpx).ok());
+  const std::string dpxBytes = readBytes(dpx);
+  const fs::path cutDpx = dir / "cut.dpx";
+  writeBytes(cutDpx, dpxBytes.substr(0, dpxBytes.size() - 100));
+  expectFileError(loadImage(cutDpx), cutDpx,
+                  "cannot read image (truncated DPX image: the file is " +
+                      std::to_string(dpxBytes.size() - 100) + " bytes, its ");
+}
+
+// An EXR chunk whose size field says 0 (its data gone) was read as rows of zeros or of another
+// chunk; OpenEXR does not tell. Every chunk the offset table points to must hold data, in
+// scanline files and in tiled ones, one level or mipmapped (whose chunks are counted per level).
+TEST(LoadImage, ExrChunksWithoutDataAreRefused) {
+  const fs::path dir = testDir();
+  std::vector<float> noise(64 * 48);
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<float>(i % 89) / 89.0f;
+  struct Layout {
+    const char* name;
+    int tile;
+    const char* levels;  // "" or "mipmap" (a tiled file's levels)
+    int roundingMode;
+    std::size_t chunks;
+  };
+  // ZIP: 16 scanlines a chunk. Tiles of 16: 4 x 3 at level 0; mipmaps of 32 x 24, 16 x 12,
+  // 8 x 6, 4 x 3, 2 x 1, 1 x 1 (rounded down) or 32 x 24, 16 x 12, 8 x 6, 4 x 3, 2 x 2, 1 x 1
+  // (up) add 2 x 2 + 1 + 1 + 1 + 1 + 1 chunks.
+  for (const Layout& layout :
+       {Layout{"scanlines", 0, "", 0, 3}, Layout{"tiles", 16, "", 0, 12},
+        Layout{"mipmap_down", 16, "mipmap", 0, 21}, Layout{"mipmap_up", 16, "mipmap", 1, 21}}) {
+    SCOPED_TRACE(layout.name);
+    const fs::path full = dir / (std::string(layout.name) + ".exr");
+    {
+      std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(full.string());
+      ASSERT_TRUE(out);
+      OIIO::ImageSpec spec(64, 48, 1, OIIO::TypeDesc::FLOAT);
+      spec.attribute("compression", "zip");
+      if (layout.tile > 0) spec.tile_width = spec.tile_height = layout.tile;
+      const bool mipmap = std::string(layout.levels) == "mipmap";
+      if (mipmap) {
+        spec.attribute("textureformat", "Plain Texture");  // what makes OpenImageIO mipmap
+        spec.attribute("openexr:levelmode", 1);
+        spec.attribute("openexr:roundingmode", layout.roundingMode);
+      }
+      ASSERT_TRUE(out->open(full.string(), spec)) << out->geterror();
+      ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, noise.data())) << out->geterror();
+      for (int w = 32, h = 24; mipmap;) {
+        OIIO::ImageSpec level = spec;
+        level.width = level.full_width = w;
+        level.height = level.full_height = h;
+        ASSERT_TRUE(out->open(full.string(), level, OIIO::ImageOutput::AppendMIPLevel))
+            << out->geterror();
+        std::vector<float> pixels(static_cast<std::size_t>(w * h), 0.5f);
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) << out->geterror();
+        if (w == 1 && h == 1) break;
+        w = layout.roundingMode != 0 ? std::max(1, (w + 1) / 2) : std::max(1, w / 2);
+        h = layout.roundingMode != 0 ? std::max(1, (h + 1) / 2) : std::max(1, h / 2);
+      }
+      ASSERT_TRUE(out->close());
+    }
+    ASSERT_TRUE(loadImage(full).ok()) << "a whole file passes the check";
+    std::string bytes = readBytes(full);
+    // The offset table is the 8-byte offsets just before the first chunk, which it points to.
+    const auto load64 = [&](std::size_t at) {
+      std::uint64_t v = 0;
+      for (std::size_t i = 8; i-- > 0;) v = v << 8 | static_cast<unsigned char>(bytes[at + i]);
+      return v;
+    };
+    std::size_t table = 0;
+    for (std::size_t at = 8; at + 8 <= bytes.size(); ++at) {
+      if (load64(at) == at + 8 * layout.chunks) {
+        table = at;
+        break;
+      }
+    }
+    ASSERT_NE(table, 0u) << "no table of " << layout.chunks << " chunks";
+    // The last chunk (of the last level: found only where the levels are counted right).
+    const std::size_t k = layout.chunks - 1;
+    const std::size_t offset = load64(table + 8 * k);
+    const std::size_t sizeField = offset + (layout.tile > 0 ? 16 : 4);
+    for (std::size_t i = 0; i < 4; ++i) bytes[sizeField + i] = 0;
+    const fs::path emptied = dir / (std::string(layout.name) + "_emptied.exr");
+    writeBytes(emptied, bytes);
+    expectFileError(loadImage(emptied), emptied,
+                    "cannot read image (corrupt EXR: chunk " + std::to_string(k) + " (at byte " +
+                        std::to_string(offset) + ") holds no pixel data)");
+  }
+}
+
 // A multi-part EXR is read from its first part, which a warning names, as are channels that are
 // not named R, G, B or Y (read by position); an EXR of 32-bit
 // unsigned integers (an ID pass), which the codec would scale by 2^-32, is refused.
