@@ -232,42 +232,20 @@ std::string sgiDamage(const std::vector<unsigned char>& bytes) {
   return "";
 }
 
-/// The pixel data a Cineon or DPX file's header promises (see image_check.hpp): @p what the
-/// format's name, @p dataOffset where its pixels start, @p recordedSize the file size its header
-/// records (0: none), @p pixelBytes a lower bound of its pixels' bytes (0: unknown).
-std::string filmScanDamage(std::string_view what, std::uint64_t size, std::uint64_t dataOffset,
-                           std::uint64_t recordedSize, std::uint64_t pixelBytes) {
-  const std::string truncated =
-      "truncated " + std::string(what) + ": the file is " + std::to_string(size) + " bytes, ";
-  if (dataOffset >= size) {
-    return truncated + "its pixels would start at byte " + std::to_string(dataOffset);
-  }
-  if (recordedSize > size) {
-    return truncated + "its header says " + std::to_string(recordedSize);
-  }
-  if (pixelBytes != 0 && dataOffset + pixelBytes > size) {
-    return truncated + "its pixels need " + std::to_string(dataOffset + pixelBytes);
-  }
-  return "";
-}
+/// Where a Cineon or DPX header records what filmScanDamage compares: byte offsets of 32-bit
+/// fields (the pixels' offset, the file size, pixels per line, lines) and of channel 0's bits
+/// per component, and the components per pixel (0: unknown, or not stored plainly).
+struct FilmScanLayout {
+  const char* name;
+  std::size_t headerBytes, dataOffset, fileSize, width, rows, bits;
+  std::uint64_t (*components)(const unsigned char* header, bool bigEndian);
+};
 
-/// A Cineon file: magic 0x802A5FD7 (either byte order), the image data offset at byte 4 and the
-/// total file size at 20; channels at 193, and channel 0's bits per pixel, pixels per line and
-/// lines at 198, 200 and 204.
-std::string cineonDamage(std::FILE* file, bool bigEndian) {
-  const std::uint64_t size = fileSize(file);
-  unsigned char h[208];
-  if (!readAt(file, 0, h, sizeof h)) return "truncated Cineon image: the file ends in its header";
-  const auto u32 = [&](std::size_t at) {
-    return bigEndian ? loadBigEndian(h + at) : loadLittleEndian(h + at);
-  };
-  const std::uint64_t channels = h[193], bits = h[198], width = u32(200), rows = u32(204);
-  const std::uint64_t pixelBytes =
-      channels <= 8 && bits <= 16 && width <= (1u << 20) && rows <= (1u << 20)
-          ? width * rows * channels * bits / 8
-          : 0;
-  return filmScanDamage("Cineon image", size, u32(4), u32(20), pixelBytes);
-}
+/// A Cineon image: magic 0x802A5FD7 (either byte order), channels at byte 193.
+constexpr FilmScanLayout kCineon{
+    "Cineon image", 208, 4, 20, 200, 204, 198, [](const unsigned char* h, bool) {
+      return std::uint64_t{h[193] <= 8 ? h[193] : 0u};
+    }};
 
 /// Components per pixel of a DPX image element's descriptor, 0 when not known here.
 std::uint64_t dpxComponents(unsigned descriptor) {
@@ -285,25 +263,44 @@ std::uint64_t dpxComponents(unsigned descriptor) {
   }
 }
 
-/// A DPX file: magic "SDPX" (either byte order), the image data offset at byte 4 and the
-/// total file size at 16; pixels per line and lines at 772 and 776, element 0's descriptor,
-/// bit size and encoding at 800, 803 and 806 (0: not run-length encoded).
-std::string dpxDamage(std::FILE* file, bool bigEndian) {
+/// A DPX image: magic "SDPX" (either byte order), element 0's descriptor at byte 800 and its
+/// encoding at 806 (0: not run-length encoded).
+constexpr FilmScanLayout kDpx{
+    "DPX image", 808, 4, 16, 772, 776, 803, [](const unsigned char* h, bool bigEndian) {
+      const unsigned encoding = bigEndian ? h[806] << 8 | h[807] : h[807] << 8 | h[806];
+      return encoding == 0 ? dpxComponents(h[800]) : 0;
+    }};
+
+/// A Cineon or DPX file against what its header says (see image_check.hpp): its pixels start
+/// inside it, it is as long as the header records and as long as its pixels need at the least.
+std::string filmScanDamage(std::FILE* file, bool bigEndian, const FilmScanLayout& layout) {
+  const std::string what = layout.name;
   const std::uint64_t size = fileSize(file);
-  unsigned char h[808];
-  if (!readAt(file, 0, h, sizeof h)) return "truncated DPX image: the file ends in its header";
+  unsigned char h[1024];
+  if (!readAt(file, 0, h, layout.headerBytes)) {
+    return "truncated " + what + ": the file ends in its header";
+  }
   const auto u32 = [&](std::size_t at) {
-    return bigEndian ? loadBigEndian(h + at) : loadLittleEndian(h + at);
+    return std::uint64_t{bigEndian ? loadBigEndian(h + at) : loadLittleEndian(h + at)};
   };
-  const std::uint64_t encoding =
-      bigEndian ? loadBigEndian16(h + 806) : (std::uint32_t{h[807]} << 8 | h[806]);
-  const std::uint64_t components = dpxComponents(h[800]), bits = h[803], width = u32(772),
-                      rows = u32(776);
-  const std::uint64_t pixelBytes =
-      encoding == 0 && bits <= 64 && width <= (1u << 20) && rows <= (1u << 20)
-          ? width * rows * components * bits / 8
-          : 0;
-  return filmScanDamage("DPX image", size, u32(4), u32(16), pixelBytes);
+  const std::uint64_t dataOffset = u32(layout.dataOffset), width = u32(layout.width),
+                      rows = u32(layout.rows), bits = h[layout.bits],
+                      components = layout.components(h, bigEndian);
+  const std::string truncated =
+      "truncated " + what + ": the file is " + std::to_string(size) + " bytes, ";
+  if (dataOffset >= size) {
+    return truncated + "its pixels would start at byte " + std::to_string(dataOffset);
+  }
+  if (const std::uint64_t recorded = u32(layout.fileSize); recorded > size) {
+    return truncated + "its header says " + std::to_string(recorded);
+  }
+  if (bits <= 64 && width <= (1u << 20) && rows <= (1u << 20)) {
+    const std::uint64_t pixelBytes = width * rows * components * bits / 8;
+    if (dataOffset + pixelBytes > size) {
+      return truncated + "its pixels need " + std::to_string(dataOffset + pixelBytes);
+    }
+  }
+  return "";
 }
 
 /// Scanlines per chunk of an OpenEXR compression, 0 for one not known here.
@@ -448,10 +445,10 @@ std::string imageDamage(const std::filesystem::path& path) {
   if (got >= 4) {
     const std::uint32_t magic = loadBigEndian(signature);
     if (magic == 0x802A5FD7u || magic == 0xD75F2A80u) {
-      return cineonDamage(file.get(), magic == 0x802A5FD7u);
+      return filmScanDamage(file.get(), magic == 0x802A5FD7u, kCineon);
     }
     if (magic == 0x53445058u || magic == 0x58504453u) {  // "SDPX", "XPDS"
-      return dpxDamage(file.get(), magic == 0x53445058u);
+      return filmScanDamage(file.get(), magic == 0x53445058u, kDpx);
     }
   }
   return "";
