@@ -1547,7 +1547,8 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         tiles[o] = touched.empty() ? std::vector<int>{kFirstUdimTile} : touched;
         if (touched.empty()) {
           report.warnings.push_back(output.file.string() + ": no triangle of " + uvSet +
-                                    " lies in a UDIM tile (1001 to 2000); tile 1001 holds "
+                                    " with a non-zero UV area lies in a UDIM tile (1001 to "
+                                    "2000); tile 1001 holds "
                                     "only the background");
         }
         // Tiles of an earlier bake the UVs no longer reach stay as they were: said, so that
@@ -1576,7 +1577,8 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
         tiles[o] = {output.tile};
         if (std::find(touched.begin(), touched.end(), output.tile) == touched.end()) {
           report.warnings.push_back(output.file.string() + ": no triangle of " + uvSet +
-                                    " lies in " + describeUdimTile(output.tile) +
+                                    " with a non-zero UV area lies in " +
+                                    describeUdimTile(output.tile) +
                                     "; the map holds only the background");
         }
       }

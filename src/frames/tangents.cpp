@@ -126,7 +126,8 @@ std::string missingTangentsWarning(const CornerTangents& tangents, const std::st
   return meshName + ": " + std::to_string(missing) + " of " +
          std::to_string(tangents.tangent.size()) +
          " face corners have no tangent (MikkTSpace found no usable position and UV differences "
-         "there, as when coordinates beyond ~1e19 overflow single precision): tangent-space "
+         "there: triangles of zero area in space or in UV, as a large polygon's slivers or "
+         "coordinates beyond ~1e19 that overflow single precision make them): tangent-space "
          "values there mean nothing";
 }
 

@@ -3,13 +3,16 @@
 /// mesh converter makes them.
 #include "subdiv/control_mesh.hpp"
 
+#include <opensubdiv/far/error.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -270,6 +273,28 @@ std::optional<CreaseIssue> findCreaseIssue(const Mesh& mesh, const SubdivisionOp
 
 namespace sgbake::subdiv_detail {
 
+namespace {
+
+/// The most corners of a face OpenSubdiv's topology takes (it counts them in 16 bits; a vertex's
+/// faces too, which OpenSubdiv's own error names).
+constexpr std::ptrdiff_t kMaxSubdivisionFaceSize = 65535;
+
+/// The last error OpenSubdiv reported on this thread. OpenSubdiv prints its errors and warnings
+/// to standard output unless given callbacks; they are kept here instead, for the error that
+/// names the mesh (a CSV written to standard output must not get a line of OpenSubdiv's).
+thread_local std::string lastOpenSubdivError;
+
+void keepOpenSubdivErrors() {
+  static std::once_flag installed;
+  std::call_once(installed, [] {
+    osd::Far::SetErrorCallback(
+        [](osd::Far::ErrorType, const char* message) { lastOpenSubdivError = message; });
+    osd::Far::SetWarningCallback([](const char*) {});
+  });
+}
+
+}  // namespace
+
 Status checkCreases(const Mesh& coarse, const SubdivisionOptions& options) {
   if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, options)) {
     return Error::badInput(coarse.source + ": " + issue->noun() + " " +
@@ -285,6 +310,13 @@ Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOption
   for (std::size_t f = 0; f < nf; ++f) {
     const auto first = coarse.cornerVertex.begin() + coarse.faceStart[f];
     const auto last = coarse.cornerVertex.begin() + coarse.faceStart[f + 1];
+    if (last - first > kMaxSubdivisionFaceSize) {
+      return Error::badInput(name + ": face " + std::to_string(f) + " has " +
+                             std::to_string(last - first) +
+                             " corners; OpenSubdiv subdivides faces "
+                             "of at most " +
+                             std::to_string(kMaxSubdivisionFaceSize));
+    }
     std::vector<std::uint32_t> sorted(first, last);
     std::sort(sorted.begin(), sorted.end());
     if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
@@ -323,9 +355,14 @@ Result<ControlMesh> buildControlMesh(const Mesh& coarse, const SubdivisionOption
       creases.vertexSharpness.empty() ? nullptr : creases.vertexSharpness.data();
   using RefinerFactory = osd::Far::TopologyRefinerFactory<osd::Far::TopologyDescriptor>;
   ControlMesh control;
+  keepOpenSubdivErrors();
+  lastOpenSubdivError.clear();
   control.refiner.reset(RefinerFactory::Create(
       descriptor, RefinerFactory::Options(osd::Sdc::SCHEME_CATMARK, sdcOptions(options))));
-  if (!control.refiner) return Error::badInput(name + ": OpenSubdiv cannot subdivide this topology");
+  if (!control.refiner) {
+    return Error::badInput(name + ": OpenSubdiv cannot subdivide this topology" +
+                           (lastOpenSubdivError.empty() ? "" : " (" + lastOpenSubdivError + ")"));
+  }
 
   control.channels = std::move(channels);
   control.faceSizes = std::move(faceSizes);

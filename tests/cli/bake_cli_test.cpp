@@ -335,16 +335,18 @@ TEST_F(BakeCliTest, MapsNoTriangleReachesAreBakedWithAWarning) {
       run({"bake", "--mesh", (dir_ / "away.obj").string(), "--map", "mask", "--size", "8",
            "--no-manifest", "-o", (dir_ / "m.png").string()});
   EXPECT_EQ(single.exitCode, 0) << single.err;
-  EXPECT_NE(single.err.find("sgbake: warning: " + (dir_ / "m.png").string() +
-                            ": no triangle of UV set 0 lies in the 0-1 UV square; the map holds "
-                            "only the background\n"),
+  EXPECT_NE(single.err.find(
+                "sgbake: warning: " + (dir_ / "m.png").string() +
+                ": no triangle of UV set 0 with a non-zero UV area lies in the 0-1 UV square; the "
+                "map holds "
+                "only the background\n"),
             std::string::npos)
       << single.err;
   const ProcessResult tiles =
       run({"bake", "--mesh", (dir_ / "away.obj").string(), "--map", "mask", "--size", "8",
            "--no-manifest", "-o", (dir_ / "m_<UDIM>.png").string()});
   EXPECT_EQ(tiles.exitCode, 0) << tiles.err;
-  EXPECT_NE(tiles.err.find("lies in a UDIM tile (1001 to 2000); tile 1001 holds only the "
+  EXPECT_NE(tiles.err.find("area lies in a UDIM tile (1001 to 2000); tile 1001 holds only the "
                            "background"),
             std::string::npos)
       << tiles.err;

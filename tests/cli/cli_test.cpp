@@ -222,9 +222,10 @@ TEST_F(CliTest, CornersWithoutATangentAreAWarning) {
   const fs::path huge = file("huge.obj", scaled("1e25"));
   const std::string warning = "sgbake: warning: " + huge.string() +
                               ": 4 of 4 face corners have no tangent (MikkTSpace found no usable "
-                              "position and UV differences there, as when coordinates beyond "
-                              "~1e19 overflow single precision): tangent-space values there mean "
-                              "nothing\n";
+                              "position and UV differences there: triangles of zero area in "
+                              "space or in UV, as a large polygon's slivers or coordinates beyond "
+                              "~1e19 that overflow single precision make them): tangent-space "
+                              "values there mean nothing\n";
   const ProcessResult tangents = sgbake({"tangents", huge.string()});
   ASSERT_EQ(tangents.exitCode, 0) << tangents.err;
   EXPECT_EQ(tangents.err, warning);

@@ -339,6 +339,36 @@ TEST(Subdivide, LevelZeroIsTheMeshAndBadLevelsAreNamed) {
   EXPECT_EQ(bad.error().message, "test.obj: face 0 uses a vertex twice and cannot be subdivided");
 }
 
+// OpenSubdiv counts a face's corners and a vertex's faces in 16 bits. A larger face is named
+// before OpenSubdiv sees it; a larger vertex fan is refused by OpenSubdiv, whose message (which
+// it would print to standard output, into a CSV written there) becomes part of the error.
+TEST(Subdivide, TopologyBeyondOpenSubdivsCountsIsNamed) {
+  Result<Mesh> bigFace = subdivideMesh(prism(65536), {1});
+  ASSERT_FALSE(bigFace);
+  EXPECT_EQ(bigFace.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(bigFace.error().message,
+            "test.obj: face 0 has 65536 corners; OpenSubdiv subdivides faces of at most 65535");
+
+  // 65,600 triangles around vertex 0.
+  const std::uint32_t n = 65600;
+  std::vector<Vec3f> positions{{0, 0, 0}};
+  std::vector<std::vector<std::uint32_t>> faces;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const double a = 2 * kPi * k / n;
+    positions.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0});
+    faces.push_back({0, 1 + k, 1 + (k + 1) % n});
+  }
+  testing::internal::CaptureStdout();
+  Result<Mesh> fan = subdivideMesh(meshOf(std::move(positions), faces), {1});
+  const std::string printed = testing::internal::GetCapturedStdout();
+  ASSERT_FALSE(fan);
+  EXPECT_EQ(fan.error().code, ErrorCode::kBadInput);
+  EXPECT_EQ(fan.error().message.rfind("test.obj: OpenSubdiv cannot subdivide this topology (", 0),
+            0u)
+      << fan.error().message;
+  EXPECT_EQ(printed, "");
+}
+
 TEST(Subdivide, AResultTooLargeForAMeshIsAnErrorNotAnOverflow) {
   // 520² quads at level 6: 1.1e9 faces, 4.4e9 corners, more than 32-bit corner indices reach.
   std::vector<Vec3f> positions;
