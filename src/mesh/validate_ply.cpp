@@ -224,6 +224,7 @@ Result<Header> parseHeader(std::string_view bytes, std::string_view name) {
       return header;
     }
     if (keyword == "format") {
+      if (sawFormat) return errorAt(name, n, "PLY header has a second format line");
       if (args.size() != 2) return errorAt(name, n, "PLY format line needs a format and a version");
       if (args[0] == "ascii") {
         header.format = Format::kAscii;
