@@ -101,6 +101,11 @@ int trackTemporary(const std::filesystem::path& path) {
   return -1;
 }
 
+/// Frees slot @p slot of trackTemporary (nothing for -1).
+void untrackTemporary(int slot) noexcept {
+  if (slot >= 0) g_tracked[slot].state.store(kFree, std::memory_order_release);
+}
+
 }  // namespace
 
 void removeTemporaryFiles() noexcept {
@@ -110,13 +115,11 @@ void removeTemporaryFiles() noexcept {
 }
 
 AtomicFile::AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd,
-                       bool durable)
-    : target_(std::move(target)), temp_(std::move(temp)), fd_(fd), durable_(durable) {
-  slot_ = trackTemporary(temp_);
-}
+                       bool durable, int slot)
+    : target_(std::move(target)), temp_(std::move(temp)), fd_(fd), durable_(durable), slot_(slot) {}
 
 void AtomicFile::forgetTemporary() noexcept {
-  if (slot_ >= 0) g_tracked[slot_].state.store(kFree, std::memory_order_release);
+  untrackTemporary(slot_);
   slot_ = -1;
 }
 
@@ -146,12 +149,16 @@ Result<AtomicFile> AtomicFile::create(const std::filesystem::path& target,
   std::mt19937_64 rng((static_cast<std::uint64_t>(entropy()) << 32) ^ entropy());
   for (int attempt = 0; attempt < kMaxNameAttempts; ++attempt) {
     std::filesystem::path temp = makeTempName(target, rng);
+    // Tracked before it exists, so that a signal from the moment it is created removes it.
+    const int slot = trackTemporary(temp);
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {
       keepPermissionsOf(target, fd);
-      return AtomicFile(target, std::move(temp), fd, options.durable);
+      return AtomicFile(target, std::move(temp), fd, options.durable, slot);
     }
-    if (errno != EEXIST) return ioError(ErrorCode::kBadInput, target, "cannot create file", errno);
+    const int err = errno;
+    untrackTemporary(slot);
+    if (err != EEXIST) return ioError(ErrorCode::kBadInput, target, "cannot create file", err);
   }
   return ioError(ErrorCode::kInternal, target, "cannot create a unique temporary file", EEXIST);
 }

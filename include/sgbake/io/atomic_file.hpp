@@ -75,7 +75,9 @@ class AtomicFile {
   const std::filesystem::path& tempPath() const { return temp_; }
 
  private:
-  AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd, bool durable);
+  /// @p slot: temp's entry in the table removeTemporaryFiles reads (made before the file was).
+  AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd, bool durable,
+             int slot);
   void forgetTemporary() noexcept;
 
   std::filesystem::path target_;
