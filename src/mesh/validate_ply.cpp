@@ -415,6 +415,8 @@ class AsciiBody {
   void locate(const Element& element, std::uint64_t index) {
     element_ = &element;
     index_ = index;
+    previousLine_ = tokenLine_;
+    firstToken_ = true;
   }
   /// Reads a position, normal or UV component (OpenMesh parses it as float).
   Status real(const Property& p, float& out) {
@@ -470,6 +472,17 @@ class AsciiBody {
     }
     token = text_.substr(begin, pos_ - begin);
     tokenLine_ = line_;
+    if (firstToken_) {
+      firstToken_ = false;
+      // Writers put one element on a line; one that starts where the last ended points at the
+      // line with a value too many, should the body run out.
+      if (previousLine_ != 0 && tokenLine_ == previousLine_ && midLine_.empty()) {
+        midLine_ = "; " + element_->name + " " + std::to_string(index_) + " starts on line " +
+                   std::to_string(tokenLine_) +
+                   ", where the one before it ends: that line may "
+                   "hold a value too many";
+      }
+    }
     return true;
   }
   Status nextToken(std::string_view& token) {
@@ -477,13 +490,16 @@ class AsciiBody {
     return errorAt(name_, line_,
                    "file is truncated: it ends inside " + element_->name + " " +
                        std::to_string(index_) + " (the header declares " +
-                       std::to_string(element_->count) + ")");
+                       std::to_string(element_->count) + ")" + midLine_);
   }
 
   std::string_view text_;
   std::size_t pos_ = 0;
   std::size_t line_;
   std::size_t tokenLine_ = 0;
+  std::size_t previousLine_ = 0;  ///< of the last value before the current element
+  bool firstToken_ = false;       ///< the current element's first value is still to be read
+  std::string midLine_;           ///< where an element first started mid-line, for errors
   std::string_view name_;
   const Element* element_ = nullptr;
   std::uint64_t index_ = 0;

@@ -93,6 +93,9 @@ const std::map<std::string, std::string>& expectedProblems() {
       {"ply_truncated_binary.ply", ".ply: file is truncated: it ends inside face 1"},
       {"ply_two_corner_face.ply", ":15: face has 2 corners (at least 3 are needed)"},
       {"ply_two_format_lines.ply", ":3: PLY header has a second format line"},
+      {"ply_value_too_many_ascii.ply",
+       ":19: file is truncated: it ends inside face 1 (the header declares 2); face 1 starts on "
+       "line 17, where the one before it ends: that line may hold a value too many"},
       {"ply_zero_normal.ply", ":14: normal has zero length"},
       {"unknown_extension.stl", ".stl: unsupported file extension '.stl'"},
   };
