@@ -213,8 +213,8 @@ struct BakeInput {
   /// the normal). Masks are the tessellation's coverage. Null: shade the mesh as it is.
   const LimitSurface* limit = nullptr;
   const SurfaceParameters* limitParameters = nullptr;
-  /// Per UV set, MikkTSpace frames of the loop triangles (computeLoopTriangleTangents: 3 per
-  /// triangle of Blender's looptris), or nullptr. Given, they are the SurfacePoint's tangent
+  /// Per UV set, MikkTSpace frames of Cycles' triangles (computeLoopTriangleTangents: 3 per
+  /// triangle, in loop-triangle order), or nullptr. Given, they are the SurfacePoint's tangent
   /// frames for tangent-space layers on that set, as Cycles' Normal Map node decodes with them;
   /// the map's own frame (kTangentNormal's) stays `tangents`, as Blender's baker uses the mesh's.
   std::array<const CornerTangents*, kMaxUvSets> triangleTangents{};
