@@ -355,7 +355,7 @@ void bake_detail::worldTriangle(const bake_detail::ShadingTriangle& tri, const W
 namespace {
 
 /// The unit normal of triangle (p0, p1, p2) as Cycles computes it (Mesh::Triangle::compute_normal,
-/// in float, the cross product scaled by the reciprocal of its length): MikkTSpace welds the
+/// in float, the cross product divided by its length): MikkTSpace welds the
 /// corners of a flat quad's two triangles where their normals are equal to the bit, so a normal
 /// that rounds otherwise gives some flat quads other tangents.
 Vec3f cyclesTriangleNormal(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2) {
