@@ -643,8 +643,12 @@ SceneMask parseMask(const json& value, const std::string& where, const InputPath
   SceneMask mask;
   mask.uvSet = defaultUv;
   if (value.is_string()) {
-    if (value.get<std::string>().empty()) fail(where, "'mask' is empty");
-    mask.image = paths(value.get<std::string>());
+    const std::string text = value.get<std::string>();
+    if (text.empty()) fail(where, "'mask' is empty");
+    if (text.find('\0') != std::string::npos) {
+      fail(where, "'mask' holds a NUL character, which no file name can");
+    }
+    mask.image = paths(text);
     return mask;
   }
   const ObjectReader reader(value, where, "a mask");
@@ -923,6 +927,17 @@ json parseJson(std::string_view text) {
     }
     return true;
   };
+  // nlohmann's parser takes a NUL byte for the end of the text: one anywhere is refused here,
+  // so that nothing after it is ignored.
+  if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    const std::string_view before = text.substr(0, nul);
+    const std::size_t line =
+        1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+    const std::size_t lineStart = before.rfind('\n');
+    const std::size_t column = nul - (lineStart == std::string_view::npos ? 0 : lineStart + 1) + 1;
+    fail("", "invalid JSON: a NUL byte at line " + std::to_string(line) + ", column " +
+                 std::to_string(column) + " (JSON text holds none; write \\u0000 in a string)");
+  }
   json document;
   try {
     document = json::parse(text.begin(), text.end(), callback);

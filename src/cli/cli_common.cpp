@@ -402,8 +402,12 @@ void printError(std::string_view message) {
   line.append(message);
   std::replace_if(line.begin(), line.end(), [](char ch) { return ch == '\n' || ch == '\r'; },
                   ' ');
+  // A NUL the message quotes (from a scene's string) would end the line for fputs: said as \0.
+  for (std::size_t at = line.find('\0'); at != std::string::npos; at = line.find('\0', at + 2)) {
+    line.replace(at, 1, "\\0");
+  }
   line += '\n';
-  std::fputs(line.c_str(), stderr);
+  std::fwrite(line.data(), 1, line.size(), stderr);
   std::fflush(stderr);
 }
 

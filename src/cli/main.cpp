@@ -3,6 +3,7 @@
 /// from the table below, and turns errors into one line on stderr and an exit code.
 #include <malloc.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -134,6 +135,16 @@ int run(int argc, char** argv) {
 
   for (const auto& [sub, action] : commands) {
     if (!sub->parsed()) continue;
+    // An option given an empty value ("--height-scale ''", from a script's unset variable) would
+    // read as 0 or as not given at all: refused, whatever the option.
+    for (const CLI::Option* option : sub->get_options()) {
+      const std::vector<std::string>& values = option->results();
+      if (std::find(values.begin(), values.end(), std::string()) != values.end()) {
+        printError(sub->get_name() + ": " + option->get_name() +
+                   " is given an empty value (see 'sgbake " + sub->get_name() + " --help')");
+        return kExitBadInput;
+      }
+    }
     const Status status = action();
     if (status) return kExitOk;
     printError(status.error().message);

@@ -145,6 +145,13 @@ Status runTangents(const TangentsArguments& args, const CLI::App& app) {
   if (args.output != "-" && mayBeSameFile(args.output, args.mesh)) {
     return Error::badInput("tangents: -o " + args.output + " is the mesh it reads");
   }
+  // As a scene's corners table: a CSV under another name (say an image's) would replace it.
+  if (args.output != "-" &&
+      toLowerAscii(std::filesystem::path(args.output).extension().string()) != ".csv") {
+    return Error::badInput("tangents: -o " + args.output +
+                           ": the table is written as CSV, its file must end in .csv (or - for "
+                           "standard output)");
+  }
   if (!args.meshOut.empty()) {
     if (toLowerAscii(std::filesystem::path(args.meshOut).extension().string()) != ".obj") {
       return Error::badInput("tangents: --mesh-out " + args.meshOut +

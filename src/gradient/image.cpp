@@ -80,9 +80,13 @@ Result<Image> loadImage(const std::filesystem::path& path, const LoadImageOption
   if (std::filesystem::is_directory(status)) {
     return fileError(path, "cannot read file (it is a directory)");
   }
-  if (std::filesystem::is_regular_file(status)) {
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (!ec && size == 0) return fileError(path, "file is empty");
+  // A device or pipe: decoders seek, and one (OpenImageIO's IFF reader on /dev/zero) never
+  // returns.
+  if (!std::filesystem::is_regular_file(status)) {
+    return fileError(path, "cannot read file (it is not a regular file: a device, pipe or socket)");
+  }
+  if (const std::uintmax_t size = std::filesystem::file_size(path, ec); !ec && size == 0) {
+    return fileError(path, "file is empty");
   }
   // A damaged PNG or JPEG is told here: decoded, it prints a line of its own (libpng) or comes
   // back padded with grey (libjpeg).

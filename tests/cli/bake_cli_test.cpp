@@ -148,6 +148,69 @@ TEST_F(BakeCliTest, BadScenesExitTwoNamingTheProblemAndCreateNothing) {
   EXPECT_NE(missing.err.find("none.json: cannot open scene (no such file)"), std::string::npos);
 }
 
+// Inputs a fuzzing run got through: a NUL byte ends nlohmann's JSON (what follows was ignored)
+// and cut the printed error short (fputs); a mask spelled as a string kept a NUL; an empty
+// option value read as 0 or as not given; a device as the image convert reads never returned;
+// `tangents -o` replaced a file of any name with CSV.
+TEST_F(BakeCliTest, NulBytesEmptyValuesDevicesAndOddTableNamesAreBadInput) {
+  writeFile(dir_ / "scene.json", "{}");
+  const std::set<std::string> before = listDirectory(dir_);
+  const std::string out = R"({"map": "mask", "file": "m.png", "size": 8})";
+  expectBadScene(bakeScene(planeScene(kHeightLayer, out) + std::string("\0 not JSON {{", 13)),
+                 "invalid JSON: a NUL byte at line ", before, dir_);
+  expectBadScene(
+      bakeScene(planeScene(R"({"type": "height", "image": "h.png", "mask": "h.png\u0000x"})",
+                           R"({"map": "height", "file": "h.exr", "size": 8})")),
+      "layers[0].mask: 'mask' holds a NUL character", before, dir_);
+  const ProcessResult quoted =
+      bakeScene(planeScene(R"({"type": "height", "image": "h.png", "sca\u0000le": 1})", out));
+  expectBadScene(quoted, "unknown key 'sca\\0le'", before, dir_);
+  EXPECT_TRUE(quoted.err.ends_with("\n")) << "the whole line: " << quoted.err;
+
+  for (const std::vector<std::string>& flags : {std::vector<std::string>{"--height-scale", ""},
+                                                {"--transform", ""},
+                                                {"--out-dir", ""},
+                                                {"--bit-depth", ""}}) {
+    std::vector<std::string> args{"bake",
+                                  "--mesh",
+                                  (dir_ / "plane.obj").string(),
+                                  "--height",
+                                  (dir_ / "h.png").string(),
+                                  "--map",
+                                  "tangent-normal",
+                                  "--size",
+                                  "8",
+                                  "-o",
+                                  (dir_ / "t.png").string(),
+                                  "--no-manifest"};
+    if (flags[0] != "--height-scale") args.insert(args.end(), {"--height-scale", "0.1"});
+    args.insert(args.end(), flags.begin(), flags.end());
+    const ProcessResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << flags[0];
+    expectOneErrorLine(r);
+    EXPECT_NE(r.err.find("bake: " + flags[0] + " is given an empty value"), std::string::npos)
+        << r.err;
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+
+  const ProcessResult device =
+      run({"convert", "/dev/zero", "--mesh", (dir_ / "plane.obj").string(), "--from", "object",
+           "--to", "tangent", "-o", (dir_ / "c.png").string()});
+  EXPECT_EQ(device.exitCode, 2);
+  expectOneErrorLine(device);
+  EXPECT_NE(device.err.find("/dev/zero: cannot read file (it is not a regular file"),
+            std::string::npos)
+      << device.err;
+
+  writeFile(dir_ / "picture.png", "not a table");
+  const ProcessResult table =
+      run({"tangents", (dir_ / "plane.obj").string(), "-o", (dir_ / "picture.png").string()});
+  EXPECT_EQ(table.exitCode, 2);
+  expectOneErrorLine(table);
+  EXPECT_NE(table.err.find("its file must end in .csv"), std::string::npos) << table.err;
+  EXPECT_EQ(readFile(dir_ / "picture.png"), "not a table");
+}
+
 TEST_F(BakeCliTest, UnreadableImageExitsTwoAndCreatesNothing) {
   writeFile(dir_ / "broken.png", "this is not a png");
   writeFile(dir_ / "scene.json", "{}");
