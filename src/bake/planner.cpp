@@ -1373,18 +1373,47 @@ Status bakeImageTile(const BakeInput& input, const BakeSettings& settings,
 }
 
 /// Creates the directory of @p file when it is missing.
-Status ensureDirectory(const fs::path& file) {
-  const fs::path dir = file.parent_path();
-  if (dir.empty()) return Ok{};
-  std::error_code ec;
-  if (fs::is_directory(dir, ec)) return Ok{};
-  fs::create_directories(dir, ec);
-  if (ec) {
-    return Error::badInput(file.string() + ": cannot create directory " + dir.string() + ": " +
-                           ec.message());
+/// Directories a run created, removed again (when still empty, deepest first) unless the run
+/// succeeds: a failed bake leaves the file system as it found it.
+class CreatedDirectories {
+ public:
+  CreatedDirectories() = default;
+  CreatedDirectories(const CreatedDirectories&) = delete;
+  CreatedDirectories& operator=(const CreatedDirectories&) = delete;
+  ~CreatedDirectories() {
+    std::error_code ec;
+    for (auto dir = created_.rbegin(); dir != created_.rend(); ++dir) fs::remove(*dir, ec);
   }
-  return Ok{};
-}
+  /// The run succeeded: the directories stay.
+  void keep() { created_.clear(); }
+  /// Creates the directory of @p file and the missing ones above it, noting each.
+  Status ensureFor(const fs::path& file) {
+    const fs::path dir = file.parent_path();
+    if (dir.empty()) return Ok{};
+    std::error_code ec;
+    if (fs::is_directory(dir, ec)) return Ok{};
+    std::vector<fs::path> missing;  // dir and its missing ancestors, deepest first
+    for (fs::path d = dir; !d.empty() && !fs::exists(d, ec); d = d.parent_path()) {
+      missing.push_back(d);
+      if (d == d.parent_path()) break;
+    }
+    for (auto d = missing.rbegin(); d != missing.rend(); ++d) {
+      if (fs::create_directory(*d, ec)) created_.push_back(*d);
+      if (ec) {
+        return Error::badInput(file.string() + ": cannot create directory " + d->string() + ": " +
+                               ec.message());
+      }
+    }
+    if (!fs::is_directory(dir, ec)) {
+      return Error::badInput(file.string() + ": cannot create directory " + dir.string() + ": " +
+                             (ec ? ec.message() : std::string("Not a directory")));
+    }
+    return Ok{};
+  }
+
+ private:
+  std::vector<fs::path> created_;
+};
 
 }  // namespace
 
@@ -1397,6 +1426,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     report.outputs.push_back(std::move(entry));
   }
   if (plan.outputsToBake() == 0) return report;
+  CreatedDirectories directories;  // removed again if the run fails
 
   bool readsOrWritesImages = !plan.images.empty();
   for (const PlannedOutput& output : plan.outputs) {
@@ -1593,7 +1623,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
     const SceneOutput& output = s.outputs[plan.outputs[o].sceneOutput];
     for (const int tile : tiles[o]) {
       const fs::path file = tileFile(output, tile);
-      if (Status ok = ensureDirectory(file); !ok) return ok.error();
+      if (Status ok = directories.ensureFor(file); !ok) return ok.error();
       Result<AtomicFile> probe = AtomicFile::create(file);  // removed when it goes out of scope
       if (!probe) return probe.error();
     }
@@ -1720,6 +1750,7 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
   if (Status ok = recordInManifests(manifestEntries); !ok) return ok.error();
   report.writeSeconds += secondsSince(start);
   progress.finishAll();
+  directories.keep();
   return report;
 }
 

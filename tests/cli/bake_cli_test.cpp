@@ -211,6 +211,23 @@ TEST_F(BakeCliTest, NulBytesEmptyValuesDevicesAndOddTableNamesAreBadInput) {
   EXPECT_EQ(readFile(dir_ / "picture.png"), "not a table");
 }
 
+// The directories a failed run created for its outputs are removed again, deepest first; a
+// run that succeeds keeps them.
+TEST_F(BakeCliTest, FailedRunsRemoveTheDirectoriesTheyCreated) {
+  fs::create_directories(dir_ / "taken.png");  // an output that is a directory: bad input
+  writeFile(dir_ / "scene.json", "{}");
+  const std::set<std::string> before = listDirectory(dir_);
+  expectBadScene(bakeScene(R"({"mesh": "plane.obj", "outputs": [
+                              {"map": "mask", "file": "new/deeper/a.png", "size": 8},
+                              {"map": "mask", "file": "taken.png", "size": 8}]})"),
+                 "taken.png: is a directory", before, dir_);
+  EXPECT_FALSE(fs::exists(dir_ / "new"));
+  const ProcessResult good = bakeScene(
+      R"({"mesh": "plane.obj", "outputs": [{"map": "mask", "file": "new/deeper/a.png", "size": 8}]})");
+  EXPECT_EQ(good.exitCode, 0) << good.err;
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "new" / "deeper" / "a.png"));
+}
+
 TEST_F(BakeCliTest, UnreadableImageExitsTwoAndCreatesNothing) {
   writeFile(dir_ / "broken.png", "this is not a png");
   writeFile(dir_ / "scene.json", "{}");
