@@ -37,8 +37,13 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
     loaded.mesh = std::move(coarse);
     return Ok{};
   }
-  // Creases that do not fit the mesh are the scene's mistake: name its key.
+  // Creases that do not fit the mesh are the scene's mistake: name its key, or the option of a
+  // scene made from the command line.
   if (const std::optional<CreaseIssue> issue = findCreaseIssue(coarse, subdivision.options())) {
+    if (scene.source.empty() && !scene.inMemory) {
+      return Error::badInput(scene.mesh.string() + ": " + issue->flag() + " #" +
+                             std::to_string(issue->index + 1) + ": " + issue->what);
+    }
     return Error::badInput(scenePrefix(scene) + "subdivision." + issue->key() + "[" +
                            std::to_string(issue->index) + "]: " + issue->what +
                            (scene.inMemory ? std::string() : " (" + scene.mesh.string() + ")"));

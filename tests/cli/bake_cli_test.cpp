@@ -1171,6 +1171,12 @@ TEST_F(BakeCliTest, CreasesFromSceneAndFlags) {
     const ProcessResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args[4] << " " << args[5] << ": " << r.err;
     expectOneErrorLine(r);
+    // A scene made from options names the option, not a key no one wrote.
+    if (args[0] == "bake") {
+      EXPECT_NE(r.err.find(mesh + ": --vertex-crease #1: vertex 99 is out of range"),
+                std::string::npos)
+          << r.err;
+    }
   }
   EXPECT_EQ(listDirectory(dir_), before);
 }

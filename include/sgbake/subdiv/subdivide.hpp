@@ -131,6 +131,11 @@ struct CreaseIssue {
   const char* key() const {
     return sharp ? "sharp_edges" : edge ? "edge_creases" : "vertex_creases";
   }
+  /// @brief The command-line option that gives the list's entries: "--edge-crease",
+  /// "--vertex-crease" or "--sharp-edge".
+  const char* flag() const {
+    return sharp ? "--sharp-edge" : edge ? "--edge-crease" : "--vertex-crease";
+  }
   /// @brief The list's entries in words: "edge crease", "vertex crease" or "sharp edge".
   const char* noun() const {
     return sharp ? "sharp edge" : edge ? "edge crease" : "vertex crease";
