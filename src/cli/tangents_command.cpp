@@ -245,7 +245,7 @@ CommandAction defineTangentsCommand(CLI::App& app) {
       ->required()
       ->type_name("FILE");
   app.add_option("-o,--output", args->output,
-                 "Write the CSV to FILE instead of standard output ('-')")
+                 "Write the CSV to FILE (ending in .csv) instead of standard output ('-')")
       ->type_name("FILE");
   app.add_option("--uv", args->uvSet, "UV set (0 = the first one in the file)")
       ->type_name("N")
