@@ -10,7 +10,11 @@
 //   - BM_TangentNormalBands/threads:N — the same map by bakeMapRows (bands of rows in a reused
 //     ring, what the CLI runs), and BM_TangentNormalBandsMargin16/threads:N with each band's
 //     final rows padded in place (extendMarginRowsInPlace, margin 16) as the CLI pads them;
-//   - BM_ObjectNormal/threads:N — the object-space map of the same scene (bakeMap);
+//   - BM_ObjectNormal/threads:N, BM_SurfaceGradient/threads:N — the object-space normal and
+//     surface-gradient maps of the same scene (bakeMap);
+//   - BM_TangentNormalStretched, BM_ObjectNormalStretched, BM_SurfaceGradientStretched — the
+//     same three maps of Suzanne placed with the scale (2, 1, 0.5), shaded in world space as
+//     Cycles shades an object whose scale was never applied (BakeInput::transform);
 //   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
 //   - BM_Mask/threads:N — the raster and coverage alone (no shading);
 //   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map.
@@ -32,6 +36,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/image.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/mesh/io.hpp"
 
 namespace {
@@ -82,13 +87,20 @@ const Scene& scene() {
   return *s;
 }
 
-void bake(benchmark::State& state, MapKind kind, bool withLayers) {
+/// The stretched placement of the *Stretched benchmarks: Suzanne scaled (2, 1, 0.5), an object
+/// whose scale was never applied.
+const ObjectTransform kStretched{Mat3::diagonal({2, 1, 0.5}), {}};
+
+void bake(benchmark::State& state, MapKind kind, bool withLayers,
+          const ObjectTransform* transform = nullptr) {
   const Scene& s = scene();
   BakeSettings settings;
   settings.map = kind;
   settings.width = settings.height = kBakeSize;
   settings.threads = static_cast<int>(state.range(0));
-  const BakeInput input{&s.mesh, &s.tangents, withLayers ? std::span<const Layer>(s.layers) : std::span<const Layer>()};
+  BakeInput input{&s.mesh, &s.tangents,
+                  withLayers ? std::span<const Layer>(s.layers) : std::span<const Layer>()};
+  input.transform = transform;
   for (auto _ : state) {
     Result<FloatImage> image = bakeMap(input, settings);
     if (!image) state.SkipWithError(image.error().message.c_str());
@@ -99,6 +111,16 @@ void bake(benchmark::State& state, MapKind kind, bool withLayers) {
 
 void BM_TangentNormal(benchmark::State& state) { bake(state, MapKind::kTangentNormal, true); }
 void BM_ObjectNormal(benchmark::State& state) { bake(state, MapKind::kObjectNormal, true); }
+void BM_TangentNormalStretched(benchmark::State& state) {
+  bake(state, MapKind::kTangentNormal, true, &kStretched);
+}
+void BM_ObjectNormalStretched(benchmark::State& state) {
+  bake(state, MapKind::kObjectNormal, true, &kStretched);
+}
+void BM_SurfaceGradientStretched(benchmark::State& state) {
+  bake(state, MapKind::kSurfaceGradient, true, &kStretched);
+}
+void BM_SurfaceGradient(benchmark::State& state) { bake(state, MapKind::kSurfaceGradient, true); }
 void BM_TangentNormalNoLayers(benchmark::State& state) { bake(state, MapKind::kTangentNormal, false); }
 void BM_Mask(benchmark::State& state) { bake(state, MapKind::kMask, false); }
 
@@ -168,6 +190,10 @@ BENCHMARK(BM_TangentNormal)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBands)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBandsMargin16)->Apply(threadArgs);
 BENCHMARK(BM_ObjectNormal)->Apply(threadArgs);
+BENCHMARK(BM_SurfaceGradient)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalStretched)->Apply(threadArgs);
+BENCHMARK(BM_ObjectNormalStretched)->Apply(threadArgs);
+BENCHMARK(BM_SurfaceGradientStretched)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalNoLayers)->Apply(threadArgs);
 BENCHMARK(BM_Mask)->Apply(threadArgs);
 BENCHMARK(BM_ExtendMargin16)->Apply(threadArgs);

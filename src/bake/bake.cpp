@@ -261,8 +261,7 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   base.green = settings.green;
   // The object's transform (not for height maps, whose heights it does not change): a rotation
   // (or mirror) with a uniform scale s shades as object space with heights divided by s
-  // (ObjectTransform::uniformScale), on the lane-parallel paths; any other is shaded in world
-  // space, sample by sample.
+  // (ObjectTransform::uniformScale); any other is shaded in world space (world_shading.hpp).
   std::vector<Layer> scaledLayers;
   WorldSpace world;
   if (input.transform != nullptr && !input.transform->shadesAsObjectSpace() &&
@@ -297,13 +296,10 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   RasterOutput output{kZero, false};
   output.blank = blank;
   // On a limit surface every sample is shaded from the surface under it (LimitShader).
-  // In world space, sample by sample (PerSampleShader).
   const auto run = [&](auto shader) {
     if (input.limit != nullptr) {
       rasterize(job, LimitShader<decltype(shader)>(shader, input.limit, input.limitParameters),
                 output, target);
-    } else if (base.world != nullptr) {
-      rasterize(job, PerSampleShader<decltype(shader)>{shader}, output, target);
     } else {
       rasterize(job, shader, output, target);
     }

@@ -5,6 +5,7 @@
 /// ObjectNormalShader with their per-sample shade() bit for bit.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -50,8 +51,8 @@ struct BakeShaderBase {
   std::array<gradient_detail::PreparedUvFrame, kMaxUvSets> preparedUv{};
 
   /// Non-null: the object is shaded in world space through this transform, as Cycles shades
-  /// it (world_shading.hpp), by shade() only (the lane-parallel paths are object-space: runBake
-  /// wraps the shader in PerSampleShader).
+  /// it (world_shading.hpp): by shade(), and by the lane-parallel paths through
+  /// batchShadeInWorld where every layer is one they take whole.
   const WorldSpace* world = nullptr;
   /// What shading in world space keeps per triangle and per sample.
   struct WorldScratch {
@@ -362,18 +363,30 @@ inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& 
   }
 }
 
-/// shader.uvHeightGradient() of an unmasked UV height layer for every sample of @p s (of the
-/// shader's current triangle), added as gamma += factor·Γ.
-inline void batchUvHeightGradient(const BakeShaderBase& shader, const SampleBatch& s,
-                                  const UvHeightSource& src, double factor, const Lanes3& unitN,
-                                  Lanes3& gamma) {
+/// Whether the batch paths take @p layer whole (batchUvHeightGradient): an unmasked UV height
+/// layer of Strength 1 on the surface. Any other takes the per-sample path.
+inline bool batchesWhole(const Layer& layer) {
+  const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+  return uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1 &&
+         layer.base == LayerBase::kSurface;
+}
+
+/// The Γ of an unmasked UV height layer for every sample of @p s on triangle @p tri (whose
+/// SurfacePoint fields constant over it are @p point's and whose prepared UV frames are
+/// @p prepared), with the unit normals @p unitN, added as gamma += factor·Γ: what
+/// BakeShaderBase::uvHeightGradient computes on the shader's triangle, and the world-space
+/// evaluator (shadeLayersInWorld) on its world triangle.
+inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint& point,
+                                  const gradient_detail::PreparedUvFrame* prepared,
+                                  const SampleBatch& s, const UvHeightSource& src, double factor,
+                                  const Lanes3& unitN, Lanes3& gamma) {
   const std::size_t n = static_cast<std::size_t>(s.count);
   Lanes3 layer{};
   const std::size_t set = static_cast<std::size_t>(src.uvSet);
-  if (src.texture != nullptr && hasUvSet(shader.point, src.uvSet) && shader.preparedUv[set].valid) {
-    const gradient_detail::PreparedUvFrame& frame = shader.preparedUv[set];
+  if (src.texture != nullptr && hasUvSet(point, src.uvSet) && prepared[set].valid) {
+    const gradient_detail::PreparedUvFrame& frame = prepared[set];
     std::array<ScalarSample, SampleBatch::kMax> h;
-    batchUvHeightSamples(shader.tri, s, src, h);
+    batchUvHeightSamples(tri, s, src, h);
     // gradientFromPreparedUvFrame with dhduv = uvDerivativesFromTexture(h, tiling, scale).
     const double ku = src.scale * src.tiling.x, kv = src.scale * src.tiling.y;
     const double tolerance = gradient_detail::guardedTolerance(src.minFrameSine);
@@ -410,10 +423,9 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
   for (std::size_t i = 0; i < n; ++i) gamma.x[i] = gamma.y[i] = gamma.z[i] = 0.0;
   for (const Layer& layer : shader.layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-    const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-    if (uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1 &&
-        layer.base == LayerBase::kSurface) {
-      batchUvHeightGradient(shader, s, *uvHeight, layer.weight, unitN, gamma);
+    if (batchesWhole(layer)) {
+      batchUvHeightGradient(shader.tri, shader.point, shader.preparedUv.data(), s,
+                            std::get<UvHeightSource>(layer.source), layer.weight, unitN, gamma);
       continue;
     }
     for (std::size_t i = 0; i < n; ++i) {
@@ -461,6 +473,91 @@ inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& 
   }
 }
 
+/// m·v of every lane of @p v, as Mat3's operator* computes it.
+inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3& out) {
+  const Vec3d c0 = m.col[0], c1 = m.col[1], c2 = m.col[2];
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = v.x[i], y = v.y[i], z = v.z[i];
+    out.x[i] = x * c0.x + y * c1.x + z * c2.x;
+    out.y[i] = x * c0.y + y * c1.y + z * c2.y;
+    out.z[i] = x * c0.z + y * c1.z + z * c2.z;
+  }
+}
+
+/// shadeInWorld() of every sample of @p s (the shader's `world` non-null), lane-parallel: the
+/// guarded world normal @p normal and the unguarded @p unguarded, both unit. Lanes it cannot
+/// finish the common way are flagged in @p slow for the per-sample path: those of
+/// batchTexelFrames' fallbacks on the world triangle, an N̂ − Γ that does not normalize the
+/// common way, a back-facing N̂ and a normal the guard turns; and every lane when some layer is
+/// not one the batch takes whole (batchesWhole), as the world evaluator's other sources are
+/// per sample. Out of line: the object-space paths stay as the compiler laid them out.
+[[gnu::noinline]] inline void batchShadeInWorld(BakeShaderBase& shader, const SampleBatch& s,
+                                                Lanes3& normal, Lanes3& unguarded,
+                                                LaneFlags& slow) {
+  const std::size_t n = static_cast<std::size_t>(s.count);
+  BakeShaderBase::WorldScratch& w = shader.worldScratch.get();
+  BatchFrames fw;
+  batchTexelFrames(w.tri, s, fw);
+  const Lanes3& unitN = fw.unitN;
+  for (std::size_t i = 0; i < n; ++i) slow[i] = slow[i] | fw.slow[i];
+  if (shader.layers.empty()) {  // the world shading normal, unbumped and unguarded
+    normal = unitN;
+    unguarded = unitN;
+    return;
+  }
+  Lanes3 gamma;
+  for (std::size_t i = 0; i < n; ++i) gamma.x[i] = gamma.y[i] = gamma.z[i] = 0.0;
+  for (const Layer& layer : shader.layers) {
+    if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+    if (!batchesWhole(layer)) {
+      std::fill_n(slow.begin(), n, 1);
+      return;
+    }
+    batchUvHeightGradient(w.tri, w.point, w.preparedUv.data(), s,
+                          std::get<UvHeightSource>(layer.source), layer.weight, unitN, gamma);
+  }
+  const Vec3d ng = w.tri.faceNormal;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double nx = unitN.x[i], ny = unitN.y[i], nz = unitN.z[i];
+    const bool finite = finiteLane(gamma.x[i]) & finiteLane(gamma.y[i]) & finiteLane(gamma.z[i]);
+    // unguarded = normalizeOr(N̂ − Γ, N̂) in its common case.
+    const double vx = nx - (finite ? gamma.x[i] : 0.0);
+    const double vy = ny - (finite ? gamma.y[i] : 0.0);
+    const double vz = nz - (finite ? gamma.z[i] : 0.0);
+    const double len2 = vx * vx + vy * vy + vz * vz;
+    const double inv = 1 / std::sqrt(len2);
+    const double ux = inv * vx, uy = inv * vy, uz = inv * vz;
+    // backFacing(N̂, Ng), then reflectsAboveSurface(unguarded, Ng, N̂) of validReflectionNormal.
+    const double iz = nx * ng.x + ny * ng.y + nz * ng.z;
+    const double ui = ux * nx + uy * ny + uz * nz;
+    const double un = ux * ng.x + uy * ng.y + uz * ng.z;
+    const bool above = 2 * ui * un - iz * 1.0 >= std::min(0.9 * iz, 0.01) * 1.0;
+    slow[i] = slow[i] | (iz < 0) | !((len2 > 0) & finiteLane(len2) & above);
+    unguarded.x[i] = normal.x[i] = ux;
+    unguarded.y[i] = normal.y[i] = uy;
+    unguarded.z[i] = normal.z[i] = uz;
+  }
+}
+
+/// worldGradient() of every sample of @p s (the shader's `world` non-null; @p f the frames of
+/// its triangle): the object-space Γ of the unguarded world normal (objectSpaceGradient), from
+/// the lane-parallel world shading.
+[[gnu::noinline]] inline void batchWorldGradients(BakeShaderBase& shader, const SampleBatch& s,
+                                                  BatchFrames& f, Lanes3& gamma) {
+  const std::size_t n = static_cast<std::size_t>(s.count);
+  Lanes3 normal, unguarded, back;
+  batchShadeInWorld(shader, s, normal, unguarded, f.slow);
+  batchTransform(shader.world->normalToObject, n, unguarded, back);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3d g = gradientFromObjectNormal({back.x[i], back.y[i], back.z[i]},
+                                             {f.unitN.x[i], f.unitN.y[i], f.unitN.z[i]});
+    const bool finite = isFinite(g);
+    gamma.x[i] = finite ? g.x : 0.0;
+    gamma.y[i] = finite ? g.y : 0.0;
+    gamma.z[i] = finite ? g.z : 0.0;
+  }
+}
+
 struct TangentNormalShader : BakeShaderBase {
   static constexpr int kChannels = 3;
   /// A positive multiple of perturbed(b, f): objectToTangent normalizes its result, and
@@ -492,18 +589,34 @@ struct TangentNormalShader : BakeShaderBase {
 
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames).
   void shadeBatch(const SampleBatch& s, double* out) {
-    const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
     if (shadedElsewhere) [[unlikely]]
       f.slow.fill(1);  // shade() takes the own frame
+    if (world != nullptr) [[unlikely]]
+      return shadeBatchInWorld(s, f, out);
 
     // The normal to express in tangent space: N̂, or N̂ − Γ (unnormalizedPerturbed).
     Lanes3 perturbedDirections;
     const Lanes3& v = layers.empty() ? f.unitN : perturbedDirections;
     if (!layers.empty()) batchPerturbedDirections(*this, s, f.unitN, perturbedDirections, f.slow);
+    encodeBatch(s, f, v, out);
+  }
 
-    // objectToTangent(f, v), the green convention and encodeNormal.
+  /// shade() in world space of every sample of @p s, frames @p f: the guarded world normal
+  /// brought back as a normal (M^T), encoded in the object's frame.
+  [[gnu::noinline]] void shadeBatchInWorld(const SampleBatch& s, BatchFrames& f, double* out) {
+    Lanes3 normal, unguarded, v;
+    batchShadeInWorld(*this, s, normal, unguarded, f.slow);
+    batchTransform(world->normalToObject, static_cast<std::size_t>(s.count), normal, v);
+    encodeBatch(s, f, v, out);
+  }
+
+  /// objectToTangent(f, v) of every sample, the green convention and encodeNormal into @p out;
+  /// then shade() of the slow lanes.
+  [[gnu::always_inline]] void encodeBatch(const SampleBatch& s, BatchFrames& f, const Lanes3& v,
+                                          double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
     constexpr double kMinDet = kMinTexelFrameSine * kMinTexelFrameSine;
     const double greenSign = green == NormalMapGreen::kDirectX ? -1.0 : 1.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -553,6 +666,8 @@ struct ObjectNormalShader : BakeShaderBase {
     const std::size_t n = static_cast<std::size_t>(s.count);
     BatchFrames f;
     batchTexelFrames(tri, s, f);
+    if (world != nullptr) [[unlikely]]
+      return shadeBatchInWorld(s, f, out);
     Lanes3 perturbedNormals;
     const Lanes3& v = layers.empty() ? f.unitN : perturbedNormals;
     if (!layers.empty()) {
@@ -578,6 +693,24 @@ struct ObjectNormalShader : BakeShaderBase {
       out[3 * i] = 0.5 * v.x[i] + 0.5;
       out[3 * i + 1] = 0.5 * v.y[i] + 0.5;
       out[3 * i + 2] = 0.5 * v.z[i] + 0.5;
+    }
+    shadeSlowLanes(*this, s, f.slow, out);
+  }
+
+  /// shade() in world space of every sample of @p s, frames @p f: the guarded world normal
+  /// brought back as a direction (M^{-1}), normalized the common way of normalizeOr.
+  [[gnu::noinline]] void shadeBatchInWorld(const SampleBatch& s, BatchFrames& f, double* out) {
+    const std::size_t n = static_cast<std::size_t>(s.count);
+    Lanes3 normal, unguarded, d;
+    batchShadeInWorld(*this, s, normal, unguarded, f.slow);
+    batchTransform(world->directionToObject, n, normal, d);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double len2 = d.x[i] * d.x[i] + d.y[i] * d.y[i] + d.z[i] * d.z[i];
+      const double inv = 1 / std::sqrt(len2);
+      f.slow[i] = f.slow[i] | !((len2 > 0) & finiteLane(len2));
+      out[3 * i] = 0.5 * (inv * d.x[i]) + 0.5;
+      out[3 * i + 1] = 0.5 * (inv * d.y[i]) + 0.5;
+      out[3 * i + 2] = 0.5 * (inv * d.z[i]) + 0.5;
     }
     shadeSlowLanes(*this, s, f.slow, out);
   }
@@ -641,7 +774,10 @@ struct DerivativeShader : BakeShaderBase {
     BatchFrames f;
     batchTexelFrames(tri, s, f);
     Lanes3 gamma;
-    batchGradients(*this, s, f.unitN, gamma);
+    if (world != nullptr) [[unlikely]]
+      batchWorldGradients(*this, s, f, gamma);
+    else
+      batchGradients(*this, s, f.unitN, gamma);
     const Vec3d du = tri.bakeDPdu, dv = tri.bakeDPdv;
     for (std::size_t i = 0; i < n; ++i) {
       out[2 * i] = gamma.x[i] * du.x + gamma.y[i] * du.y + gamma.z[i] * du.z;
@@ -664,7 +800,10 @@ struct SurfaceGradientShader : BakeShaderBase {
     BatchFrames f;
     batchTexelFrames(tri, s, f);
     Lanes3 gamma;
-    batchGradients(*this, s, f.unitN, gamma);
+    if (world != nullptr) [[unlikely]]
+      batchWorldGradients(*this, s, f, gamma);
+    else
+      batchGradients(*this, s, f.unitN, gamma);
     for (std::size_t i = 0; i < n; ++i) {
       out[3 * i] = gamma.x[i];
       out[3 * i + 1] = gamma.y[i];
@@ -686,18 +825,6 @@ struct BitangentShader : BakeShaderBase {
   void shade(const Vec3d& b, int, int, double* out) {
     put(encodeNormal(normalizeOr(texelFrame(tri, b).bitangent, Vec3d{})), out);
   }
-};
-
-/// A bake shader shading sample by sample: without its lane-parallel shadeBatch, which is
-/// object-space (a bake in world space, BakeShaderBase::world, goes through this).
-template <class Inner>
-struct PerSampleShader {
-  static constexpr int kChannels = Inner::kChannels;
-  Inner inner;
-  void beginTriangle(std::uint32_t triangle, const std::array<std::uint32_t, 3>& corners) {
-    inner.beginTriangle(triangle, corners);
-  }
-  void shade(const Vec3d& b, int x, int y, double* out) { inner.shade(b, x, y, out); }
 };
 
 struct MaskShader {

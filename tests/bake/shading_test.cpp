@@ -3,19 +3,23 @@
 // triangles and barycentrics, every kind of layer stack
 // (none, image heights through sampleMany, other height textures, masked and volume layers
 // through the per-sample path, overflowing gradients), both green conventions, and the rare
-// samples that take a fallback (an interpolated normal or tangent that vanishes).
+// samples that take a fallback (an interpolated normal or tangent that vanishes); each on the
+// object as it is and on the object stretched in the world (shaded in world space).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
-#include <type_traits>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bake/shaders.hpp"
 #include "bake_test_util.hpp"
+#include "sgbake/core/math.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/volume.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 
 namespace sgbake {
 namespace {
@@ -102,15 +106,22 @@ class ShadeBatch : public ::testing::Test {
   }
 
   /// shadeBatch of random batches of every size against shade(), sample by sample, bit for bit,
-  /// for the tangent-space and the object-space normal shaders.
+  /// for every shader that has one: on the object as it is, and on the object placed in the
+  /// world by a stretching transform (shaded in world space, BakeShaderBase::world).
   void expectBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
                                 const std::string& what) {
-    expectShaderBatchEqualsSamples<bake_detail::TangentNormalShader>(layers, green, what);
-    expectShaderBatchEqualsSamples<bake_detail::ObjectNormalShader>(layers, green,
-                                                                    what + " (object space)");
-    expectShaderBatchEqualsSamples<bake_detail::SurfaceGradientShader>(layers, green,
-                                                                       what + " (surface gradient)");
-    expectShaderBatchEqualsSamples<bake_detail::DerivativeShader>(layers, green, what + " (derivative)");
+    for (const WorldSpace* space : {static_cast<const WorldSpace*>(nullptr), &stretched}) {
+      world = space;
+      const std::string where = what + (space != nullptr ? ", stretched in the world" : "");
+      expectShaderBatchEqualsSamples<bake_detail::TangentNormalShader>(layers, green, where);
+      expectShaderBatchEqualsSamples<bake_detail::ObjectNormalShader>(layers, green,
+                                                                      where + " (object space)");
+      expectShaderBatchEqualsSamples<bake_detail::SurfaceGradientShader>(
+          layers, green, where + " (surface gradient)");
+      expectShaderBatchEqualsSamples<bake_detail::DerivativeShader>(layers, green,
+                                                                    where + " (derivative)");
+    }
+    world = nullptr;  // (height maps are not shaded in world space)
     expectShaderBatchEqualsSamples<bake_detail::HeightShader>(layers, green, what + " (height)");
   }
 
@@ -125,6 +136,7 @@ class ShadeBatch : public ::testing::Test {
     base.tangents = kTangentSpace ? &scene.tangents : nullptr;
     base.layers = layers;
     base.green = green;
+    base.world = world;
     Shader batchShader{base}, sampleShader{base};
     std::mt19937 rng(11);
     int fallbacks = 0;
@@ -152,12 +164,26 @@ class ShadeBatch : public ::testing::Test {
         }
       }
     }
-    if (kTangentSpace || (kObjectSpace && layers.empty())) {
+    // (In the world, the object-space fallback is the world face normal brought back.)
+    if (kTangentSpace || (kObjectSpace && layers.empty() && world == nullptr)) {
       EXPECT_GT(fallbacks, 0) << what << ": no sample took a fallback";
     }
   }
 
   Scene scene;
+  /// A turned, stretched and moved object: scaled (2, 1, 0.5), turned 30° about (1, 1, 0).
+  const WorldSpace stretched = [] {
+    const double c = std::cos(kPi / 6), s = std::sin(kPi / 6), k = 1 / std::sqrt(2.0);
+    // Rodrigues' rotation about the unit axis (k, k, 0).
+    const Mat3 turn =
+        Mat3::fromColumns({c + k * k * (1 - c), k * k * (1 - c), -k * s},
+                          {k * k * (1 - c), c + k * k * (1 - c), k * s}, {k * s, -k * s, c});
+    ObjectTransform transform;
+    transform.linear = turn * Mat3::diagonal({2, 1, 0.5});
+    transform.translation = {0.5, -1, 2};
+    return *WorldSpace::of(transform);
+  }();
+  const WorldSpace* world = nullptr;  ///< the placement expectShaderBatchEqualsSamples shades in
   ImageScalarTexture bilinear = *ImageScalarTexture::create(Image(1, 1, 1));
   ImageScalarTexture bicubic = *ImageScalarTexture::create(Image(1, 1, 1));
   DirectionalSine sine = *DirectionalSine::create({});
