@@ -52,7 +52,7 @@ struct BakeShaderBase {
 
   /// Non-null: the object is shaded in world space through this transform, as Cycles shades
   /// it (world_shading.hpp): by shade(), and by the lane-parallel paths through
-  /// batchShadeInWorld where every layer is one they take whole.
+  /// batchShadeInWorld.
   const WorldSpace* world = nullptr;
   /// What shading in world space keeps per triangle and per sample.
   struct WorldScratch {
@@ -488,9 +488,9 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
 /// guarded world normal @p normal and the unguarded @p unguarded, both unit. Lanes it cannot
 /// finish the common way are flagged in @p slow for the per-sample path: those of
 /// batchTexelFrames' fallbacks on the world triangle, an N̂ − Γ that does not normalize the
-/// common way, a back-facing N̂ and a normal the guard turns; and every lane when some layer is
-/// not one the batch takes whole (batchesWhole), as the world evaluator's other sources are
-/// per sample. Out of line: the object-space paths stay as the compiler laid them out.
+/// common way, a back-facing N̂ and a normal the guard turns. Layers the batch does not take
+/// whole (batchesWhole) are added sample by sample (addWorldLayerGradient), in layer order.
+/// Out of line: the object-space paths stay as the compiler laid them out.
 [[gnu::noinline]] inline void batchShadeInWorld(BakeShaderBase& shader, const SampleBatch& s,
                                                 Lanes3& normal, Lanes3& unguarded,
                                                 LaneFlags& slow) {
@@ -509,9 +509,20 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
   for (std::size_t i = 0; i < n; ++i) gamma.x[i] = gamma.y[i] = gamma.z[i] = 0.0;
   for (const Layer& layer : shader.layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-    if (!batchesWhole(layer)) {
-      std::fill_n(slow.begin(), n, 1);
-      return;
+    if (!batchesWhole(layer)) {  // sample by sample, shadeLayersInWorld's step
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
+        const SurfacePoint& objectPoint = shader.pointAt(b, texelFrame(shader.tri, b));
+        const SurfacePoint& worldPoint = surfacePointAt(w.tri, b, texelFrame(w.tri, b), w.point);
+        Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
+        gradient_detail::addWorldLayerGradient(layer, objectPoint, worldPoint, w.tri.faceNormal,
+                                               *shader.world, w.preparedUv.data(),
+                                               worldPoint.normal, g);
+        gamma.x[i] = g.x;
+        gamma.y[i] = g.y;
+        gamma.z[i] = g.z;
+      }
+      continue;
     }
     batchUvHeightGradient(w.tri, w.point, w.preparedUv.data(), s,
                           std::get<UvHeightSource>(layer.source), layer.weight, unitN, gamma);

@@ -202,22 +202,14 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const PreparedUvFrame* preparedWorldUv) {
   const Vec3d& n = worldPoint.normal;
   const Vec3d& ng = worldGeometricNormal;
-  const WorldLayerEvaluator evaluate(objectPoint, worldPoint, space, preparedWorldUv);
   // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point.
   auto composite = [&](bool back) {
     const Vec3d incoming = back ? -n : n;
     Vec3d gamma{};
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-      const double factor = layer.weight * layerMask(layer.mask, objectPoint);
-      if (factor == 0) continue;  // masked out: the source is not sampled
-      const WorldGradient g = std::visit(evaluate, layer.source);
-      if (layer.base == LayerBase::kLayersAbove) {
-        if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
-          gamma = stackGradient(factor * g.gamma, g.strength, n, ng, gamma, incoming);
-        continue;
-      }
-      gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
+      addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
+                            gamma);
     }
     return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
   };
@@ -232,6 +224,23 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
     result.normal = validReflectionNormal(result.unguarded, ng, n);
   }
   return result;
+}
+
+void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
+                           const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
+                           const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
+                           const Vec3d& incoming, Vec3d& gamma) {
+  const double factor = layer.weight * layerMask(layer.mask, objectPoint);
+  if (factor == 0) return;  // masked out: the source is not sampled
+  const Vec3d& n = worldPoint.normal;
+  const WorldGradient g = std::visit(
+      WorldLayerEvaluator(objectPoint, worldPoint, space, preparedWorldUv), layer.source);
+  if (layer.base == LayerBase::kLayersAbove) {
+    if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
+      gamma = stackGradient(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma, incoming);
+    return;
+  }
+  gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
 }
 
 }  // namespace gradient_detail

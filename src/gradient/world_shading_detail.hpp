@@ -1,6 +1,7 @@
 /// @file world_shading_detail.hpp
 /// @brief Private: shadeLayersInWorld with the world triangle's UV frames prepared once per
-/// triangle (the bake shaders' way, as BakeShaderBase::preparedUv for object space).
+/// triangle (the bake shaders' way, as BakeShaderBase::preparedUv for object space), and its
+/// step for one layer (what the lane-parallel world shading takes sample by sample).
 #pragma once
 
 #include <span>
@@ -16,5 +17,14 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const SurfacePoint& worldPoint,
                                      const Vec3d& worldGeometricNormal, const WorldSpace& space,
                                      const PreparedUvFrame* preparedWorldUv);
+
+/// @brief One layer's step of shadeLayersInWorld's sum, bit for bit: @p gamma, the world Γ of
+/// the layers before @p layer (whose weight is finite and nonzero), becomes the Γ after it,
+/// its guards (a layer on the layers above) seeing the incoming direction @p incoming (the
+/// world normal; its negation at a back-facing point). Arguments as shadeLayersInWorld's.
+void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
+                           const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
+                           const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
+                           const Vec3d& incoming, Vec3d& gamma);
 
 }  // namespace sgbake::gradient_detail
