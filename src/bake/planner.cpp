@@ -759,9 +759,13 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       if (!output.upToDate && shadedThroughTransform(o)) shaded.push_back(o.file.string());
     }
     if (!shaded.empty()) {
+      // A rotation (or mirror) with a uniform scale shades as object space (runBake).
+      const std::optional<double> uniform = scene.transform->uniformScale();
       plan.steps.push_back(
-          {"shade in world space through the object transform, as Cycles does (heights in "
-           "world units), sample by sample",
+          {uniform ? "shade in object space with heights divided by the object's uniform scale " +
+                         formatNumber(*uniform) + " (as Cycles shades it in world space)"
+                   : std::string("shade in world space through the object transform, as Cycles "
+                                 "does (heights in world units)"),
            "the scene's \"transform\", for " + joinLabels(shaded)});
     }
   }

@@ -605,6 +605,15 @@ TEST_F(PlannerTest, TheTransformReBakesWhatItShades) {
   EXPECT_NE(explained.find("shade in world space through the object transform"), std::string::npos)
       << explained;
   EXPECT_EQ(explainPlan(plan(plain)).find("world space"), std::string::npos);
+  // A turn with a uniform scale shades as object space, heights divided by the scale.
+  std::string turned = plain;
+  turned.insert(1, R"("transform": [[0, -2, 0], [2, 0, 0], [0, 0, 2]], )");
+  const std::string turnedPlan = explainPlan(plan(turned));
+  EXPECT_NE(turnedPlan.find("shade in object space with heights divided by the object's uniform "
+                            "scale 2 "),
+            std::string::npos)
+      << turnedPlan;
+  EXPECT_EQ(turnedPlan.find("world space through"), std::string::npos) << turnedPlan;
   const std::string before = readFile(dir_ / "o.exr");
   ASSERT_TRUE(executePlan(p));
   EXPECT_NE(readFile(dir_ / "o.exr"), before);
