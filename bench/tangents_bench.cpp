@@ -5,20 +5,24 @@
 ///
 ///     ninja -C build sgbake_bench_tangents
 ///     build/bench/sgbake_bench_tangents
-///     SGBAKE_BENCH_MESH=big.obj build/bench/sgbake_bench_tangents   # also load + tangents of a file
-///     build/bench/sgbake_bench_tangents --benchmark_filter=Tangents/torus --benchmark_repetitions=5
+///     SGBAKE_BENCH_MESH=big.obj build/bench/sgbake_bench_tangents   # also load + tangents of a
+///     file build/bench/sgbake_bench_tangents --benchmark_filter=Tangents/torus
+///     --benchmark_repetitions=5
 ///
 /// Benchmarks:
 ///   - `Tangents/torus/threads:1` and `Tangents/torus/threads:N` (N = all cores): computeTangents
 ///     on a procedural torus of 500 x 250 quads (125k faces, 500k corners) with smooth analytic
 ///     normals and one UV set with a seam in both directions, built here in memory so the number
 ///     does not depend on any file or loader.
+///   - `Triangulate/<corners>/<waves>`: triangulatePolygon of one n-gon, a circle (waves 0) or a
+///     wavy ring whose every other stretch is reflex.
 ///   - With SGBAKE_BENCH_MESH=PATH: `Load/<file>` (loadMesh) and `Tangents/<file>/threads:*`.
 /// Times are wall-clock (UseRealTime), since the work is spread over threads; `items_per_second`
 /// is corners per second. Compare with Blender using bench/tangents_vs_blender.py.
 
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -32,6 +36,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/mesh/io.hpp"
 #include "sgbake/mesh/mesh.hpp"
+#include "sgbake/mesh/triangulate.hpp"
 
 namespace {
 
@@ -137,6 +142,26 @@ void registerTangents(const std::string& label, const sgbake::Mesh& mesh) {
   }
 }
 
+/// @brief Times triangulatePolygon on one ring of state.range(0) corners: a circle (every corner
+/// convex, or straight in float) when state.range(1) is 0, else a ring with that many waves
+/// (half its corners reflex).
+void benchTriangulate(benchmark::State& state) {
+  const auto k = static_cast<std::size_t>(state.range(0));
+  const double waves = static_cast<double>(state.range(1));
+  std::vector<sgbake::Vec3f> points(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const double a = 2 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(k);
+    const double r = 1 + 0.3 * std::sin(waves * a);
+    points[i] = {static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)), 0.0f};
+  }
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (auto _ : state) {
+    sgbake::triangulatePolygon(points, triangles);
+    benchmark::DoNotOptimize(triangles.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(k));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -146,6 +171,12 @@ int main(int argc, char** argv) {
   // The meshes live until the benchmarks have run; the registered closures refer to them.
   const sgbake::Mesh torus = makeTorus(500, 250);  // 125000 quads, 500000 corners
   registerTangents("torus", torus);
+  benchmark::RegisterBenchmark("Triangulate", benchTriangulate)
+      ->Args({1000, 0})
+      ->Args({100000, 0})
+      ->Args({1000, 20})
+      ->Args({100000, 200})
+      ->Unit(benchmark::kMillisecond);
 
   sgbake::Mesh fileMesh;
   const char* meshPath = std::getenv("SGBAKE_BENCH_MESH");
