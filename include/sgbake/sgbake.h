@@ -98,6 +98,26 @@ SGBAKE_C_API int sgbake_compute_tangents(const float* positions, size_t num_vert
                                          float* out_signs, char* error_buf,
                                          size_t error_buf_size);
 
+/// @brief The triangles Blender 3.4 tessellates a mesh into (its loop triangles,
+/// `Mesh.loop_triangles`): a triangle as it is, a quad split as Blender splits it, a k-gon cut into
+/// k − 2 triangles by Blender's ear clipping. These are the triangles sgbake bakes and computes the
+/// tangent frames of n-gons on.
+///
+/// @param[in]  positions, num_vertices, face_start, num_faces, corner_vertex, num_corners
+///             the mesh, as for sgbake_compute_tangents.
+/// @param[out] out_triangles (#C − 2·#F) × 3 corner indices (Blender: `loop_triangles[i].loops`),
+///             face after face, in Blender's order and corner order.
+/// @param[out] error_buf, error_buf_size as for sgbake_compute_tangents.
+///
+/// @return SGBAKE_OK, SGBAKE_ERROR_BAD_INPUT (the mesh fails the checks of
+///         sgbake_compute_tangents that concern these arrays, or out_triangles is NULL for a
+///         non-empty mesh) or SGBAKE_ERROR_INTERNAL.
+SGBAKE_C_API int sgbake_loop_triangles(const float* positions, size_t num_vertices,
+                                       const uint32_t* face_start, size_t num_faces,
+                                       const uint32_t* corner_vertex, size_t num_corners,
+                                       uint32_t* out_triangles, char* error_buf,
+                                       size_t error_buf_size);
+
 /// @brief A mesh as flat arrays, for sgbake_bake_map (conventions at the top of this file).
 ///
 /// Blender: positions from `vertices.foreach_get("co")`, face_start from

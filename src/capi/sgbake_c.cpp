@@ -186,6 +186,27 @@ std::vector<Vec2f> toVec2(const float* values, std::size_t n) {
   return out;
 }
 
+/// sgbake_loop_triangles: loopTriangles of the validated mesh.
+Status loopTrianglesFromArrays(const MeshArrays& a, std::uint32_t* outTriangles) {
+  const std::string where = "sgbake_loop_triangles: ";
+  if (Status valid = validateMesh(where, a); !valid) return valid;
+  if (a.numCorners == 0) return Ok{};
+  if (outTriangles == nullptr) return Error::badInput(where + "out_triangles is NULL");
+  Mesh mesh;
+  mesh.positions = toVec3(a.positions, a.numVertices);
+  mesh.faceStart.assign(a.faceStart, a.faceStart + a.numFaces + 1);
+  mesh.cornerVertex.assign(a.cornerVertex, a.cornerVertex + a.numCorners);
+  const std::vector<std::array<std::uint32_t, 3>> triangles = loopTriangles(mesh);
+  if (triangles.size() != a.numCorners - 2 * a.numFaces) {
+    return Error::internal(where + "loopTriangles returned " + std::to_string(triangles.size()) +
+                           " triangles for " + std::to_string(a.numFaces) + " faces of " +
+                           std::to_string(a.numCorners) + " corners");
+  }
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t i = 0; i < 3; ++i) outTriangles[3 * t + i] = triangles[t][i];
+  return Ok{};
+}
+
 Status computeTangentsFromArrays(const MeshArrays& a, int threads, float* outTangents,
                                  float* outSigns) {
   const std::string where = "sgbake_compute_tangents: ";
@@ -454,6 +475,22 @@ int sgbake_compute_tangents(const float* positions, size_t num_vertices,
         positions, num_vertices, face_start, num_faces,    corner_vertex,  corner_normals, false,
         nullptr,   false,        nullptr,    {corner_uvs}, {"corner_uvs"}, num_corners};
     return sgbake::computeTangentsFromArrays(arrays, threads, out_tangents, out_signs);
+  });
+}
+
+int sgbake_loop_triangles(const float* positions, size_t num_vertices, const uint32_t* face_start,
+                          size_t num_faces, const uint32_t* corner_vertex, size_t num_corners,
+                          uint32_t* out_triangles, char* error_buf, size_t error_buf_size) {
+  return sgbake::guarded("sgbake_loop_triangles", error_buf, error_buf_size, [&] {
+    sgbake::MeshArrays arrays;
+    arrays.positions = positions;
+    arrays.numVertices = num_vertices;
+    arrays.faceStart = face_start;
+    arrays.numFaces = num_faces;
+    arrays.cornerVertex = corner_vertex;
+    arrays.normalsOptional = true;
+    arrays.numCorners = num_corners;
+    return sgbake::loopTrianglesFromArrays(arrays, out_triangles);
   });
 }
 

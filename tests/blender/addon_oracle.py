@@ -1479,13 +1479,6 @@ def evaluate_materials(entry, r):
     return failures
 
 
-def needs_asan_runtime(library):
-    """Whether the library links libasan (a SGBAKE_SANITIZE build): its dynamic section then
-    names the runtime, so the file holds the string."""
-    with open(library, "rb") as f:
-        return b"libasan.so" in f.read()
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cli", required=True, help="path to the sgbake executable")
@@ -1502,7 +1495,7 @@ def main():
             print(f"error: {path} is not a file (build {what} first)")
             return 2
     library = os.path.abspath(args.library)
-    if needs_asan_runtime(library):
+    if bc.needs_asan_runtime(library):
         print(f"SKIP: {library} is built with AddressSanitizer; its runtime must be the first "
               "library of the process, so Blender cannot load it")
         return bc.SKIP

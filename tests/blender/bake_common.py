@@ -101,6 +101,14 @@ def work_dir(keep, prefix):
         shutil.rmtree(path, ignore_errors=True)
 
 
+def needs_asan_runtime(library):
+    """Whether the library links libasan (a SGBAKE_SANITIZE build): its dynamic section then
+    names the runtime, so the file holds the string. Such a library cannot be loaded into a
+    process (Blender, Python) whose first library is not that runtime."""
+    with open(library, "rb") as f:
+        return b"libasan.so" in f.read()
+
+
 def report(failures, passed="PASS"):
     """Prints a driver's verdict and returns its exit status: with failures, "FAIL: N
     problem(s):" and each failure on an indented line, 1; without, the line `passed`, 0."""

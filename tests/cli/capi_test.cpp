@@ -313,5 +313,44 @@ TEST(CApi, TruncatesTheMessageToATooSmallErrorBuffer) {
   EXPECT_EQ(call(nullptr, 100), SGBAKE_ERROR_BAD_INPUT);
 }
 
+TEST(CApi, LoopTrianglesAreBlendersAndBadArraysAreRefused) {
+  // A triangle, a quad split on its 1–3 diagonal (corners 1 and 3 on the same side of 0–2, as
+  // Blender's float test finds) and a regular pentagon, whose loop triangles Blender 3.4.1
+  // gives as (4, 0, 1), (1, 2, 3), (1, 3, 4) (tests/mesh/triangulate_test.cpp, "reg5").
+  std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0,                  // triangle
+                                  0, 0, 1, 1, 0, 1, 1, 1, 1, 0.2f, 0.1f, 1};  // concave quad
+  const float reg5[5][2] = {{1.0f, 0.0f},
+                            {0.309017003f, 0.95105654f},
+                            {-0.809017003f, 0.587785244f},
+                            {-0.809017003f, -0.587785244f},
+                            {0.309017003f, -0.95105654f}};
+  for (const auto& q : reg5) positions.insert(positions.end(), {q[0], q[1], 2.0f});
+  const std::vector<std::uint32_t> faceStart = {0, 3, 7, 12};
+  const std::vector<std::uint32_t> cornerVertex = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};
+  std::vector<std::uint32_t> triangles(3 * (12 - 2 * 3), 99);
+  char error[256] = "untouched";
+  ASSERT_EQ(sgbake_loop_triangles(positions.data(), positions.size() / 3, faceStart.data(), 3,
+                                  cornerVertex.data(), 12, triangles.data(), error, sizeof error),
+            SGBAKE_OK)
+      << error;
+  // The quad: 1 and 3 lie on the same side of the 0–2 diagonal (3 is inside the triangle 0 1 2).
+  const std::vector<std::uint32_t> expected = {0,  1, 2, 3, 4, 6,  4, 5,  6,
+                                               11, 7, 8, 8, 9, 10, 8, 10, 11};
+  EXPECT_EQ(triangles, expected);
+  EXPECT_STREQ(error, "untouched");
+
+  EXPECT_EQ(sgbake_loop_triangles(positions.data(), positions.size() / 3, faceStart.data(), 3,
+                                  cornerVertex.data(), 12, nullptr, error, sizeof error),
+            SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_STREQ(error, "sgbake_loop_triangles: out_triangles is NULL");
+  const std::vector<std::uint32_t> shortFace = {0, 2, 7, 12};
+  EXPECT_EQ(sgbake_loop_triangles(positions.data(), positions.size() / 3, shortFace.data(), 3,
+                                  cornerVertex.data(), 12, triangles.data(), error, sizeof error),
+            SGBAKE_ERROR_BAD_INPUT);
+  EXPECT_NE(std::string(error).find("sgbake_loop_triangles: face 0 has 2 corners"),
+            std::string::npos)
+      << error;
+}
+
 }  // namespace
 }  // namespace sgbake
