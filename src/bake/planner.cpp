@@ -1387,9 +1387,14 @@ class CreatedDirectories {
   ~CreatedDirectories() {
     std::error_code ec;
     for (auto dir = created_.rbegin(); dir != created_.rend(); ++dir) fs::remove(*dir, ec);
+    keep();
   }
   /// The run succeeded: the directories stay.
-  void keep() { created_.clear(); }
+  void keep() {
+    created_.clear();
+    for (const int handle : tracked_) forgetCreatedDirectory(handle);
+    tracked_.clear();
+  }
   /// Creates the directory of @p file and the missing ones above it, noting each.
   Status ensureFor(const fs::path& file) {
     const fs::path dir = file.parent_path();
@@ -1402,7 +1407,15 @@ class CreatedDirectories {
       if (d == d.parent_path()) break;
     }
     for (auto d = missing.rbegin(); d != missing.rend(); ++d) {
-      if (fs::create_directory(*d, ec)) created_.push_back(*d);
+      // Noted before it exists, so that a signal from the moment it is made removes it (and
+      // forgotten when it was there already: someone else's).
+      const int handle = trackCreatedDirectory(*d);
+      if (fs::create_directory(*d, ec)) {
+        created_.push_back(*d);
+        tracked_.push_back(handle);
+      } else {
+        forgetCreatedDirectory(handle);
+      }
       if (ec) {
         return Error::badInput(file.string() + ": cannot create directory " + d->string() + ": " +
                                ec.message());
@@ -1417,6 +1430,7 @@ class CreatedDirectories {
 
  private:
   std::vector<fs::path> created_;
+  std::vector<int> tracked_;  ///< their trackCreatedDirectory handles (removed on a signal)
 };
 
 }  // namespace

@@ -77,7 +77,7 @@ int syncDirectory(const std::filesystem::path& dir) {
 constexpr std::size_t kMaxTrackedTemporaries = 64;
 constexpr std::size_t kMaxTrackedPathBytes = 4096;
 
-enum SlotState : int { kFree = 0, kBusy = 1, kHoldsPath = 2 };
+enum SlotState : int { kFree = 0, kBusy = 1, kHoldsPath = 2, kHoldsDirectory = 3 };
 
 struct TrackedTemporary {
   std::atomic<int> state{kFree};
@@ -87,19 +87,22 @@ static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs l
 
 TrackedTemporary g_tracked[kMaxTrackedTemporaries];
 
-/// @return the slot now holding @p path, or -1 when the table is full or the path too long
-int trackTemporary(const std::filesystem::path& path) {
+/// @return the slot now holding @p path as @p kind (a temporary file, or a directory), or -1
+/// when the table is full or the path too long
+int trackPath(const std::filesystem::path& path, SlotState kind) {
   const std::string& text = path.native();
   if (text.size() >= kMaxTrackedPathBytes) return -1;
   for (std::size_t i = 0; i < kMaxTrackedTemporaries; ++i) {
     int expected = kFree;
     if (!g_tracked[i].state.compare_exchange_strong(expected, kBusy)) continue;
     std::memcpy(g_tracked[i].path, text.c_str(), text.size() + 1);
-    g_tracked[i].state.store(kHoldsPath, std::memory_order_release);
+    g_tracked[i].state.store(kind, std::memory_order_release);
     return static_cast<int>(i);
   }
   return -1;
 }
+
+int trackTemporary(const std::filesystem::path& path) { return trackPath(path, kHoldsPath); }
 
 /// Frees slot @p slot of trackTemporary (nothing for -1).
 void untrackTemporary(int slot) noexcept {
@@ -109,10 +112,26 @@ void untrackTemporary(int slot) noexcept {
 }  // namespace
 
 void removeTemporaryFiles() noexcept {
+  std::size_t directories = 0;
   for (TrackedTemporary& tracked : g_tracked) {
-    if (tracked.state.load(std::memory_order_acquire) == kHoldsPath) ::unlink(tracked.path);
+    const int state = tracked.state.load(std::memory_order_acquire);
+    if (state == kHoldsPath) ::unlink(tracked.path);
+    directories += state == kHoldsDirectory;
+  }
+  // Then the directories, those left empty only: a directory inside another goes first, and a
+  // slot's place in the table says nothing of that, so as many passes as there are directories.
+  for (std::size_t pass = 0; pass < directories; ++pass) {
+    for (TrackedTemporary& tracked : g_tracked) {
+      if (tracked.state.load(std::memory_order_acquire) == kHoldsDirectory) ::rmdir(tracked.path);
+    }
   }
 }
+
+int trackCreatedDirectory(const std::filesystem::path& dir) {
+  return trackPath(dir, kHoldsDirectory);
+}
+
+void forgetCreatedDirectory(int handle) noexcept { untrackTemporary(handle); }
 
 AtomicFile::AtomicFile(std::filesystem::path target, std::filesystem::path temp, int fd,
                        bool durable, int slot)

@@ -89,11 +89,22 @@ class AtomicFile {
 };
 
 /// @brief Removes the temporary file of every AtomicFile that is neither committed nor discarded
-/// (in any thread). Async-signal-safe: meant for a handler of SIGINT/SIGTERM, which cannot run
-/// destructors, so that an interrupted program leaves no temporaries behind. The AtomicFiles
-/// themselves stay as they are (their commits will fail).
-/// @note Up to 64 temporaries, of paths up to 4095 bytes, are tracked; others are not removed.
+/// (in any thread), then every directory noted by trackCreatedDirectory that is left empty.
+/// Async-signal-safe: meant for a handler of SIGINT/SIGTERM, which cannot run destructors, so
+/// that an interrupted program leaves no temporaries, and no directories it made for them,
+/// behind. The AtomicFiles themselves stay as they are (their commits will fail).
+/// @note Up to 64 temporaries and directories in all, of paths up to 4095 bytes, are tracked;
+/// others are not removed.
 void removeTemporaryFiles() noexcept;
+
+/// @brief Notes @p dir, a directory just made to hold outputs, for removeTemporaryFiles (which
+/// removes it again if it is then empty) until forgetCreatedDirectory.
+/// @return the handle forgetCreatedDirectory takes, or -1 when it could not be noted
+int trackCreatedDirectory(const std::filesystem::path& dir);
+
+/// @brief Ends what trackCreatedDirectory(…) = @p handle began (nothing for -1): the directory
+/// stays, or was removed by its owner.
+void forgetCreatedDirectory(int handle) noexcept;
 
 /// @brief The temporaries of @p target (`<target>.tmp-<pid>-<hex>`) whose process no longer
 /// runs on this machine: left by a run that was killed outright (SIGKILL, a crash, a power
