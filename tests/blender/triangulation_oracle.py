@@ -17,7 +17,6 @@ import argparse
 import ctypes
 import json
 import os
-import shutil
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -124,9 +123,7 @@ def main():
     parser.add_argument("--sabotage", action="store_true",
                         help="reverse one of sgbake's triangles (the test must fail)")
     args = parser.parse_args()
-    if shutil.which(args.blender) is None:
-        print(f"skipped: no Blender ('{args.blender}')")
-        return bc.SKIP
+    blender = bc.blender_or_skip(args.blender, test="triangulation")
     if bc.needs_asan_runtime(args.lib):
         print(f"SKIP: {args.lib} is built with AddressSanitizer; its runtime must be the first "
               "library of the process, so Python cannot load it")
@@ -136,10 +133,10 @@ def main():
         with open(script, "w", encoding="ascii") as f:
             f.write(BLENDER_SCRIPT)
         out = os.path.join(work, "polygons.json")
-        blender = objio.run_blender(args.blender, script, [out, str(args.seed)],
+        run = objio.run_blender(blender, script, [out, str(args.seed)],
                                     capture_output=True, text=True)
-        if blender.returncode != 0:
-            print(f"Blender failed ({blender.returncode}):\n{blender.stderr[-2000:]}")
+        if run.returncode != 0:
+            print(f"Blender failed ({run.returncode}):\n{run.stderr[-2000:]}")
             return 1
         with open(out, encoding="ascii") as f:
             mesh = json.load(f)
