@@ -559,13 +559,24 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
   Lanes3 normal, unguarded, back;
   batchShadeInWorld(shader, s, normal, unguarded, f.slow);
   batchTransform(shader.world->normalToObject, n, unguarded, back);
+  // gradientFromObjectNormal(back, N̂) lane by lane (its unitAndLength scaled by the largest
+  // component first), zero where it is not finite.
+  const double floor = std::min(gradient_detail::guardedTolerance(kMinObjectNormalCosine), 1.0);
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3d g = gradientFromObjectNormal({back.x[i], back.y[i], back.z[i]},
-                                             {f.unitN.x[i], f.unitN.y[i], f.unitN.z[i]});
-    const bool finite = isFinite(g);
-    gamma.x[i] = finite ? g.x : 0.0;
-    gamma.y[i] = finite ? g.y : 0.0;
-    gamma.z[i] = finite ? g.z : 0.0;
+    const double ax = back.x[i], ay = back.y[i], az = back.z[i];
+    const double m = std::max(std::max(std::abs(ax), std::abs(ay)), std::abs(az));
+    const bool usable = (m > 0) & finiteLane(m);
+    const double sx = (1 / m) * ax, sy = (1 / m) * ay, sz = (1 / m) * az;
+    const double l = std::sqrt(sx * sx + sy * sy + sz * sz);
+    const double vx = (1 / l) * sx, vy = (1 / l) * sy, vz = (1 / l) * sz;
+    const double nx = f.unitN.x[i], ny = f.unitN.y[i], nz = f.unitN.z[i];
+    const double k = vx * nx + vy * ny + vz * nz;
+    const double inv = 1 / std::max(std::abs(k), floor);
+    const double gx = inv * (k * nx - vx), gy = inv * (k * ny - vy), gz = inv * (k * nz - vz);
+    const bool keep = usable & finiteLane(gx) & finiteLane(gy) & finiteLane(gz);
+    gamma.x[i] = keep ? gx : 0.0;
+    gamma.y[i] = keep ? gy : 0.0;
+    gamma.z[i] = keep ? gz : 0.0;
   }
 }
 
