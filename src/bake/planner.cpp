@@ -1387,14 +1387,10 @@ class CreatedDirectories {
   ~CreatedDirectories() {
     std::error_code ec;
     for (auto dir = created_.rbegin(); dir != created_.rend(); ++dir) fs::remove(*dir, ec);
-    keep();
+    forgetAll();  // only now: a signal while they are removed still finds them
   }
   /// The run succeeded: the directories stay.
-  void keep() {
-    created_.clear();
-    for (const int handle : tracked_) forgetCreatedDirectory(handle);
-    tracked_.clear();
-  }
+  void keep() { forgetAll(); }
   /// Creates the directory of @p file and the missing ones above it, noting each.
   Status ensureFor(const fs::path& file) {
     const fs::path dir = file.parent_path();
@@ -1429,6 +1425,13 @@ class CreatedDirectories {
   }
 
  private:
+  /// Neither this object nor the signal handler removes them any more.
+  void forgetAll() {
+    created_.clear();
+    for (const int handle : tracked_) forgetCreatedDirectory(handle);
+    tracked_.clear();
+  }
+
   std::vector<fs::path> created_;
   std::vector<int> tracked_;  ///< their trackCreatedDirectory handles (removed on a signal)
 };
