@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <set>
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -294,7 +293,7 @@ std::vector<int> udimTiles(const Mesh& mesh, int uvSet, std::size_t* trianglesOu
   if (uvSet < 0 || !mesh.hasUvSet(static_cast<std::size_t>(uvSet))) return {};
   const std::vector<Vec2f>& uvs = mesh.uvSets[static_cast<std::size_t>(uvSet)].uvs;
   constexpr int kTilesU = 10, kTilesV = (kLastUdimTile - kFirstUdimTile) / 10 + 1;
-  std::set<int> tiles;
+  std::vector<std::uint8_t> touched(std::size_t{kTilesU} * kTilesV, 0);  // by tile − 1001
   for (const std::array<std::uint32_t, 3>& t : loopTriangles(mesh)) {
     const std::array<Vec2d, 3> p{cast<double>(uvs[t[0]]), cast<double>(uvs[t[1]]),
                                  cast<double>(uvs[t[2]])};
@@ -307,16 +306,25 @@ std::vector<int> udimTiles(const Mesh& mesh, int uvSet, std::size_t* trianglesOu
     const int u1 = std::min(kTilesU - 1, static_cast<int>(std::floor(std::min(maxU, double(kTilesU)))));
     const int v0 = std::max(0, static_cast<int>(std::floor(std::max(minV, -1.0))));
     const int v1 = std::min(kTilesV - 1, static_cast<int>(std::floor(std::min(maxV, double(kTilesV)))));
+    // The common case needs no test: a triangle (of nonzero area) whose bounds lie inside the
+    // open square of one tile overlaps it.
+    if (u0 == u1 && v0 == v1 && minU > u0 && maxU < u0 + 1 && minV > v0 && maxV < v0 + 1) {
+      touched[static_cast<std::size_t>(v0 * 10 + u0)] = 1;
+      continue;
+    }
     bool inAnyTile = false;
     for (int tv = v0; tv <= v1; ++tv)
       for (int tu = u0; tu <= u1; ++tu)
         if (overlapsOpenSquare(p, {double(tu), double(tv)})) {
-          tiles.insert(kFirstUdimTile + tv * 10 + tu);
+          touched[static_cast<std::size_t>(tv * 10 + tu)] = 1;
           inAnyTile = true;
         }
     if (!inAnyTile && trianglesOutside != nullptr) ++*trianglesOutside;
   }
-  return {tiles.begin(), tiles.end()};
+  std::vector<int> tiles;
+  for (std::size_t i = 0; i < touched.size(); ++i)
+    if (touched[i] != 0) tiles.push_back(kFirstUdimTile + static_cast<int>(i));
+  return tiles;
 }
 
 }  // namespace sgbake
