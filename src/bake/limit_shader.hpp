@@ -54,6 +54,8 @@ struct LimitShader {
   const SurfaceParameters* parameters = nullptr;
   std::array<std::uint32_t, 3> corners{};
   ShadingTriangle meshTriangle;  ///< the tessellation's triangle, as beginTriangle loaded it
+  /// inner.tri holds a limit point (useLimitPoint), not meshTriangle.
+  bool onLimit = false;
   /// Made on first use: every copy of the shader (one per row block) evaluates on its own.
   std::shared_ptr<LimitSurface::Evaluator> evaluator;
 
@@ -67,15 +69,15 @@ struct LimitShader {
     corners = c;
     inner.beginTriangle(triangle,
                         c);  // the tessellation's triangle: the fallback where Bfr has nothing
-    meshTriangle = inner.tri;
-    if (!meshTriangle.hasTangents) {  // no MikkTSpace frames (the planner skips them): the
-      // triangle's own, as the limit surface's are made (T = ∂P/∂u made orthogonal to N)
-      for (std::size_t i = 0; i < 3; ++i) {
-        frameFromUvDerivatives(meshTriangle.normal[i], meshTriangle.dPdu[0], meshTriangle.dPdv[0],
-                               meshTriangle.tangent[i], meshTriangle.sign[i]);
-      }
-      meshTriangle.hasTangents = true;
+    ShadingTriangle& t = inner.tri;
+    if (!t.hasTangents) {  // no MikkTSpace frames (the planner skips them): the triangle's
+      // own, as the limit surface's are made (T = ∂P/∂u made orthogonal to N)
+      for (std::size_t i = 0; i < 3; ++i)
+        frameFromUvDerivatives(t.normal[i], t.dPdu[0], t.dPdv[0], t.tangent[i], t.sign[i]);
+      t.hasTangents = true;
     }
+    meshTriangle = t;
+    onLimit = false;
   }
 
   void shade(const Vec3d& b, int x, int y, double* out) {
@@ -90,22 +92,30 @@ struct LimitShader {
       start = start + b[i] * cast<double>(parameters->cornerCoord[corners[i]]);
       target = target + b[i] * cast<double>(uvs[corners[i]]);
     }
-    inner.tri = meshTriangle;
     LimitPoint p;
-    if (evaluator->locate(face, subFace, start, bakeSet, target, p)) useLimitPoint(p);
+    if (evaluator->locate(face, subFace, start, bakeSet, target, p)) {
+      useLimitPoint(p);
+      onLimit = true;
+    } else if (onLimit) {  // the fallback: the tessellation's triangle
+      inner.tri = meshTriangle;
+      onLimit = false;
+    }
     inner.triangleChanged();
     inner.shade(b, x, y, out);
   }
 
  private:
-  /// Rewrites inner.tri (the tessellation's triangle) so that every corner carries the limit
-  /// surface's values at @p p.
+  /// Rewrites inner.tri so that every corner carries the limit surface's values at @p p: every
+  /// field a shader reads, so that inner.tri, meshTriangle or the last limit point before, need
+  /// not be restored to meshTriangle first (a 2 KB copy per sample). The fields left as they are
+  /// (hasTangents, polygonNormal, layerTangent, UVs past numUvSets) are meshTriangle's, or
+  /// unread once polygonFrame and hasLayerTangents are false.
   void useLimitPoint(const LimitPoint& p) {
     ShadingTriangle& t = inner.tri;
-    const Vec3d n = normalizeOr(cross(p.dPds, p.dPdt), t.faceNormal);
+    const Vec3d n = normalizeOr(cross(p.dPds, p.dPdt), meshTriangle.faceNormal);
     Vec3d tangent{0, 0, 0};
     double sign = 1;
-    t.numUvSets = std::min(t.numUvSets, p.numUvSets);
+    t.numUvSets = std::min(meshTriangle.numUvSets, p.numUvSets);
     for (int s = 0; s < t.numUvSets; ++s) {
       const std::size_t k = static_cast<std::size_t>(s);
       limitUvDerivatives(p.dPds, p.dPdt, p.dUVds[k], p.dUVdt[k], t.dPdu[k], t.dPdv[k]);

@@ -163,16 +163,29 @@ bool LimitSurface::Evaluator::locate(std::uint32_t face, std::uint32_t subFace, 
   Vec2d uv, a, b;
   if (!state_->evaluateUv(face, subFace, st, k, uv, a, b)) return false;
   const double tolerance = 1e-12 * std::max(1.0, std::max(std::abs(target.x), std::abs(target.y)));
+  double previous = 0;  // the residual before the last step (0: no step yet)
   for (int step = 0; step < kMaxSteps; ++step) {
     const Vec2d r = target - uv;
-    if (std::max(std::abs(r.x), std::abs(r.y)) <= tolerance) break;
+    const double residual = std::max(std::abs(r.x), std::abs(r.y));
+    if (residual <= tolerance) break;
     // Solve [dUV/ds dUV/dt] · Δ = r.
     const double det = a.x * b.y - a.y * b.x;
     if (!(std::abs(det) > 0) || !std::isfinite(det)) break;
     const Vec2d delta{(r.x * b.y - r.y * b.x) / det, (a.x * r.y - a.y * r.x) / det};
-    const Vec2d next{std::clamp(st.x + delta.x, 0.0, 1.0), std::clamp(st.y + delta.y, 0.0, 1.0)};
+    const Vec2d free{st.x + delta.x, st.y + delta.y};
+    const Vec2d next{std::clamp(free.x, 0.0, 1.0), std::clamp(free.y, 0.0, 1.0)};
     if (next == st) break;  // pinned at the border of the sub-face
     st = next;
+    // Newton's method converges quadratically, r' ≈ c·r², with c ≈ r / previous² as measured
+    // on the step before. When the residual so predicted after this step is far below the
+    // tolerance, the step is not checked: the point is evaluated where it lands (a UV
+    // evaluation fewer per sample, a quarter of what locating costs). A step the clamp
+    // shortened is checked.
+    if (previous > 0 && next == free &&
+        residual * residual * residual <= 1e-3 * tolerance * previous * previous) {
+      break;
+    }
+    previous = residual;
     state_->evaluateUv(face, subFace, st, k, uv, a, b);
   }
   return state_->evaluate(face, subFace, st, out);
