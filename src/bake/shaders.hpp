@@ -488,7 +488,8 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
 /// guarded world normal @p normal and the unguarded @p unguarded, both unit. Lanes it cannot
 /// finish the common way are flagged in @p slow for the per-sample path: those of
 /// batchTexelFrames' fallbacks on the world triangle, an N̂ − Γ that does not normalize the
-/// common way, a back-facing N̂ and a normal the guard turns. Layers the batch does not take
+/// common way, a back-facing N̂, a normal the guard turns and a normal map decoded below the
+/// surface (NormalBelowSurface). Layers the batch does not take
 /// whole (batchesWhole) are added sample by sample (addWorldLayerGradient), in layer order.
 /// Out of line: the object-space paths stay as the compiler laid them out.
 [[gnu::noinline]] inline void batchShadeInWorld(BakeShaderBase& shader, const SampleBatch& s,
@@ -515,9 +516,11 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
         const SurfacePoint& objectPoint = shader.pointAt(b, texelFrame(shader.tri, b));
         const SurfacePoint& worldPoint = surfacePointAt(w.tri, b, texelFrame(w.tri, b), w.point);
         Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
+        gradient_detail::NormalBelowSurface below;
         gradient_detail::addWorldLayerGradient(layer, objectPoint, worldPoint, w.tri.faceNormal,
                                                *shader.world, w.preparedUv.data(),
-                                               worldPoint.normal, g);
+                                               worldPoint.normal, g, &below);
+        slow[i] = slow[i] | below.found;  // shadeLayersInWorld shades it from the decoded normal
         gamma.x[i] = g.x;
         gamma.y[i] = g.y;
         gamma.z[i] = g.z;

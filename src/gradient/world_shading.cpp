@@ -1,5 +1,6 @@
 #include "sgbake/gradient/world_shading.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <type_traits>
@@ -30,6 +31,10 @@ bool isFinite(const Mat3& m) {
 struct WorldGradient {
   Vec3d gamma;
   double strength = 1;
+  /// A normal map's decoded world normal lies at or below the tangent plane (gamma stands for
+  /// its mirror image): then `decoded` is that normal, unit.
+  bool belowSurface = false;
+  Vec3d decoded{};
 };
 
 /// Carries world normals and heights' gradients for one point.
@@ -58,12 +63,12 @@ class WorldLayerEvaluator {
   WorldGradient operator()(const TangentNormalSource& s) const {
     TangentNormalSource unblended = s;
     unblended.options.strength = 1;
-    return {decodedNormal(layerGradient(unblended, object_)), s.options.strength};
+    return decodedNormal(layerGradient(unblended, object_), s.options.strength);
   }
   WorldGradient operator()(const ObjectNormalSource& s) const {
     ObjectNormalSource unblended = s;
     unblended.strength = 1;
-    return {decodedNormal(layerGradient(unblended, object_)), s.strength};
+    return decodedNormal(layerGradient(unblended, object_), s.strength);
   }
   WorldGradient operator()(const VolumeSource& s) const {
     return {heightGradient(layerGradient(s, object_))};
@@ -79,15 +84,26 @@ class WorldLayerEvaluator {
     const Vec3d v = space_.normalToWorld * sigma;
     return v - dot(v, n) * n;
   }
-  /// The Γ of a normal map's object-space normal N − Γ_o, carried to world space as a normal.
-  Vec3d decodedNormal(const Vec3d& gammaObject) const {
+  /// The Γ of a normal map's object-space normal N − Γ_o, carried to world space as a normal
+  /// (and that normal when the Γ cannot stand for it).
+  WorldGradient decodedNormal(const Vec3d& gammaObject, double strength = 1) const {
     const Vec3d n = space_.normalToWorld * (object_.normal - gammaObject);
-    return finiteOrZero(gradientFromObjectNormal(n, world_.normal));
+    WorldGradient g{finiteOrZero(gradientFromObjectNormal(n, world_.normal)), strength};
+    // gradientFromObjectNormal's own test: ⟨n̂, N⟩ below its floor mirrors or clamps n̂.
+    const Vec3d unit = normalizeOr(n, Vec3d{});
+    if (!(dot(unit, world_.normal) >=
+          std::min(gradient_detail::guardedTolerance(kMinObjectNormalCosine), 1.0)) &&
+        lengthSquared(unit) > 0) {
+      g.belowSurface = true;
+      g.decoded = unit;
+    }
+    return g;
   }
   template <class Source>
   WorldGradient projected(ProjectedKind kind, const Source& s) const {
     const Vec3d gamma = layerGradient(s, object_);
-    return {kind == ProjectedKind::kHeight ? heightGradient(gamma) : decodedNormal(gamma)};
+    return kind == ProjectedKind::kHeight ? WorldGradient{heightGradient(gamma)}
+                                          : decodedNormal(gamma);
   }
   static Vec3d finiteOrZero(const Vec3d& v) { return sgbake::isFinite(v) ? v : Vec3d{}; }
 
@@ -202,20 +218,32 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const PreparedUvFrame* preparedWorldUv) {
   const Vec3d& n = worldPoint.normal;
   const Vec3d& ng = worldGeometricNormal;
-  // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point.
+  // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point;
+  // from the front, also whether the one layer is a normal map that decodes below the surface.
+  NormalBelowSurface below;
+  int active = 0;
   auto composite = [&](bool back) {
     const Vec3d incoming = back ? -n : n;
     Vec3d gamma{};
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+      ++active;
       addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
-                            gamma);
+                            gamma, back ? nullptr : &below);
     }
     return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
   };
 
   WorldShadedNormal result;
   result.unguarded = normalizeOr(n - composite(false), n);
+  if (active == 1 && below.found) {
+    // A Normal Map node alone: Cycles blends its decoded normal by Strength and guards it as
+    // it is, below the surface too (the guard then turns it back up, on its own side of Ng).
+    result.unguarded =
+        below.strength == 1
+            ? below.decoded
+            : normalizeOr(n + std::max(below.strength, 0.0) * (below.decoded - n), n);
+  }
   if (layers.empty()) {
     result.normal = n;
   } else if (backFacing(n, ng)) {  // backFacingNormal, in world space
@@ -229,12 +257,15 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
 void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
                            const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
                            const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
-                           const Vec3d& incoming, Vec3d& gamma) {
+                           const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below) {
+  if (below != nullptr) *below = {};
   const double factor = layer.weight * layerMask(layer.mask, objectPoint);
   if (factor == 0) return;  // masked out: the source is not sampled
   const Vec3d& n = worldPoint.normal;
   const WorldGradient g = std::visit(
       WorldLayerEvaluator(objectPoint, worldPoint, space, preparedWorldUv), layer.source);
+  if (below != nullptr && g.belowSurface && factor == 1 && layer.base == LayerBase::kSurface)
+    *below = {true, g.decoded, g.strength};
   if (layer.base == LayerBase::kLayersAbove) {
     if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
       gamma = stackGradient(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma, incoming);

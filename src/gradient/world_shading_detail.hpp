@@ -18,13 +18,24 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const Vec3d& worldGeometricNormal, const WorldSpace& space,
                                      const PreparedUvFrame* preparedWorldUv);
 
+/// @brief A normal-map layer whose decoded world normal lies at or below the tangent plane
+/// (⟨n, N⟩ below kMinObjectNormalCosine), which no Γ stands for: N − Γ resolves to its mirror
+/// image above the plane. A stretched object turns an object-space normal 60° from N that far.
+struct NormalBelowSurface {
+  bool found = false;  ///< the layer is such a layer, unmasked, on the surface, at weight 1
+  Vec3d decoded{};     ///< its unit decoded world normal, before Strength
+  double strength = 1;
+};
+
 /// @brief One layer's step of shadeLayersInWorld's sum, bit for bit: @p gamma, the world Γ of
 /// the layers before @p layer (whose weight is finite and nonzero), becomes the Γ after it,
 /// its guards (a layer on the layers above) seeing the incoming direction @p incoming (the
 /// world normal; its negation at a back-facing point). Arguments as shadeLayersInWorld's.
+/// @param[out] below when non-null, set as NormalBelowSurface says for this layer
 void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
                            const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
                            const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
-                           const Vec3d& incoming, Vec3d& gamma);
+                           const Vec3d& incoming, Vec3d& gamma,
+                           NormalBelowSurface* below = nullptr);
 
 }  // namespace sgbake::gradient_detail

@@ -94,6 +94,18 @@ Image noiseImage(std::mt19937& rng, int size) {
   return image;
 }
 
+/// Object-space normals that swing through every direction, some behind the surface: in the
+/// stretched world, some of those in front of it decode behind it (NormalBelowSurface).
+class SwirlNormalTexture final : public VectorTexture {
+ public:
+  Vec3d sample(Vec2d st) const override {
+    const Vec3d n = normalizeOr(
+        Vec3d{std::sin(5 * st.x), std::cos(4 * st.y), 0.3 + 0.5 * std::sin(3 * (st.x + st.y))},
+        Vec3d{0, 0, 1});
+    return 0.5 * n + Vec3d{0.5, 0.5, 0.5};
+  }
+};
+
 class ShadeBatch : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -109,8 +121,9 @@ class ShadeBatch : public ::testing::Test {
   /// for every shader that has one: on the object as it is, and on the object placed in the
   /// world by a stretching transform (shaded in world space, BakeShaderBase::world).
   void expectBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
-                                const std::string& what) {
-    for (const WorldSpace* space : {static_cast<const WorldSpace*>(nullptr), &stretched}) {
+                                const std::string& what, const WorldSpace* placement = nullptr) {
+    if (placement == nullptr) placement = &stretched;
+    for (const WorldSpace* space : {static_cast<const WorldSpace*>(nullptr), placement}) {
       world = space;
       const std::string where = what + (space != nullptr ? ", stretched in the world" : "");
       expectShaderBatchEqualsSamples<bake_detail::TangentNormalShader>(layers, green, where);
@@ -183,6 +196,8 @@ class ShadeBatch : public ::testing::Test {
     transform.translation = {0.5, -1, 2};
     return *WorldSpace::of(transform);
   }();
+  /// Squashed a hundredfold: normals 60° from N in object space end up far below the surface.
+  const WorldSpace squashed = *WorldSpace::of({Mat3::diagonal({10, 1, 0.1}), {}});
   const WorldSpace* world = nullptr;  ///< the placement expectShaderBatchEqualsSamples shades in
   ImageScalarTexture bilinear = *ImageScalarTexture::create(Image(1, 1, 1));
   ImageScalarTexture bicubic = *ImageScalarTexture::create(Image(1, 1, 1));
@@ -233,6 +248,70 @@ TEST_F(ShadeBatch, LayersOnTheLayersAbove) {
       volumeOnTop,
   };
   expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "layers on the layers above");
+}
+
+TEST_F(ShadeBatch, NormalMapsDecodedBelowTheSurface) {
+  // Alone, at Strength 1 and 0.6, such a map is shaded from its decoded normal in the world
+  // (the per-sample path, also where the guard passes the mirror image N − Γ resolves to);
+  // with a height on it, from the Γ sum. Either way the same bits.
+  SwirlNormalTexture swirl;
+  ObjectNormalSource weak{&swirl, 0};
+  weak.strength = 0.6;
+  const std::vector<Layer> alone{Layer{ObjectNormalSource{&swirl, 0}, 1.0, {}}};
+  const std::vector<Layer> blended{Layer{weak, 1.0, {}}};
+  const std::vector<Layer> withHeight{Layer{ObjectNormalSource{&swirl, 0}, 1.0, {}},
+                                      Layer{UvHeightSource{&bilinear, 0, 0.02}, 1.0, {}}};
+  for (const WorldSpace* placement : {&stretched, &squashed}) {
+    expectBatchEqualsSamples(alone, NormalMapGreen::kOpenGL, "normals below the surface",
+                             placement);
+    expectBatchEqualsSamples(blended, NormalMapGreen::kOpenGL, "normals below the surface, 0.6",
+                             placement);
+    expectBatchEqualsSamples(withHeight, NormalMapGreen::kOpenGL, "normals below, and a height",
+                             placement);
+  }
+}
+
+/// One object-space normal everywhere.
+class ConstantNormalTexture final : public VectorTexture {
+ public:
+  explicit ConstantNormalTexture(Vec3d n) : encoded_(0.5 * n + Vec3d{0.5, 0.5, 0.5}) {}
+  Vec3d sample(Vec2d) const override { return encoded_; }
+
+ private:
+  Vec3d encoded_;
+};
+
+// A flat triangle (N = Ng = ẑ) under a shear that keeps ẑ but takes an object normal 60° from
+// it 35° below the world's tangent plane: Cycles' guard passes that normal as it is (its test
+// reflects I about the normal's line), so the bake shows it below the surface, lane-parallel
+// as sample by sample; the Γ sum would give its mirror image above the plane.
+TEST(ShadeBatchBelowTheSurface, ANormalFarBelowIsBakedAsItIs) {
+  const Mesh mesh = test::uvPlaneMesh({{{0.1f, 0.1f}, {0.9f, 0.2f}, {0.3f, 0.8f}}});
+  const WorldSpace shear =
+      *WorldSpace::of({Mat3::fromColumns({1, 0, 0}, {0, 1, 0}, {2, 0, 1}), {0.5, -1, 2}});
+  const Vec3d v{std::sin(kPi / 3), 0, std::cos(kPi / 3)};
+  ConstantNormalTexture map(v);
+  const std::vector<Layer> layers{Layer{ObjectNormalSource{&map, 0}, 1.0, {}}};
+  const Vec3d below = normalizeOr(shear.normalToWorld * v, {});  // (0.57, 0, −0.82)
+  ASSERT_LT(below.z, -0.8);
+  bake_detail::ObjectNormalShader shader;
+  shader.mesh = &mesh;
+  shader.layers = layers;
+  shader.world = &shear;
+  shader.beginTriangle(0, {0, 1, 2});
+  std::mt19937 rng(5);
+  const SampleBatch batch = randomBatch(rng, SampleBatch::kMax);
+  std::vector<double> lanes(3 * static_cast<std::size_t>(batch.count));
+  shader.shadeBatch(batch, lanes.data());
+  // Blender's baker brings it back to object space as a direction (M^{-1}).
+  const Vec3d expected =
+      bake_detail::encodeNormal(normalizeOr(shear.directionToObject * below, {}));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(batch.count); ++i) {
+    double one[3];
+    shader.shade({batch.b0[i], batch.b1[i], batch.b2[i]}, 0, 0, one);
+    EXPECT_EQ(std::memcmp(one, &lanes[3 * i], sizeof one), 0) << "lane " << i;
+    EXPECT_LT(length(Vec3d{one[0], one[1], one[2]} - expected), 1e-12) << "lane " << i;
+  }
 }
 
 TEST_F(ShadeBatch, OverflowingAndCancellingGradients) {

@@ -141,6 +141,57 @@ TEST(WorldShading, StrengthBlendsTheWorldNormals) {
   EXPECT_LT(maxAbsDiff(blended, normalizeOr(0.5 * bumped + 0.5 * n, {})), 1e-15);
 }
 
+/// One object-space normal everywhere.
+class ConstantNormalTexture final : public VectorTexture {
+ public:
+  explicit ConstantNormalTexture(Vec3d n) : encoded_(0.5 * n + Vec3d{0.5, 0.5, 0.5}) {}
+  Vec3d sample(Vec2d) const override { return encoded_; }
+
+ private:
+  Vec3d encoded_;
+};
+
+// A shear can carry an object normal 60° from N below the world's tangent plane. No Γ stands
+// for such a normal (N − Γ resolves to its mirror image above the plane); Cycles' guard sees
+// the decoded normal itself. Its test reflects I about the normal's line, so a normal far
+// enough below passes it and is baked below the surface; one nearer the plane is turned up on
+// its own side.
+TEST(WorldShading, ANormalMapDecodedBelowTheSurfaceIsGuardedAsItIs) {
+  // M^{-T} maps (x, y, z) to (x, y, z − 2x): N = ẑ stays, v = (sin 60°, 0, cos 60°) goes below.
+  const WorldSpace space = spaceOf(Mat3::fromColumns({1, 0, 0}, {0, 1, 0}, {2, 0, 1}));
+  const Vec3d v{std::sin(kPi / 3), 0, std::cos(kPi / 3)};
+  ConstantNormalTexture map(v);
+  SurfacePoint object;
+  object.numUvSets = 1;
+  object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
+  const SurfacePoint world = worldSurfacePoint(object, space);
+  const Vec3d n = world.normal, decoded = normalizeOr(space.normalToWorld * v, {});
+  ASSERT_LT(maxAbsDiff(n, Vec3d{0, 0, 1}), 1e-15);
+  ASSERT_LT(dot(decoded, n), -0.8);
+  for (const double strength : {1.0, 0.6}) {
+    ObjectNormalSource source{&map, 0};
+    source.strength = strength;
+    const std::vector<Layer> layers{{source, 1.0, {}}};
+    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, n, space);
+    const Vec3d unguarded = strength == 1 ? decoded : normalizeOr(n + strength * (decoded - n), {});
+    EXPECT_LT(maxAbsDiff(shaded.unguarded, unguarded), 1e-15) << strength;
+    EXPECT_LT(maxAbsDiff(shaded.normal, gradient_detail::validReflectionNormal(unguarded, n, n)),
+              1e-15)
+        << strength;
+  }
+  // Strength 1: 35° below the plane, its reflection of I rises: kept (the mirror image the Γ
+  // resolves to lies 35° above it).
+  const std::vector<Layer> alone{{ObjectNormalSource{&map, 0}, 1.0, {}}};
+  EXPECT_LT(maxAbsDiff(shadeLayersInWorld(alone, object, world, n, space).normal, decoded), 1e-15);
+  // Strength 0.6: 5° below, turned up to the guard's 44.7° from N, towards +x.
+  ObjectNormalSource weak{&map, 0};
+  weak.strength = 0.6;
+  const Vec3d turned =
+      shadeLayersInWorld(std::vector<Layer>{{weak, 1.0, {}}}, object, world, n, space).normal;
+  EXPECT_NEAR(std::acos(turned.z), std::acos(0.01) / 2, 1e-12);
+  EXPECT_GT(turned.x, 0.7);
+}
+
 // Where the world normal points behind the world triangle, Cycles shades from behind and bakes
 // the front normal reversed (gradient_detail::backFacingNormal); in front, and for the Γ the
 // derivative maps read, nothing changes. The ramp of the stretched plane, with N leaning past
