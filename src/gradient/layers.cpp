@@ -264,16 +264,21 @@ Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point,
 }
 
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
-                    const Vec3d& gammaAbove, const Vec3d& incoming) {
+                    const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+                    Vec3d* bumpedOut) {
   if (!isFinite(gamma) || !isFinite(gammaAbove)) return gammaAbove;
-  // The normal the layers above hand on, guarded as the node that made it guards it.
-  const Vec3d above = validReflectionNormal(normalizeOr(n - gammaAbove, n), ng, incoming);
+  // The normal the layers above hand on, unguarded: in Blender 3.4 the Normal Map and Bump
+  // nodes hand on what they make, and only the closure guards (a stretched chain's p99 off
+  // Cycles: 3.3° tangent, 6.0° object when this normal was guarded too).
+  const Vec3d above = aboveNormal != nullptr ? *aboveNormal : normalizeOr(n - gammaAbove, n);
   // The same derivatives along the plane of Ng, perpendicular to that normal.
   const double across = dot(ng, above);
   const Vec3d sigma = std::abs(across) > 0 ? gamma - (dot(gamma, above) / across) * ng : gamma;
   Vec3d bumped = normalizeOr(above - sigma, above);
   if (strength != 1) bumped = normalizeOr(strength * bumped + (1 - strength) * above, above);
+  // The closure's guard, which the normal must pass to be a Γ for the layers after it.
   bumped = validReflectionNormal(bumped, ng, incoming);
+  if (bumpedOut != nullptr) *bumpedOut = bumped;
   // The Γ that resolves to it: N − Γ = n₂ / ⟨n₂, N⟩.
   const double height = dot(bumped, n);
   if (!(height > 0)) return gammaAbove;  // only when the guard had nothing to turn to

@@ -15,11 +15,15 @@ namespace sgbake::gradient_detail {
 
 /// @brief stackLayerGradient's step (see there) from the layer's weighted, masked Γ without its
 /// Strength, @p gamma: the Γ after it, from @p gammaAbove, at unit normal @p n with unit
-/// geometric normal @p ng, its guards seeing the incoming direction @p incoming (n, but −n at
+/// geometric normal @p ng, its guard seeing the incoming direction @p incoming (n, but −n at
 /// a back-facing point: backFacingNormal). @p strength > 0. gammaAbove when anything is not
-/// finite.
+/// finite. @p aboveNormal, when given, is the unit normal the layers above hand on, in place of
+/// normalize(n − gammaAbove): one no Γ stands for (NormalBelowSurface). @p bumpedOut, when
+/// given, receives the unit normal the step makes (guarded), which the returned Γ stands for
+/// only when it lies above the surface.
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
-                    const Vec3d& gammaAbove, const Vec3d& incoming);
+                    const Vec3d& gammaAbove, const Vec3d& incoming,
+                    const Vec3d* aboveNormal = nullptr, Vec3d* bumpedOut = nullptr);
 
 /// @brief Whether Cycles shades @p n as back-facing: a unit shading normal that points behind
 /// its triangle's unit geometric normal @p ng (custom normals, smooth normals of a folded mesh,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <type_traits>
 #include <variant>
@@ -218,32 +219,41 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const PreparedUvFrame* preparedWorldUv) {
   const Vec3d& n = worldPoint.normal;
   const Vec3d& ng = worldGeometricNormal;
-  // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point;
-  // from the front, also whether the one layer is a normal map that decodes below the surface.
-  NormalBelowSurface below;
-  int active = 0;
+  // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point.
+  // From the front, also the normal the layers hand on when it lies below the surface, where
+  // no Γ stands for it (NormalBelowSurface): a normal map first, then the layers on it.
+  std::optional<Vec3d> handed;
   auto composite = [&](bool back) {
     const Vec3d incoming = back ? -n : n;
     Vec3d gamma{};
+    int active = 0;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       ++active;
+      if (back) {
+        addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
+                              gamma);
+        continue;
+      }
+      NormalBelowSurface step;
+      const bool onHanded = handed.has_value() && layer.base == LayerBase::kLayersAbove;
       addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
-                            gamma, back ? nullptr : &below);
+                            gamma, &step, onHanded ? &*handed : nullptr);
+      // A normal map below the surface added to other layers is their Γ sum's, mirrored.
+      if (step.found && (active == 1 || onHanded)) {
+        handed = step.handedOn(n);
+      } else {
+        handed.reset();
+      }
     }
     return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
   };
 
   WorldShadedNormal result;
   result.unguarded = normalizeOr(n - composite(false), n);
-  if (active == 1 && below.found) {
-    // A Normal Map node alone: Cycles blends its decoded normal by Strength and guards it as
-    // it is, below the surface too (the guard then turns it back up, on its own side of Ng).
-    result.unguarded =
-        below.strength == 1
-            ? below.decoded
-            : normalizeOr(n + std::max(below.strength, 0.0) * (below.decoded - n), n);
-  }
+  // Cycles' closure guards that normal as it is, below the surface too (a normal far below
+  // passes the guard; one nearer the plane is turned up on its own side of Ng).
+  if (handed) result.unguarded = *handed;
   if (layers.empty()) {
     result.normal = n;
   } else if (backFacing(n, ng)) {  // backFacingNormal, in world space
@@ -257,7 +267,8 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
 void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
                            const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
                            const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
-                           const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below) {
+                           const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below,
+                           const Vec3d* aboveNormal) {
   if (below != nullptr) *below = {};
   const double factor = layer.weight * layerMask(layer.mask, objectPoint);
   if (factor == 0) return;  // masked out: the source is not sampled
@@ -267,8 +278,17 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
   if (below != nullptr && g.belowSurface && factor == 1 && layer.base == LayerBase::kSurface)
     *below = {true, g.decoded, g.strength};
   if (layer.base == LayerBase::kLayersAbove) {
-    if (g.strength > 0)  // Blender clamps Strength at 0 (and NaN is no bump)
-      gamma = stackGradient(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma, incoming);
+    if (!(g.strength > 0)) {  // Blender clamps Strength at 0 (and NaN is no bump)
+      if (below != nullptr && aboveNormal != nullptr) *below = {true, *aboveNormal, 1};
+      return;
+    }
+    Vec3d bumped = n;
+    gamma = stackGradient(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma, incoming,
+                          aboveNormal, aboveNormal != nullptr ? &bumped : nullptr);
+    if (below != nullptr && aboveNormal != nullptr &&
+        !(dot(bumped, n) >= std::min(guardedTolerance(kMinObjectNormalCosine), 1.0))) {
+      *below = {true, bumped, 1};
+    }
     return;
   }
   gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);

@@ -192,6 +192,33 @@ TEST(WorldShading, ANormalMapDecodedBelowTheSurfaceIsGuardedAsItIs) {
   EXPECT_GT(turned.x, 0.7);
 }
 
+// A Bump node on such a normal map bumps the decoded normal itself (Cycles' nodes hand on what
+// they make; only the closure guards): a flat height leaves the map's result as it is, a
+// gentle one moves it a little, not over to the mirror image 35° above the plane.
+TEST(WorldShading, AHeightOnANormalMapDecodedBelowTheSurfaceBumpsThatNormal) {
+  const WorldSpace space = spaceOf(Mat3::fromColumns({1, 0, 0}, {0, 1, 0}, {2, 0, 1}));
+  ConstantNormalTexture map(Vec3d{std::sin(kPi / 3), 0, std::cos(kPi / 3)});
+  SurfacePoint object;
+  object.numUvSets = 1;
+  object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
+  const SurfacePoint world = worldSurfacePoint(object, space);
+  const Vec3d n = world.normal;
+  const Vec3d alone = shadeLayersInWorld(std::vector<Layer>{{ObjectNormalSource{&map, 0}, 1.0, {}}},
+                                         object, world, n, space)
+                          .normal;
+  ASSERT_LT(alone.z, -0.8);  // kept below the surface (see the test above)
+  for (const double slope : {0.0, 0.02}) {
+    RampTexture ramp(slope);
+    Layer bump{UvHeightSource{&ramp, 0, 1.0}, 1.0, {}};
+    bump.base = LayerBase::kLayersAbove;
+    const std::vector<Layer> chain{{ObjectNormalSource{&map, 0}, 1.0, {}}, bump};
+    const Vec3d bumped = shadeLayersInWorld(chain, object, world, n, space).normal;
+    const double degrees = std::acos(std::min(1.0, dot(bumped, alone))) * 180 / kPi;
+    EXPECT_LT(degrees, slope == 0 ? 1e-6 : 3.0) << slope;
+    EXPECT_GT(degrees, slope == 0 ? -1.0 : 0.1) << slope;
+  }
+}
+
 // Where the world normal points behind the world triangle, Cycles shades from behind and bakes
 // the front normal reversed (gradient_detail::backFacingNormal); in front, and for the Γ the
 // derivative maps read, nothing changes. The ramp of the stretched plane, with N leaning past
