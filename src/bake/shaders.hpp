@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <variant>
 
@@ -179,7 +180,7 @@ struct BakeShaderBase {
     const WorldShadedNormal shaded = shadeInWorld(b, f);
     return objectSpaceGradient(shaded, point, *world);
   }
-  const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
+  [[gnu::always_inline]] const SurfacePoint& pointAt(const Vec3d& b, const TexelFrame& f) {
     return surfacePointAt(tri, b, f, point);
   }
 
@@ -209,19 +210,65 @@ struct BakeShaderBase {
   }
 
   /// gamma += weight · mask · Γ of one layer (finite, nonzero weight) at @p p: gradient()'s step
-  /// (a layer on the layers above: gamma = stackLayerGradient, with the triangle's Ng).
-  void addLayerGradient(const Layer& layer, const SurfacePoint& p, Vec3d& gamma) const {
+  /// (a layer on the layers above: gamma = stackLayerGradient, with the triangle's Ng). With
+  /// @p below non-null, also whether the layer makes a normal below the surface
+  /// (gradient_detail::NormalBelowSurface: a normal map on the surface at weight 1, or a layer
+  /// on the layers above given the normal they hand on, @p aboveNormal).
+  void addLayerGradient(const Layer& layer, const SurfacePoint& p, Vec3d& gamma,
+                        gradient_detail::NormalBelowSurface* below = nullptr,
+                        const Vec3d* aboveNormal = nullptr) const {
     if (layer.base == LayerBase::kLayersAbove) {
-      gamma = stackLayerGradient(layer, p, tri.faceNormal, gamma);
+      gamma = below == nullptr ? stackLayerGradient(layer, p, tri.faceNormal, gamma)
+                               : gradient_detail::stackLayerGradientOn(
+                                     layer, p, tri.faceNormal, gamma, p.normal, aboveNormal, below);
       return;
     }
+    if (below != nullptr) *below = {};
     const double factor = layer.mask.texture == nullptr
                               ? layer.weight
                               : layer.weight * layerMask(layer.mask, p);
     if (factor == 0) return;  // masked out: the source is not sampled
     const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-    gamma += factor * (uvHeight != nullptr ? uvHeightGradient(*uvHeight, p)
-                                           : layerGradient(layer.source, p));
+    if (uvHeight != nullptr) {
+      gamma += factor * uvHeightGradient(*uvHeight, p);
+    } else if (below != nullptr) {
+      gamma += factor * gradient_detail::layerGradientNoting(layer.source, p, below);
+      below->found = below->found && factor == 1;
+    } else {
+      gamma += factor * layerGradient(layer.source, p);
+    }
+  }
+
+  /// gradient(p), and in @p handed the normal the layers hand on where no Γ stands for it
+  /// (gradient_detail::NormalBelowSurface: a normal map first that decodes below the surface,
+  /// then the layers on the layers above while what they make stays below); empty elsewhere.
+  Vec3d gradient(const SurfacePoint& p, std::optional<Vec3d>& handed) const {
+    handed.reset();
+    // Only a normal map first can start a normal below the surface: otherwise gradient(p).
+    const auto first = std::find_if(layers.begin(), layers.end(), [](const Layer& layer) {
+      return layer.weight != 0 && std::isfinite(layer.weight);
+    });
+    if (first == layers.end() || first->base != LayerBase::kSurface ||
+        !(std::holds_alternative<TangentNormalSource>(first->source) ||
+          std::holds_alternative<ObjectNormalSource>(first->source))) {
+      return gradient(p);
+    }
+    Vec3d gamma{};
+    int active = 0;
+    for (const Layer& layer : layers) {
+      if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+      ++active;
+      gradient_detail::NormalBelowSurface step;
+      const bool onHanded = handed.has_value() && layer.base == LayerBase::kLayersAbove;
+      addLayerGradient(layer, p, gamma, &step, onHanded ? &*handed : nullptr);
+      // A normal map below the surface added to other layers is their Γ sum's, mirrored.
+      if (step.found && (onHanded || (active == 1 && layer.base == LayerBase::kSurface))) {
+        handed = step.handedOn(p.normal);
+      } else {
+        handed.reset();
+      }
+    }
+    return isFinite(gamma) ? gamma : Vec3d{};
   }
 
   /// perturbedNormal(point, layers) in object space: N' = normalize(N − Γ) (eq. 33 with the
@@ -229,11 +276,14 @@ struct BakeShaderBase {
   /// its identity matrix products and its fallback normalization (computed for every texel);
   /// then Cycles' validReflectionNormal with the triangle's geometric normal, as Blender bakes.
   /// Where N̂ faces away from the triangle, what Cycles bakes there (backFacingNormal).
+  /// A normal the layers hand on below the surface is guarded as it is (NormalBelowSurface).
   Vec3d perturbed(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& p = pointAt(b, f);
     if (gradient_detail::backFacing(p.normal, tri.faceNormal)) return backFacingNormal(p);
-    return validReflectionNormal(unitOr(p.normal - gradient(p), p.normal), tri.faceNormal,
-                                 p.normal);
+    std::optional<Vec3d> handed;
+    const Vec3d gamma = gradient(p, handed);
+    return validReflectionNormal(handed ? *handed : unitOr(p.normal - gamma, p.normal),
+                                 tri.faceNormal, p.normal);
   }
   /// gradient_detail::backFacingNormal with the triangle's layers and Ng (out of line: rare).
   [[gnu::noinline]] Vec3d backFacingNormal(const SurfacePoint& p) const {
@@ -414,11 +464,24 @@ inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint
   }
 }
 
+/// shader.addLayerGradient of a normal map at @p p, flagging @p slow where it decodes below the
+/// surface. Out of line: inlined, it kept the compiler from inlining surfacePointAt into
+/// batchGradients (1 % of a one-thread bake with a triplanar layer).
+[[gnu::noinline]] inline void addNormalMapGradient(const BakeShaderBase& shader, const Layer& layer,
+                                                   const SurfacePoint& p, Vec3d& gamma,
+                                                   std::int64_t& slow) {
+  gradient_detail::NormalBelowSurface below;
+  shader.addLayerGradient(layer, p, gamma, &below);
+  slow = slow | below.found;
+}
+
 /// gamma = shader.gradient() of every sample's SurfacePoint (zero when not finite), bit for bit:
 /// unmasked UV image heights lane-parallel (batchUvHeightGradient), any other layer sample by
-/// sample through addLayerGradient, in layer order.
+/// sample through addLayerGradient, in layer order. With @p slow non-null, the lanes where a
+/// normal map decodes below the surface are flagged there too (gradient(p, handed) may then
+/// differ: the per-sample path shades them).
 inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
-                           Lanes3& gamma) {
+                           Lanes3& gamma, LaneFlags* slow = nullptr) {
   const std::size_t n = static_cast<std::size_t>(s.count);
   for (std::size_t i = 0; i < n; ++i) gamma.x[i] = gamma.y[i] = gamma.z[i] = 0.0;
   for (const Layer& layer : shader.layers) {
@@ -428,10 +491,19 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
                             std::get<UvHeightSource>(layer.source), layer.weight, unitN, gamma);
       continue;
     }
+    // (Only a normal map on the surface can start a normal below it.)
+    const bool noteBelow = slow != nullptr && layer.base == LayerBase::kSurface &&
+                           (std::holds_alternative<TangentNormalSource>(layer.source) ||
+                            std::holds_alternative<ObjectNormalSource>(layer.source));
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
       Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
-      shader.addLayerGradient(layer, shader.pointAt(b, texelFrame(shader.tri, b)), g);
+      const SurfacePoint& p = shader.pointAt(b, texelFrame(shader.tri, b));
+      if (noteBelow) [[unlikely]] {
+        addNormalMapGradient(shader, layer, p, g, (*slow)[i]);
+      } else {
+        shader.addLayerGradient(layer, p, g);
+      }
       gamma.x[i] = g.x;
       gamma.y[i] = g.y;
       gamma.z[i] = g.z;
@@ -447,12 +519,13 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
 
 /// v = N̂ − Γ of every sample (batchGradients), not normalized; slow[i] also when |v|² is not a
 /// normal positive number (zero, subnormal, overflowing), whose normalization takes a fallback,
-/// and when v fails reflectsAboveSurface (validReflectionNormal turns it: the scalar path) or
-/// N̂ faces away from the triangle (backFacing: the scalar path shades it as Cycles does).
+/// when v fails reflectsAboveSurface (validReflectionNormal turns it: the scalar path), when
+/// N̂ faces away from the triangle (backFacing: the scalar path shades it as Cycles does) and
+/// when a normal map decodes below the surface (NormalBelowSurface: perturbed() takes it).
 inline void batchPerturbedDirections(BakeShaderBase& shader, const SampleBatch& s, const Lanes3& unitN,
                                      Lanes3& v, LaneFlags& slow) {
   Lanes3 gamma;
-  batchGradients(shader, s, unitN, gamma);
+  batchGradients(shader, s, unitN, gamma, &slow);
   const Vec3d ng = shader.tri.faceNormal;
   for (std::size_t i = 0; i < static_cast<std::size_t>(s.count); ++i) {
     const double vx = unitN.x[i] - gamma.x[i];
@@ -593,7 +666,9 @@ struct TangentNormalShader : BakeShaderBase {
   Vec3d unnormalizedPerturbed(const Vec3d& b, const TexelFrame& f) {
     const SurfacePoint& p = pointAt(b, f);
     if (gradient_detail::backFacing(p.normal, tri.faceNormal)) return backFacingNormal(p);
-    const Vec3d v = p.normal - gradient(p);
+    std::optional<Vec3d> handed;
+    const Vec3d v = p.normal - gradient(p, handed);
+    if (handed) return validReflectionNormal(*handed, tri.faceNormal, p.normal);
     const double len2 = lengthSquared(v);
     if (len2 >= std::numeric_limits<double>::min() && std::isfinite(len2) &&
         reflectsAboveSurface(v, tri.faceNormal, p.normal, len2)) {

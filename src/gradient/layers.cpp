@@ -6,6 +6,7 @@
 #include <string>
 #include <variant>
 
+#include "gradient/prepared_uv_frame.hpp"
 #include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
@@ -34,19 +35,38 @@ Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
   return withNormalMapStrength(unblendedGradient(s, point), point.normal, s.strength);
 }
 
-Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point) {
+Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point,
+               gradient_detail::NormalBelowSurface* below = nullptr) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const Vec2d st =
       textureCoordinates(uvFrame(point, s.uvSet).uv, s.options.tiling, s.options.offset);
   const Vec3d n = decodeNormalTexel(s.texture->sample(st), s.options.green);
+  if (below != nullptr && isFinite(n) &&
+      !(n.z >= std::min(gradient_detail::guardedTolerance(s.options.minNormalZ), 1.0) *
+                   std::sqrt(lengthSquared(n)))) {
+    // slopesFromTangentNormal clamps z here: the decoded normal itself (none at n = 0).
+    const Vec3d decoded = decodeTangentNormal(n, point, s.frameUvSet(), s.options);
+    if (lengthSquared(decoded) > 0)
+      *below = {true, normalizeOr(decoded, point.normal), s.options.strength};
+  }
   return gradientFromTangentNormal(n, point, s.frameUvSet(), s.options);
 }
 
-Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point) {
+Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
+               gradient_detail::NormalBelowSurface* below = nullptr) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const Vec2d st = textureCoordinates(uvFrame(point, s.uvSet).uv, s.tiling, s.offset);
-  const Vec3d gamma =
-      gradientFromObjectNormal(decodeNormalTexel(s.texture->sample(st)), point.normal, s.minCosine);
+  const Vec3d n = decodeNormalTexel(s.texture->sample(st));
+  if (below != nullptr) {
+    // gradientFromObjectNormal's own test: below its floor it mirrors or clamps n̂.
+    const Vec3d unit = normalizeOr(n, Vec3d{});
+    if (lengthSquared(unit) > 0 &&
+        !(dot(unit, point.normal) >=
+          std::min(gradient_detail::guardedTolerance(s.minCosine), 1.0))) {
+      *below = {true, unit, s.strength};
+    }
+  }
+  const Vec3d gamma = gradientFromObjectNormal(n, point.normal, s.minCosine);
   return withNormalMapStrength(isFinite(gamma) ? gamma : Vec3d{}, point.normal, s.strength);
 }
 
@@ -197,6 +217,46 @@ Vec3d layerGradient(const LayerSource& source, const SurfacePoint& point) {
   return std::visit([&](const auto& s) { return evaluate(s, point); }, source);
 }
 
+namespace gradient_detail {
+
+Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
+                          NormalBelowSurface* below) {
+  if (below != nullptr) *below = {};
+  if (const auto* tangent = std::get_if<TangentNormalSource>(&source))
+    return evaluate(*tangent, point, below);
+  if (const auto* object = std::get_if<ObjectNormalSource>(&source))
+    return evaluate(*object, point, below);
+  return layerGradient(source, point);
+}
+
+Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
+                           const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+                           NormalBelowSurface* below) {
+  if (below != nullptr) *below = {};
+  // Nothing to bump: the normal above is handed on as it is.
+  auto handOn = [&] {
+    if (below != nullptr && aboveNormal != nullptr) *below = {true, *aboveNormal, 1};
+    return gammaAbove;
+  };
+  const double factor = layer.weight * layerMask(layer.mask, point);
+  if (factor == 0) return handOn();  // masked out: the source is not sampled
+  const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
+  const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
+  if (!(strength > 0)) return handOn();  // Blender clamps Strength at 0 (and NaN is no bump)
+  const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
+                                                    : layerGradient(layer.source, point));
+  Vec3d bumped = point.normal;
+  const Vec3d result = stackGradient(gamma, strength, point.normal, ng, gammaAbove, incoming,
+                                     aboveNormal, aboveNormal != nullptr ? &bumped : nullptr);
+  if (below != nullptr && aboveNormal != nullptr &&
+      !(dot(bumped, point.normal) >= std::min(guardedTolerance(kMinObjectNormalCosine), 1.0))) {
+    *below = {true, bumped, 1};
+  }
+  return result;
+}
+
+}  // namespace gradient_detail
+
 double layerMask(const LayerMask& mask, const SurfacePoint& point) {
   if (mask.texture == nullptr) return 1;
   if (!hasUvSet(point, mask.uvSet)) return 0;
@@ -212,14 +272,8 @@ namespace {
 /// stackLayerGradient with the guards seeing @p incoming.
 Vec3d stackLayerGradientSeen(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
                              const Vec3d& gammaAbove, const Vec3d& incoming) {
-  const double factor = layer.weight * layerMask(layer.mask, point);
-  if (factor == 0) return gammaAbove;  // masked out: the source is not sampled
-  const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-  const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
-  if (!(strength > 0)) return gammaAbove;  // Blender clamps Strength at 0 (and NaN is no bump)
-  const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
-                                                    : layerGradient(layer.source, point));
-  return gradient_detail::stackGradient(gamma, strength, point.normal, ng, gammaAbove, incoming);
+  return gradient_detail::stackLayerGradientOn(layer, point, ng, gammaAbove, incoming, nullptr,
+                                               nullptr);
 }
 
 /// compositeGradient, its stacked layers' guards seeing the incoming direction N, or −N at a

@@ -13,6 +13,25 @@
 
 namespace sgbake::gradient_detail {
 
+/// @brief A layer that makes a normal at or below the tangent plane (⟨n, N⟩ below
+/// kMinObjectNormalCosine, or a tangent-space texel's z below its minNormalZ), which no Γ stands
+/// for: N − Γ resolves to its mirror image above the plane, or to a clamped one. Cycles' Normal
+/// Map and Bump nodes hand such a normal on as it is, and the closure's guard tests it as it is.
+/// A stretched object turns an object-space normal 60° from N that far.
+struct NormalBelowSurface {
+  /// The layer is a normal map, unmasked, on the surface, at weight 1, that decodes there; or a
+  /// layer on the layers above, given the normal they hand on, that bumps it there.
+  bool found = false;
+  Vec3d decoded{};  ///< that unit normal (a normal map's before its Strength)
+  double strength = 1;
+  /// The normal the layer hands on: `decoded` blended with @p n by Strength, as the Normal
+  /// Map node blends it.
+  Vec3d handedOn(const Vec3d& n) const {
+    return strength == 1 ? decoded
+                         : normalizeOr(n + (strength > 0 ? strength : 0.0) * (decoded - n), n);
+  }
+};
+
 /// @brief stackLayerGradient's step (see there) from the layer's weighted, masked Γ without its
 /// Strength, @p gamma: the Γ after it, from @p gammaAbove, at unit normal @p n with unit
 /// geometric normal @p ng, its guard seeing the incoming direction @p incoming (n, but −n at
@@ -24,6 +43,19 @@ namespace sgbake::gradient_detail {
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
                     const Vec3d& gammaAbove, const Vec3d& incoming,
                     const Vec3d* aboveNormal = nullptr, Vec3d* bumpedOut = nullptr);
+
+/// @brief stackLayerGradient seen from @p incoming, with stackGradient's @p aboveNormal, and
+/// @p below set (when non-null) when @p aboveNormal is given and what the layer makes of it
+/// lies below the surface too.
+Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
+                           const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+                           NormalBelowSurface* below);
+
+/// @brief layerGradient, and @p below (non-null) set when the source is a normal map that
+/// decodes below the surface here (a tangent-space texel with z below its minNormalZ, an
+/// object-space normal within kMinObjectNormalCosine of the tangent plane or behind it).
+Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
+                          NormalBelowSurface* below);
 
 /// @brief Whether Cycles shades @p n as back-facing: a unit shading normal that points behind
 /// its triangle's unit geometric normal @p ng (custom normals, smooth normals of a folded mesh,

@@ -51,13 +51,12 @@ bool uvDerivativeTangentFrame(const UvFrame& frame, Vec3d normal, Vec3d& tangent
   return true;
 }
 
-Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
-                                const TangentNormalOptions& options) {
-  // Tiling repeats the map without steepening it: Blender's Normal Map node decodes the texel
-  // in the frame of the untiled UVs (a Mapping node only moves the lookup), and so does every
-  // engine. (A height map's tiling does steepen its slopes: the heights are squeezed.)
-  const Vec2d slopes = slopesFromTangentNormal(n, options.minNormalZ);
+namespace {
 
+/// The frame gradientFromTangentNormal decodes in (see there): T/L and B of the MikkTSpace frame
+/// of the UV set, or of set 0, or the UV-derivative frame. False when there is none.
+bool tangentNormalFrame(const SurfacePoint& point, int uvSet, const TangentNormalOptions& options,
+                        Vec3d& tangent, Vec3d& bitangent) {
   // The MikkTSpace frame of the map's UV set, if the point has one (set 0's is point.tangent);
   // kMikkTSpace falls back on set 0's.
   const Vec3d* mikkTangent = nullptr;
@@ -78,19 +77,34 @@ Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
     // interpolated normal N_i = L·N and B_i = sign · N_i × T (sign = interpolated sign < 0 ?
     // −1 : +1). Divided by L: x·T/L + y·B + z·N with B = sign · N × T, so T/L decodes.
     const double sign = mikkSign < 0 ? -1.0 : 1.0;
-    const Vec3d bitangent = sign * cross(point.normal, *mikkTangent);
-    const Vec3d tangent = (1 / point.normalLength) * *mikkTangent;
-    return withNormalMapStrength(finiteOrZero(gradientFromTangentFrame(slopes, tangent, bitangent)),
-                                 point.normal, options.strength);
+    bitangent = sign * cross(point.normal, *mikkTangent);
+    tangent = (1 / point.normalLength) * *mikkTangent;
+    return true;
   }
-  if (uvSet < 0 || uvSet >= point.numUvSets || uvSet >= kMaxUvSets) return {};
+  if (uvSet < 0 || uvSet >= point.numUvSets || uvSet >= kMaxUvSets) return false;
+  return uvDerivativeTangentFrame(point.uv[static_cast<std::size_t>(uvSet)], point.normal, tangent,
+                                  bitangent, options.minFrameSine);
+}
+
+}  // namespace
+
+Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
+                                const TangentNormalOptions& options) {
+  // Tiling repeats the map without steepening it: Blender's Normal Map node decodes the texel
+  // in the frame of the untiled UVs (a Mapping node only moves the lookup), and so does every
+  // engine. (A height map's tiling does steepen its slopes: the heights are squeezed.)
+  const Vec2d slopes = slopesFromTangentNormal(n, options.minNormalZ);
   Vec3d tangent, bitangent;
-  if (!uvDerivativeTangentFrame(point.uv[static_cast<std::size_t>(uvSet)], point.normal, tangent,
-                                bitangent, options.minFrameSine)) {
-    return {};
-  }
+  if (!tangentNormalFrame(point, uvSet, options, tangent, bitangent)) return {};
   return withNormalMapStrength(finiteOrZero(gradientFromTangentFrame(slopes, tangent, bitangent)),
                                point.normal, options.strength);
+}
+
+Vec3d decodeTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
+                          const TangentNormalOptions& options) {
+  Vec3d tangent, bitangent;
+  if (!isFinite(n) || !tangentNormalFrame(point, uvSet, options, tangent, bitangent)) return {};
+  return finiteOrZero(n.x * tangent + n.y * bitangent + n.z * point.normal);
 }
 
 Vec3d withNormalMapStrength(Vec3d gamma, Vec3d normal, double strength) {

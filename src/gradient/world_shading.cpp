@@ -64,12 +64,12 @@ class WorldLayerEvaluator {
   WorldGradient operator()(const TangentNormalSource& s) const {
     TangentNormalSource unblended = s;
     unblended.options.strength = 1;
-    return decodedNormal(layerGradient(unblended, object_), s.options.strength);
+    return decodedNormal(objectNormal(unblended), s.options.strength);
   }
   WorldGradient operator()(const ObjectNormalSource& s) const {
     ObjectNormalSource unblended = s;
     unblended.strength = 1;
-    return decodedNormal(layerGradient(unblended, object_), s.strength);
+    return decodedNormal(objectNormal(unblended), s.strength);
   }
   WorldGradient operator()(const VolumeSource& s) const {
     return {heightGradient(layerGradient(s, object_))};
@@ -85,10 +85,18 @@ class WorldLayerEvaluator {
     const Vec3d v = space_.normalToWorld * sigma;
     return v - dot(v, n) * n;
   }
-  /// The Γ of a normal map's object-space normal N − Γ_o, carried to world space as a normal
-  /// (and that normal when the Γ cannot stand for it).
-  WorldGradient decodedNormal(const Vec3d& gammaObject, double strength = 1) const {
-    const Vec3d n = space_.normalToWorld * (object_.normal - gammaObject);
+  /// A normal map's decoded object-space normal (Strength 1): N − Γ_o, or the decoded normal
+  /// itself where it lies below the object's surface and Γ_o cannot stand for it.
+  template <class Source>
+  Vec3d objectNormal(const Source& s) const {
+    gradient_detail::NormalBelowSurface below;
+    const Vec3d gamma = gradient_detail::layerGradientNoting(s, object_, &below);
+    return below.found ? below.decoded : object_.normal - gamma;
+  }
+  /// The Γ of a normal map's object-space normal @p objectNormal, carried to world space as a
+  /// normal (and that normal when the Γ cannot stand for it).
+  WorldGradient decodedNormal(const Vec3d& objectNormal, double strength = 1) const {
+    const Vec3d n = space_.normalToWorld * objectNormal;
     WorldGradient g{finiteOrZero(gradientFromObjectNormal(n, world_.normal)), strength};
     // gradientFromObjectNormal's own test: ⟨n̂, N⟩ below its floor mirrors or clamps n̂.
     const Vec3d unit = normalizeOr(n, Vec3d{});
@@ -104,7 +112,7 @@ class WorldLayerEvaluator {
   WorldGradient projected(ProjectedKind kind, const Source& s) const {
     const Vec3d gamma = layerGradient(s, object_);
     return kind == ProjectedKind::kHeight ? WorldGradient{heightGradient(gamma)}
-                                          : decodedNormal(gamma);
+                                          : decodedNormal(object_.normal - gamma);
   }
   static Vec3d finiteOrZero(const Vec3d& v) { return sgbake::isFinite(v) ? v : Vec3d{}; }
 

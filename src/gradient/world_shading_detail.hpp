@@ -7,6 +7,7 @@
 #include <span>
 
 #include "gradient/prepared_uv_frame.hpp"
+#include "gradient/stacking.hpp"
 #include "sgbake/gradient/world_shading.hpp"
 
 namespace sgbake::gradient_detail {
@@ -17,23 +18,6 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
                                      const SurfacePoint& worldPoint,
                                      const Vec3d& worldGeometricNormal, const WorldSpace& space,
                                      const PreparedUvFrame* preparedWorldUv);
-
-/// @brief A layer that makes a world normal at or below the tangent plane (⟨n, N⟩ below
-/// kMinObjectNormalCosine), which no Γ stands for: N − Γ resolves to its mirror image above the
-/// plane. A stretched object turns an object-space normal 60° from N that far.
-struct NormalBelowSurface {
-  /// The layer is a normal map, unmasked, on the surface, at weight 1, that decodes there; or a
-  /// layer on the layers above, given the normal they hand on, that bumps it there.
-  bool found = false;
-  Vec3d decoded{};  ///< that unit normal (a normal map's before its Strength)
-  double strength = 1;
-  /// The normal the layer hands on: `decoded` blended with @p n by Strength, as the Normal
-  /// Map node blends it.
-  Vec3d handedOn(const Vec3d& n) const {
-    return strength == 1 ? decoded
-                         : normalizeOr(n + (strength > 0 ? strength : 0.0) * (decoded - n), n);
-  }
-};
 
 /// @brief One layer's step of shadeLayersInWorld's sum, bit for bit: @p gamma, the world Γ of
 /// the layers before @p layer (whose weight is finite and nonzero), becomes the Γ after it,

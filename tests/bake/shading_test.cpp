@@ -281,37 +281,54 @@ class ConstantNormalTexture final : public VectorTexture {
   Vec3d encoded_;
 };
 
-// A flat triangle (N = Ng = ẑ) under a shear that keeps ẑ but takes an object normal 60° from
-// it 35° below the world's tangent plane: Cycles' guard passes that normal as it is (its test
-// reflects I about the normal's line), so the bake shows it below the surface, lane-parallel
-// as sample by sample; the Γ sum would give its mirror image above the plane.
-TEST(ShadeBatchBelowTheSurface, ANormalFarBelowIsBakedAsItIs) {
+/// ObjectNormalShader's output for @p layers on a flat triangle (N = Ng = ẑ, UVs = positions, no
+/// MikkTSpace frames) placed by @p world (or not), lane-parallel and sample by sample: equal bit
+/// for bit, and equal to the encoded @p expected.
+void expectFlatTriangleBakes(std::span<const Layer> layers, const WorldSpace* world,
+                             const Vec3d& expected, const std::string& what) {
   const Mesh mesh = test::uvPlaneMesh({{{0.1f, 0.1f}, {0.9f, 0.2f}, {0.3f, 0.8f}}});
-  const WorldSpace shear =
-      *WorldSpace::of({Mat3::fromColumns({1, 0, 0}, {0, 1, 0}, {2, 0, 1}), {0.5, -1, 2}});
-  const Vec3d v{std::sin(kPi / 3), 0, std::cos(kPi / 3)};
-  ConstantNormalTexture map(v);
-  const std::vector<Layer> layers{Layer{ObjectNormalSource{&map, 0}, 1.0, {}}};
-  const Vec3d below = normalizeOr(shear.normalToWorld * v, {});  // (0.57, 0, −0.82)
-  ASSERT_LT(below.z, -0.8);
   bake_detail::ObjectNormalShader shader;
   shader.mesh = &mesh;
   shader.layers = layers;
-  shader.world = &shear;
+  shader.world = world;
   shader.beginTriangle(0, {0, 1, 2});
   std::mt19937 rng(5);
   const SampleBatch batch = randomBatch(rng, SampleBatch::kMax);
   std::vector<double> lanes(3 * static_cast<std::size_t>(batch.count));
   shader.shadeBatch(batch, lanes.data());
-  // Blender's baker brings it back to object space as a direction (M^{-1}).
-  const Vec3d expected =
-      bake_detail::encodeNormal(normalizeOr(shear.directionToObject * below, {}));
+  const Vec3d encoded = bake_detail::encodeNormal(expected);
   for (std::size_t i = 0; i < static_cast<std::size_t>(batch.count); ++i) {
     double one[3];
     shader.shade({batch.b0[i], batch.b1[i], batch.b2[i]}, 0, 0, one);
-    EXPECT_EQ(std::memcmp(one, &lanes[3 * i], sizeof one), 0) << "lane " << i;
-    EXPECT_LT(length(Vec3d{one[0], one[1], one[2]} - expected), 1e-12) << "lane " << i;
+    EXPECT_EQ(std::memcmp(one, &lanes[3 * i], sizeof one), 0) << what << ", lane " << i;
+    EXPECT_LT(length(Vec3d{one[0], one[1], one[2]} - encoded), 1e-12) << what << ", lane " << i;
   }
+}
+
+// A normal map that decodes far below the surface: Cycles' guard passes such a normal as it is
+// (its test reflects I about the normal's line), so the bake shows it below the surface; the Γ
+// sum would give its mirror image above the plane (an object-space map) or a grazing one (a
+// tangent-space texel with z < 0, whose slopes are clamped). Lane-parallel as sample by sample.
+TEST(ShadeBatchBelowTheSurface, ANormalFarBelowIsBakedAsItIs) {
+  // 150° from N in object space, for an object-space and a tangent-space map (the flat
+  // triangle's UV-derivative frame is x̂, ŷ, ẑ).
+  const Vec3d steep{std::sin(5 * kPi / 6), 0, std::cos(5 * kPi / 6)};
+  ConstantNormalTexture steepMap(steep);
+  expectFlatTriangleBakes(std::vector<Layer>{Layer{ObjectNormalSource{&steepMap, 0}, 1.0, {}}},
+                          nullptr, steep, "object-space map");
+  expectFlatTriangleBakes(std::vector<Layer>{Layer{TangentNormalSource{&steepMap, 0}, 1.0, {}}},
+                          nullptr, steep, "tangent-space map");
+  // 60° from N in object space, under a shear that keeps ẑ but takes that normal 35° below the
+  // world's tangent plane. Blender's baker brings it back to object space as a direction
+  // (M^{-1}).
+  const WorldSpace shear =
+      *WorldSpace::of({Mat3::fromColumns({1, 0, 0}, {0, 1, 0}, {2, 0, 1}), {0.5, -1, 2}});
+  const Vec3d v{std::sin(kPi / 3), 0, std::cos(kPi / 3)};
+  ConstantNormalTexture map(v);
+  const Vec3d below = normalizeOr(shear.normalToWorld * v, {});  // (0.57, 0, −0.82)
+  ASSERT_LT(below.z, -0.8);
+  expectFlatTriangleBakes(std::vector<Layer>{Layer{ObjectNormalSource{&map, 0}, 1.0, {}}}, &shear,
+                          normalizeOr(shear.directionToObject * below, {}), "sheared");
 }
 
 TEST_F(ShadeBatch, OverflowingAndCancellingGradients) {

@@ -4,9 +4,9 @@
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
         [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist,
                  nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
-                 nmap_cube_s2,nmap_suzanne,nmap_suzanne_flat,chain_sphere,chain_suzanne,
-                 stretch_sphere,
-                 stretch_cube,stretch_nmap_sphere,stretch_nmap_sphere_object,
+                 nmap_cube_s2,nmap_suzanne,nmap_suzanne_flat,nmap_sphere_steep,chain_sphere,
+                 chain_suzanne,stretch_sphere,stretch_cube,stretch_nmap_sphere,
+                 stretch_nmap_sphere_object,
                  stretch_chain_suzanne,sphere_backfacing,nmap_sphere_backfacing,
                  stretch_sphere_backfacing,stretch_nmap_sphere_backfacing]
         [--sabotage green|scale|input|strength|normal-green]
@@ -33,7 +33,10 @@
    a smooth procedural 512^2 float EXR whose normals lean up to 60 deg - 40 deg at Strength
    2 - from the surface normal, so that Cycles' valid-reflection guard bends a good part of
    them; tangent space on the UV sphere at Strength 1, 0.5 and 2 and on the flat cube at
-   Strength 1 and 2, object space on the UV sphere; 256^2, see bake_scene.py) runs instead
+   Strength 1 and 2, object space on the UV sphere; nmap_sphere_steep leans up to 150 deg, so
+   that a third of its texels decode below the surface, which Cycles' guard keeps there or
+   turns up on their own side (sgbake mirrored or clamped them: p99 102 deg off, now 0.18);
+   256^2, see bake_scene.py) runs instead
      sgbake bake scene.json   (normal layer: normal.exr, space, strength, bilinear; outputs
                                tangent-normal -> ours_nmap_tangent.exr and object-normal ->
                                ours_nmap_object.exr; the same flags as above)
@@ -167,9 +170,10 @@ SGBAKE_TIMEOUT = 120
 DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
                  "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
                  "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne",
-                 "nmap_suzanne_flat",                 "chain_sphere", "chain_suzanne", "stretch_sphere", "stretch_cube",
-                 "stretch_nmap_sphere", "stretch_nmap_sphere_object", "stretch_chain_suzanne",
-                 "sphere_backfacing", "nmap_sphere_backfacing", "stretch_sphere_backfacing",
+                 "nmap_suzanne_flat", "nmap_sphere_steep", "chain_sphere", "chain_suzanne",
+                 "stretch_sphere", "stretch_cube", "stretch_nmap_sphere",
+                 "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
+                 "nmap_sphere_backfacing", "stretch_sphere_backfacing",
                  "stretch_nmap_sphere_backfacing")
 
 

@@ -304,6 +304,38 @@ TEST(GradientFromTangentNormal, MikkTSpaceFrameMatchesBlendersForwardDecode) {
   EXPECT_LT(worst, 1e-12);
 }
 
+// decodeTangentNormal is Blender's forward decode x·T + y·B + z·N itself, for every texel: a
+// positive multiple of N − Γ above the horizon, below the tangent plane where z < 0 (where Γ only
+// clamps it).
+TEST(DecodeTangentNormal, IsBlendersForwardDecodeAboveAndBelowTheHorizon) {
+  Random rng(16);
+  int below = 0;
+  for (int i = 0; i < 2000; ++i) {
+    SurfacePoint p;
+    p.normal = rng.unit();
+    const Vec3d t = rng.unit();
+    p.tangent = normalizeOr(t - dot(t, p.normal) * p.normal, Vec3d{});
+    if (length(cross(p.normal, t)) < 0.2) continue;
+    p.bitangentSign = i % 2 ? 1.0 : -1.0;
+    p.hasTangentFrame = true;
+    const Vec3d n = rng.uniform(0.8, 1.2) * rng.unit();
+    const Vec3d b = p.bitangentSign * cross(p.normal, p.tangent);
+    const Vec3d decoded = decodeTangentNormal(n, p, 0);
+    EXPECT_LT(maxAbsDiff(decoded, n.x * p.tangent + n.y * b + n.z * p.normal), 1e-15);
+    if (n.z > 0.05 * length(n)) {
+      EXPECT_LT(maxAbsDiff(normalizeOr(decoded, Vec3d{}),
+                           resolveNormal(p.normal, gradientFromTangentNormal(n, p, 0))),
+                1e-12);
+    } else if (n.z < 0) {
+      ++below;
+      EXPECT_LT(dot(decoded, p.normal), 0);
+    }
+  }
+  EXPECT_GT(below, 500);
+  SurfacePoint frameless;  // no MikkTSpace frame, no UV set: no decode
+  EXPECT_EQ(decodeTangentNormal({0.1, 0.2, 0.9}, frameless, 0), (Vec3d{0, 0, 0}));
+}
+
 // Without precomputed tangents the frame is built from ∂P/∂u like the JCGT framework; it equals
 // the MikkTSpace form whenever the MikkTSpace frame is that same frame.
 TEST(GradientFromTangentNormal, UvDerivativeFrameEqualsMikkTSpaceWhenTheFramesAgree) {

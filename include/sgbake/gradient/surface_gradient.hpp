@@ -241,6 +241,13 @@ Vec3d withNormalMapStrength(Vec3d gamma, Vec3d normal, double strength);
 Vec3d gradientFromTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
                                 const TangentNormalOptions& options = {});
 
+/// @brief The object-space normal Blender's Normal Map node decodes @p n to, x·T + y·B + z·N in
+/// the frame gradientFromTangentNormal uses (not normalized, before Strength; zero without a
+/// frame). Where n_z > 0 it is a positive multiple of N − Γ; where n_z ≤ 0 it lies at or below
+/// the tangent plane, where Γ only clamps it (see slopesFromTangentNormal).
+Vec3d decodeTangentNormal(Vec3d n, const SurfacePoint& point, int uvSet,
+                          const TangentNormalOptions& options = {});
+
 // ---------------------------------------------------------------------------------------------
 // Object-space normals → Γ (eq. 38)
 // ---------------------------------------------------------------------------------------------
