@@ -20,9 +20,12 @@
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/volume.hpp"
 #include "sgbake/gradient/world_shading.hpp"
+#include "support/analytic_textures.hpp"
 
 namespace sgbake {
 namespace {
+
+using test::ConstantNormalTexture;
 
 using bake_detail::SampleBatch;
 
@@ -270,16 +273,6 @@ TEST_F(ShadeBatch, NormalMapsDecodedBelowTheSurface) {
                              placement);
   }
 }
-
-/// One object-space normal everywhere.
-class ConstantNormalTexture final : public VectorTexture {
- public:
-  explicit ConstantNormalTexture(Vec3d n) : encoded_(0.5 * n + Vec3d{0.5, 0.5, 0.5}) {}
-  Vec3d sample(Vec2d) const override { return encoded_; }
-
- private:
-  Vec3d encoded_;
-};
 
 /// ObjectNormalShader's output for @p layers on a flat triangle (N = Ng = ẑ, UVs = positions, no
 /// MikkTSpace frames) placed by @p world (or not), lane-parallel and sample by sample: equal bit

@@ -281,18 +281,25 @@ TEST(SlopesFromTangentNormal, GuardsGrazingAndBelowHorizonTexels) {
 
 // The MikkTSpace form reproduces Blender's forward decode normalize(x·T + y·B + z·N) exactly,
 // for unit and non-unit tangents, tangents not orthogonal to N, both signs, and any tiling = 1.
+/// A point with a random MikkTSpace frame for sample @p i: its tangent orthogonal to N and of
+/// unit length every third sample (every sample with @p orthonormal), arbitrary otherwise; both
+/// bitangent signs. False when the tangent lies too near N.
+bool randomMikkTSpacePoint(Random& rng, int i, bool orthonormal, SurfacePoint& p) {
+  p.normal = rng.unit();
+  const Vec3d t = rng.unit();
+  p.tangent = orthonormal || i % 3 == 0 ? normalizeOr(t - dot(t, p.normal) * p.normal, Vec3d{})
+                                        : rng.uniform(0.5, 1.5) * t;
+  p.bitangentSign = i % 2 ? 1.0 : -1.0;
+  p.hasTangentFrame = true;
+  return length(cross(p.normal, p.tangent)) >= 0.2;
+}
+
 TEST(GradientFromTangentNormal, MikkTSpaceFrameMatchesBlendersForwardDecode) {
   Random rng(6);
   double worst = 0;
   for (int i = 0; i < 2000; ++i) {
     SurfacePoint p;
-    p.normal = rng.unit();
-    const Vec3d t = rng.unit();
-    p.tangent = i % 3 == 0 ? normalizeOr(t - dot(t, p.normal) * p.normal, Vec3d{})  // orthonormal
-                           : rng.uniform(0.5, 1.5) * t;                             // arbitrary
-    if (length(cross(p.normal, p.tangent)) < 0.2) continue;
-    p.bitangentSign = i % 2 ? 1.0 : -1.0;
-    p.hasTangentFrame = true;
+    if (!randomMikkTSpacePoint(rng, i, false, p)) continue;
     Vec3d n = rng.unit();
     if (n.z < 0.05) n.z = std::abs(n.z) + 0.05;  // a valid texel, above the guard
     n = rng.uniform(0.8, 1.2) * n;               // and not of unit length
@@ -312,12 +319,7 @@ TEST(DecodeTangentNormal, IsBlendersForwardDecodeAboveAndBelowTheHorizon) {
   int below = 0;
   for (int i = 0; i < 2000; ++i) {
     SurfacePoint p;
-    p.normal = rng.unit();
-    const Vec3d t = rng.unit();
-    p.tangent = normalizeOr(t - dot(t, p.normal) * p.normal, Vec3d{});
-    if (length(cross(p.normal, t)) < 0.2) continue;
-    p.bitangentSign = i % 2 ? 1.0 : -1.0;
-    p.hasTangentFrame = true;
+    if (!randomMikkTSpacePoint(rng, i, true, p)) continue;
     const Vec3d n = rng.uniform(0.8, 1.2) * rng.unit();
     const Vec3d b = p.bitangentSign * cross(p.normal, p.tangent);
     const Vec3d decoded = decodeTangentNormal(n, p, 0);

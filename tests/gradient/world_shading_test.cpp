@@ -18,6 +18,7 @@ namespace sgbake {
 namespace {
 
 using test::AnalyticHeight;
+using test::ConstantNormalTexture;
 using test::maxAbsDiff;
 using test::samplePoint;
 
@@ -140,16 +141,6 @@ TEST(WorldShading, StrengthBlendsTheWorldNormals) {
       shadeLayersInWorld(std::vector<Layer>{{half, 1.0, {}}}, object, world, n, space).normal;
   EXPECT_LT(maxAbsDiff(blended, normalizeOr(0.5 * bumped + 0.5 * n, {})), 1e-15);
 }
-
-/// One object-space normal everywhere.
-class ConstantNormalTexture final : public VectorTexture {
- public:
-  explicit ConstantNormalTexture(Vec3d n) : encoded_(0.5 * n + Vec3d{0.5, 0.5, 0.5}) {}
-  Vec3d sample(Vec2d) const override { return encoded_; }
-
- private:
-  Vec3d encoded_;
-};
 
 // A shear can carry an object normal 60° from N below the world's tangent plane. No Γ stands
 // for such a normal (N − Γ resolves to its mirror image above the plane); Cycles' guard sees

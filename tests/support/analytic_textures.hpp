@@ -15,6 +15,16 @@ inline double maxAbsDiff(Vec3d a, Vec3d b) {
   return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
 }
 
+/// One normal everywhere, encoded n/2 + 0.5 as a normal map's texel.
+class ConstantNormalTexture final : public VectorTexture {
+ public:
+  explicit ConstantNormalTexture(Vec3d n) : encoded_(0.5 * n + Vec3d{0.5, 0.5, 0.5}) {}
+  Vec3d sample(Vec2d) const override { return encoded_; }
+
+ private:
+  Vec3d encoded_;
+};
+
 /// h(s, t) = a·s + b·t + c·sin(2π s)·cos(2π t), exact derivatives; counts its samples
 /// (thread-safe), so tests can check what was (not) evaluated.
 class AnalyticHeight final : public ScalarTexture {
