@@ -278,8 +278,14 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
                            const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below,
                            const Vec3d* aboveNormal) {
   if (below != nullptr) *below = {};
+  // A layer on the layers above that bumps nothing hands their normal on as it is.
+  const bool handsOn =
+      below != nullptr && aboveNormal != nullptr && layer.base == LayerBase::kLayersAbove;
   const double factor = layer.weight * layerMask(layer.mask, objectPoint);
-  if (factor == 0) return;  // masked out: the source is not sampled
+  if (factor == 0) {  // masked out: the source is not sampled
+    if (handsOn) *below = {true, *aboveNormal, 1};
+    return;
+  }
   const Vec3d& n = worldPoint.normal;
   const WorldGradient g = std::visit(
       WorldLayerEvaluator(objectPoint, worldPoint, space, preparedWorldUv), layer.source);
@@ -287,16 +293,14 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
     *below = {true, g.decoded, g.strength};
   if (layer.base == LayerBase::kLayersAbove) {
     if (!(g.strength > 0)) {  // Blender clamps Strength at 0 (and NaN is no bump)
-      if (below != nullptr && aboveNormal != nullptr) *below = {true, *aboveNormal, 1};
+      if (handsOn) *below = {true, *aboveNormal, 1};
       return;
     }
     Vec3d bumped = n;
     gamma = stackGradient(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma, incoming,
                           aboveNormal, aboveNormal != nullptr ? &bumped : nullptr);
-    if (below != nullptr && aboveNormal != nullptr &&
-        !(dot(bumped, n) >= std::min(guardedTolerance(kMinObjectNormalCosine), 1.0))) {
+    if (handsOn && !(dot(bumped, n) >= std::min(guardedTolerance(kMinObjectNormalCosine), 1.0)))
       *below = {true, bumped, 1};
-    }
     return;
   }
   gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
