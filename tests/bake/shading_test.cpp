@@ -311,6 +311,14 @@ TEST(ShadeBatchBelowTheSurface, ANormalFarBelowIsBakedAsItIs) {
                           nullptr, steep, "object-space map");
   expectFlatTriangleBakes(std::vector<Layer>{Layer{TangentNormalSource{&steepMap, 0}, 1.0, {}}},
                           nullptr, steep, "tangent-space map");
+  // A flat height stacked on it (a Bump node on the Normal Map's output) bumps that normal by
+  // nothing: the same.
+  test::LinearHeight flat{0, 0};
+  Layer onTop{UvHeightSource{&flat, 0, 1.0}, 1.0, {}};
+  onTop.base = LayerBase::kLayersAbove;
+  expectFlatTriangleBakes(
+      std::vector<Layer>{Layer{TangentNormalSource{&steepMap, 0}, 1.0, {}}, onTop}, nullptr, steep,
+      "tangent-space map, a flat bump on it");
   // 60° from N in object space, under a shear that keeps ẑ but takes that normal 35° below the
   // world's tangent plane. Blender's baker brings it back to object space as a direction
   // (M^{-1}).
