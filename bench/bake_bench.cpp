@@ -17,7 +17,10 @@
 //     Cycles shades an object whose scale was never applied (BakeInput::transform);
 //   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
 //   - BM_Mask/threads:N — the raster and coverage alone (no shading);
-//   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map.
+//   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map;
+//   - BM_TangentNormalLimit/threads:N — the tangent map of Suzanne's exact limit surface
+//     ("subdivision": {"level": "limit"}: every sample located on the surface with Bfr), and
+//     BM_TangentNormalLevel3/threads:N — the same map of the level-3 mesh its raster walks.
 // Setup (loading the mesh, MikkTSpace, building the texture) is not timed; writing files is not
 // part of this library.
 
@@ -38,6 +41,7 @@
 #include "sgbake/gradient/image.hpp"
 #include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/mesh/io.hpp"
+#include "sgbake/subdiv/limit_surface.hpp"
 
 namespace {
 
@@ -109,7 +113,46 @@ void bake(benchmark::State& state, MapKind kind, bool withLayers,
   state.counters["texels"] = double(kBakeSize) * kBakeSize;
 }
 
+/// Suzanne's limit surface (Blender's default options) and its level-3 tessellation with that
+/// mesh's MikkTSpace frames, made once.
+struct LimitScene {
+  LimitTessellation limit;
+  CornerTangents tangents;
+};
+const LimitScene& limitScene() {
+  static const std::unique_ptr<LimitScene> s = [] {
+    Result<LimitTessellation> limit = tessellateLimitSurface(scene().mesh, {});
+    if (!limit) std::exit(1);
+    Result<CornerTangents> tangents = computeTangents(limit->mesh.view(0));
+    if (!tangents) std::exit(1);
+    return std::make_unique<LimitScene>(LimitScene{std::move(*limit), std::move(*tangents)});
+  }();
+  return *s;
+}
+
+/// The tangent map of the limit surface (@p exact) or of its tessellation as a mesh.
+void bakeSubdivided(benchmark::State& state, bool exact) {
+  const LimitScene& l = limitScene();
+  BakeSettings settings;
+  settings.map = MapKind::kTangentNormal;
+  settings.width = settings.height = kBakeSize;
+  settings.threads = static_cast<int>(state.range(0));
+  BakeInput input{&l.limit.mesh, exact ? nullptr : &l.tangents, scene().layers};
+  if (exact) {
+    input.limit = &l.limit.surface;
+    input.limitParameters = &l.limit.parameters;
+  }
+  for (auto _ : state) {
+    Result<FloatImage> image = bakeMap(input, settings);
+    if (!image) state.SkipWithError(image.error().message.c_str());
+    benchmark::DoNotOptimize(image);
+  }
+  state.counters["texels"] = double(kBakeSize) * kBakeSize;
+}
+
 void BM_TangentNormal(benchmark::State& state) { bake(state, MapKind::kTangentNormal, true); }
+void BM_TangentNormalLimit(benchmark::State& state) { bakeSubdivided(state, true); }
+void BM_TangentNormalLevel3(benchmark::State& state) { bakeSubdivided(state, false); }
 void BM_ObjectNormal(benchmark::State& state) { bake(state, MapKind::kObjectNormal, true); }
 void BM_TangentNormalStretched(benchmark::State& state) {
   bake(state, MapKind::kTangentNormal, true, &kStretched);
@@ -198,5 +241,7 @@ BENCHMARK(BM_TangentNormalNoLayers)->Apply(threadArgs);
 BENCHMARK(BM_Mask)->Apply(threadArgs);
 BENCHMARK(BM_ExtendMargin16)->Apply(threadArgs);
 BENCHMARK(BM_PushPull)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalLevel3)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalLimit)->Apply(threadArgs);
 
 BENCHMARK_MAIN();
