@@ -124,8 +124,8 @@ struct LayerMask {
 enum class LayerBase {
   /// The surface's shading normal N: the layer's Γ is added to the others' (eq. 34-35).
   kSurface,
-  /// The normal the layers above it make, n₁ = normalize(N − Γ_above) (guarded as Cycles
-  /// guards every Bump and Normal Map node's output): Blender's Bump node with its Normal input
+  /// The normal the layers above it make, n₁ = normalize(N − Γ_above) (unguarded: in Blender
+  /// 3.4 only the closure guards, not the nodes): Blender's Bump node with its Normal input
   /// linked to the node before it (a Normal Map node, another Bump node). Heights only (UV
   /// height maps, volumes, planar and triplanar heights): a Normal Map node has no Normal input.
   /// See stackLayerGradient.
@@ -182,14 +182,15 @@ Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point
 /// @brief Γ after a layer based on kLayersAbove (finite nonzero weight), from @p gammaAbove,
 /// the composite of the layers before it: Cycles' Bump node with its Normal input linked.
 ///
-/// With n₁ = validReflectionNormal(normalize(N − Γ_above), Ng, N), the normal the layers above
-/// make, and γ = weight · mask · Γ of the layer's source without its Strength (⊥ N, and
-/// ⟨γ, e⟩ = the height's derivative along e for every e in the plane of Ng): the Bump node's
-/// surface gradient relative to n₁ is the vector ⊥ n₁ with the same derivatives along the
-/// plane, σ = γ − (⟨γ, n₁⟩ / ⟨Ng, n₁⟩) Ng (Cycles' (∂h/∂x R_x + ∂h/∂y R_y) / det with
-/// R_x = ∂P/∂y × n₁, R_y = n₁ × ∂P/∂x, for any two directions ∂P/∂x, ∂P/∂y spanning the plane).
-/// Then n₂ = normalize(n₁ − σ), blended with n₁ by the layer's Strength (UV height maps), guarded
-/// again; returned as the Γ that resolves to it, N − n₂ / ⟨n₂, N⟩ (a guarded n₂ has ⟨n₂, N⟩ > 0).
+/// With n₁ = normalize(N − Γ_above), the normal the layers above make (not guarded: Blender
+/// 3.4's Normal Map and Bump nodes hand on what they make), and γ = weight · mask · Γ of the
+/// layer's source without its Strength (⊥ N, and ⟨γ, e⟩ = the height's derivative along e for every
+/// e in the plane of Ng): the Bump node's surface gradient relative to n₁ is the vector ⊥ n₁ with
+/// the same derivatives along the plane, σ = γ − (⟨γ, n₁⟩ / ⟨Ng, n₁⟩) Ng (Cycles' (∂h/∂x R_x +
+/// ∂h/∂y R_y) / det with R_x = ∂P/∂y × n₁, R_y = n₁ × ∂P/∂x, for any two directions ∂P/∂x, ∂P/∂y
+/// spanning the plane). Then n₂ = normalize(n₁ − σ), blended with n₁ by the layer's Strength (UV
+/// height maps), guarded as the closure guards it; returned as the Γ that resolves to it, N − n₂ /
+/// ⟨n₂, N⟩ (gammaAbove where ⟨n₂, N⟩ ≤ 0: no Γ stands for a normal below the surface).
 Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
                          const Vec3d& geometricNormal, const Vec3d& gammaAbove);
 
