@@ -58,13 +58,9 @@ Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
   const Vec2d st = textureCoordinates(uvFrame(point, s.uvSet).uv, s.tiling, s.offset);
   const Vec3d n = decodeNormalTexel(s.texture->sample(st));
   if (below != nullptr) {
-    // gradientFromObjectNormal's own test: below its floor it mirrors or clamps n̂.
     const Vec3d unit = normalizeOr(n, Vec3d{});
-    if (lengthSquared(unit) > 0 &&
-        !(dot(unit, point.normal) >=
-          std::min(gradient_detail::guardedTolerance(s.minCosine), 1.0))) {
+    if (gradient_detail::belowSurface(unit, point.normal, s.minCosine))
       *below = {true, unit, s.strength};
-    }
   }
   const Vec3d gamma = gradientFromObjectNormal(n, point.normal, s.minCosine);
   return withNormalMapStrength(isFinite(gamma) ? gamma : Vec3d{}, point.normal, s.strength);
@@ -233,25 +229,36 @@ Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const 
                            const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
                            NormalBelowSurface* below) {
   if (below != nullptr) *below = {};
-  // Nothing to bump: the normal above is handed on as it is.
-  auto handOn = [&] {
-    if (below != nullptr && aboveNormal != nullptr) *below = {true, *aboveNormal, 1};
-    return gammaAbove;
-  };
   const double factor = layer.weight * layerMask(layer.mask, point);
-  if (factor == 0) return handOn();  // masked out: the source is not sampled
+  if (factor == 0) {  // masked out: the source is not sampled
+    noteHandedOn(below, aboveNormal);
+    return gammaAbove;
+  }
   const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
   const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
-  if (!(strength > 0)) return handOn();  // Blender clamps Strength at 0 (and NaN is no bump)
+  if (!(strength > 0)) {  // Blender clamps Strength at 0 (and NaN is no bump)
+    noteHandedOn(below, aboveNormal);
+    return gammaAbove;
+  }
   const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
                                                     : layerGradient(layer.source, point));
-  Vec3d bumped = point.normal;
-  const Vec3d result = stackGradient(gamma, strength, point.normal, ng, gammaAbove, incoming,
-                                     aboveNormal, aboveNormal != nullptr ? &bumped : nullptr);
-  if (below != nullptr && aboveNormal != nullptr &&
-      !(dot(bumped, point.normal) >= std::min(guardedTolerance(kMinObjectNormalCosine), 1.0))) {
-    *below = {true, bumped, 1};
+  return stackGradientNoting(gamma, strength, point.normal, ng, gammaAbove, incoming, aboveNormal,
+                             below);
+}
+
+Vec3d stackGradientNoting(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
+                          const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+                          NormalBelowSurface* below) {
+  if (below != nullptr) *below = {};
+  if (!(strength > 0)) {  // Blender clamps Strength at 0 (and NaN is no bump)
+    noteHandedOn(below, aboveNormal);
+    return gammaAbove;
   }
+  Vec3d bumped = n;
+  const Vec3d result = stackGradient(gamma, strength, n, ng, gammaAbove, incoming, aboveNormal,
+                                     aboveNormal != nullptr ? &bumped : nullptr);
+  if (below != nullptr && aboveNormal != nullptr && belowSurface(bumped, n))
+    *below = {true, bumped, 1};
   return result;
 }
 

@@ -5,11 +5,14 @@
 /// point whose shading normal faces away from its triangle.
 #pragma once
 
+#include <algorithm>
 #include <span>
 
+#include "gradient/prepared_uv_frame.hpp"
 #include "gradient/valid_reflection.hpp"
 #include "sgbake/core/vec.hpp"
 #include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/surface_gradient.hpp"
 
 namespace sgbake::gradient_detail {
 
@@ -31,6 +34,28 @@ struct NormalBelowSurface {
                          : normalizeOr(n + (strength > 0 ? strength : 0.0) * (decoded - n), n);
   }
 };
+
+/// @brief Whether unit @p unit lies below the floor under which the Γ of a normal mirrors or
+/// clamps it (gradientFromObjectNormal's test, ⟨n̂, N⟩ < @p minCosine): what NormalBelowSurface
+/// notes. False for a zero @p unit.
+inline bool belowSurface(const Vec3d& unit, const Vec3d& n,
+                         double minCosine = kMinObjectNormalCosine) {
+  return lengthSquared(unit) > 0 && !(dot(unit, n) >= std::min(guardedTolerance(minCosine), 1.0));
+}
+
+/// @brief stackGradient (@p strength of any value: none > 0 bumps nothing) with
+/// NormalBelowSurface noted in @p below (when non-null) for a layer given @p aboveNormal: that
+/// normal handed on when the layer bumps nothing, the normal the step makes when it lies below
+/// the surface too. What stackLayerGradientOn and the world shading's step share.
+Vec3d stackGradientNoting(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
+                          const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+                          NormalBelowSurface* below);
+
+/// @brief Notes in @p below (when non-null) @p aboveNormal (when non-null) handed on as it is,
+/// by a layer on the layers above that bumps nothing.
+inline void noteHandedOn(NormalBelowSurface* below, const Vec3d* aboveNormal) {
+  if (below != nullptr && aboveNormal != nullptr) *below = {true, *aboveNormal, 1};
+}
 
 /// @brief stackLayerGradient's step (see there) from the layer's weighted, masked Γ without its
 /// Strength, @p gamma: the Γ after it, from @p gammaAbove, at unit normal @p n with unit

@@ -98,11 +98,8 @@ class WorldLayerEvaluator {
   WorldGradient decodedNormal(const Vec3d& objectNormal, double strength = 1) const {
     const Vec3d n = space_.normalToWorld * objectNormal;
     WorldGradient g{finiteOrZero(gradientFromObjectNormal(n, world_.normal)), strength};
-    // gradientFromObjectNormal's own test: ⟨n̂, N⟩ below its floor mirrors or clamps n̂.
     const Vec3d unit = normalizeOr(n, Vec3d{});
-    if (!(dot(unit, world_.normal) >=
-          std::min(gradient_detail::guardedTolerance(kMinObjectNormalCosine), 1.0)) &&
-        lengthSquared(unit) > 0) {
+    if (gradient_detail::belowSurface(unit, world_.normal)) {
       g.belowSurface = true;
       g.decoded = unit;
     }
@@ -278,12 +275,9 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
                            const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below,
                            const Vec3d* aboveNormal) {
   if (below != nullptr) *below = {};
-  // A layer on the layers above that bumps nothing hands their normal on as it is.
-  const bool handsOn =
-      below != nullptr && aboveNormal != nullptr && layer.base == LayerBase::kLayersAbove;
   const double factor = layer.weight * layerMask(layer.mask, objectPoint);
   if (factor == 0) {  // masked out: the source is not sampled
-    if (handsOn) *below = {true, *aboveNormal, 1};
+    if (layer.base == LayerBase::kLayersAbove) noteHandedOn(below, aboveNormal);
     return;
   }
   const Vec3d& n = worldPoint.normal;
@@ -292,15 +286,8 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
   if (below != nullptr && g.belowSurface && factor == 1 && layer.base == LayerBase::kSurface)
     *below = {true, g.decoded, g.strength};
   if (layer.base == LayerBase::kLayersAbove) {
-    if (!(g.strength > 0)) {  // Blender clamps Strength at 0 (and NaN is no bump)
-      if (handsOn) *below = {true, *aboveNormal, 1};
-      return;
-    }
-    Vec3d bumped = n;
-    gamma = stackGradient(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma, incoming,
-                          aboveNormal, aboveNormal != nullptr ? &bumped : nullptr);
-    if (handsOn && !(dot(bumped, n) >= std::min(guardedTolerance(kMinObjectNormalCosine), 1.0)))
-      *below = {true, bumped, 1};
+    gamma = stackGradientNoting(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma,
+                                incoming, aboveNormal, below);
     return;
   }
   gamma += factor * withNormalMapStrength(g.gamma, n, g.strength);
