@@ -43,23 +43,25 @@ Prints one JSON line:
   sgbake_s (target >= 25), write_s (OIIO alone), writer_thread_s, total_over_write = sgbake_s /
   write_s (target <= 2), oiio_start_s, oiio_process_s, total_over_oiio_process,
   t1_s, t2_s (wall, --threads 1 / 2), t1_compute_s, t2_compute_s, scaling = t1_compute_s /
-  t2_compute_s (target >= 1.8), wall_scaling = t1_s / t2_s; one_core_s (--threads 1 pinned to
-  one CPU with taskset; null without taskset), one_core_wall_scaling = one_core_s / t2_s,
+  t2_compute_s, wall_scaling = t1_s / t2_s; one_core_s (--threads 1 pinned to one CPU with
+  taskset; null without taskset), one_core_wall_scaling = one_core_s / t2_s,
   one_core_after_load_s and t2_after_load_s (total_s - load_s from --stats: everything after
-  the inputs are loaded, writing included), after_load_scaling = their ratio; plus size, margin, format, bit_depth, faces, height_size,
-  the 1-minute load average before and after (measure on an idle machine: with the load above
-  the core count the figures, above all the scaling, are meaningless) and sgbake's stats of
-  the best all-core run.
-"compute" is the work without file I/O: tangents_s + bake_s + pad_s + convert_s from --stats
-(else wall - load_s - write_s); bake_s excludes the waits for the writer thread. The scaling
-target is about the compute: writing a PNG is serial zlib, and as total_over_write <= 2 lets
-writing be up to half the wall time, whole-process scaling could never reach 1.8
-(wall_scaling is reported too). --threads 1 bakes and writes on one thread, but the module
-load, the mesh parse and OpenImageIO's EXR decode still overlap on others: the one-core run
-pins the whole process to one CPU, and after_load_scaling is what the second core buys for
-everything after loading (writing included). With two cores the writer thread shares them with the
-compute, so the 2-thread compute gets less than two cores; the library benchmark
-`sgbake_bench_bake` (BM_TangentNormal/threads:1 vs 2, no I/O) measures the kernel alone.
+  the inputs are loaded, writing included), after_load_scaling = their ratio (target >= 1.8;
+  without taskset, scaling is held to it instead); plus size, margin, format, bit_depth,
+  faces, height_size, the 1-minute load average before and after (measure on an idle machine:
+  with the load above the core count the figures, above all the scaling, are meaningless) and
+  sgbake's stats of the best all-core run.
+--threads 1 bakes and writes on one thread, but the module load, the mesh parse and
+OpenImageIO's EXR decode still overlap on others: the one-core run pins the whole process to
+one CPU, and after_load_scaling is what the second core buys for everything after loading,
+writing included. That is the scaling target's figure: the whole process's (wall_scaling)
+could never reach 1.8, as the image I/O module's load is serial (see README). "compute" is
+tangents_s + bake_s + pad_s + convert_s from --stats (else wall - load_s - write_s). With
+several threads the strips are compressed by the same threads that bake, between the bake's
+tasks (sgbake's ImageFileWriter), so the 2-thread compute includes time spent writing and
+its scaling (reported as scaling) understates what the second core buys; the library
+benchmark `sgbake_bench_bake` (BM_TangentNormal/threads:1 vs 2, no I/O) measures the kernel
+alone.
 sgbake runs with --no-manifest: otherwise its incremental manifest would skip every run after
 the first as "up to date".
 With --check the exit status is 1 when a target is missed.
@@ -299,10 +301,11 @@ def main():
         misses.append(f"speedup {result['speedup']:.1f} < {TARGET_SPEEDUP}")
     if result["total_over_write"] > TARGET_TOTAL_OVER_WRITE:
         misses.append(f"total/write {result['total_over_write']:.2f} > {TARGET_TOTAL_OVER_WRITE}")
-    if result["scaling"] is None:
-        misses.append("no compute time for the 1/2-thread scaling")
-    elif result["scaling"] < TARGET_SCALING:
-        misses.append(f"1->2 thread scaling {result['scaling']:.2f} < {TARGET_SCALING}")
+    scaling_key = "after_load_scaling" if result["one_core_s"] is not None else "scaling"
+    if result[scaling_key] is None:
+        misses.append(f"no {scaling_key} for the 1/2-thread scaling")
+    elif result[scaling_key] < TARGET_SCALING:
+        misses.append(f"1->2 thread {scaling_key} {result[scaling_key]:.2f} < {TARGET_SCALING}")
     for miss in misses:
         print("FAIL: " + miss, file=sys.stderr)
     return 1 if misses else 0

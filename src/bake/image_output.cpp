@@ -5,6 +5,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -24,7 +25,6 @@
 #include <new>
 #include <optional>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -237,10 +237,12 @@ Status checkContents(const FloatImage& image, const std::filesystem::path& path,
   return Ok{};
 }
 
-/// Strips writeRows may queue ahead of the writer's thread before it waits.
-constexpr std::size_t kMaxQueuedStrips = 3;
-/// Rows per strip the writer's thread compresses: writeRows splits larger requests, so that
-/// converting one strip overlaps compressing the one before.
+/// Strips writeRows may queue ahead of the one being written before it waits: two bands of
+/// bakeMapRows (256 rows each), so that the bake hands a band over without waiting while the
+/// band before is still being written.
+constexpr std::size_t kMaxQueuedStrips = 8;
+/// Rows per strip a task compresses: writeRows splits larger requests, so that converting one
+/// strip overlaps compressing the one before.
 constexpr int kStripRows = 64;
 
 using Clock = std::chrono::steady_clock;
@@ -250,8 +252,10 @@ double secondsSince(Clock::time_point start) {
 
 }  // namespace
 
-/// Everything an ImageFileWriter owns; the writer's thread reads the queue and the codec's file.
-struct ImageFileWriter::State {
+/// Everything an ImageFileWriter owns. Queued strips are written by tasks of the caller's task
+/// arena (see writeRows), which hold the state by a shared_ptr: a task that runs after the
+/// writer is gone finds the queue empty and returns.
+struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::State> {
   std::filesystem::path path;
   AtomicFile file;
   std::unique_ptr<io_detail::ImageWriter> out;
@@ -267,63 +271,73 @@ struct ImageFileWriter::State {
     std::vector<std::byte> data;
   };
   std::mutex mutex;
-  std::condition_variable changed;  ///< queue, failure or stop changed
+  std::condition_variable changed;  ///< a strip was written, or writing stopped
   std::deque<Strip> queue;
   std::vector<std::vector<std::byte>> spare;  ///< written strips' buffers, for reuse
-  bool stop = false;      ///< no more strips: the thread exits once the queue is empty
-  bool failed = false;    ///< a strip failed to write (the rest are dropped)
-  bool abandoned = false; ///< the writer is destroyed uncommitted: queued strips are dropped
-  std::string failure;    ///< the codec's reason, one line
-  double fileSeconds = 0; ///< time inside the codec (guarded by mutex)
-  double waitSeconds = 0; ///< caller's time waiting for the thread
+  /// Strips are handed to tasks (threads != 1); else writeRows writes each one itself.
+  bool tasks = false;
+  bool writing = false;    ///< a thread is writing strips (one at a time, in order)
+  bool scheduled = false;  ///< a task is enqueued and has not started yet
+  bool failed = false;     ///< a strip failed to write (the rest are dropped)
+  bool abandoned = false;  ///< the writer is destroyed uncommitted: queued strips are dropped
+  std::string failure;     ///< the codec's reason, one line
+  double fileSeconds = 0;  ///< time inside the codec (guarded by mutex)
+  double waitSeconds = 0;  ///< caller's time waiting for the queue, or writing itself
   /// Largest magnitude a float strip value keeps: ±65504 (the largest half) or FLT_MAX
   float floatLimit = std::numeric_limits<float>::max();
   std::uint64_t clipped = 0;  ///< values the file cannot store as they are (see clippedValues)
-  std::thread thread;
 
   explicit State(AtomicFile f) : file(std::move(f)) {}
 
-  void run() {
-    std::unique_lock lock(mutex);
-    for (;;) {
-      changed.wait(lock, [&] { return stop || !queue.empty(); });
-      if (queue.empty()) return;  // stop, and nothing left
+  /// Writes the queued strips in order, unless another thread is writing them already; returns
+  /// when the queue is empty. Called with @p lock held, returns it held.
+  void drain(std::unique_lock<std::mutex>& lock) {
+    if (writing) return;
+    writing = true;
+    while (!queue.empty()) {
       Strip strip = std::move(queue.front());
       queue.pop_front();
       const bool skip = failed || abandoned;
       lock.unlock();
       changed.notify_all();  // room in the queue
-      write(std::move(strip), skip, lock);
-      changed.notify_all();
+      bool ok = true;
+      const Clock::time_point start = Clock::now();
+      if (!skip)
+        ok = out->writeRows(strip.row, strip.row + strip.rows, stripType, strip.data.data());
+      const double seconds = secondsSince(start);
+      lock.lock();
+      fileSeconds += seconds;
+      spare.push_back(std::move(strip.data));
+      if (!ok && !failed) {
+        failed = true;
+        failure = oneLineReason(out->error());
+      }
     }
-  }
-
-  /// Writes @p strip to the file unless @p skip (the writer failed or was abandoned) and
-  /// records the time and any failure; called with @p lock released, returns it held.
-  void write(Strip strip, bool skip, std::unique_lock<std::mutex>& lock) {
-    bool ok = true;
-    const Clock::time_point start = Clock::now();
-    if (!skip) ok = out->writeRows(strip.row, strip.row + strip.rows, stripType, strip.data.data());
-    const double seconds = secondsSince(start);
-    lock.lock();
-    fileSeconds += seconds;
-    spare.push_back(std::move(strip.data));
-    if (!ok && !failed) {
-      failed = true;
-      failure = oneLineReason(out->error());
-    }
-  }
-
-  /// Stops the thread after the queued strips and waits for it.
-  void join() {
-    if (!thread.joinable()) return;
-    const Clock::time_point start = Clock::now();
-    {
-      std::lock_guard lock(mutex);
-      stop = true;
-    }
+    writing = false;
     changed.notify_all();
-    thread.join();
+  }
+
+  /// Has a task of the caller's arena drain the queue, unless one is about to or a thread is
+  /// writing (it takes the new strip before it stops). Called with mutex held.
+  void schedule() {
+    if (writing || scheduled) return;
+    scheduled = true;
+    tbb::this_task_arena::enqueue([self = shared_from_this()] {
+      std::unique_lock lock(self->mutex);
+      self->scheduled = false;
+      self->drain(lock);
+    });
+  }
+
+  /// Waits until every queued strip is written (writing them itself when no thread is).
+  void flush() {
+    const Clock::time_point start = Clock::now();
+    std::unique_lock lock(mutex);
+    for (;;) {
+      drain(lock);
+      if (!writing) break;
+      changed.wait(lock, [&] { return !writing; });
+    }
     waitSeconds += secondsSince(start);
   }
 
@@ -337,7 +351,7 @@ struct ImageFileWriter::State {
   }
 };
 
-ImageFileWriter::ImageFileWriter(std::unique_ptr<State> state) : state_(std::move(state)) {}
+ImageFileWriter::ImageFileWriter(std::shared_ptr<State> state) : state_(std::move(state)) {}
 ImageFileWriter::ImageFileWriter(ImageFileWriter&&) noexcept = default;
 ImageFileWriter& ImageFileWriter::operator=(ImageFileWriter&&) noexcept = default;
 
@@ -347,9 +361,12 @@ ImageFileWriter::~ImageFileWriter() {
     std::lock_guard lock(state_->mutex);
     state_->abandoned = true;  // no use compressing strips of a file that will be removed
   }
-  state_->join();
+  state_->flush();
   if (state_->out) state_->out->close();
-  // state_->file is discarded by its destructor: the temporary goes, the target stays.
+  // Now, not when a task that is still enqueued lets the state go: the temporary goes, the
+  // target stays.
+  state_->out.reset();
+  state_->file.discard();
 }
 
 Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path, int width,
@@ -372,7 +389,7 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
   // The temporary file first: an unwritable destination fails before any conversion work.
   Result<AtomicFile> file = AtomicFile::create(path);
   if (!file) return file.error();
-  auto state = std::make_unique<State>(std::move(*file));
+  auto state = std::make_shared<State>(std::move(*file));
   state->path = path;
   state->width = width;
   state->height = height;
@@ -417,10 +434,7 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
     return fileError(ErrorCode::kInternal, path,
                      "cannot write " + upperName(format) + " image (" + oneLineReason(reason) + ")");
   }
-  if (options.threads != 1) {  // one thread asked for: writeRows writes each strip itself
-    State* raw = state.get();
-    state->thread = std::thread([raw] { raw->run(); });
-  }
+  state->tasks = options.threads != 1;  // one thread asked for: writeRows writes each strip
   return ImageFileWriter(std::move(state));
 }
 
@@ -507,28 +521,32 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
                       });
   });
   clipped += stripClipped.load(std::memory_order_relaxed);
-  if (!thread.joinable()) {  // no writer thread (threads == 1): write the strip here
-    const Clock::time_point start = Clock::now();
-    std::unique_lock lock(mutex, std::defer_lock);
-    write(std::move(strip), failed, lock);
-    waitSeconds += secondsSince(start);  // the caller is held up by the file, as by a wait
-    if (failed) return writeFailure();
-    return Ok{};
-  }
   const Clock::time_point start = Clock::now();
   std::unique_lock lock(mutex);
-  changed.wait(lock, [&] { return failed || queue.size() < kMaxQueuedStrips; });
+  if (!tasks) {  // threads == 1: write the strip here
+    queue.push_back(std::move(strip));
+    drain(lock);
+    waitSeconds += secondsSince(start);  // the caller is held up by the file, as by a wait
+    return failed ? Status{writeFailure()} : Status{Ok{}};
+  }
+  // A full queue: the task writing is behind; wait for it, or write when none is.
+  while (!failed && queue.size() >= kMaxQueuedStrips) {
+    if (!writing) {
+      drain(lock);
+    } else {
+      changed.wait(lock, [&] { return failed || !writing || queue.size() < kMaxQueuedStrips; });
+    }
+  }
   waitSeconds += secondsSince(start);
   if (failed) return writeFailure();
   queue.push_back(std::move(strip));
-  lock.unlock();
-  changed.notify_all();
+  schedule();
   return Ok{};
 }
 
 Result<AtomicFile> ImageFileWriter::finish() {
   State& s = *state_;
-  s.join();
+  s.flush();
   if (s.failed) return s.writeFailure();
   if (s.nextRow != s.height) {
     return fileError(ErrorCode::kInternal, s.path,

@@ -27,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/prepare.hpp"
+#include "bake/raster.hpp"
 #include "sgbake/bake/bake.hpp"
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/frames/tangents.hpp"
@@ -1714,9 +1715,13 @@ Result<ExecuteReport> executePlan(const Plan& plan, const ExecuteOptions& option
       } else {
         const BakeInput input = plan_detail::bakeInputFor(loaded, layers);
         const BakeSettings settings = plan_detail::bakeSettingsFor(output, tile, options.threads);
-        if (Status ok = bakeImageTile(input, settings, stored, file, report, pending); !ok) {
-          return ok.error();
-        }
+        // One arena for the bake and the writer's tasks: writing takes turns with baking on
+        // the `threads` threads instead of running beside them.
+        Status baked = Ok{};
+        bake_detail::runWithThreads(settings.threads, [&] {
+          baked = bakeImageTile(input, settings, stored, file, report, pending);
+        });
+        if (!baked) return baked.error();
       }
       outputReport.files.push_back(file);
       for (const fs::path& stale : staleTemporaries(file)) {

@@ -180,11 +180,13 @@ struct TriangleBins {
 TriangleBins binTriangles(const RasterJob& job);
 
 /// @brief Runs @p work() in a task arena of at most @p threads threads (0: the caller's arena,
-/// i.e. all cores by default).
+/// i.e. all cores by default). A caller already in an arena of that many threads runs @p work
+/// there: nested calls share the arena, and with it the tasks ImageFileWriter enqueues in it.
 template <class Work>
 void runWithThreads(int threads, const Work& work) {
-  if (threads > 0) {
-    tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
+  const int wanted = std::min(threads, tbb::info::default_concurrency());
+  if (threads > 0 && tbb::this_task_arena::max_concurrency() != wanted) {
+    tbb::task_arena arena(wanted);
     arena.execute(work);
   } else {
     work();

@@ -258,8 +258,8 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   }
   if (transform) settings.transform = &*transform;
 
-  // Converted band by band; each band's rows go to the writer's thread, which compresses and
-  // writes them while the next band is converted. The output image never exists whole.
+  // Converted band by band; each band's rows go to the writer, whose tasks compress and write
+  // them while the next band is converted. The output image never exists whole.
   ImageWriteOptions writeOptions;
   writeOptions.format = *format;
   writeOptions.bitDepth = bitDepth;

@@ -5,8 +5,10 @@
 
 #include <OpenImageIO/imageio.h>
 #include <sys/stat.h>
+#include <tbb/task_arena.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -17,6 +19,7 @@
 #include <set>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/files.hpp"
@@ -376,8 +379,8 @@ TEST_F(ImageOutputTest, IntegerCodesRoundHalfAwayFromZero) {
   }
 }
 
-// With the writer's own thread (threads 0) and without it (threads 1: each strip written by
-// writeRows itself, before it returns).
+// With the strips written by tasks of the caller's arena (threads 0) and without them (threads 1:
+// each strip written by writeRows itself, before it returns).
 TEST_F(ImageOutputTest, StripsWrittenInTurnEqualTheWholeImage) {
   const FloatImage image = rampImage(7, 9, 3);
   ASSERT_TRUE(writeImage(image, dir_ / "whole.png"));
@@ -413,6 +416,56 @@ TEST_F(ImageOutputTest, StripsWrittenInTurnEqualTheWholeImage) {
   }
 }
 
+// More strips at once than the queue holds (writeRows splits 300 rows into strips of 64): the
+// caller waits for the task writing them, or writes them itself when no thread is; in an arena
+// of two threads, of one, and in the caller's. The file is the whole image, row for row.
+TEST_F(ImageOutputTest, MoreStripsThanTheQueueHoldsAreWrittenInOrder) {
+  const int width = 5, height = 1000;
+  const FloatImage image = rampImage(width, height, 3);
+  const std::span<const float> pixels(image.pixels);
+  ImageWriteOptions options;
+  options.bitDepth = 32;  // float EXR: every ramp value exactly
+  const auto writeAll = [&](const fs::path& path, int threads) {
+    options.threads = threads;
+    Result<ImageFileWriter> writer = ImageFileWriter::open(path, width, height, 3, options);
+    ASSERT_TRUE(writer.ok());
+    const auto rowValues = static_cast<std::size_t>(width * 3);
+    for (int row = 0; row < height; row += 300) {
+      const int rows = std::min(300, height - row);
+      ASSERT_TRUE(writer->writeRows(
+          row, rows, pixels.subspan(std::size_t(row) * rowValues, std::size_t(rows) * rowValues),
+          {}));
+    }
+    ASSERT_TRUE(writer->commit());
+  };
+  const std::vector<std::pair<int, int>> cases = {{0, 0}, {2, 2}, {1, 2}, {2, 1}};
+  for (const auto& [arenaThreads, threads] : cases) {
+    SCOPED_TRACE("arena " + std::to_string(arenaThreads) + ", threads " + std::to_string(threads));
+    const fs::path path =
+        dir_ / ("many" + std::to_string(arenaThreads) + std::to_string(threads) + ".exr");
+    if (arenaThreads == 0) {
+      writeAll(path, threads);
+    } else {
+      tbb::task_arena(arenaThreads).execute([&] { writeAll(path, threads); });
+    }
+    const ReadBack back = readBack(path);
+    ASSERT_EQ(back.spec.height, height);
+    for (int r = 0; r < height; ++r)
+      for (int x = 0; x < width; ++x)
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(back.at(x, r, c), image.at(x, r, c)) << x << "," << r;
+  }
+  // Abandoned with strips queued: nothing is left, at once (not when a late task lets go).
+  const std::set<std::string> before = listDirectory(dir_);
+  {
+    options.threads = 0;
+    Result<ImageFileWriter> abandoned =
+        ImageFileWriter::open(dir_ / "abandoned.exr", width, height, 3, options);
+    ASSERT_TRUE(abandoned.ok());
+    ASSERT_TRUE(abandoned->writeRows(0, height, pixels, {}));
+  }
+  EXPECT_EQ(listDirectory(dir_), before);
+}
+
 TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
   const fs::path path = dir_ / "n.png";
   {
@@ -421,7 +474,7 @@ TEST_F(ImageOutputTest, StripWriterRejectsGapsAndLeavesNothingWhenUnfinished) {
   }
   const FloatImage image = rampImage(4, 4, 1);
   const std::span<const float> pixels(image.pixels);
-  for (const int threads : {0, 1}) {  // the writer's own thread, or none (see above)
+  for (const int threads : {0, 1}) {  // strips written by tasks, or by writeRows (see above)
     SCOPED_TRACE("threads " + std::to_string(threads));
     ImageWriteOptions options;
     options.threads = threads;

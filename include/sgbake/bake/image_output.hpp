@@ -102,13 +102,16 @@ Status writeImage(const FloatImage& image, const std::filesystem::path& path,
 /// nothing (the rules, formats and errors of writeImage, which is built on it).
 ///
 /// writeRows converts a strip of rows to the file's pixel type (in parallel) and queues it; a
-/// thread of the writer's own compresses and writes the queued strips in order (PNG's zlib, for
-/// one, is serial), so a caller that bakes strip k+1 while strip k is written overlaps the two.
-/// At most a few strips wait in the queue: writeRows blocks while it is full. (With
-/// ImageWriteOptions::threads 1 there is no such thread: writeRows writes each strip before it
-/// returns.) commit() waits for
-/// the queue, closes the file and renames it over the target; a writer destroyed without a
-/// successful commit removes its temporary and leaves the target as it was.
+/// task enqueued in the caller's task arena (tbb::this_task_arena::enqueue) compresses and
+/// writes the queued strips in order (PNG's zlib, for one, is serial). So a caller that bakes
+/// strip k+1 in the same arena while strip k is written overlaps the two on the arena's threads,
+/// without a thread more: one of them writes between the bake's tasks, the others bake. At most
+/// a few strips wait in the queue: while it is full, writeRows waits for the task, or writes a
+/// strip itself when no thread is writing (so a writer never waits on a task that has not
+/// started). With ImageWriteOptions::threads 1 there are no tasks: writeRows writes each strip
+/// before it returns. commit() writes or waits for what is queued, closes the file and renames
+/// it over the target; a writer destroyed without a successful commit removes its temporary at
+/// once and leaves the target as it was.
 ///
 ///     Result<ImageFileWriter> out = ImageFileWriter::open("n.png", 4096, 4096, 3, options);
 ///     for (each strip of rows, top first) out->writeRows(row, rows, pixels, coverage);
@@ -150,17 +153,17 @@ class ImageFileWriter {
   /// than half a code; in half files, beyond ±65504; in float files, infinities; in all, NaN.
   std::uint64_t clippedValues() const;
 
-  /// Seconds the writer's thread (or writeRows, without one) spent inside OpenImageIO
-  /// (compressing and writing) so far.
+  /// Seconds spent inside OpenImageIO (compressing and writing), by whichever thread wrote, so
+  /// far.
   double fileSeconds() const;
-  /// Seconds writeRows and commit spent waiting for the writer's thread, or writing the strips
-  /// themselves without one, so far: how long the caller was held up by the file.
+  /// Seconds writeRows and commit spent waiting for the strips to be written, or writing them
+  /// themselves, so far: how long the caller was held up by the file.
   double waitSeconds() const;
 
  private:
   struct State;
-  explicit ImageFileWriter(std::unique_ptr<State> state);
-  std::unique_ptr<State> state_;
+  explicit ImageFileWriter(std::shared_ptr<State> state);
+  std::shared_ptr<State> state_;
 };
 
 /// @brief One line (without "warning:") saying that @p clipped of the @p values values written

@@ -216,8 +216,8 @@ struct ExecuteReport {
   double bakeSeconds = 0;      ///< bakeMap and the corner table
   double padSeconds = 0;       ///< margins
   double convertSeconds = 0;   ///< converting pixels to the files' types
-  /// Image files inside OpenImageIO (compressing, writing; on the writer's own thread, while
-  /// the next rows are baked), CSV files, output hashes, manifests
+  /// Image files inside OpenImageIO (compressing, writing; between the bake's tasks, while the
+  /// next rows are baked), CSV files, output hashes, manifests
   double writeSeconds = 0;
   /// The part of the image writing the bake waited for (not overlapped with baking)
   double writeWaitSeconds = 0;
