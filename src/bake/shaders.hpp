@@ -254,20 +254,14 @@ struct BakeShaderBase {
       return gradient(p);
     }
     Vec3d gamma{};
-    int active = 0;
+    gradient_detail::HandedNormal tracked;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-      ++active;
       gradient_detail::NormalBelowSurface step;
-      const bool onHanded = handed.has_value() && layer.base == LayerBase::kLayersAbove;
-      addLayerGradient(layer, p, gamma, &step, onHanded ? &*handed : nullptr);
-      // A normal map below the surface added to other layers is their Γ sum's, mirrored.
-      if (step.found && (onHanded || (active == 1 && layer.base == LayerBase::kSurface))) {
-        handed = step.handedOn(p.normal);
-      } else {
-        handed.reset();
-      }
+      addLayerGradient(layer, p, gamma, &step, tracked.givenTo(layer));
+      tracked.add(layer, step, p.normal);
     }
+    handed = tracked.normal();
     return isFinite(gamma) ? gamma : Vec3d{};
   }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <optional>
 #include <span>
 
 #include "gradient/prepared_uv_frame.hpp"
@@ -33,6 +34,46 @@ struct NormalBelowSurface {
     return strength == 1 ? decoded
                          : normalizeOr(n + (strength > 0 ? strength : 0.0) * (decoded - n), n);
   }
+};
+
+/// @brief Follows the normal a stack of layers hands on where no Γ stands for it
+/// (NormalBelowSurface), layer by layer, as a composite adds them in order: a normal map first
+/// (weight 1, unmasked, on the surface) that decodes below the surface starts it, the layers on
+/// the layers above carry it while what they make stays below, and any other layer ends it (a
+/// normal map below the surface added to other layers is their Γ sum's, mirrored).
+///
+///     HandedNormal handed;
+///     for (each active layer) {
+///       NormalBelowSurface step;
+///       const Vec3d* above = handed.givenTo(layer);
+///       (add the layer's Γ, noting in step, on `above` when non-null);
+///       handed.add(layer, step, n);
+///     }
+///     if (handed.normal()) (guard *handed.normal() instead of normalize(n − Γ))
+class HandedNormal {
+ public:
+  /// The normal @p layer is given, when it bumps the layers above and they hand one on; else
+  /// null (the layer works on Γ as usual).
+  const Vec3d* givenTo(const Layer& layer) const {
+    return handed_ && layer.base == LayerBase::kLayersAbove ? &*handed_ : nullptr;
+  }
+  /// After @p layer added its Γ, what it noted in @p step, at unit normal @p n.
+  void add(const Layer& layer, const NormalBelowSurface& step, const Vec3d& n) {
+    const bool carried = givenTo(layer) != nullptr;
+    const bool starts = layers_ == 0 && layer.base == LayerBase::kSurface;
+    ++layers_;
+    if (step.found && (carried || starts)) {
+      handed_ = step.handedOn(n);
+    } else {
+      handed_.reset();
+    }
+  }
+  /// The normal the layers added so far hand on below the surface, if they do.
+  const std::optional<Vec3d>& normal() const { return handed_; }
+
+ private:
+  std::optional<Vec3d> handed_;
+  int layers_ = 0;
 };
 
 /// @brief Whether unit @p unit lies below the floor under which the Γ of a normal mirrors or

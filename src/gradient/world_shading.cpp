@@ -227,29 +227,21 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
   // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point.
   // From the front, also the normal the layers hand on when it lies below the surface, where
   // no Γ stands for it (NormalBelowSurface): a normal map first, then the layers on it.
-  std::optional<Vec3d> handed;
+  HandedNormal handed;
   auto composite = [&](bool back) {
     const Vec3d incoming = back ? -n : n;
     Vec3d gamma{};
-    int active = 0;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-      ++active;
       if (back) {
         addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
                               gamma);
         continue;
       }
       NormalBelowSurface step;
-      const bool onHanded = handed.has_value() && layer.base == LayerBase::kLayersAbove;
       addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
-                            gamma, &step, onHanded ? &*handed : nullptr);
-      // A normal map below the surface added to other layers is their Γ sum's, mirrored.
-      if (step.found && (active == 1 || onHanded)) {
-        handed = step.handedOn(n);
-      } else {
-        handed.reset();
-      }
+                            gamma, &step, handed.givenTo(layer));
+      handed.add(layer, step, n);
     }
     return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
   };
@@ -258,7 +250,7 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
   result.unguarded = normalizeOr(n - composite(false), n);
   // Cycles' closure guards that normal as it is, below the surface too (a normal far below
   // passes the guard; one nearer the plane is turned up on its own side of Ng).
-  if (handed) result.unguarded = *handed;
+  if (handed.normal()) result.unguarded = *handed.normal();
   if (layers.empty()) {
     result.normal = n;
   } else if (backFacing(n, ng)) {  // backFacingNormal, in world space
