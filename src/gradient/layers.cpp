@@ -215,13 +215,25 @@ Vec3d layerGradient(const LayerSource& source, const SurfacePoint& point) {
 
 namespace gradient_detail {
 
-Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
+Vec3d layerGradientNoting(const TangentNormalSource& source, const SurfacePoint& point,
                           NormalBelowSurface* below) {
   if (below != nullptr) *below = {};
+  return evaluate(source, point, below);
+}
+
+Vec3d layerGradientNoting(const ObjectNormalSource& source, const SurfacePoint& point,
+                          NormalBelowSurface* below) {
+  if (below != nullptr) *below = {};
+  return evaluate(source, point, below);
+}
+
+Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
+                          NormalBelowSurface* below) {
   if (const auto* tangent = std::get_if<TangentNormalSource>(&source))
-    return evaluate(*tangent, point, below);
+    return layerGradientNoting(*tangent, point, below);
   if (const auto* object = std::get_if<ObjectNormalSource>(&source))
-    return evaluate(*object, point, below);
+    return layerGradientNoting(*object, point, below);
+  if (below != nullptr) *below = {};
   return layerGradient(source, point);
 }
 

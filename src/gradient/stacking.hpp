@@ -122,6 +122,12 @@ Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const 
 /// object-space normal within kMinObjectNormalCosine of the tangent plane or behind it).
 Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
                           NormalBelowSurface* below);
+/// @brief layerGradientNoting of a tangent-space normal map, without a LayerSource to hold it.
+Vec3d layerGradientNoting(const TangentNormalSource& source, const SurfacePoint& point,
+                          NormalBelowSurface* below);
+/// @brief layerGradientNoting of an object-space normal map, without a LayerSource to hold it.
+Vec3d layerGradientNoting(const ObjectNormalSource& source, const SurfacePoint& point,
+                          NormalBelowSurface* below);
 
 /// @brief Whether Cycles shades @p n as back-facing: a unit shading normal that points behind
 /// its triangle's unit geometric normal @p ng (custom normals, smooth normals of a folded mesh,
