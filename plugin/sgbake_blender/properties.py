@@ -23,6 +23,11 @@ GREENS = (
     ("opengl", "OpenGL (Y+)", "Green = +bitangent, as Blender, Substance and Unity use"),
     ("directx", "DirectX (Y-)", "Green = -bitangent, as Unreal and 3ds Max use"),
 )
+# Blender's bake Swizzle (Render > Bake > Swizzle), the same names as BakeSettings.normal_r.
+SWIZZLE_AXES = (
+    ("POS_X", "+X", ""), ("POS_Y", "+Y", ""), ("POS_Z", "+Z", ""),
+    ("NEG_X", "-X", ""), ("NEG_Y", "-Y", ""), ("NEG_Z", "-Z", ""),
+)
 SPACES = (
     ("tangent", "Tangent", "The normal map is in tangent space"),
     ("object", "Object", "The normal map is in object space"),
@@ -167,6 +172,15 @@ class SgbakeSettings(bpy.types.PropertyGroup):
                          description="N x N samples per texel, averaged")
     green: EnumProperty(name="Green", items=GREENS, default="opengl",
                         description="Green channel of the baked tangent-space normal map")
+    swizzle_r: EnumProperty(name="R", items=SWIZZLE_AXES, default="POS_X",
+                            description="Axis of the normal the red channel stores, as the "
+                                        "bake's Swizzle (a DirectX green negates G after it)")
+    swizzle_g: EnumProperty(name="G", items=SWIZZLE_AXES, default="POS_Y",
+                            description="Axis of the normal the green channel stores, as the "
+                                        "bake's Swizzle (a DirectX green negates G after it)")
+    swizzle_b: EnumProperty(name="B", items=SWIZZLE_AXES, default="POS_Z",
+                            description="Axis of the normal the blue channel stores, as the "
+                                        "bake's Swizzle")
     uv_map: StringProperty(
         name="UV Map",
         description="UV map to bake on; empty: the active UV map (Blender's bake default)")

@@ -153,6 +153,9 @@ def layer_json(layer, uv_index, default_uv=None):
     return entry
 
 
+IDENTITY_SWIZZLE = ("POS_X", "POS_Y", "POS_Z")
+
+
 def output_json(settings, tile=1001):
     """The single entry of "outputs" (no "file": the pixels come back in memory) for UDIM
     tile `tile` (1001: the 0-1 UV square)."""
@@ -161,7 +164,13 @@ def output_json(settings, tile=1001):
               "alpha": bool(settings.use_alpha), "tile": int(tile)}
     if settings.padding != "push-pull":  # push-pull fills every texel: no margin
         output["margin"] = int(settings.margin)
-    if settings.map == "tangent-normal":
+    swizzle = [settings.swizzle_r, settings.swizzle_g, settings.swizzle_b]
+    if settings.map in ("tangent-normal", "object-normal") and swizzle != list(IDENTITY_SWIZZLE):
+        # The scene takes the green convention in "swizzle" then: a DirectX green negates G.
+        if settings.map == "tangent-normal" and settings.green == "directx":
+            swizzle[1] = ("NEG_" if swizzle[1].startswith("POS_") else "POS_") + swizzle[1][4:]
+        output["swizzle"] = ",".join(swizzle)
+    elif settings.map == "tangent-normal":
         output["green"] = settings.green
     return output
 

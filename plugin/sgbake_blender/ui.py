@@ -53,6 +53,12 @@ class SGBAKE_PT_bake(bpy.types.Panel):
         layout.prop(settings, "samples")
         if settings.map == "tangent-normal":
             layout.prop(settings, "green")
+        if settings.map in ("tangent-normal", "object-normal"):
+            row = layout.row(align=True)
+            row.label(text="Swizzle")
+            row.prop(settings, "swizzle_r", text="")
+            row.prop(settings, "swizzle_g", text="")
+            row.prop(settings, "swizzle_b", text="")
         if ob is not None and ob.type == "MESH":
             layout.prop_search(settings, "uv_map", ob.data, "uv_layers")
         else:

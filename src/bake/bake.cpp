@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -55,6 +56,56 @@ const MapInfo& info(MapKind kind) {
 }
 
 }  // namespace
+
+Result<NormalSwizzle> parseNormalSwizzle(std::string_view text) {
+  const auto bad = [&](std::string_view why) {
+    return Error::badInput("swizzle '" + std::string(text) + "' " + std::string(why) +
+                           " (expected three signed axes, e.g. \"+X+Y+Z\" or \"+X-Y+Z\", or "
+                           "Blender's POS_X, NEG_Y, ...)");
+  };
+  NormalSwizzle swizzle{};
+  int found = 0;
+  std::size_t i = 0;
+  const auto upper = [&](std::size_t k) {
+    return k < text.size() ? static_cast<char>(std::toupper(static_cast<unsigned char>(text[k])))
+                           : '\0';
+  };
+  while (i < text.size()) {
+    const char c = upper(i);
+    if (c == ',' || c == ' ') {
+      ++i;
+      continue;
+    }
+    bool negate = false;
+    if (c == '+' || c == '-') {
+      negate = c == '-';
+      ++i;
+    } else if (upper(i + 3) == '_' && ((c == 'P' && upper(i + 1) == 'O' && upper(i + 2) == 'S') ||
+                                       (c == 'N' && upper(i + 1) == 'E' && upper(i + 2) == 'G'))) {
+      negate = c == 'N';
+      i += 4;
+    } else {
+      return bad("has '" + std::string(1, text[i]) + "' where a sign is expected");
+    }
+    const char axis = upper(i);
+    if (axis != 'X' && axis != 'Y' && axis != 'Z')
+      return bad("has a sign without an axis X, Y or Z");
+    if (found == 3) return bad("has more than three axes");
+    swizzle[static_cast<std::size_t>(found++)] = {axis - 'X', negate};
+    ++i;
+  }
+  if (found != 3) return bad("has " + std::to_string(found) + " axes, not three");
+  return swizzle;
+}
+
+std::string normalSwizzleName(const NormalSwizzle& swizzle) {
+  std::string name;
+  for (const SwizzleAxis& s : swizzle) {
+    name += s.negate ? '-' : '+';
+    name += static_cast<char>('X' + s.axis);
+  }
+  return name;
+}
 
 Result<MapKind> parseMapKind(std::string_view name) {
   std::string known;
@@ -213,6 +264,12 @@ Status validateSettings(const BakeInput& input, const BakeSettings& s) {
                            " is out of range (1001 to 2000)");
   }
   if (s.threads < 0) return Error::badInput(where + ": threads must be 0 (all cores) or more");
+  for (const SwizzleAxis& axis : s.swizzle) {
+    if (axis.axis < 0 || axis.axis > 2) {
+      return Error::badInput(where + ": a swizzle axis must be 0 (x), 1 (y) or 2 (z), not " +
+                             std::to_string(axis.axis));
+    }
+  }
   if (input.tangents != nullptr && (input.tangents->tangent.size() != mesh.numCorners() ||
                                     input.tangents->sign.size() != mesh.numCorners())) {
     return Error::badInput(where + ": tangent frames do not match the mesh (" +
@@ -258,7 +315,11 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   base.triangleTangents = input.triangleTangents;
   base.layers = input.layers;
   base.uvSet = settings.uvSet;
-  base.green = settings.green;
+  // Normal maps: the swizzle, then G negated for DirectX green (tangent-space maps).
+  base.channels = settings.swizzle;
+  if (settings.map == MapKind::kTangentNormal && settings.green == NormalMapGreen::kDirectX) {
+    base.channels[1].negate = !base.channels[1].negate;
+  }
   // The object's transform (not for height maps, whose heights it does not change): a rotation
   // (or mirror) with a uniform scale s shades as object space with heights divided by s
   // (ObjectTransform::uniformScale); any other is shaded in world space (world_shading.hpp).
@@ -291,7 +352,11 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   if (normalMap) base.shadingCorners = shadingCorners;
   if (layerFrames) base.frameTriangles = shadingCorners.empty() ? job.triangles : shadingCorners;
 
-  static constexpr float kFlat[3] = {0.5f, 0.5f, 1.0f};
+  // Texels outside the islands of a tangent-space map: the surface's normal, (0, 0, 1), encoded.
+  double flatEncoded[3];
+  base.putEncoded(0, 0, 1, flatEncoded);
+  const float kFlat[3] = {static_cast<float>(flatEncoded[0]), static_cast<float>(flatEncoded[1]),
+                          static_cast<float>(flatEncoded[2])};
   static constexpr float kZero[3] = {0, 0, 0};
   RasterOutput output{kZero, false};
   output.blank = blank;

@@ -1195,7 +1195,8 @@ using plan_detail::ProgressReporter;
 
 /// What a baked image file says about itself (ImageWriteOptions::attributes), so that a tool
 /// reading it knows how to decode it: the map, how its values are stored, the range of a
-/// signed map in an integer file, the green convention, the UV set and the UDIM tile.
+/// signed map in an integer file, the green convention and any other swizzle of a normal map's
+/// channels, the UV set and the UDIM tile.
 std::vector<std::pair<std::string, std::string>> bakedFileAttributes(const SceneOutput& output,
                                                                      const BakeSettings& settings) {
   const MapKind map = settings.map;
@@ -1214,9 +1215,19 @@ std::vector<std::pair<std::string, std::string>> bakedFileAttributes(const Scene
       {"sgbake:version", sgbake_version()}};
   if (output.storesSignedRange())
     attributes.emplace_back("sgbake:range", formatNumber(output.range));
-  if (map == MapKind::kTangentNormal) {
-    attributes.emplace_back("sgbake:green",
-                            settings.green == NormalMapGreen::kDirectX ? "directx" : "opengl");
+  // The channels as stored: the swizzle, G negated for a DirectX green.
+  NormalSwizzle stored = settings.swizzle;
+  if (map == MapKind::kTangentNormal && settings.green == NormalMapGreen::kDirectX)
+    stored[1].negate = !stored[1].negate;
+  if (map == MapKind::kTangentNormal && stored[1].axis == 1) {
+    attributes.emplace_back("sgbake:green", stored[1].negate ? "directx" : "opengl");
+  }
+  // Any other swizzle than a green convention's (a DirectX green, or the same as a swizzle,
+  // gives the same file).
+  constexpr NormalSwizzle kDirectX = {{{0, false}, {1, true}, {2, false}}};
+  if ((map == MapKind::kTangentNormal || map == MapKind::kObjectNormal) &&
+      stored != kIdentitySwizzle && !(map == MapKind::kTangentNormal && stored == kDirectX)) {
+    attributes.emplace_back("sgbake:swizzle", normalSwizzleName(stored));
   }
   return attributes;
 }

@@ -468,6 +468,7 @@ BakeSettings bakeSettingsFor(const SceneOutput& output, int tile, int threads) {
   settings.uvSet = output.uvSet;
   settings.udimTile = tile;
   settings.green = output.green;
+  settings.swizzle = output.swizzle;
   settings.threads = threads;
   return settings;
 }

@@ -407,8 +407,8 @@ std::map<std::string, std::string> layerKeysElsewhere(SceneLayerType type) {
 }
 
 const std::vector<std::string> kMapOutputKeys = {
-    "map",     "file", "size",  "width", "height", "margin",    "padding",
-    "samples", "uv",   "green", "tile",  "format", "bit_depth", "alpha", "range"};
+    "map", "file",  "size",    "width", "height", "margin",    "padding", "samples",
+    "uv",  "green", "swizzle", "tile",  "format", "bit_depth", "alpha",   "range"};
 const std::vector<std::string> kCornersOutputKeys = {"map", "file"};
 
 // ---- Parsing each part -------------------------------------------------------------------------
@@ -815,6 +815,24 @@ SceneOutput parseOutput(const json& value, const std::string& where,
   if (reader.has("samples")) output.samples = reader.smallInteger("samples", 1, kMaxBakeSamples);
   if (reader.has("uv")) output.uvSet = reader.smallInteger("uv", 0, kMaxUvSets - 1);
   reader.optionalName("green", kGreens, output.green);
+  if (reader.has("swizzle")) {
+    // "+X-Y+Z", or ["+X", "-Y", "+Z"] (Blender's POS_X, NEG_Y, ... too).
+    const json& given = reader.at("swizzle");
+    std::string text;
+    if (given.is_array() && given.size() == 3 &&
+        std::ranges::all_of(given, [](const json& v) { return v.is_string(); })) {
+      for (const json& axis : given) text += axis.get<std::string>() + ",";
+    } else if (given.is_string()) {
+      text = given.get<std::string>();
+    } else {
+      fail(where, "swizzle " + given.dump() +
+                      " must be a string such as \"+X-Y+Z\" or three strings such as "
+                      "[\"+X\", \"-Y\", \"+Z\"]");
+    }
+    Result<NormalSwizzle> swizzle = parseNormalSwizzle(text);
+    if (!swizzle) fail(where, swizzle.error().message);
+    output.swizzle = *swizzle;
+  }
   if (reader.has("tile")) {
     output.tile = reader.smallInteger("tile", kFirstUdimTile, kLastUdimTile);
   }
@@ -849,6 +867,15 @@ SceneOutput parseOutput(const json& value, const std::string& where,
   }
   if (reader.has("green") && output.map != MapKind::kTangentNormal) {
     fail(where, "key 'green' applies only to tangent-normal maps");
+  }
+  if (reader.has("swizzle") && output.map != MapKind::kTangentNormal &&
+      output.map != MapKind::kObjectNormal) {
+    fail(where, "key 'swizzle' applies only to tangent-normal and object-normal maps");
+  }
+  if (reader.has("swizzle") && reader.has("green")) {
+    fail(where,
+         "give the green channel's direction either with 'green' or in 'swizzle' (its "
+         "second axis: +Y OpenGL, -Y DirectX), not both");
   }
   if (reader.has("range") && !isSignedMap(output.map)) {
     fail(where, "key 'range' applies only to derivative and surface-gradient maps");
@@ -1373,6 +1400,7 @@ std::string outputParametersJson(const SceneOutput& output) {
   j["margin"] = output.margin;
   j["padding"] = nameIn(kPaddings, output.padding);
   if (output.map == MapKind::kTangentNormal) j["green"] = nameIn(kGreens, output.green);
+  if (output.swizzle != kIdentitySwizzle) j["swizzle"] = normalSwizzleName(output.swizzle);
   if (!hasUdimToken(output.file.string())) j["tile"] = output.tile;
   j["format"] = imageFormatName(output.resolvedFormat());
   j["bit_depth"] = output.resolvedBitDepth();

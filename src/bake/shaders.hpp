@@ -43,7 +43,9 @@ struct BakeShaderBase {
   /// (layersOfMaterial), the last entry for every higher index; `layers` is set per triangle.
   std::span<const std::vector<Layer>> layersByMaterial;
   int uvSet = 0;
-  NormalMapGreen green = NormalMapGreen::kOpenGL;
+  /// How normal maps store a unit normal (putEncoded): the output's swizzle, with G negated for
+  /// a DirectX green (withDirectXGreen).
+  NormalSwizzle channels = kIdentitySwizzle;
   ShadingTriangle tri;
   SurfacePoint point;  ///< constant fields set per triangle, the rest per sample
 
@@ -283,6 +285,15 @@ struct BakeShaderBase {
   [[gnu::noinline]] Vec3d backFacingNormal(const SurfacePoint& p) const {
     return gradient_detail::backFacingNormal(layers, p, tri.faceNormal);
   }
+  /// A normal map's channels of the normal (x, y, z): 0.5·(±n[axis]) + 0.5 each, by `channels`
+  /// (+X+Y+Z: encodeNormal's n/2 + 0.5).
+  [[gnu::always_inline]] void putEncoded(double x, double y, double z, double* out) const {
+    for (std::size_t c = 0; c < 3; ++c) {
+      const SwizzleAxis& s = channels[c];
+      const double v = s.axis == 0 ? x : s.axis == 1 ? y : z;
+      out[c] = 0.5 * ((s.negate ? -1.0 : 1.0) * v) + 0.5;
+    }
+  }
   static void put(const Vec3d& v, double* out) {
     out[0] = v.x;
     out[1] = v.y;
@@ -303,6 +314,18 @@ using LaneFlags = std::array<std::int64_t, SampleBatch::kMax>;
 struct Lanes3 {
   Lanes x, y, z;
 };
+
+/// BakeShaderBase::putEncoded of lanes [0, @p n) of @p v into @p out (3 values per lane), by
+/// @p channels: one loop per channel over the component it stores, so that each vectorizes.
+[[gnu::always_inline]] inline void putEncodedLanes(const NormalSwizzle& channels, const Lanes3& v,
+                                                   std::size_t n, double* out) {
+  for (std::size_t c = 0; c < 3; ++c) {
+    const SwizzleAxis& s = channels[c];
+    const double* from = s.axis == 0 ? v.x.data() : s.axis == 1 ? v.y.data() : v.z.data();
+    const double sign = s.negate ? -1.0 : 1.0;
+    for (std::size_t i = 0; i < n; ++i) out[3 * i + c] = 0.5 * (sign * from[i]) + 0.5;
+  }
+}
 
 /// x is finite (and not NaN), written so that loops over lanes vectorize. (The lane loops
 /// combine conditions with & and |, not && and ||, for the same reason: no branches.)
@@ -676,9 +699,8 @@ struct TangentNormalShader : BakeShaderBase {
     const Vec3d normal = world != nullptr ? world->normalToObject * shadeInWorld(b, f).normal
                          : layers.empty() ? unitNormal(tri, f)
                                           : unnormalizedPerturbed(b, f);
-    Vec3d n = objectToTangent(outputFrame(b, f), normal);
-    if (green == NormalMapGreen::kDirectX) n.y = -n.y;
-    put(encodeNormal(n), out);
+    const Vec3d n = objectToTangent(outputFrame(b, f), normal);
+    putEncoded(n.x, n.y, n.z, out);
   }
 
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames).
@@ -706,13 +728,13 @@ struct TangentNormalShader : BakeShaderBase {
     encodeBatch(s, f, v, out);
   }
 
-  /// objectToTangent(f, v) of every sample, the green convention and encodeNormal into @p out;
-  /// then shade() of the slow lanes.
+  /// objectToTangent(f, v) of every sample, encoded (putEncoded) into @p out; then shade() of
+  /// the slow lanes.
   [[gnu::always_inline]] void encodeBatch(const SampleBatch& s, BatchFrames& f, const Lanes3& v,
                                           double* out) {
     const std::size_t n = static_cast<std::size_t>(s.count);
     constexpr double kMinDet = kMinTexelFrameSine * kMinTexelFrameSine;
-    const double greenSign = green == NormalMapGreen::kDirectX ? -1.0 : 1.0;
+    Lanes3 o;  // the unit tangent-space normals
     for (std::size_t i = 0; i < n; ++i) {
       const double tx = f.T.x[i], ty = f.T.y[i], tz = f.T.z[i];
       const double nx = f.N.x[i], ny = f.N.y[i], nz = f.N.z[i];
@@ -732,13 +754,11 @@ struct TangentNormalShader : BakeShaderBase {
       const double len2 = wx * wx + wy * wy + wz * wz;
       const double inv = 1 / std::sqrt(len2);
       f.slow[i] = f.slow[i] | (!flat & !((len2 > 0) & finiteLane(len2)));
-      const double ox = flat ? 0.0 : inv * wx;
-      const double oy = flat ? 0.0 : inv * wy;
-      const double oz = flat ? 1.0 : inv * wz;
-      out[3 * i] = 0.5 * ox + 0.5;
-      out[3 * i + 1] = 0.5 * (greenSign * oy) + 0.5;
-      out[3 * i + 2] = 0.5 * oz + 0.5;
+      o.x[i] = flat ? 0.0 : inv * wx;
+      o.y[i] = flat ? 0.0 : inv * wy;
+      o.z[i] = flat ? 1.0 : inv * wz;
     }
+    putEncodedLanes(channels, o, n, out);
     shadeSlowLanes(*this, s, f.slow, out);
   }
 };
@@ -749,9 +769,11 @@ struct ObjectNormalShader : BakeShaderBase {
     const TexelFrame f = texelFrame(tri, b);
     if (world != nullptr) {  // Blender's baker brings it back as a direction (M^{-1}), measured
       const Vec3d n = shadeInWorld(b, f).normal;
-      return put(encodeNormal(normalizeOr(world->directionToObject * n, unitNormal(tri, f))), out);
+      const Vec3d o = normalizeOr(world->directionToObject * n, unitNormal(tri, f));
+      return putEncoded(o.x, o.y, o.z, out);
     }
-    put(encodeNormal(layers.empty() ? unitNormal(tri, f) : perturbed(b, f)), out);
+    const Vec3d o = layers.empty() ? unitNormal(tri, f) : perturbed(b, f);
+    putEncoded(o.x, o.y, o.z, out);
   }
 
   /// shade() of every sample of @p s, lane-parallel (see batchTexelFrames): N̂, or N̂ − Γ
@@ -783,11 +805,7 @@ struct ObjectNormalShader : BakeShaderBase {
         f.slow[i] = f.slow[i] | !(2 * wi * wn - iz * 1.0 >= std::min(0.9 * iz, 0.01) * 1.0);
       }
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      out[3 * i] = 0.5 * v.x[i] + 0.5;
-      out[3 * i + 1] = 0.5 * v.y[i] + 0.5;
-      out[3 * i + 2] = 0.5 * v.z[i] + 0.5;
-    }
+    putEncodedLanes(channels, v, n, out);
     shadeSlowLanes(*this, s, f.slow, out);
   }
 
@@ -802,10 +820,11 @@ struct ObjectNormalShader : BakeShaderBase {
       const double len2 = d.x[i] * d.x[i] + d.y[i] * d.y[i] + d.z[i] * d.z[i];
       const double inv = 1 / std::sqrt(len2);
       f.slow[i] = f.slow[i] | !((len2 > 0) & finiteLane(len2));
-      out[3 * i] = 0.5 * (inv * d.x[i]) + 0.5;
-      out[3 * i + 1] = 0.5 * (inv * d.y[i]) + 0.5;
-      out[3 * i + 2] = 0.5 * (inv * d.z[i]) + 0.5;
+      d.x[i] = inv * d.x[i];
+      d.y[i] = inv * d.y[i];
+      d.z[i] = inv * d.z[i];
     }
+    putEncodedLanes(channels, d, n, out);
     shadeSlowLanes(*this, s, f.slow, out);
   }
 };

@@ -48,6 +48,7 @@ struct BakeArguments {
   int samples = 1;
   int uvSet = 0;
   std::string green = "opengl";
+  std::string swizzle;  ///< empty: +X+Y+Z
   std::string heightImage;
   double heightScale = 1;
   std::string filter = "bilinear";
@@ -113,7 +114,8 @@ constexpr const char* kFooter =
     "    .tif; '<UDIM>' in the name bakes every UDIM tile the UV set touches),\n"
     "    size = 1024 (or width and height), margin = 16,\n"
     "    padding = extend|adjacent-faces|push-pull,\n"
-    "    samples = 1 (N x N per texel), uv, green = opengl|directx, tile = 1001,\n"
+    "    samples = 1 (N x N per texel), uv, green = opengl|directx, swizzle = \"+X+Y+Z\"\n"
+    "    (normal maps' channels as Blender's bake Swizzle; not with green), tile = 1001,\n"
     "    format = png|exr|tiff, bit_depth = 8|16|32 (default 16; 8 for masks in PNG/TIFF),\n"
     "    alpha = false (coverage as alpha), range = 1 (derivative and surface-gradient maps\n"
     "    in PNG/TIFF integers store v / (2 range) + 0.5; EXR and float TIFF store v;\n"
@@ -151,6 +153,7 @@ const char* const kOneMapOptions[] = {"--mesh",
                                       "--samples",
                                       "--uv",
                                       "--green",
+                                      "--swizzle",
                                       "--height",
                                       "--height-scale",
                                       "--filter",
@@ -370,6 +373,11 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
   output.samples = args.samples;
   output.uvSet = args.uvSet;
   output.green = args.green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
+  if (!args.swizzle.empty()) {
+    Result<NormalSwizzle> swizzle = parseNormalSwizzle(args.swizzle);
+    if (!swizzle) return Error::badInput("bake: --swizzle: " + swizzle.error().message);
+    output.swizzle = *swizzle;
+  }
   output.bitDepth = args.bitDepth;
   output.alpha = args.alpha;
   if (args.range) {
@@ -459,10 +467,17 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
         {"--filter", height || normal, "--height or --normal"},
         {"--normal-space", normal, "--normal"},
         {"--normal-green", normal, "--normal"},
-        {"--green", args.map == "tangent-normal", "--map tangent-normal"}}) {
+        {"--green", args.map == "tangent-normal", "--map tangent-normal"},
+        {"--swizzle", args.map == "tangent-normal" || args.map == "object-normal",
+         "--map tangent-normal or object-normal"}}) {
     if (!applies && app.count(option) > 0) {
       return Error::badInput(std::string("bake: ") + option + " applies only with " + needs);
     }
+  }
+  if (app.count("--green") > 0 && app.count("--swizzle") > 0) {
+    return Error::badInput(
+        "bake: give the green channel's direction either with --green or in --swizzle (its "
+        "second axis: +Y OpenGL, -Y DirectX), not both");
   }
   // A margin or padding that would be ignored (0 and extend, the defaults, may be said).
   if (args.padding == "push-pull" && app.count("--margin") > 0 && args.margin > 0) {
@@ -620,6 +635,11 @@ CommandAction defineBakeCommand(CLI::App& app) {
   app.add_option("--green", args->green, "Green channel of a tangent-normal map: opengl or directx")
       ->type_name("CONVENTION")
       ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--swizzle", args->swizzle,
+                 "Channels of a normal map as Blender's bake Swizzle: three signed axes for R, G, "
+                 "B, e.g. +X-Y+Z (default +X+Y+Z; not with --green)")
+      ->type_name("AXES")
       ->group(oneMap);
   app.add_option("--height", args->heightImage, "Height image layer")
       ->type_name("IMAGE")

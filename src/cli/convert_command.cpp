@@ -201,6 +201,15 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
         args.input + ": the file says it is " + (map == "object-normal" ? "an " : "a ") + map +
         " map (sgbake:map); --from " + std::string(normalSpaceName(*from)) + " would misread it");
   }
+  // Channels sgbake wrote swizzled (sgbake:swizzle) other than a green convention: convert reads
+  // x, y, z in R, G, B.
+  if (const std::string swizzle = saidOf("sgbake:swizzle");
+      !swizzle.empty() && swizzle != "+X+Y+Z" &&
+      !(swizzle == "+X-Y+Z" && *from == NormalSpace::kTangent)) {
+    return Error::badInput(args.input + ": the file says its channels are " + swizzle +
+                           " (sgbake:swizzle); convert reads normal maps stored +X+Y+Z (a "
+                           "tangent-space one +X-Y+Z too, --green directx)");
+  }
   int tile = args.tile;
   const std::string saidTile = saidOf("sgbake:udim_tile");
   if (!saidTile.empty() && saidTile != std::to_string(args.tile)) {

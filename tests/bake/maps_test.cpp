@@ -684,6 +684,72 @@ TEST(Maps, DirectXGreenFlipsG) {
   }
 }
 
+TEST(NormalSwizzle, ParsesSignedAxesAndBlendersNamesAndWritesThemBack) {
+  const Result<NormalSwizzle> dx = parseNormalSwizzle("+x -Y, +z");
+  ASSERT_TRUE(dx.ok()) << dx.error().message;
+  EXPECT_EQ(normalSwizzleName(*dx), "+X-Y+Z");
+  const Result<NormalSwizzle> blender = parseNormalSwizzle("NEG_Z,pos_x,NEG_Y");
+  ASSERT_TRUE(blender.ok()) << blender.error().message;
+  EXPECT_EQ(normalSwizzleName(*blender), "-Z+X-Y");
+  EXPECT_EQ(normalSwizzleName(kIdentitySwizzle), "+X+Y+Z");
+  for (const char* bad : {"", "+X+Y", "+X+Y+Z+X", "X+Y+Z", "+W+Y+Z", "+X+Y+", "POS_X,NEG_Q,+Z"}) {
+    const Result<NormalSwizzle> parsed = parseNormalSwizzle(bad);
+    ASSERT_FALSE(parsed.ok()) << bad;
+    EXPECT_EQ(parsed.error().code, ErrorCode::kBadInput);
+    EXPECT_NE(parsed.error().message.find(std::string("'") + bad + "'"), std::string::npos)
+        << parsed.error().message;
+  }
+}
+
+// Blender's bake Swizzle: channel c of a swizzled map is ±(the normal's component axis), as
+// the unswizzled map encodes it; uncovered texels of a tangent-space map are the flat normal
+// swizzled. In both spaces, and with a DirectX green negating G after the swizzle.
+TEST(Maps, SwizzleStoresSignedComponentsOfTheNormal) {
+  const Mesh mesh = scaledPlane(1, 1);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::LinearHeight height(0.2, 0.4);
+  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, 1.0}, 1.0, {}}};
+  const NormalSwizzle swizzle = {{{2, true}, {0, false}, {1, true}}};  // -Z+X-Y
+  for (const MapKind map : {MapKind::kTangentNormal, MapKind::kObjectNormal}) {
+    for (const NormalMapGreen green : {NormalMapGreen::kOpenGL, NormalMapGreen::kDirectX}) {
+      if (map == MapKind::kObjectNormal && green == NormalMapGreen::kDirectX) continue;
+      SCOPED_TRACE(std::string(mapKindName(map)) +
+                   (green == NormalMapGreen::kDirectX ? ", DirectX" : ""));
+      BakeSettings s;
+      s.map = map;
+      s.width = s.height = 16;
+      const Result<FloatImage> plain = bakeMap({&mesh, &*tangents, layers}, s);
+      s.swizzle = swizzle;
+      s.green = green;
+      const Result<FloatImage> swizzled = bakeMap({&mesh, &*tangents, layers}, s);
+      ASSERT_TRUE(plain.ok() && swizzled.ok());
+      int covered = 0, outside = 0;
+      for (std::size_t i = 0; i < plain->coverage.size(); ++i) {
+        const bool in = plain->coverage[i] > 0;
+        covered += in;
+        outside += !in && map == MapKind::kTangentNormal;
+        const Vec3d n = in ? 2.0 * Vec3d{plain->pixels[3 * i], plain->pixels[3 * i + 1],
+                                         plain->pixels[3 * i + 2]} -
+                                 Vec3d{1, 1, 1}
+                           : Vec3d{0, 0, 1};
+        if (!in && map == MapKind::kObjectNormal) continue;  // (black)
+        const double g = green == NormalMapGreen::kDirectX ? -1 : 1;
+        const Vec3d expected{-n.z, g * n.x, -n.y};
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(swizzled->pixels[3 * i + static_cast<std::size_t>(c)],
+                      0.5 * expected[static_cast<std::size_t>(c)] + 0.5, 1e-6)
+              << "texel " << i << " channel " << c;
+        }
+      }
+      EXPECT_GT(covered, 100);
+      if (map == MapKind::kTangentNormal) {
+        EXPECT_GT(outside, 0);
+      }
+    }
+  }
+}
+
 // --- Blender's per-texel frame on a hand-built triangle --------------------------------------
 
 struct HandTriangle {

@@ -696,6 +696,12 @@ TEST_F(PlannerTest, BakedFilesSayHowTheyAreEncoded) {
                      {"map": "derivative", "file": "d.exr", "size": 8},
                      {"map": "tangent-normal", "file": "n_<UDIM>.exr", "size": 8,
                       "green": "directx"},
+                     {"map": "tangent-normal", "file": "n_swizzled.exr", "size": 8,
+                      "swizzle": "+X-Y+Z"},
+                     {"map": "tangent-normal", "file": "n_moved.exr", "size": 8,
+                      "swizzle": "+Y-X+Z"},
+                     {"map": "object-normal", "file": "o_moved.exr", "size": 8,
+                      "swizzle": "-X+Y+Z"},
                      {"map": "height", "file": "h_out.png", "size": 8, "uv": 0})"));
   // What OpenImageIO reads back: PNG text chunks and EXR header attributes.
   auto attributes = [&](const std::string& name) {
@@ -728,6 +734,12 @@ TEST_F(PlannerTest, BakedFilesSayHowTheyAreEncoded) {
                                                   {"sgbake:uv", "0"},
                                                   {"sgbake:udim_tile", "1001"},
                                                   {"sgbake:version", version}}));
+  // A DirectX green said as a swizzle is a DirectX green; other swizzles are said as such (and
+  // G's direction, when G holds ±y).
+  EXPECT_EQ(attributes("n_swizzled.exr"), attributes("n_1001.exr"));
+  EXPECT_EQ(attributes("n_moved.exr").at("sgbake:swizzle"), "+Y-X+Z");
+  EXPECT_EQ(attributes("n_moved.exr").count("sgbake:green"), 0u);
+  EXPECT_EQ(attributes("o_moved.exr").at("sgbake:swizzle"), "-X+Y+Z");
   EXPECT_EQ(attributes("h_out.png").at("sgbake:encoding"), "value");
 }
 

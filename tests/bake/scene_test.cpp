@@ -561,6 +561,41 @@ TEST(Scene, InvalidCombinations) {
             "scene.json: outputs[0]: give either 'size' or 'width'/'height', not both");
 }
 
+TEST(Scene, SwizzleIsParsedForNormalMapsAndInTheParametersOnlyWhenNotTheDefault) {
+  const NormalSwizzle expected = {{{2, true}, {0, false}, {1, true}}};
+  for (const char* given : {R"("-Z+X-Y")", R"(["-z", "+x", "-y"])", R"("NEG_Z,POS_X,NEG_Y")"}) {
+    SCOPED_TRACE(given);
+    Result<Scene> scene = parseScene(
+        withOutput(std::string(R"({"map": "object-normal", "file": "n.png", "swizzle": )") + given +
+                   "}"),
+        options());
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->outputs[0].swizzle, expected);
+    EXPECT_NE(outputParametersJson(scene->outputs[0]).find(R"("swizzle":"-Z+X-Y")"),
+              std::string::npos);
+  }
+  Result<Scene> plain = parseScene(
+      withOutput(R"({"map": "tangent-normal", "file": "n.png", "swizzle": "+x+y+z"})"), options());
+  ASSERT_TRUE(plain) << plain.error().message;
+  // +X+Y+Z is the default: the text (and manifest hash) of scenes without the key.
+  EXPECT_EQ(outputParametersJson(plain->outputs[0]).find("swizzle"), std::string::npos);
+
+  EXPECT_EQ(parseError(withOutput(R"({"map": "height", "file": "h.exr", "swizzle": "+X+Y+Z"})")),
+            "scene.json: outputs[0]: key 'swizzle' applies only to tangent-normal and "
+            "object-normal maps");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "tangent-normal", "file": "n.png", "green": "directx",
+                                      "swizzle": "+X-Y+Z"})")),
+            "scene.json: outputs[0]: give the green channel's direction either with 'green' or "
+            "in 'swizzle' (its second axis: +Y OpenGL, -Y DirectX), not both");
+  EXPECT_EQ(
+      parseError(withOutput(R"({"map": "tangent-normal", "file": "n.png", "swizzle": "+X+Y"})")),
+      "scene.json: outputs[0]: swizzle '+X+Y' has 2 axes, not three (expected three signed "
+      "axes, e.g. \"+X+Y+Z\" or \"+X-Y+Z\", or Blender's POS_X, NEG_Y, ...)");
+  EXPECT_EQ(parseError(withOutput(R"({"map": "tangent-normal", "file": "n.png", "swizzle": 3})")),
+            "scene.json: outputs[0]: swizzle 3 must be a string such as \"+X-Y+Z\" or three "
+            "strings such as [\"+X\", \"-Y\", \"+Z\"]");
+}
+
 TEST(Scene, SubdivisionIsParsedAndValidated) {
   Result<Scene> scene = parseScene(
       R"({"mesh": "m.obj", "subdivision": {"level": 2, "uv_smooth": "keep-corners",

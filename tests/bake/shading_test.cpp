@@ -2,7 +2,7 @@
 // derivative and height shaders) against their per-sample shade(), bit for bit: random
 // triangles and barycentrics, every kind of layer stack
 // (none, image heights through sampleMany, other height textures, masked and volume layers
-// through the per-sample path, overflowing gradients), both green conventions, and the rare
+// through the per-sample path, overflowing gradients), swizzled channels, and the rare
 // samples that take a fallback (an interpolated normal or tangent that vanishes); each on the
 // object as it is and on the object stretched in the world (shaded in world space).
 #include <gtest/gtest.h>
@@ -28,6 +28,10 @@ namespace {
 using test::ConstantNormalTexture;
 
 using bake_detail::SampleBatch;
+
+/// Normal-map channels besides +X+Y+Z: a DirectX green, and every channel moved and two negated.
+constexpr NormalSwizzle kDirectXGreen = {{{0, false}, {1, true}, {2, false}}};
+constexpr NormalSwizzle kScrambled = {{{2, true}, {0, false}, {1, true}}};
 
 /// Six triangles with random corners, normals and tangents, plus two made to hit fallbacks: one
 /// whose corner normals cancel at the centroid region (N = 0 there) and one whose tangents are
@@ -123,26 +127,26 @@ class ShadeBatch : public ::testing::Test {
   /// shadeBatch of random batches of every size against shade(), sample by sample, bit for bit,
   /// for every shader that has one: on the object as it is, and on the object placed in the
   /// world by a stretching transform (shaded in world space, BakeShaderBase::world).
-  void expectBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
+  void expectBatchEqualsSamples(std::span<const Layer> layers, NormalSwizzle channels,
                                 const std::string& what, const WorldSpace* placement = nullptr) {
     if (placement == nullptr) placement = &stretched;
     for (const WorldSpace* space : {static_cast<const WorldSpace*>(nullptr), placement}) {
       world = space;
       const std::string where = what + (space != nullptr ? ", stretched in the world" : "");
-      expectShaderBatchEqualsSamples<bake_detail::TangentNormalShader>(layers, green, where);
-      expectShaderBatchEqualsSamples<bake_detail::ObjectNormalShader>(layers, green,
+      expectShaderBatchEqualsSamples<bake_detail::TangentNormalShader>(layers, channels, where);
+      expectShaderBatchEqualsSamples<bake_detail::ObjectNormalShader>(layers, channels,
                                                                       where + " (object space)");
       expectShaderBatchEqualsSamples<bake_detail::SurfaceGradientShader>(
-          layers, green, where + " (surface gradient)");
-      expectShaderBatchEqualsSamples<bake_detail::DerivativeShader>(layers, green,
+          layers, channels, where + " (surface gradient)");
+      expectShaderBatchEqualsSamples<bake_detail::DerivativeShader>(layers, channels,
                                                                     where + " (derivative)");
     }
     world = nullptr;  // (height maps are not shaded in world space)
-    expectShaderBatchEqualsSamples<bake_detail::HeightShader>(layers, green, what + " (height)");
+    expectShaderBatchEqualsSamples<bake_detail::HeightShader>(layers, channels, what + " (height)");
   }
 
   template <class Shader>
-  void expectShaderBatchEqualsSamples(std::span<const Layer> layers, NormalMapGreen green,
+  void expectShaderBatchEqualsSamples(std::span<const Layer> layers, NormalSwizzle channels,
                                       const std::string& what) {
     constexpr bool kTangentSpace = std::is_same_v<Shader, bake_detail::TangentNormalShader>;
     constexpr bool kObjectSpace = std::is_same_v<Shader, bake_detail::ObjectNormalShader>;
@@ -151,7 +155,7 @@ class ShadeBatch : public ::testing::Test {
     base.mesh = &scene.mesh;
     base.tangents = kTangentSpace ? &scene.tangents : nullptr;
     base.layers = layers;
-    base.green = green;
+    base.channels = channels;
     base.world = world;
     Shader batchShader{base}, sampleShader{base};
     std::mt19937 rng(11);
@@ -174,9 +178,12 @@ class ShadeBatch : public ::testing::Test {
               << ") against (" << one[0] << ", " << one[1] << ", " << one[2] << ")";
           // Tangent space: the flat frame's (0, 0, 1). Object space without layers: the face
           // normal, taken where Σ bi·Ni vanishes (triangle 6).
-          const Vec3d face = bake_detail::encodeNormal(sampleShader.tri.faceNormal);
-          if (kTangentSpace) fallbacks += one[0] == 0.5 && one[1] == 0.5 && one[2] == 1.0;
-          if (kObjectSpace) fallbacks += one[0] == face.x && one[1] == face.y && one[2] == face.z;
+          const Vec3d ng = sampleShader.tri.faceNormal;
+          double flat[3], face[3];
+          base.putEncoded(0, 0, 1, flat);
+          base.putEncoded(ng.x, ng.y, ng.z, face);
+          if (kTangentSpace) fallbacks += std::memcmp(one, flat, sizeof flat) == 0;
+          if (kObjectSpace) fallbacks += std::memcmp(one, face, sizeof face) == 0;
         }
       }
     }
@@ -209,8 +216,9 @@ class ShadeBatch : public ::testing::Test {
 };
 
 TEST_F(ShadeBatch, WithoutLayers) {
-  expectBatchEqualsSamples({}, NormalMapGreen::kOpenGL, "no layers");
-  expectBatchEqualsSamples({}, NormalMapGreen::kDirectX, "no layers, DirectX");
+  expectBatchEqualsSamples({}, kIdentitySwizzle, "no layers");
+  expectBatchEqualsSamples({}, kDirectXGreen, "no layers, DirectX");
+  expectBatchEqualsSamples({}, kScrambled, "no layers, -Z+X-Y");
 }
 
 TEST_F(ShadeBatch, ImageHeightLayers) {
@@ -219,8 +227,9 @@ TEST_F(ShadeBatch, ImageHeightLayers) {
       Layer{UvHeightSource{&bicubic, 0, 0.05}, -0.5, {}},
       Layer{UvHeightSource{&bilinear, 0, 0.1}, 0.0, {}},  // weight 0: skipped
   };
-  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "image heights");
-  expectBatchEqualsSamples(layers, NormalMapGreen::kDirectX, "image heights, DirectX");
+  expectBatchEqualsSamples(layers, kIdentitySwizzle, "image heights");
+  expectBatchEqualsSamples(layers, kDirectXGreen, "image heights, DirectX");
+  expectBatchEqualsSamples(layers, kScrambled, "image heights, -Z+X-Y");
 }
 
 TEST_F(ShadeBatch, OtherLayersTakeThePerSamplePath) {
@@ -230,7 +239,7 @@ TEST_F(ShadeBatch, OtherLayersTakeThePerSamplePath) {
       Layer{VolumeSource{&sine, GradientScheme::kAnalytic, 0, 1}, 1.0, {}},
       Layer{UvHeightSource{&bicubic, 1, 0.1}, 1.0, {}},  // a UV set the mesh does not have
   };
-  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "mixed layers");
+  expectBatchEqualsSamples(layers, kIdentitySwizzle, "mixed layers");
 }
 
 TEST_F(ShadeBatch, LayersOnTheLayersAbove) {
@@ -250,7 +259,7 @@ TEST_F(ShadeBatch, LayersOnTheLayersAbove) {
       strengthOnTop,
       volumeOnTop,
   };
-  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "layers on the layers above");
+  expectBatchEqualsSamples(layers, kIdentitySwizzle, "layers on the layers above");
 }
 
 TEST_F(ShadeBatch, NormalMapsDecodedBelowTheSurface) {
@@ -265,11 +274,10 @@ TEST_F(ShadeBatch, NormalMapsDecodedBelowTheSurface) {
   const std::vector<Layer> withHeight{Layer{ObjectNormalSource{&swirl, 0}, 1.0, {}},
                                       Layer{UvHeightSource{&bilinear, 0, 0.02}, 1.0, {}}};
   for (const WorldSpace* placement : {&stretched, &squashed}) {
-    expectBatchEqualsSamples(alone, NormalMapGreen::kOpenGL, "normals below the surface",
+    expectBatchEqualsSamples(alone, kIdentitySwizzle, "normals below the surface", placement);
+    expectBatchEqualsSamples(blended, kIdentitySwizzle, "normals below the surface, 0.6",
                              placement);
-    expectBatchEqualsSamples(blended, NormalMapGreen::kOpenGL, "normals below the surface, 0.6",
-                             placement);
-    expectBatchEqualsSamples(withHeight, NormalMapGreen::kOpenGL, "normals below, and a height",
+    expectBatchEqualsSamples(withHeight, kIdentitySwizzle, "normals below, and a height",
                              placement);
   }
 }
@@ -338,7 +346,7 @@ TEST_F(ShadeBatch, OverflowingAndCancellingGradients) {
       Layer{UvHeightSource{&bilinear, 0, 1e306}, 1e3, {}},
       Layer{UvHeightSource{&bicubic, 0, 40}, 1.0, {}},
   };
-  expectBatchEqualsSamples(layers, NormalMapGreen::kOpenGL, "extreme gradients");
+  expectBatchEqualsSamples(layers, kIdentitySwizzle, "extreme gradients");
 }
 
 }  // namespace

@@ -829,6 +829,23 @@ def options_case(settings, height, work):
                "expected": json.dumps(expected),
                "message": f"sent {json.dumps(sent)}; wrong (layer, key, sent, expected) "
                           f"{wrong}"}]
+    # The output's Swizzle: sent as "swizzle" (a DirectX green folded into its G), not "green";
+    # the default sends "green" alone, as before. (BlenderSwizzleOracle checks the bake.)
+    for kind, axes, green, want in (
+            ("tangent-normal", ("NEG_Z", "POS_X", "NEG_Y"), "directx",
+             {"swizzle": "NEG_Z,NEG_X,NEG_Y"}),
+            ("object-normal", ("NEG_Z", "POS_X", "NEG_Y"), "opengl",
+             {"swizzle": "NEG_Z,POS_X,NEG_Y"}),
+            ("tangent-normal", ("POS_X", "POS_Y", "POS_Z"), "directx", {"green": "directx"})):
+        settings.map, settings.green = kind, green
+        settings.swizzle_r, settings.swizzle_g, settings.swizzle_b = axes
+        output = operators.BakeJob(bpy.context).scene["outputs"][0]
+        got = {key: output[key] for key in ("swizzle", "green") if key in output}
+        checks.append({"name": f"swizzle {','.join(axes)}, green {green}: the {kind} output",
+                       "ok": got == want, "expected": json.dumps(want),
+                       "message": f"sent {json.dumps(output)}"})
+    settings.swizzle_r, settings.swizzle_g, settings.swizzle_b = ("POS_X", "POS_Y", "POS_Z")
+    settings.map, settings.green = OPTIONS_MAP, "opengl"
     try:
         result = sorted(bpy.ops.object.sgbake_bake())
     except RuntimeError as exc:

@@ -3,7 +3,7 @@
     blender -b --factory-startup --python-exit-code 1 \\
         --python tests/blender/bake_scene.py -- OUT_DIR [--cases NAME,...] [--size N]
         [--passes object,tangent,mask] [--margin M] [--margin-type EXTEND|ADJACENT_FACES]
-        [--height-size H] [--samples S]
+        [--height-size H] [--samples S] [--swizzle R,G,B]
 
 Used by bake_oracle.py (the BlenderBakeOracle test) and, as a module, by
 bench/bake_vs_cycles.py. For every case it builds one object at the origin (identity
@@ -24,6 +24,7 @@ and bakes with Cycles on the CPU (1 sample, denoising off, margin 0 unless --mar
 --margin-type, default EXTEND):
   blender_object.exr   NORMAL, normal_space OBJECT,  channels POS_X / POS_Y / POS_Z
   blender_tangent.exr  NORMAL, normal_space TANGENT, channels POS_X / POS_Y / POS_Z
+  (--swizzle: the bake's Swizzle instead, e.g. NEG_Z,POS_X,NEG_Y; swizzle_oracle.py)
   blender_mask.exr     EMIT of the white emission: 1 where a triangle covers the texel centre
 Texels no triangle covers keep the image's initial (0, 0, 0). Each bake goes into a 32-bit
 float Non-Color image whose raw pixels are saved as OpenEXR and checked bit for bit after
@@ -422,9 +423,10 @@ def make_normal_material(normal_image, space, strength, uv_map, height_image=Non
     return mat, target
 
 
-def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND"):
+def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND",
+              swizzle=("POS_X", "POS_Y", "POS_Z")):
     """Bakes one pass of `ob` into `image`; returns the seconds bpy.ops.object.bake took.
-    kind: "object" / "tangent" (NORMAL in that space, +X +Y +Z) or "mask" (EMIT)."""
+    kind: "object" / "tangent" (NORMAL in that space, channels `swizzle`) or "mask" (EMIT)."""
     target.image = image
     mat.node_tree.nodes.active = target
     bpy.ops.object.select_all(action="DESELECT")
@@ -435,8 +437,8 @@ def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND"):
     if kind == "mask":
         kwargs["type"] = "EMIT"
     else:
-        kwargs.update(type="NORMAL", normal_space=kind.upper(), normal_r="POS_X",
-                      normal_g="POS_Y", normal_b="POS_Z")
+        kwargs.update(type="NORMAL", normal_space=kind.upper(), normal_r=swizzle[0],
+                      normal_g=swizzle[1], normal_b=swizzle[2])
     t0 = time.perf_counter()
     result = bpy.ops.object.bake(**kwargs)
     seconds = time.perf_counter() - t0
@@ -447,7 +449,7 @@ def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND"):
 
 def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), margin=0,
                height_size=HEIGHT_SIZE, save_bakes=True, runs=1, margin_type="EXTEND",
-               scale=None):
+               scale=None, swizzle=("POS_X", "POS_Y", "POS_Z")):
     """Builds case `name`, writes mesh.obj and height.exr into out_dir, bakes `passes`
     (saved as blender_PASS.exr when save_bakes); returns the case's manifest entry. scale
     replaces the case's Bump Distance (0: no bump, the interpolated normal). With
@@ -521,7 +523,7 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
         img = bake_common.new_float_image(f"blender_{kind}", size, size)
         for _ in range(runs):
             cpu0 = time.process_time()
-            seconds = bake_pass(ob, mat, target, img, kind, margin, margin_type)
+            seconds = bake_pass(ob, mat, target, img, kind, margin, margin_type, swizzle)
             cpu = time.process_time() - cpu0
             if kind not in entry["bake_s"] or seconds < entry["bake_s"][kind]:
                 entry["bake_s"][kind] = seconds
@@ -548,6 +550,8 @@ def parse_args(argv):
     parser.add_argument("--height-size", type=int, default=HEIGHT_SIZE)
     parser.add_argument("--samples", type=int, default=1)
     parser.add_argument("--threads", type=int, help="Cycles threads (default: all cores)")
+    parser.add_argument("--swizzle", default="POS_X,POS_Y,POS_Z",
+                        help="the normal passes' Swizzle, R,G,B (Blender's names)")
     return parser.parse_args(argv)
 
 
@@ -562,10 +566,12 @@ def main(argv):
             raise SystemExit(f"unknown case {name!r} (known: {', '.join(CASES)})")
         entry = build_case(name, os.path.join(args.out_dir, name), size=args.size,
                            passes=args.passes.split(","), margin=args.margin,
-                           margin_type=args.margin_type, height_size=args.height_size)
+                           margin_type=args.margin_type, height_size=args.height_size,
+                           swizzle=tuple(args.swizzle.split(",")))
         entry["blender_version"] = bpy.app.version_string
         entry["cycles_threads"] = scene.render.threads
         entry["samples"] = args.samples
+        entry["swizzle"] = args.swizzle
         entries.append(entry)
         print(RESULT_TAG + json.dumps(entry), flush=True)
     with open(os.path.join(args.out_dir, "cases.json"), "w", encoding="ascii") as f:

@@ -769,6 +769,21 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
   EXPECT_NE(green.err.find("bake: --green applies only with --map tangent-normal"),
             std::string::npos)
       << green.err;
+  const ProcessResult swizzleMask = run({"bake", "--mesh", mesh, "--map", "mask", "--swizzle",
+                                         "+X+Y+Z", "-o", (dir_ / "o.png").string()});
+  EXPECT_EQ(swizzleMask.err,
+            "sgbake: error: bake: --swizzle applies only with --map tangent-normal or "
+            "object-normal\n");
+  const ProcessResult both = run({"bake", "--mesh", mesh, "--green", "directx", "--swizzle",
+                                  "+X-Y+Z", "-o", (dir_ / "o.png").string()});
+  EXPECT_NE(both.err.find("either with --green or in --swizzle"), std::string::npos) << both.err;
+  const ProcessResult badSwizzle =
+      run({"bake", "--mesh", mesh, "--swizzle", "+X+Y+W", "-o", (dir_ / "o.png").string()});
+  EXPECT_EQ(badSwizzle.exitCode, 2);
+  EXPECT_NE(badSwizzle.err.find("bake: --swizzle: swizzle '+X+Y+W' has a sign without an axis"),
+            std::string::npos)
+      << badSwizzle.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o.png"));
   const ProcessResult smooth =
       run({"bake", "--mesh", mesh, "--uv-smooth", "all", "-o", (dir_ / "o.png").string()});
   EXPECT_NE(smooth.err.find("bake: --uv-smooth applies to a subdivided mesh; add --subdivide N"),
@@ -1232,6 +1247,20 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   EXPECT_EQ(wrongSpace.err, "sgbake: error: " + (dir_ / "ts.exr").string() +
                                 ": the file says it is a tangent-normal map (sgbake:map); --from "
                                 "object would misread it\n");
+  // A map baked with its channels swizzled is refused: convert reads x, y, z in R, G, B.
+  const ProcessResult baked =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "tangent-normal", "--size",
+           "8", "--swizzle", "-Y+X+Z", "-o", (dir_ / "swizzled.exr").string()});
+  ASSERT_EQ(baked.exitCode, 0) << baked.err;
+  const ProcessResult swizzled =
+      run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "tangent", "--to",
+           "object", (dir_ / "swizzled.exr").string(), "-o", (dir_ / "back.exr").string()});
+  EXPECT_EQ(swizzled.exitCode, 2);
+  EXPECT_EQ(swizzled.err, "sgbake: error: " + (dir_ / "swizzled.exr").string() +
+                              ": the file says its channels are -Y+X+Z (sgbake:swizzle); convert "
+                              "reads normal maps stored +X+Y+Z (a tangent-space one +X-Y+Z too, "
+                              "--green directx)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "back.exr"));
   // Its tile is the default of --tile: a map of tile 1002 converts back as tile 1002.
   writeFile(dir_ / "plane1002.obj",
             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 2 0\nvt 2 1\nvt 1 1\n"

@@ -99,6 +99,27 @@ enum class MapKind {
   kMask,             ///< ("mask") R = coverage in [0, 1] (fraction of samples inside a triangle)
 };
 
+/// @brief One channel of a baked normal map: which component of the normal it stores (0 x,
+/// 1 y, 2 z) and whether negated. Blender's bake Swizzle setting (+X, +Y, +Z, −X, −Y, −Z per
+/// channel; normal_r, normal_g, normal_b of bpy.types.BakeSettings).
+struct SwizzleAxis {
+  int axis = 0;
+  bool negate = false;
+  friend bool operator==(const SwizzleAxis&, const SwizzleAxis&) = default;
+};
+/// @brief R, G, B of a baked normal map: channel c stores sign·n[axis]/2 + 0.5, as Blender's
+/// baker encodes it in every space.
+using NormalSwizzle = std::array<SwizzleAxis, 3>;
+/// @brief +X +Y +Z: the normal's x, y, z in R, G, B (Blender's default).
+inline constexpr NormalSwizzle kIdentitySwizzle = {{{0, false}, {1, false}, {2, false}}};
+
+/// @brief Parses a swizzle written as three signed axes, "+X-Y+Z" (case-insensitive; commas or
+/// spaces between them allowed), or Blender's names "POS_X,NEG_Y,POS_Z". kBadInput says what is
+/// wrong.
+Result<NormalSwizzle> parseNormalSwizzle(std::string_view text);
+/// @brief "+X-Y+Z": the form parseNormalSwizzle reads and sgbake writes.
+std::string normalSwizzleName(const NormalSwizzle& swizzle);
+
 /// @brief Parses a CLI/scene map name ("tangent-normal", ...); kBadInput names the unknown map.
 Result<MapKind> parseMapKind(std::string_view name);
 /// @brief The CLI/scene name of @p kind.
@@ -194,6 +215,9 @@ struct BakeSettings {
   int uvSet = 0;          ///< UV set that places the mesh in the image
   int udimTile = 1001;    ///< which UDIM tile (1001 = [0,1)²), kFirstUdimTile … kLastUdimTile
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< kDirectX flips G of kTangentNormal
+  /// Channels of kTangentNormal and kObjectNormal (Blender's bake Swizzle); with green
+  /// kDirectX, G is negated after it.
+  NormalSwizzle swizzle = kIdentitySwizzle;
   int threads = 0;        ///< 0 = all cores; the result does not depend on it
 };
 

@@ -202,6 +202,9 @@ struct SceneOutput {
   int samples = 1;                                 ///< "samples": N×N per texel
   int uvSet = 0;                                   ///< "uv"
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps)
+  /// "swizzle" (tangent- and object-normal maps): "+X-Y+Z" or ["+X", "-Y", "+Z"], Blender's
+  /// bake Swizzle; not with "green"
+  NormalSwizzle swizzle = kIdentitySwizzle;
   int tile = kFirstUdimTile;  ///< "tile": the UDIM tile when the file has no `<UDIM>` token
   ImageFormat format = ImageFormat::kAuto;  ///< "format": exr | png | tiff (default: extension)
   int bitDepth = 0;                         ///< "bit_depth": 8, 16 or 32; 0 = defaultBitDepth
