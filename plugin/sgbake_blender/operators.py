@@ -542,6 +542,14 @@ def material_layers(node_tree, render_uv=None):
             if shader and normal is not None and _source_node(normal) is None:
                 ignored.append(f"'{node.name}' has no bump and is mixed in (Cycles averages "
                                "its normal with the bumped ones)")
+            # A Principled BSDF's clearcoat is a closure of its own, on Clearcoat Normal.
+            coat = node.inputs.get("Clearcoat")
+            coat_normal = node.inputs.get("Clearcoat Normal")
+            if (node.type == "BSDF_PRINCIPLED" and coat is not None and coat_normal is not None
+                    and (coat.is_linked or coat.default_value > 0)
+                    and _source_node(coat_normal) is None):
+                ignored.append(f"'{node.name}' has a clearcoat without a bump (Clearcoat Normal "
+                               "unlinked: Cycles averages its normal with the bumped ones)")
     return found, skipped, ignored
 
 

@@ -436,6 +436,23 @@ def material_checks(settings, ob, distance):
     _, _, plain_notes = operators.material_layers(tree)
     check("Layers from Material: no note for the plain material", not plain_notes,
           "no note", str(plain_notes))
+    # A Principled BSDF bumped through Normal: its clearcoat (a closure on Clearcoat Normal) is
+    # named while it is on and unbumped.
+    principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    tree.links.new(bump.outputs["Normal"], principled.inputs["Normal"])
+    tree.links.new(principled.outputs["BSDF"], add.inputs[0])
+    coat_notes = {}
+    for state in ("off", "on", "bumped"):
+        principled.inputs["Clearcoat"].default_value = 0.0 if state == "off" else 0.5
+        if state == "bumped":
+            tree.links.new(bump.outputs["Normal"], principled.inputs["Clearcoat Normal"])
+        coat_notes[state] = [note for note in operators.material_layers(tree)[2]
+                             if "clearcoat" in note]
+    check("Layers from Material: an unbumped clearcoat on a bumped Principled BSDF",
+          not coat_notes["off"] and len(coat_notes["on"]) == 1 and not coat_notes["bumped"],
+          "a note with Clearcoat 0.5 only", str(coat_notes))
+    tree.links.new(diffuse.outputs["BSDF"], add.inputs[0])
+    tree.nodes.remove(principled)
     # A Bump fed by the texture's Alpha output reads the alpha channel.
     tree.links.new(tex.outputs["Alpha"], bump.inputs["Height"])
     alpha, _, _ = operators.material_layers(tree)
