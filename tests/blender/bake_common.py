@@ -426,3 +426,19 @@ def angle_stats(angles):
             "p99_deg": float(np.percentile(angles, 99)),
             "max_deg": float(angles.max()),
             "texels": int(angles.size)}
+
+
+def judge_against_control(label, ours, control, median_limit, control_min, control_what,
+                          p99_limit=None, min_texels=1000):
+    """Prints one line judging the angle_stats `ours` against Cycles (more than `min_texels`
+    texels, median <= `median_limit`, p99 <= `p99_limit` when given) and those of a negative
+    control (`control_what`: median > `control_min`); returns whether both pass."""
+    ok = (ours["texels"] > min_texels and ours["median_deg"] <= median_limit
+          and (p99_limit is None or ours["p99_deg"] <= p99_limit))
+    told = control["median_deg"] > control_min
+    p99 = f"{ours['p99_deg']:.4f}" + (f" (limit {p99_limit})" if p99_limit is not None else "")
+    print(f"{label}: {'ok  ' if ok else 'FAIL'} vs Cycles median {ours['median_deg']:.4f} deg "
+          f"(limit {median_limit}), p99 {p99}, max {ours['max_deg']:.3f}, {ours['texels']} "
+          f"texels; {'ok  ' if told else 'FAIL'} {control_what} median "
+          f"{control['median_deg']:.3f} deg (must exceed {control_min})")
+    return ok and told

@@ -109,18 +109,11 @@ def main():
                                          [case_dir, "ours", "control"], RESULT_TAG)
         if stats is None:
             return 1
-        failed = False
-        for space in SPACES:
-            ours, control = stats["ours"][space], stats["control"][space]
-            ok = (ours["texels"] > 1000 and ours["median_deg"] <= MEDIAN_LIMIT_DEG
-                  and ours["p99_deg"] <= P99_LIMIT_DEG)
-            told = control["median_deg"] > CONTROL_MIN_DEG
-            failed |= not (ok and told)
-            print(f"{space} space, swizzle {SWIZZLE_BLENDER}: {'ok  ' if ok else 'FAIL'} vs "
-                  f"Cycles median {ours['median_deg']:.4f} deg (limit {MEDIAN_LIMIT_DEG}), p99 "
-                  f"{ours['p99_deg']:.4f} (limit {P99_LIMIT_DEG}), max {ours['max_deg']:.3f}, "
-                  f"{ours['texels']} texels; {'ok  ' if told else 'FAIL'} without the swizzle "
-                  f"median {control['median_deg']:.2f} deg (must exceed {CONTROL_MIN_DEG})")
+        passed = [bc.judge_against_control(
+            f"{space} space, swizzle {SWIZZLE_BLENDER}", stats["ours"][space],
+            stats["control"][space], MEDIAN_LIMIT_DEG, CONTROL_MIN_DEG, "without the swizzle",
+            p99_limit=P99_LIMIT_DEG) for space in SPACES]
+        failed = not all(passed)
         print("FAILED" if failed else "PASSED")
         return 1 if failed else 0
 

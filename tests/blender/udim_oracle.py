@@ -161,17 +161,10 @@ def main():
         stats = run_blender(blender, ["compare", out_dir, "ours", "control"])
         if stats is None:
             return 1
-        failed = False
-        for tile in TILES:
-            ours, control = stats["ours"][str(tile)], stats["control"][str(tile)]
-            ok = ours["texels"] > 1000 and ours["median_deg"] <= MEDIAN_LIMIT_DEG
-            told = control["median_deg"] > CONTROL_MIN_DEG
-            failed |= not (ok and told)
-            print(f"tile {tile}: {'ok  ' if ok else 'FAIL'} bake vs Cycles median "
-                  f"{ours['median_deg']:.3f} deg (limit {MEDIAN_LIMIT_DEG}), p99 "
-                  f"{ours['p99_deg']:.3f}, max {ours['max_deg']:.3f}, {ours['texels']} texels; "
-                  f"{'ok  ' if told else 'FAIL'} swapped tiles median "
-                  f"{control['median_deg']:.3f} deg (must exceed {CONTROL_MIN_DEG})")
+        passed = [bc.judge_against_control(
+            f"tile {tile}", stats["ours"][str(tile)], stats["control"][str(tile)],
+            MEDIAN_LIMIT_DEG, CONTROL_MIN_DEG, "swapped tiles") for tile in TILES]
+        failed = not all(passed)
         print("FAILED" if failed else "PASSED")
         return 1 if failed else 0
 
