@@ -239,8 +239,11 @@ Status checkContents(const FloatImage& image, const std::filesystem::path& path,
 
 /// Strips writeRows may queue ahead of the one being written before it waits: two bands of
 /// bakeMapRows (256 rows each), so that the bake hands a band over without waiting while the
-/// band before is still being written.
+/// band before is still being written; fewer (but at least kMinQueuedStrips) when they would
+/// hold more than kMaxQueuedBytes (wide images: a 16384-wide 16-bit RGB strip is 6.3 MB).
 constexpr std::size_t kMaxQueuedStrips = 8;
+constexpr std::size_t kMinQueuedStrips = 2;
+constexpr std::size_t kMaxQueuedBytes = std::size_t{16} << 20;
 /// Rows per strip a task compresses: writeRows splits larger requests, so that converting one
 /// strip overlaps compressing the one before.
 constexpr int kStripRows = 64;
@@ -273,6 +276,7 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
   std::mutex mutex;
   std::condition_variable changed;  ///< a strip was written, or writing stopped
   std::deque<Strip> queue;
+  std::size_t queuedBytes = 0;                ///< of the strips in `queue`
   std::vector<std::vector<std::byte>> spare;  ///< written strips' buffers, for reuse
   /// Strips are handed to tasks (threads != 1); else writeRows writes each one itself.
   bool tasks = false;
@@ -297,6 +301,7 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
     while (!queue.empty()) {
       Strip strip = std::move(queue.front());
       queue.pop_front();
+      queuedBytes -= strip.data.size();
       const bool skip = failed || abandoned;
       lock.unlock();
       changed.notify_all();  // room in the queue
@@ -315,6 +320,12 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
     }
     writing = false;
     changed.notify_all();
+  }
+
+  /// Whether writeRows must wait before it queues another strip (kMaxQueuedStrips).
+  bool full() const {
+    return queue.size() >= kMaxQueuedStrips ||
+           (queue.size() >= kMinQueuedStrips && queuedBytes >= kMaxQueuedBytes);
   }
 
   /// Has a task of the caller's arena drain the queue, unless one is about to or a thread is
@@ -524,21 +535,23 @@ Status ImageFileWriter::State::queueStrip(int row, int rows, std::span<const flo
   const Clock::time_point start = Clock::now();
   std::unique_lock lock(mutex);
   if (!tasks) {  // threads == 1: write the strip here
+    queuedBytes += strip.data.size();
     queue.push_back(std::move(strip));
     drain(lock);
     waitSeconds += secondsSince(start);  // the caller is held up by the file, as by a wait
     return failed ? Status{writeFailure()} : Status{Ok{}};
   }
   // A full queue: the task writing is behind; wait for it, or write when none is.
-  while (!failed && queue.size() >= kMaxQueuedStrips) {
+  while (!failed && full()) {
     if (!writing) {
       drain(lock);
     } else {
-      changed.wait(lock, [&] { return failed || !writing || queue.size() < kMaxQueuedStrips; });
+      changed.wait(lock, [&] { return failed || !writing || !full(); });
     }
   }
   waitSeconds += secondsSince(start);
   if (failed) return writeFailure();
+  queuedBytes += strip.data.size();
   queue.push_back(std::move(strip));
   schedule();
   return Ok{};
