@@ -33,7 +33,9 @@ struct ConvertShader {
   const CornerTangents* tangents = nullptr;
   const FloatImage* input = nullptr;
   NormalSpace from = NormalSpace::kObject, to = NormalSpace::kTangent;
-  NormalMapGreen green = NormalMapGreen::kOpenGL;
+  /// How the input and the output store a normal: the swizzles, G negated on the tangent side
+  /// for a DirectX green (convertShader).
+  NormalSwizzle inputChannels = kIdentitySwizzle, outputChannels = kIdentitySwizzle;
   int uvSet = 0;
   ShadingTriangle tri;
   /// With a transform (ConvertSettings::transform): the object-space side's texels to object
@@ -48,9 +50,14 @@ struct ConvertShader {
 
   void shade(const Vec3d& b, int x, int y, double* out) const {
     const int row = input->height - 1 - y;
-    const Vec3d c{input->at(x, row, 0), input->at(x, row, 1), input->at(x, row, 2)};
-    const Vec3d n = decodeNormalTexel(
-        c, from == NormalSpace::kTangent ? green : NormalMapGreen::kOpenGL);
+    // Channel k holds ±n[axis]/2 + 0.5: back to n/2 + 0.5 first.
+    Vec3d c;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double v = input->at(x, row, static_cast<int>(k));
+      const SwizzleAxis& s = inputChannels[k];
+      c[static_cast<std::size_t>(s.axis)] = s.negate ? 1.0 - v : v;
+    }
+    const Vec3d n = decodeNormalTexel(c);
     const TexelFrame f = texelFrame(tri, b);
     Vec3d result;
     if (from == to) {
@@ -63,11 +70,10 @@ struct ConvertShader {
         result = normalizeOr(*normalToObjectMap * result, unitNormal(tri, f));
       }
     }
-    if (to == NormalSpace::kTangent && green == NormalMapGreen::kDirectX) result.y = -result.y;
-    const Vec3d e = encodeNormal(result);
-    out[0] = e.x;
-    out[1] = e.y;
-    out[2] = e.z;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const SwizzleAxis& s = outputChannels[k];
+      out[k] = 0.5 * ((s.negate ? -1.0 : 1.0) * result[static_cast<std::size_t>(s.axis)]) + 0.5;
+    }
   }
 };
 
@@ -119,6 +125,18 @@ Status validateConvert(const Mesh& mesh, const CornerTangents& tangents, const F
                            " is out of range (1 to " + std::to_string(kMaxBakeSamples) + ")");
   }
   if (settings.threads < 0) return Error::badInput(where + ": threads must be 0 (all cores) or more");
+  const auto axis = [](const SwizzleAxis& s) { return s.axis; };
+  for (const NormalSwizzle& channels : {settings.inputSwizzle, settings.outputSwizzle}) {
+    if (!std::ranges::all_of(channels,
+                             [&](const SwizzleAxis& s) { return axis(s) >= 0 && axis(s) <= 2; })) {
+      return Error::badInput(where + ": a swizzle axis must be 0 (x), 1 (y) or 2 (z)");
+    }
+  }
+  const NormalSwizzle& in = settings.inputSwizzle;
+  if (in[0].axis == in[1].axis || in[0].axis == in[2].axis || in[1].axis == in[2].axis) {
+    return Error::badInput(where + ": the input's swizzle " + normalSwizzleName(in) +
+                           " names an axis twice: its channels cannot be read back");
+  }
   if (settings.limit != nullptr &&
       (settings.limitParameters == nullptr ||
        !isTessellationOf(mesh, *settings.limit, *settings.limitParameters))) {
@@ -143,7 +161,14 @@ bake_detail::ConvertShader convertShader(const Mesh& mesh, const CornerTangents&
   shader.input = &input;
   shader.from = from;
   shader.to = to;
-  shader.green = settings.green;
+  // The swizzles, G negated on the tangent-space side for a DirectX green.
+  const auto withGreen = [&](NormalSwizzle channels, NormalSpace space) {
+    if (space == NormalSpace::kTangent && settings.green == NormalMapGreen::kDirectX)
+      channels[1].negate = !channels[1].negate;
+    return channels;
+  };
+  shader.inputChannels = withGreen(settings.inputSwizzle, from);
+  shader.outputChannels = withGreen(settings.outputSwizzle, to);
   shader.uvSet = settings.uvSet;
   if (settings.transform != nullptr && !settings.transform->shadesAsObjectSpace()) {
     const WorldSpace space = WorldSpace::of(*settings.transform).value();  // validateConvert

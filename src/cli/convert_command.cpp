@@ -39,6 +39,8 @@ struct ConvertArguments {
   std::string to;
   int uvSet = 0;
   std::string green = "opengl";
+  std::string swizzle;       ///< the output's channels; empty: +X+Y+Z
+  std::string inputSwizzle;  ///< the input's channels; empty: its sgbake:swizzle, else +X+Y+Z
   int tile = kFirstUdimTile;
   int samples = 1;
   int bitDepth = 0;
@@ -54,9 +56,11 @@ struct ConvertArguments {
 constexpr const char* kFooter =
     "What it does:\n"
     "  Every texel the mesh covers (in the UV set; tile 1001 unless --tile, or the tile a map\n"
-    "  sgbake wrote says it is, sgbake:udim_tile; its sgbake:green is --green's default, and\n"
-    "  its sgbake:map must agree with --from) is decoded as\n"
-    "  n = 2c - 1 and re-expressed in the per-texel MikkTSpace frame Blender's baker uses:\n"
+    "  sgbake wrote says it is, sgbake:udim_tile; its sgbake:green is --green's default, its\n"
+    "  sgbake:swizzle --input-swizzle's, and its sgbake:map must agree with --from) is decoded\n"
+    "  as n = 2c - 1 (the input's channels in --input-swizzle's order, the output's in\n"
+    "  --swizzle's: Blender's bake Swizzle, default +X+Y+Z) and re-expressed in the per-texel "
+    "MikkTSpace frame Blender's baker uses:\n"
     "  object -> tangent applies inverse([T B N]); tangent -> object applies x T + y B + z N.\n"
     "  Texels outside the UV islands keep their input values (--padding keep), or are padded\n"
     "  from the converted islands as `sgbake bake` pads (--padding extend or adjacent-faces by\n"
@@ -142,6 +146,15 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
     return Error::badInput("convert: --green: unknown value '" + args.green +
                            "' (expected opengl or directx)");
   }
+  // --green is the tangent-space side's: its swizzle says G's direction as well.
+  for (const auto& [option, side] :
+       {std::pair{"--swizzle", args.to}, {"--input-swizzle", args.from}}) {
+    if (side == "tangent" && app.count("--green") > 0 && app.count(option) > 0) {
+      return Error::badInput(std::string("convert: give the tangent-space side's green either with "
+                                         "--green or in ") +
+                             option + " (its second axis: +Y OpenGL, -Y DirectX), not both");
+    }
+  }
   for (const auto& [input, what] : {std::pair{args.input, "the image"}, {args.mesh, "the mesh"}}) {
     if (mayBeSameFile(args.output, input)) {
       return Error::badInput("convert: -o " + args.output + " is " + what +
@@ -201,15 +214,6 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
         args.input + ": the file says it is " + (map == "object-normal" ? "an " : "a ") + map +
         " map (sgbake:map); --from " + std::string(normalSpaceName(*from)) + " would misread it");
   }
-  // Channels sgbake wrote swizzled (sgbake:swizzle) other than a green convention: convert reads
-  // x, y, z in R, G, B.
-  if (const std::string swizzle = saidOf("sgbake:swizzle");
-      !swizzle.empty() && swizzle != "+X+Y+Z" &&
-      !(swizzle == "+X-Y+Z" && *from == NormalSpace::kTangent)) {
-    return Error::badInput(args.input + ": the file says its channels are " + swizzle +
-                           " (sgbake:swizzle); convert reads normal maps stored +X+Y+Z (a "
-                           "tangent-space one +X-Y+Z too, --green directx)");
-  }
   int tile = args.tile;
   const std::string saidTile = saidOf("sgbake:udim_tile");
   if (!saidTile.empty() && saidTile != std::to_string(args.tile)) {
@@ -230,6 +234,28 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   if (*from == NormalSpace::kTangent && app.count("--green") == 0 &&
       (saidGreen == "opengl" || saidGreen == "directx")) {
     green = saidGreen;
+  }
+  // The channels: the flags', else (the input) what the file says it stores. sgbake:swizzle is
+  // the stored order, its DirectX green included, which sgbake:green says again: the green is
+  // taken out, as --green applies it.
+  NormalSwizzle inputSwizzle = kIdentitySwizzle, outputSwizzle = kIdentitySwizzle;
+  if (!args.inputSwizzle.empty()) {
+    Result<NormalSwizzle> parsed = parseNormalSwizzle(args.inputSwizzle);
+    if (!parsed) return Error::badInput("convert: --input-swizzle: " + parsed.error().message);
+    inputSwizzle = *parsed;
+  } else if (const std::string saidSwizzle = saidOf("sgbake:swizzle"); !saidSwizzle.empty()) {
+    Result<NormalSwizzle> parsed = parseNormalSwizzle(saidSwizzle);
+    if (!parsed) {
+      return Error::badInput(args.input + ": sgbake:swizzle: " + parsed.error().message);
+    }
+    inputSwizzle = *parsed;
+    if (*from == NormalSpace::kTangent && green == "directx")
+      inputSwizzle[1].negate = !inputSwizzle[1].negate;
+  }
+  if (!args.swizzle.empty()) {
+    Result<NormalSwizzle> parsed = parseNormalSwizzle(args.swizzle);
+    if (!parsed) return Error::badInput("convert: --swizzle: " + parsed.error().message);
+    outputSwizzle = *parsed;
   }
   if (image->channels() < 3) {
     return Error::badInput(args.input + ": image has " + std::to_string(image->channels()) +
@@ -259,6 +285,8 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
   settings.uvSet = args.uvSet;
   settings.udimTile = tile;
   settings.green = green == "directx" ? NormalMapGreen::kDirectX : NormalMapGreen::kOpenGL;
+  settings.inputSwizzle = inputSwizzle;
+  settings.outputSwizzle = outputSwizzle;
   settings.samples = args.samples;
   settings.threads = args.threads;
   if (limit) {
@@ -282,7 +310,14 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
                              {"sgbake:uv", std::to_string(args.uvSet)},
                              {"sgbake:udim_tile", std::to_string(tile)},
                              {"sgbake:version", sgbake_version()}};
-  if (toTangent) writeOptions.attributes.emplace_back("sgbake:green", green);
+  // As a baked map says them: the green of G holding ±y, any other swizzle as stored.
+  NormalSwizzle stored = outputSwizzle;
+  if (toTangent && green == "directx") stored[1].negate = !stored[1].negate;
+  if (toTangent && stored[1].axis == 1)
+    writeOptions.attributes.emplace_back("sgbake:green", stored[1].negate ? "directx" : "opengl");
+  constexpr NormalSwizzle kDirectX = {{{0, false}, {1, true}, {2, false}}};
+  if (stored != kIdentitySwizzle && !(toTangent && stored == kDirectX))
+    writeOptions.attributes.emplace_back("sgbake:swizzle", normalSwizzleName(stored));
   Result<ImageFileWriter> writer =
       ImageFileWriter::open(args.output, input.width, input.height, 3, writeOptions);
   if (!writer) return writer.error();
@@ -403,6 +438,15 @@ CommandAction defineConvertCommand(CLI::App& app) {
                  "Green channel of the tangent-space side: opengl (Y+) or directx (Y-)")
       ->type_name("CONVENTION")
       ->capture_default_str();
+  app.add_option("--swizzle", args->swizzle,
+                 "Channels of the output as Blender's bake Swizzle: three signed axes for R, G, B, "
+                 "e.g. -Y+X+Z (default +X+Y+Z; a tangent-space side's G is negated after it by "
+                 "--green directx)")
+      ->type_name("AXES");
+  app.add_option("--input-swizzle", args->inputSwizzle,
+                 "Channels of the input, as --swizzle, each axis once (default: what the file's "
+                 "sgbake:swizzle says, else +X+Y+Z)")
+      ->type_name("AXES");
   app.add_option("--tile", args->tile, "UDIM tile the image covers (1001 to 2000)")
       ->type_name("N")
       ->check(CLI::Range(kFirstUdimTile, kLastUdimTile).description(""))

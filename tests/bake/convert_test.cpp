@@ -195,6 +195,77 @@ TEST(Convert, TexelsOutsideIslandsAndExtraChannelsKeepTheInput) {
   }
 }
 
+// Swizzled channels (Blender's bake Swizzle) on either side: the input is read in its order,
+// the output written in its own, and a DirectX green negates the G channel of the
+// tangent-space side after its swizzle; a swizzle naming an axis twice cannot be read back.
+TEST(Convert, SwizzledChannelsAreReadAndWrittenInTheirOrder) {
+  const Mesh mesh =
+      test::uvPlaneMesh({{{0.25f, 0.25f}, {0.75f, 0.25f}, {0.75f, 0.75f}, {0.25f, 0.75f}}});
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const NormalSwizzle in = {{{1, true}, {2, false}, {0, false}}};  // -Y+Z+X
+  const NormalSwizzle out = {{{2, true}, {0, false}, {1, true}}};  // -Z+X-Y
+  FloatImage input;
+  input.width = 16;
+  input.height = 12;
+  input.channels = 3;
+  input.coverage.assign(16 * 12, 0.0f);
+  std::vector<Vec3d> normals;  // what each texel stands for
+  for (int i = 0; i < 16 * 12; ++i) {
+    const Vec3d n = normalizeOr(Vec3d{0.3 * std::sin(i), 0.4 * std::cos(3.0 * i), 1.0}, Vec3d{});
+    normals.push_back(n);
+    for (const SwizzleAxis& s : in) {
+      const double v = n[static_cast<std::size_t>(s.axis)];
+      input.pixels.push_back(static_cast<float>(0.5 * (s.negate ? -v : v) + 0.5));
+    }
+  }
+  for (const NormalMapGreen green : {NormalMapGreen::kOpenGL, NormalMapGreen::kDirectX}) {
+    for (const NormalSpace from : {NormalSpace::kObject, NormalSpace::kTangent}) {
+      const NormalSpace to =
+          from == NormalSpace::kObject ? NormalSpace::kTangent : NormalSpace::kObject;
+      SCOPED_TRACE(std::string(normalSpaceName(from)) +
+                   (green == NormalMapGreen::kDirectX ? ", DirectX" : ""));
+      ConvertSettings cs;
+      cs.green = green;
+      cs.inputSwizzle = in;
+      cs.outputSwizzle = out;
+      const Result<FloatImage> converted = convertNormalMap(mesh, *tangents, input, from, to, cs);
+      ASSERT_TRUE(converted.ok()) << converted.error().message;
+      int covered = 0;
+      for (std::size_t i = 0; i < normals.size(); ++i) {
+        if (converted->coverage[i] == 0) {
+          for (std::size_t c = 0; c < 3; ++c)
+            EXPECT_EQ(converted->pixels[3 * i + c], input.pixels[3 * i + c]);
+          continue;
+        }
+        ++covered;
+        // The plane's frame is (x̂, ŷ, ẑ): the normal is the same in both spaces. A DirectX
+        // green reads the input's G negated (from tangent space: the component in[1] stands
+        // for comes out negated) or writes the output's G negated (to tangent space).
+        const bool dx = green == NormalMapGreen::kDirectX;
+        Vec3d n = normals[i];
+        if (dx && from == NormalSpace::kTangent) {
+          n[static_cast<std::size_t>(in[1].axis)] = -n[static_cast<std::size_t>(in[1].axis)];
+        }
+        for (std::size_t c = 0; c < 3; ++c) {
+          const double v = n[static_cast<std::size_t>(out[c].axis)];
+          const bool negate = out[c].negate != (dx && to == NormalSpace::kTangent && c == 1);
+          EXPECT_NEAR(converted->pixels[3 * i + c], 0.5 * (negate ? -v : v) + 0.5, 2e-6)
+              << "texel " << i << " channel " << c;
+        }
+      }
+      EXPECT_EQ(covered, 8 * 6);
+    }
+  }
+  ConvertSettings twice;
+  twice.inputSwizzle = {{{0, false}, {0, true}, {2, false}}};
+  const Result<FloatImage> refused =
+      convertNormalMap(mesh, *tangents, input, NormalSpace::kObject, NormalSpace::kTangent, twice);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("swizzle +X-X+Z names an axis twice"), std::string::npos)
+      << refused.error().message;
+}
+
 TEST(Convert, ThreadsGiveIdenticalBits) {
   const Baked b = bakeBoth(test::torus, 80, 1);
   ConvertSettings cs;

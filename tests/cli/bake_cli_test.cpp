@@ -1247,20 +1247,42 @@ TEST_F(BakeCliTest, ConvertObjectToTangentAndBack) {
   EXPECT_EQ(wrongSpace.err, "sgbake: error: " + (dir_ / "ts.exr").string() +
                                 ": the file says it is a tangent-normal map (sgbake:map); --from "
                                 "object would misread it\n");
-  // A map baked with its channels swizzled is refused: convert reads x, y, z in R, G, B.
-  const ProcessResult baked =
-      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "tangent-normal", "--size",
-           "8", "--swizzle", "-Y+X+Z", "-o", (dir_ / "swizzled.exr").string()});
-  ASSERT_EQ(baked.exitCode, 0) << baked.err;
-  const ProcessResult swizzled =
-      run({"convert", "--mesh", (dir_ / "plane.obj").string(), "--from", "tangent", "--to",
-           "object", (dir_ / "swizzled.exr").string(), "-o", (dir_ / "back.exr").string()});
-  EXPECT_EQ(swizzled.exitCode, 2);
-  EXPECT_EQ(swizzled.err, "sgbake: error: " + (dir_ / "swizzled.exr").string() +
-                              ": the file says its channels are -Y+X+Z (sgbake:swizzle); convert "
-                              "reads normal maps stored +X+Y+Z (a tangent-space one +X-Y+Z too, "
-                              "--green directx)\n");
-  EXPECT_FALSE(fs::exists(dir_ / "back.exr"));
+  // A map baked with its channels swizzled (and a DirectX green) is read in the order its
+  // sgbake:swizzle says: it converts to what the unswizzled map converts to. --swizzle writes
+  // the output's channels in its order, and says so.
+  const std::string plane = (dir_ / "plane.obj").string();
+  for (const auto& [file, swizzle] :
+       {std::pair{"plain.exr", "+X-Y+Z"}, {"swizzled.exr", "-Y-X+Z"}}) {
+    const ProcessResult baked =
+        run({"bake", "--mesh", plane, "--map", "tangent-normal", "--size", "8", "--height",
+             (dir_ / "h.png").string(), "--height-scale", "0.3", "--margin", "0", "--swizzle",
+             swizzle, "--bit-depth", "32", "-o", (dir_ / file).string()});
+    ASSERT_EQ(baked.exitCode, 0) << baked.err;
+  }
+  for (const char* name : {"plain", "swizzled"}) {
+    const ProcessResult converted =
+        run({"convert", "--mesh", plane, "--from", "tangent", "--to", "object", "--swizzle",
+             "+Z-X+Y", (dir_ / (std::string(name) + ".exr")).string(), "-o",
+             (dir_ / (std::string(name) + "_os.exr")).string()});
+    ASSERT_EQ(converted.exitCode, 0) << converted.err;
+  }
+  const std::vector<float> plainBack = readPixels(dir_ / "plain_os.exr");
+  const std::vector<float> swizzledBack = readPixels(dir_ / "swizzled_os.exr");
+  ASSERT_EQ(plainBack.size(), swizzledBack.size());
+  ASSERT_FALSE(plainBack.empty());
+  for (std::size_t i = 0; i < plainBack.size(); ++i)
+    EXPECT_NEAR(swizzledBack[i], plainBack[i], 1e-6) << i;
+  std::unique_ptr<OIIO::ImageInput> written =
+      OIIO::ImageInput::open((dir_ / "plain_os.exr").string());
+  ASSERT_TRUE(written);
+  EXPECT_EQ(written->spec().get_string_attribute("sgbake:swizzle"), "+Z-X+Y");
+  const ProcessResult both =
+      run({"convert", "--mesh", plane, "--from", "object", "--to", "tangent", "--green", "directx",
+           "--swizzle", "+X-Y+Z", (dir_ / "plain_os.exr").string(), "-o",
+           (dir_ / "again.exr").string()});
+  EXPECT_EQ(both.exitCode, 2);
+  EXPECT_NE(both.err.find("either with --green or in --swizzle"), std::string::npos) << both.err;
+  EXPECT_FALSE(fs::exists(dir_ / "again.exr"));
   // Its tile is the default of --tile: a map of tile 1002 converts back as tile 1002.
   writeFile(dir_ / "plane1002.obj",
             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 2 0\nvt 2 1\nvt 1 1\n"

@@ -32,6 +32,12 @@ struct ConvertSettings {
   /// Green convention of the tangent-space side (the input when converting from tangent space,
   /// the output when converting to it).
   NormalMapGreen green = NormalMapGreen::kOpenGL;
+  /// Channels of the input and of the output image, as BakeSettings::swizzle (Blender's bake
+  /// Swizzle; on the tangent-space side G is negated after it for a DirectX green). The input's
+  /// must name each axis once. Texels outside the UV islands keep the input's values, channels
+  /// as they are.
+  NormalSwizzle inputSwizzle = kIdentitySwizzle;
+  NormalSwizzle outputSwizzle = kIdentitySwizzle;
   int samples = 1;  ///< N×N frames per texel, results averaged (encoded), as bakeMap
   int threads = 0;  ///< 0 = all cores; the result does not depend on it
   /// Optional, as BakeInput::limit: the mesh is the tessellation of this limit surface
