@@ -255,9 +255,11 @@ double secondsSince(Clock::time_point start) {
 
 }  // namespace
 
-/// Everything an ImageFileWriter owns. Queued strips are written by tasks of the caller's task
-/// arena (see writeRows), which hold the state by a shared_ptr: a task that runs after the
-/// writer is gone finds the queue empty and returns.
+/// Everything an ImageFileWriter owns. Queued strips are written by tasks enqueued in the task
+/// arena open() was called in (see writeRows), which hold the state by a shared_ptr, and the
+/// state holds that arena: a task that runs after the writer is gone (it may, since nothing
+/// waits for an enqueued task to start) finds the queue empty and returns, and the arena it
+/// runs in outlives a temporary task_arena that made it.
 struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::State> {
   std::filesystem::path path;
   AtomicFile file;
@@ -290,6 +292,8 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
   /// Largest magnitude a float strip value keeps: ±65504 (the largest half) or FLT_MAX
   float floatLimit = std::numeric_limits<float>::max();
   std::uint64_t clipped = 0;  ///< values the file cannot store as they are (see clippedValues)
+  /// The caller's arena at open(), where the tasks are enqueued (kept alive by this handle).
+  tbb::task_arena arena{tbb::task_arena::attach()};
 
   explicit State(AtomicFile f) : file(std::move(f)) {}
 
@@ -333,7 +337,7 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
   void schedule() {
     if (writing || scheduled) return;
     scheduled = true;
-    tbb::this_task_arena::enqueue([self = shared_from_this()] {
+    arena.enqueue([self = shared_from_this()] {
       std::unique_lock lock(self->mutex);
       self->scheduled = false;
       self->drain(lock);
@@ -349,6 +353,7 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
       if (!writing) break;
       changed.wait(lock, [&] { return !writing; });
     }
+    std::vector<std::vector<std::byte>>().swap(spare);  // not kept until a late task lets go
     waitSeconds += secondsSince(start);
   }
 

@@ -102,11 +102,11 @@ Status writeImage(const FloatImage& image, const std::filesystem::path& path,
 /// nothing (the rules, formats and errors of writeImage, which is built on it).
 ///
 /// writeRows converts a strip of rows to the file's pixel type (in parallel) and queues it; a
-/// task enqueued in the caller's task arena (tbb::this_task_arena::enqueue) compresses and
-/// writes the queued strips in order (PNG's zlib, for one, is serial). So a caller that bakes
-/// strip k+1 in the same arena while strip k is written overlaps the two on the arena's threads,
-/// without a thread more: one of them writes between the bake's tasks, the others bake. At most
-/// a few strips wait in the queue: while it is full, writeRows waits for the task, or writes a
+/// task enqueued in the task arena open() was called in (task_arena::attach, then enqueue)
+/// compresses and writes the queued strips in order (PNG's zlib, for one, is serial). So a caller
+/// that bakes strip k+1 in the same arena while strip k is written overlaps the two on the arena's
+/// threads, without a thread more: one of them writes between the bake's tasks, the others bake. At
+/// most a few strips wait in the queue: while it is full, writeRows waits for the task, or writes a
 /// strip itself when no thread is writing (so a writer never waits on a task that has not
 /// started). With ImageWriteOptions::threads 1 there are no tasks: writeRows writes each strip
 /// before it returns. commit() writes or waits for what is queued, closes the file and renames
