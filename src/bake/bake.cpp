@@ -98,6 +98,16 @@ Result<NormalSwizzle> parseNormalSwizzle(std::string_view text) {
   return swizzle;
 }
 
+std::vector<std::pair<std::string, std::string>> normalChannelAttributes(
+    const NormalSwizzle& stored, bool tangentSpace) {
+  std::vector<std::pair<std::string, std::string>> attributes;
+  if (tangentSpace && stored[1].axis == 1)
+    attributes.emplace_back("sgbake:green", stored[1].negate ? "directx" : "opengl");
+  if (stored != kIdentitySwizzle && !(tangentSpace && stored == kDirectXSwizzle))
+    attributes.emplace_back("sgbake:swizzle", normalSwizzleName(stored));
+  return attributes;
+}
+
 std::string normalSwizzleName(const NormalSwizzle& swizzle) {
   std::string name;
   for (const SwizzleAxis& s : swizzle) {
@@ -316,10 +326,9 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   base.layers = input.layers;
   base.uvSet = settings.uvSet;
   // Normal maps: the swizzle, then G negated for DirectX green (tangent-space maps).
-  base.channels = settings.swizzle;
-  if (settings.map == MapKind::kTangentNormal && settings.green == NormalMapGreen::kDirectX) {
-    base.channels[1].negate = !base.channels[1].negate;
-  }
+  base.channels = storedChannels(settings.swizzle, settings.map == MapKind::kTangentNormal
+                                                       ? settings.green
+                                                       : NormalMapGreen::kOpenGL);
   // The object's transform (not for height maps, whose heights it does not change): a rotation
   // (or mirror) with a uniform scale s shades as object space with heights divided by s
   // (ObjectTransform::uniformScale); any other is shaded in world space (world_shading.hpp).

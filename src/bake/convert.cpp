@@ -162,13 +162,11 @@ bake_detail::ConvertShader convertShader(const Mesh& mesh, const CornerTangents&
   shader.from = from;
   shader.to = to;
   // The swizzles, G negated on the tangent-space side for a DirectX green.
-  const auto withGreen = [&](NormalSwizzle channels, NormalSpace space) {
-    if (space == NormalSpace::kTangent && settings.green == NormalMapGreen::kDirectX)
-      channels[1].negate = !channels[1].negate;
-    return channels;
+  const auto green = [&](NormalSpace space) {
+    return space == NormalSpace::kTangent ? settings.green : NormalMapGreen::kOpenGL;
   };
-  shader.inputChannels = withGreen(settings.inputSwizzle, from);
-  shader.outputChannels = withGreen(settings.outputSwizzle, to);
+  shader.inputChannels = storedChannels(settings.inputSwizzle, green(from));
+  shader.outputChannels = storedChannels(settings.outputSwizzle, green(to));
   shader.uvSet = settings.uvSet;
   if (settings.transform != nullptr && !settings.transform->shadesAsObjectSpace()) {
     const WorldSpace space = WorldSpace::of(*settings.transform).value();  // validateConvert

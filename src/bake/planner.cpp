@@ -1215,19 +1215,12 @@ std::vector<std::pair<std::string, std::string>> bakedFileAttributes(const Scene
       {"sgbake:version", sgbake_version()}};
   if (output.storesSignedRange())
     attributes.emplace_back("sgbake:range", formatNumber(output.range));
-  // The channels as stored: the swizzle, G negated for a DirectX green.
-  NormalSwizzle stored = settings.swizzle;
-  if (map == MapKind::kTangentNormal && settings.green == NormalMapGreen::kDirectX)
-    stored[1].negate = !stored[1].negate;
-  if (map == MapKind::kTangentNormal && stored[1].axis == 1) {
-    attributes.emplace_back("sgbake:green", stored[1].negate ? "directx" : "opengl");
-  }
-  // Any other swizzle than a green convention's (a DirectX green, or the same as a swizzle,
-  // gives the same file).
-  constexpr NormalSwizzle kDirectX = {{{0, false}, {1, true}, {2, false}}};
-  if ((map == MapKind::kTangentNormal || map == MapKind::kObjectNormal) &&
-      stored != kIdentitySwizzle && !(map == MapKind::kTangentNormal && stored == kDirectX)) {
-    attributes.emplace_back("sgbake:swizzle", normalSwizzleName(stored));
+  if (map == MapKind::kTangentNormal || map == MapKind::kObjectNormal) {
+    const bool tangentSpace = map == MapKind::kTangentNormal;
+    const NormalSwizzle stored =
+        storedChannels(settings.swizzle, tangentSpace ? settings.green : NormalMapGreen::kOpenGL);
+    for (auto& attribute : normalChannelAttributes(stored, tangentSpace))
+      attributes.push_back(std::move(attribute));
   }
   return attributes;
 }

@@ -43,8 +43,7 @@ struct BakeShaderBase {
   /// (layersOfMaterial), the last entry for every higher index; `layers` is set per triangle.
   std::span<const std::vector<Layer>> layersByMaterial;
   int uvSet = 0;
-  /// How normal maps store a unit normal (putEncoded): the output's swizzle, with G negated for
-  /// a DirectX green (withDirectXGreen).
+  /// How normal maps store a unit normal (putEncoded): the output's storedChannels.
   NormalSwizzle channels = kIdentitySwizzle;
   ShadingTriangle tri;
   SurfacePoint point;  ///< constant fields set per triangle, the rest per sample

@@ -248,9 +248,10 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
     if (!parsed) {
       return Error::badInput(args.input + ": sgbake:swizzle: " + parsed.error().message);
     }
-    inputSwizzle = *parsed;
-    if (*from == NormalSpace::kTangent && green == "directx")
-      inputSwizzle[1].negate = !inputSwizzle[1].negate;
+    // (storedChannels negates G back: a second negation of it is its own inverse.)
+    inputSwizzle = storedChannels(*parsed, *from == NormalSpace::kTangent && green == "directx"
+                                               ? NormalMapGreen::kDirectX
+                                               : NormalMapGreen::kOpenGL);
   }
   if (!args.swizzle.empty()) {
     Result<NormalSwizzle> parsed = parseNormalSwizzle(args.swizzle);
@@ -310,14 +311,11 @@ Status runConvert(const ConvertArguments& args, const CLI::App& app) {
                              {"sgbake:uv", std::to_string(args.uvSet)},
                              {"sgbake:udim_tile", std::to_string(tile)},
                              {"sgbake:version", sgbake_version()}};
-  // As a baked map says them: the green of G holding ±y, any other swizzle as stored.
-  NormalSwizzle stored = outputSwizzle;
-  if (toTangent && green == "directx") stored[1].negate = !stored[1].negate;
-  if (toTangent && stored[1].axis == 1)
-    writeOptions.attributes.emplace_back("sgbake:green", stored[1].negate ? "directx" : "opengl");
-  constexpr NormalSwizzle kDirectX = {{{0, false}, {1, true}, {2, false}}};
-  if (stored != kIdentitySwizzle && !(toTangent && stored == kDirectX))
-    writeOptions.attributes.emplace_back("sgbake:swizzle", normalSwizzleName(stored));
+  // Its channels, as a baked map says them.
+  const NormalSwizzle stored =
+      storedChannels(outputSwizzle, toTangent ? settings.green : NormalMapGreen::kOpenGL);
+  for (auto& attribute : normalChannelAttributes(stored, toTangent))
+    writeOptions.attributes.push_back(std::move(attribute));
   Result<ImageFileWriter> writer =
       ImageFileWriter::open(args.output, input.width, input.height, 3, writeOptions);
   if (!writer) return writer.error();

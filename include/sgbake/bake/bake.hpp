@@ -75,6 +75,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "sgbake/core/result.hpp"
@@ -112,6 +113,21 @@ struct SwizzleAxis {
 using NormalSwizzle = std::array<SwizzleAxis, 3>;
 /// @brief +X +Y +Z: the normal's x, y, z in R, G, B (Blender's default).
 inline constexpr NormalSwizzle kIdentitySwizzle = {{{0, false}, {1, false}, {2, false}}};
+
+/// @brief +X-Y+Z: a DirectX green.
+inline constexpr NormalSwizzle kDirectXSwizzle = {{{0, false}, {1, true}, {2, false}}};
+/// @brief The channels a tangent-space normal map stores: @p swizzle, then its G negated for a
+/// DirectX @p green (the same on an object-space map, whose green is OpenGL).
+inline NormalSwizzle storedChannels(NormalSwizzle swizzle, NormalMapGreen green) {
+  if (green == NormalMapGreen::kDirectX) swizzle[1].negate = !swizzle[1].negate;
+  return swizzle;
+}
+/// @brief What a normal-map file says of its channels @p stored (storedChannels): in a
+/// tangent-space map whose G holds ±y, sgbake:green ("opengl" or "directx"); for any swizzle
+/// other than +X+Y+Z and a tangent-space map's DirectX green, sgbake:swizzle ("-Z+X-Y"). So
+/// the same channels said as a green or as a swizzle make the same file.
+std::vector<std::pair<std::string, std::string>> normalChannelAttributes(
+    const NormalSwizzle& stored, bool tangentSpace);
 
 /// @brief Parses a swizzle written as three signed axes, "+X-Y+Z" (case-insensitive; commas or
 /// spaces between them allowed), or Blender's names "POS_X,NEG_Y,POS_Z". kBadInput says what is
