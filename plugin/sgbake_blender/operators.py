@@ -553,6 +553,31 @@ def material_layers(node_tree, render_uv=None):
     return found, skipped, ignored
 
 
+class SGBAKE_OT_from_blender_bake(bpy.types.Operator):
+    """Take over the settings of Blender's own bake panel that sgbake has: the normal map's
+    space (Normal bakes) and Swizzle, the margin's size and type"""
+    bl_idname = "sgbake.from_blender_bake"
+    bl_label = "From Blender's Bake Settings"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        settings, bake = context.scene.sgbake, context.scene.render.bake
+        taken = []
+        cycles = getattr(context.scene, "cycles", None)  # (Cycles' add-on holds the bake type)
+        if cycles is not None and cycles.bake_type == "NORMAL":
+            settings.map = "tangent-normal" if bake.normal_space == "TANGENT" else "object-normal"
+            taken.append(f"map {settings.map}")
+        settings.swizzle_r, settings.swizzle_g, settings.swizzle_b = (
+            bake.normal_r, bake.normal_g, bake.normal_b)
+        settings.green = "opengl"  # the swizzle says G's direction
+        settings.margin = bake.margin
+        settings.padding = "adjacent-faces" if bake.margin_type == "ADJACENT_FACES" else "extend"
+        taken += [f"swizzle {bake.normal_r}, {bake.normal_g}, {bake.normal_b}",
+                  f"margin {bake.margin} ({settings.padding})"]
+        self.report({"INFO"}, "took " + "; ".join(taken))
+        return {"FINISHED"}
+
+
 class SGBAKE_OT_layer_add(bpy.types.Operator):
     """Add a layer below the active one"""
     bl_idname = "sgbake.layer_add"
@@ -611,5 +636,6 @@ class SGBAKE_OT_layer_move(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (OBJECT_OT_sgbake_bake, OBJECT_OT_sgbake_layers_from_material, SGBAKE_OT_layer_add,
+CLASSES = (OBJECT_OT_sgbake_bake, OBJECT_OT_sgbake_layers_from_material,
+           SGBAKE_OT_from_blender_bake, SGBAKE_OT_layer_add,
            SGBAKE_OT_layer_remove, SGBAKE_OT_layer_move)

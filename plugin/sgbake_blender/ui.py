@@ -41,6 +41,7 @@ class SGBAKE_PT_bake(bpy.types.Panel):
         layout.label(text=line, icon="CHECKMARK" if loaded else "ERROR")
 
         ob = context.active_object
+        layout.operator("sgbake.from_blender_bake", icon="IMPORT")
         layout.prop(settings, "map")
         layout.prop(settings, "surface")
         col = layout.column(align=True)

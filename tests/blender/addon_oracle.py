@@ -861,6 +861,21 @@ def options_case(settings, height, work):
         checks.append({"name": f"swizzle {','.join(axes)}, green {green}: the {kind} output",
                        "ok": got == want, "expected": json.dumps(want),
                        "message": f"sent {json.dumps(output)}"})
+    # From Blender's Bake Settings: the Normal bake's space and Swizzle, the margin.
+    bake = bpy.context.scene.render.bake
+    bpy.context.scene.cycles.bake_type = "NORMAL"
+    bake.normal_space, bake.margin, bake.margin_type = "OBJECT", 7, "EXTEND"
+    bake.normal_r, bake.normal_g, bake.normal_b = "NEG_Y", "POS_Z", "NEG_X"
+    settings.green = "directx"
+    kept = settings.margin, settings.padding
+    result = sorted(bpy.ops.sgbake.from_blender_bake())
+    got = [result, settings.map, settings.swizzle_r, settings.swizzle_g, settings.swizzle_b,
+           settings.green, settings.margin, settings.padding]
+    want = [["FINISHED"], "object-normal", "NEG_Y", "POS_Z", "NEG_X", "opengl", 7, "extend"]
+    checks.append({"name": "From Blender's Bake Settings", "ok": got == want,
+                   "expected": str(want), "message": str(got)})
+    bake.normal_r, bake.normal_g, bake.normal_b = "POS_X", "POS_Y", "POS_Z"
+    settings.margin, settings.padding = kept
     settings.swizzle_r, settings.swizzle_g, settings.swizzle_b = ("POS_X", "POS_Y", "POS_Z")
     settings.map, settings.green = OPTIONS_MAP, "opengl"
     try:
