@@ -442,3 +442,13 @@ def judge_against_control(label, ours, control, median_limit, control_min, contr
           f"texels; {'ok  ' if told else 'FAIL'} {control_what} median "
           f"{control['median_deg']:.3f} deg (must exceed {control_min})")
     return ok and told
+
+
+def bake_scene_file(cli, directory, name, scene):
+    """Writes `scene` (a dict) as DIRECTORY/NAME.json and bakes it with `CLI bake` (no
+    manifest); returns whether it exited with 0."""
+    path = os.path.join(directory, name + ".json")
+    with open(path, "w", encoding="ascii") as f:
+        json.dump(scene, f)
+    proc = run_tool([cli, "bake", path, "--no-manifest"])
+    return proc is not None and proc.returncode == 0

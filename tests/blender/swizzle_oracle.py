@@ -81,11 +81,7 @@ def bake(cli, case_dir, prefix, swizzle):
              "layers": [{"type": "normal", "image": "normal.exr", "space": nmap["space"],
                          "strength": nmap["strength"], "filter": "bilinear"}],
              "outputs": outputs}
-    path = os.path.join(case_dir, prefix + ".json")
-    with open(path, "w", encoding="ascii") as f:
-        json.dump(scene, f)
-    proc = bc.run_tool([cli, "bake", path, "--no-manifest"])
-    return proc is not None and proc.returncode == 0
+    return bc.bake_scene_file(cli, case_dir, prefix, scene)
 
 
 def main():

@@ -133,11 +133,7 @@ def bake(cli, out_dir, heights, prefix):
              "margin": 0, "bit_depth": 32},
             {"map": "mask", "file": "mask.<UDIM>.exr", "size": SIZE, "margin": 0,
              "bit_depth": 32}]}
-    path = os.path.join(out_dir, prefix + ".json")
-    with open(path, "w", encoding="ascii") as f:
-        json.dump(scene, f)
-    proc = bc.run_tool([cli, "bake", path, "--no-manifest"])
-    return proc is not None and proc.returncode == 0
+    return bc.bake_scene_file(cli, out_dir, prefix, scene)
 
 
 def main():
