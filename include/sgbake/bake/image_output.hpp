@@ -106,9 +106,9 @@ Status writeImage(const FloatImage& image, const std::filesystem::path& path,
 /// compresses and writes the queued strips in order (PNG's zlib, for one, is serial). So a caller
 /// that bakes strip k+1 in the same arena while strip k is written overlaps the two on the arena's
 /// threads, without a thread more: one of them writes between the bake's tasks, the others bake. At
-/// most a few strips wait in the queue: while it is full, writeRows waits for the task, or writes a
-/// strip itself when no thread is writing (so a writer never waits on a task that has not
-/// started). With ImageWriteOptions::threads 1 there are no tasks: writeRows writes each strip
+/// most a few strips wait in the queue: while it is full, writeRows waits for the task, or writes
+/// the queued strips itself when no thread is writing (so a writer never waits on a task that has
+/// not started). With ImageWriteOptions::threads 1 there are no tasks: writeRows writes each strip
 /// before it returns. commit() writes or waits for what is queued, closes the file and renames
 /// it over the target; a writer destroyed without a successful commit removes its temporary at
 /// once and leaves the target as it was.
