@@ -4,6 +4,7 @@
 #include "sgbake/bake/image_output.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -340,18 +341,26 @@ struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::St
     arena.enqueue([self = shared_from_this()] {
       std::unique_lock lock(self->mutex);
       self->scheduled = false;
+      self->changed.notify_all();  // flush() may wait for this start
       self->drain(lock);
     });
   }
 
-  /// Waits until every queued strip is written (writing them itself when no thread is).
+  /// Waits until every queued strip is written (writing them itself when no thread is), and
+  /// until a task enqueued for them has started: it finds nothing left to write, and no task
+  /// holds the state past the writer (a task never run would keep it, and its arena, forever).
   void flush() {
     const Clock::time_point start = Clock::now();
     std::unique_lock lock(mutex);
     for (;;) {
       drain(lock);
-      if (!writing) break;
-      changed.wait(lock, [&] { return !writing; });
+      if (writing) {
+        changed.wait(lock, [&] { return !writing; });
+      } else if (scheduled) {
+        changed.wait(lock, [&] { return !scheduled; });  // enqueue: a thread will run it
+      } else {
+        break;
+      }
     }
     std::vector<std::vector<std::byte>>().swap(spare);  // not kept until a late task lets go
     waitSeconds += secondsSince(start);
@@ -450,7 +459,10 @@ Result<ImageFileWriter> ImageFileWriter::open(const std::filesystem::path& path,
     return fileError(ErrorCode::kInternal, path,
                      "cannot write " + upperName(format) + " image (" + oneLineReason(reason) + ")");
   }
-  state->tasks = options.threads != 1;  // one thread asked for: writeRows writes each strip
+  // One thread asked for, or only one to be had: writeRows writes each strip itself.
+  state->tasks =
+      options.threads != 1 && state->arena.max_concurrency() > 1 &&
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
   return ImageFileWriter(std::move(state));
 }
 
