@@ -345,6 +345,13 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
       base.world = &world;
     }
   }
+  // Heights differentiated as the Bump node does read them again half a texel away.
+  if (std::ranges::any_of(base.layers, [](const Layer& layer) {
+        const auto* height = std::get_if<UvHeightSource>(&layer.source);
+        return height != nullptr && height->gradient == HeightGradient::kBumpNode;
+      })) {
+    base.bumpTexel = {1.0 / settings.width, 1.0 / settings.height};
+  }
   // Layers of one material: each triangle takes its face's.
   const std::vector<std::vector<Layer>> byMaterial = layersByMaterial(base.layers);
   base.layersByMaterial = byMaterial;

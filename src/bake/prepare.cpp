@@ -314,6 +314,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.strength = layer.strength;
       source.tiling = layer.tiling;
       source.offset = layer.offset;
+      source.gradient = layer.heightGradient;
       result.source = source;
       break;
     }

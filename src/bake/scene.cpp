@@ -104,6 +104,8 @@ constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
 constexpr Named<GradientScheme> kSchemes[] = {{"analytic", GradientScheme::kAnalytic},
                                               {"central", GradientScheme::kCentral},
                                               {"tetrahedral", GradientScheme::kTetrahedral}};
+constexpr Named<HeightGradient> kHeightGradients[] = {{"analytic", HeightGradient::kAnalytic},
+                                                      {"bump-node", HeightGradient::kBumpNode}};
 constexpr Named<PaddingMode> kPaddings[] = {{"extend", PaddingMode::kExtend},
                                             {"push-pull", PaddingMode::kPushPull},
                                             {"adjacent-faces", PaddingMode::kAdjacentFaces}};
@@ -370,7 +372,7 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
     keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
   switch (type) {
     case SceneLayerType::kHeight:
-      add({"uv", "scale", "strength", "base", "channel"});
+      add({"uv", "scale", "strength", "base", "channel", "gradient"});
       break;
     case SceneLayerType::kNormal:
       add({"uv", "space", "green", "strength", "tangent_uv"});
@@ -712,6 +714,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
   reader.optionalName("channel", kChannels, layer.channel);
+  if (layer.type == SceneLayerType::kHeight)
+    reader.optionalName("gradient", kHeightGradients, layer.heightGradient);
   if (reader.has("tangent_uv"))
     layer.tangentUvSet = reader.smallInteger("tangent_uv", 0, kMaxUvSets - 1);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
@@ -1353,6 +1357,8 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
       j["strength"] = layer.strength;
       if (layer.channel != ImageChannels::kLuminance)
         j["channel"] = nameIn(kChannels, layer.channel);
+      if (layer.heightGradient != HeightGradient::kAnalytic)
+        j["gradient"] = nameIn(kHeightGradients, layer.heightGradient);
       break;
     case SceneLayerType::kNormal:
       j["uv"] = layer.uvSet;

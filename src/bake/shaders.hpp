@@ -18,6 +18,7 @@
 #include "bake/height.hpp"
 #include "bake/raster.hpp"
 #include "bake/texel_frame.hpp"
+#include "gradient/bump_node.hpp"
 #include "gradient/prepared_uv_frame.hpp"
 #include "gradient/stacking.hpp"
 #include "gradient/world_shading_detail.hpp"
@@ -47,6 +48,11 @@ struct BakeShaderBase {
   NormalSwizzle channels = kIdentitySwizzle;
   ShadingTriangle tri;
   SurfacePoint point;  ///< constant fields set per triangle, the rest per sample
+
+  /// (1/width, 1/height) of the bake when a layer reads heights as the Bump node does
+  /// (HeightGradient::kBumpNode): each triangle's points get the BumpOffsets of a bake texel
+  /// there (bakeBumpOffsets). Zero otherwise.
+  Vec2d bumpTexel{};
 
   /// The current triangle's UV frames with their normal-independent eq. 31 terms (unit ∂P/∂u,
   /// ∂P/∂v, lengths, T̂ × B̂) computed once, for the UV height layers (see gradient()).
@@ -143,6 +149,7 @@ struct BakeShaderBase {
   /// Updates what is derived from `tri` (after beginTriangle, or after LimitShader rewrote it).
   void triangleChanged() {
     beginSurfacePoint(tri, point);
+    if (bumpTexel.x > 0) point.bump = bumpOffsets(tri);
     for (std::size_t s = 0; s < static_cast<std::size_t>(tri.numUvSets); ++s)
       preparedUv[s] = gradient_detail::prepareUvFrame(point.uv[s]);
     if (world != nullptr) beginWorldTriangle();
@@ -150,6 +157,12 @@ struct BakeShaderBase {
   // The world and material cases are out of line (noinline), as the rare cases they are:
   // inlined into shade(), and shade() into the lane-parallel paths' slow lanes, they made the
   // compiler stop inlining batchTexelFrames there (10 % of a one-thread bake).
+  /// Where the Bump node reads heights again on @p t (in its space) when Cycles bakes the map.
+  [[gnu::noinline]] BumpOffsets bumpOffsets(const ShadingTriangle& t) const {
+    if (uvSet < 0 || uvSet >= t.numUvSets) return {};
+    const std::size_t set = static_cast<std::size_t>(uvSet);
+    return gradient_detail::bakeBumpOffsets(t.faceNormal, t.dPdu[set], t.dPdv[set], bumpTexel);
+  }
   /// `layers` = those of the material of the face of @p corner (layersByMaterial).
   [[gnu::noinline]] void selectLayersOfFace(std::uint32_t corner) {
     const std::size_t material = mesh->material(faceOfCorner(*mesh, corner));
@@ -160,6 +173,7 @@ struct BakeShaderBase {
     WorldScratch& w = worldScratch.get();
     worldTriangle(tri, *world, w.tri);
     beginSurfacePoint(w.tri, w.point);
+    if (bumpTexel.x > 0) w.point.bump = bumpOffsets(w.tri);
     for (std::size_t s = 0; s < static_cast<std::size_t>(w.tri.numUvSets); ++s)
       w.preparedUv[s] = gradient_detail::prepareUvFrame(w.point.uv[s]);
   }
@@ -191,6 +205,11 @@ struct BakeShaderBase {
     if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return {};
     const std::size_t set = static_cast<std::size_t>(s.uvSet);
     const ScalarSample h = s.texture->sample(textureCoordinates(p.uv[set].uv, s.tiling, s.offset));
+    if (gradient_detail::usesBumpNode(s, p)) [[unlikely]] {
+      return withNormalMapStrength(
+          gradient_detail::bumpNodeGradient(s, p.uv[set], p.normal, p.bump, h.value), p.normal,
+          s.strength);
+    }
     return withNormalMapStrength(
         gradient_detail::gradientFromPreparedUvFrame(preparedUv[set], p.normal,
                                                      uvDerivativesFromTexture(h, s.tiling, s.scale),
@@ -430,11 +449,12 @@ inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& 
 }
 
 /// Whether the batch paths take @p layer whole (batchUvHeightGradient): an unmasked UV height
-/// layer of Strength 1 on the surface. Any other takes the per-sample path.
+/// layer of Strength 1 on the surface, differentiated exactly. Any other takes the per-sample
+/// path.
 inline bool batchesWhole(const Layer& layer) {
   const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
   return uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1 &&
-         layer.base == LayerBase::kSurface;
+         layer.base == LayerBase::kSurface && uvHeight->gradient == HeightGradient::kAnalytic;
 }
 
 /// The Γ of an unmasked UV height layer for every sample of @p s on triangle @p tri (whose

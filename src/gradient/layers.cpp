@@ -6,6 +6,7 @@
 #include <string>
 #include <variant>
 
+#include "gradient/bump_node.hpp"
 #include "gradient/prepared_uv_frame.hpp"
 #include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
@@ -27,6 +28,8 @@ Vec3d unblendedGradient(const UvHeightSource& s, const SurfacePoint& point) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const UvFrame& frame = uvFrame(point, s.uvSet);
   const ScalarSample h = s.texture->sample(textureCoordinates(frame.uv, s.tiling, s.offset));
+  if (gradient_detail::usesBumpNode(s, point))
+    return gradient_detail::bumpNodeGradient(s, frame, point.normal, point.bump, h.value);
   return gradientFromUvDerivatives(frame, point.normal,
                                    uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
 }

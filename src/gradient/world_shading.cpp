@@ -7,6 +7,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "gradient/bump_node.hpp"
 #include "gradient/prepared_uv_frame.hpp"
 #include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
@@ -54,6 +55,11 @@ class WorldLayerEvaluator {
     const std::size_t set = static_cast<std::size_t>(s.uvSet);
     const ScalarSample h =
         s.texture->sample(textureCoordinates(world_.uv[set].uv, s.tiling, s.offset));
+    if (gradient_detail::usesBumpNode(s, world_)) {
+      return {gradient_detail::bumpNodeGradient(s, world_.uv[set], world_.normal, world_.bump,
+                                                h.value),
+              s.strength};
+    }
     const gradient_detail::PreparedUvFrame frame =
         prepared_ != nullptr ? prepared_[set] : gradient_detail::prepareUvFrame(world_.uv[set]);
     return {

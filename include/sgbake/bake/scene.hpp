@@ -144,6 +144,9 @@ struct SceneLayer {
   /// Height), or one channel: r, g, b, a (a height packed into another map, or the Image
   /// Texture's Alpha output)
   ImageChannels channel = ImageChannels::kLuminance;
+  /// "gradient" of a height layer: "analytic" (exact), or "bump-node": the forward differences
+  /// half a texel apart that Blender's Bump node takes when Cycles bakes (HeightGradient)
+  HeightGradient heightGradient = HeightGradient::kAnalytic;
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
   /// "tangent_uv" (tangent-space normal layers): the UV set whose tangent frames decode the
   /// map, when not its "uv" (TangentNormalSource::tangentUvSet)

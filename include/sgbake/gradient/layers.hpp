@@ -32,6 +32,15 @@
 
 namespace sgbake {
 
+/// @brief How a height layer's slopes are taken.
+enum class HeightGradient {
+  kAnalytic,  ///< the exact derivatives of the filtered height (eq. 31)
+  /// Blender's Bump node as Cycles bakes it: the height read again at the point's BumpOffsets
+  /// (half a bake texel along two directions of the geometric normal), Γ from those forward
+  /// differences. Exact where the point has no offsets (per-corner tables).
+  kBumpNode,
+};
+
 /// @brief A height map on a UV set: h = scale · texture(tiling ∘ uv + offset); Γ by eq. 31.
 struct UvHeightSource {
   const ScalarTexture* texture = nullptr;  ///< heights; not owned
@@ -43,6 +52,7 @@ struct UvHeightSource {
   /// Blender's Bump node Strength (withNormalMapStrength: a blend of the bumped normal with N,
   /// as Cycles' Bump node ends, not a scale); heights are not changed by it.
   double strength = 1;
+  HeightGradient gradient = HeightGradient::kAnalytic;
 };
 
 /// @brief A tangent-space normal map on a UV set (eq. 14-15), decoded in the MikkTSpace frame or

@@ -26,6 +26,15 @@ struct UvFrame {
   Vec3d dPdv{};  ///< object-space ∂P/∂v
 };
 
+/// @brief Where Blender's Bump node reads a height again around a point (Cycles' ray
+/// differentials dP.dx, dP.dy of the shading point, in the point's space): the offsets a height
+/// layer with HeightGradient::kBumpNode differences over. Both zero when the point has none
+/// (heights are then differentiated exactly).
+struct BumpOffsets {
+  Vec3d dx{}, dy{};
+  bool empty() const { return dx == Vec3d{} && dy == Vec3d{}; }
+};
+
 /// @brief A point on the surface, in object space.
 struct SurfacePoint {
   Vec3d position{};  ///< P
@@ -47,6 +56,9 @@ struct SurfacePoint {
   std::array<Vec3d, kMaxUvSets> uvTangent{};
   std::array<double, kMaxUvSets> uvBitangentSign{};
   std::array<bool, kMaxUvSets> hasUvTangentFrame{};
+  /// Where a Bump node would read the heights again here (set by the baker for layers that
+  /// ask for it, see bakeBumpOffsets); empty elsewhere.
+  BumpOffsets bump{};
 };
 
 }  // namespace sgbake
