@@ -52,6 +52,7 @@ struct BakeArguments {
   std::string heightImage;
   double heightScale = 1;
   std::string filter = "bilinear";
+  std::string heightGradient = "analytic";
   std::string normalImage;
   std::string normalSpace = "tangent";
   std::string normalGreen = "opengl";
@@ -90,7 +91,9 @@ constexpr const char* kFooter =
     "    height     image, uv, scale = 1, strength = 1 (Blender's Bump Strength: a blend of\n"
     "               normals), channel = luminance|r|g|b|a (one channel: a packed height),\n"
     "               filter = bilinear|bicubic|hermite, wrap = repeat|clamp,\n"
-    "               tiling = 1 (number or [s, t]), offset = [0, 0]\n"
+    "               tiling = 1 (number or [s, t]), offset = [0, 0],\n"
+    "               gradient = analytic|bump-node (bump-node: slopes as Blender's Bump\n"
+    "               node takes them when Cycles bakes, differences half a texel apart)\n"
     "    normal     image, uv, space = tangent|object, green = opengl|directx, strength = 1,\n"
     "               filter = bilinear|bicubic, wrap, tiling, offset, tangent_uv (tangent\n"
     "               space: the UV set whose tangents decode it, if not uv)\n"
@@ -157,6 +160,7 @@ const char* const kOneMapOptions[] = {"--mesh",
                                       "--height",
                                       "--height-scale",
                                       "--filter",
+                                      "--height-gradient",
                                       "--normal",
                                       "--normal-space",
                                       "--normal-green",
@@ -323,8 +327,14 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     if (Status ok = parseName("--filter", args.filter, {"bilinear", "bicubic", "hermite"}); !ok) {
       return ok.error();
     }
+    if (Status ok = parseName("--height-gradient", args.heightGradient, {"analytic", "bump-node"});
+        !ok) {
+      return ok.error();
+    }
     SceneLayer height;
     height.type = SceneLayerType::kHeight;
+    height.heightGradient =
+        args.heightGradient == "bump-node" ? HeightGradient::kBumpNode : HeightGradient::kAnalytic;
     height.image = args.heightImage;
     height.scale = args.heightScale;
     height.uvSet = args.uvSet;
@@ -464,6 +474,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   const bool height = !args.heightImage.empty(), normal = !args.normalImage.empty();
   for (const auto& [option, applies, needs] :
        {std::tuple{"--height-scale", height, "--height"},
+        {"--height-gradient", height, "--height"},
         {"--filter", height || normal, "--height or --normal"},
         {"--normal-space", normal, "--normal"},
         {"--normal-green", normal, "--normal"},
@@ -652,6 +663,12 @@ CommandAction defineBakeCommand(CLI::App& app) {
   app.add_option("--filter", args->filter,
                  "Image filter: bilinear, bicubic or hermite (heights only)")
       ->type_name("FILTER")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--height-gradient", args->heightGradient,
+                 "Slopes of --height: analytic (exact), or bump-node (Blender's Bump node as "
+                 "Cycles bakes it: differences half a texel apart)")
+      ->type_name("MODE")
       ->capture_default_str()
       ->group(oneMap);
   app.add_option("--normal", args->normalImage, "Normal-map layer")

@@ -78,6 +78,17 @@ inline Vec3d bumpNodeGradient(const UvHeightSource& s, const UvFrame& frame, con
   return isFinite(gamma) ? gamma : Vec3d{};
 }
 
+/// @p point with the BumpOffsets that give, seen from the front, the bump Cycles makes from
+/// behind (as backFacingNormal reads it). There Cycles flips Ng, N and ∂P/∂u, ∂P/∂v: the first
+/// of its orthonormals flips, the second stays, and solving for the UV offsets with the flipped
+/// derivatives reads the heights at +dP.dx and −dP.dy of the front. Its normal is then the
+/// flipped one of the front bump with offsets (dx, −dy).
+inline SurfacePoint seenFromBehind(const SurfacePoint& point) {
+  SurfacePoint seen = point;
+  seen.bump.dy = -point.bump.dy;
+  return seen;
+}
+
 /// Whether @p s is differentiated as the Bump node does at @p point.
 inline bool usesBumpNode(const UvHeightSource& s, const SurfacePoint& point) {
   return s.gradient == HeightGradient::kBumpNode && !point.bump.empty();

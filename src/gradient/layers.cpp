@@ -336,6 +336,10 @@ Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
 namespace gradient_detail {
 
 Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng) {
+  if (!point.bump.empty()) {
+    const SurfacePoint seen = seenFromBehind(point);
+    return backFacingGuarded(point.normal, compositeSeen(layers, seen, ng, true), ng);
+  }
   return backFacingGuarded(point.normal, compositeSeen(layers, point, ng, true), ng);
 }
 

@@ -240,8 +240,9 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       if (back) {
-        addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
-                              gamma);
+        addWorldLayerGradient(layer, objectPoint,
+                              worldPoint.bump.empty() ? worldPoint : seenFromBehind(worldPoint), ng,
+                              space, preparedWorldUv, incoming, gamma);
         continue;
       }
       NormalBelowSurface step;

@@ -178,17 +178,22 @@ TEST(Maps, BackFacingTexelsBakeWhatCyclesShadesFromBehind) {
 
 TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
   // h = scale·(a·u + b·v) on P = (Lx u, Ly v, 0): Γ = scale·(a/Lx, b/Ly, 0), N' = normalize(−Γ + ẑ),
-  // MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself.
+  // MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself. The
+  // Bump node's forward differences are exact on a linear height: the same maps.
   const double lx = 2, ly = 0.5, a = 0.3, b = -0.2, scale = 0.7;
   const Mesh mesh = scaledPlane(lx, ly);
   const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
   ASSERT_TRUE(tangents.ok());
   const test::LinearHeight height(a, b);
-  const std::vector<Layer> layers{Layer{UvHeightSource{&height, 0, scale}, 1.0, {}}};
   const Vec3d gamma{scale * a / lx, scale * b / ly, 0};
   const Vec3d perturbed = normalizeOr(Vec3d{-gamma.x, -gamma.y, 1}, Vec3d{});
 
-  for (const int samples : {1, 3}) {
+  for (const auto& [samples, differences] :
+       {std::pair{1, HeightGradient::kAnalytic}, std::pair{3, HeightGradient::kAnalytic},
+        std::pair{1, HeightGradient::kBumpNode}, std::pair{3, HeightGradient::kBumpNode}}) {
+    UvHeightSource source{&height, 0, scale};
+    source.gradient = differences;
+    const std::vector<Layer> layers{Layer{source, 1.0, {}}};
     const auto tn = bake(mesh, &*tangents, layers, MapKind::kTangentNormal, 32, samples);
     const auto on = bake(mesh, &*tangents, layers, MapKind::kObjectNormal, 32, samples);
     const auto sg = bake(mesh, &*tangents, layers, MapKind::kSurfaceGradient, 32, samples);
@@ -578,6 +583,39 @@ TEST(Maps, TangentSpaceLayersOnAnotherUvSetDecodeInItsOwnFrames) {
   std::get<TangentNormalSource>(split[0].source).tangentUvSet = 2;  // a set the mesh lacks
   splitInput.layers = split;
   EXPECT_FALSE(bakeMap(splitInput, settings).ok());
+}
+
+// Heights differenced as the Bump node does (HeightGradient::kBumpNode) are a first-order
+// estimate half a texel wide: on a curved height the bake differs from the exact one, by about
+// a quarter as much when the bake is four times larger; and the per-sample path it takes gives
+// the analytic layer's bits when the layer asks for exact slopes.
+TEST(Maps, BumpNodeSlopesConvergeToTheExactOnesAsTheBakeGrows) {
+  const Mesh mesh = scaledPlane(2, 0.5);
+  const Result<CornerTangents> tangents = computeTangents(mesh.view(0));
+  ASSERT_TRUE(tangents.ok());
+  const test::SineHeight height(0.02, 2);
+  UvHeightSource exact{&height, 0, 1.0};
+  UvHeightSource differenced = exact;
+  differenced.gradient = HeightGradient::kBumpNode;
+  const std::vector<Layer> exactLayers{Layer{exact, 1.0, {}}};
+  const std::vector<Layer> bumpLayers{Layer{differenced, 1.0, {}}};
+  // Largest angle between the two bakes' normals, degrees.
+  const auto largestGap = [&](int size) {
+    const auto a = bake(mesh, &*tangents, exactLayers, MapKind::kTangentNormal, size);
+    const auto b = bake(mesh, &*tangents, bumpLayers, MapKind::kTangentNormal, size);
+    EXPECT_TRUE(a.ok() && b.ok());
+    double gap = 0;
+    forEachCoveredTexel(*a, [&](int x, int y, const std::string&) {
+      const Vec3d na = normalizeOr(2.0 * test::pixelUp(*a, x, y) - Vec3d{1, 1, 1}, Vec3d{});
+      const Vec3d nb = normalizeOr(2.0 * test::pixelUp(*b, x, y) - Vec3d{1, 1, 1}, Vec3d{});
+      gap = std::max(gap, std::acos(std::clamp(dot(na, nb), -1.0, 1.0)) * 180 / kPi);
+    });
+    return gap;
+  };
+  const double at64 = largestGap(64), at256 = largestGap(256);
+  EXPECT_GT(at64, 0.5);  // visibly not the exact slopes at 64²
+  EXPECT_LT(at256, at64 / 3);
+  EXPECT_GT(at256, at64 / 6);  // first order: a quarter
 }
 
 // A height layer's strength is Blender's Bump Strength: the bumped normal blended with the
