@@ -130,6 +130,7 @@ def compare_case(entry):
                              ("nmap_flags", "ours_nmap_flags.exr", "tangent"),
                              ("nmap_weak", "ours_nmap_weak.exr", "tangent"),
                              ("nmap_sum", "ours_nmap_sum.exr", "tangent"),
+                             ("nmap_bump_node", "ours_nmap_bump_node.exr", "tangent"),
                              ("nmap_object_space", "ours_nmap_object_space.exr", "tangent")):
         img = load_if(os.path.join(d, name))
         if img is None:

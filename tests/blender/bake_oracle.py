@@ -295,7 +295,8 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     map_green = "directx" if sabotage == "normal-green" else "opengl"
     green = "directx" if sabotage == "green" else "opengl"
 
-    def scene_file(name, layer_strength, outputs, base="above", transform=True):
+    def scene_file(name, layer_strength, outputs, base="above", transform=True,
+                   gradient="analytic"):
         layer = {"type": "normal", "image": p("normal.exr"), "space": nmap["space"],
                  "strength": layer_strength, "filter": "bilinear", "uv": 0, "weight": 1.0}
         if nmap["space"] == "tangent":
@@ -303,7 +304,7 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
         layers = [layer]
         if "bump" in nmap:  # the Bump node on the Normal Map's output
             layers.append({"type": "height", "image": p("height.exr"), "scale": nmap["bump"],
-                           "filter": "bilinear", "base": base})
+                           "filter": "bilinear", "base": base, "gradient": gradient})
         scene = {"mesh": p("mesh.obj"), "layers": layers, "outputs": []}
         if transform and transformed(entry):
             scene["transform"] = entry["transform"]
@@ -332,6 +333,11 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     if "bump" in nmap and not run_sgbake(
             cli, scene_file("scene_sum.json", strength, [("tangent-normal", "ours_nmap_sum.exr")],
                             base="surface"), log):
+        failed.append(log[-1])
+    if "bump" in nmap and not run_sgbake(
+            cli, scene_file("scene_bump_node.json", strength,
+                            [("tangent-normal", "ours_nmap_bump_node.exr")],
+                            gradient="bump-node"), log):
         failed.append(log[-1])
     if nmap["strength"] == 1.0 and "bump" not in nmap:  # the flags have no Strength or chain
         flags = ["bake", "--mesh", p("mesh.obj"), "--normal", p("normal.exr"), "--normal-space",
@@ -419,6 +425,19 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
             if passes_nmap(s["flipped_green"], chain, stretched):
                 fails.append(f"{name}: negative control: the normal-map bake with green "
                              f"flipped still passes")
+    if chain and "nmap_bump_node" in r:
+        s = r["nmap_bump_node"]
+        ok = "error" not in s and passes_bump_node(s)
+        print(f"  (e) bump-node chain vs Blender:         {fmt_nmap(s)} -> "
+              f"{'ok' if ok else 'FAIL'} (median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= "
+              f"{BUMP_NODE_P99_DEG})")
+        if not ok:
+            fails.append(f"{name}: the bump-node chain differs from Blender's: {fmt_nmap(s)}")
+        if passes_bump_node(r["nmap_tangent"]):
+            fails.append(f"{name}: negative control: the analytic chain passes the bump-node "
+                         f"bars")
+    elif chain:
+        fails.append(f"{name}: no bump-node chain bake to compare")
     if chain:
         negative_control(name, r, "nmap_sum", "bump added, not stacked:  ",
                          "the bake with the bump added to the normal map's gradient", chain,
