@@ -486,8 +486,11 @@ def material_layers(node_tree, render_uv=None):
             ignored += _ignored(node, tex, ("Strength", "Distance"), "Height")
             scale = node.inputs["Distance"].default_value
             values = _texture_settings(tex, render_uv)
+            # The node's slopes as Cycles takes them when it bakes (forward differences half
+            # a texel apart): the layer then bakes what Cycles bakes from it.
             values.update(type="height", scale=-scale if node.invert else scale,
-                          strength=max(node.inputs["Strength"].default_value, 0.0))
+                          strength=max(node.inputs["Strength"].default_value, 0.0),
+                          slopes="bump-node")
             if _source_link(node.inputs["Height"]).from_socket.name == "Alpha":
                 values["channel"] = "a"
         else:

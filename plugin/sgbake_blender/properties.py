@@ -46,6 +46,13 @@ BASES = (
     ("above", "Layers Above", "Bump the normal the layers above make, as a Bump node whose "
                               "Normal input is linked to the node before it"),
 )
+SLOPES = (
+    ("analytic", "Exact", "The exact slopes of the filtered height"),
+    ("bump-node", "As Cycles' Bump", "The slopes Cycles' Bump node takes when it bakes: the "
+                                      "height read again half a texel away, so the map is "
+                                      "Cycles' bake to float rounding (and changes with the "
+                                      "bake's size, as Cycles' does)"),
+)
 KINDS = (
     ("height", "Height", "The image holds heights"),
     ("tangent-normal", "Tangent Normal", "The image holds tangent-space normals"),
@@ -96,6 +103,9 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                           description="What of a height layer's image is the height")
     base: EnumProperty(name="Bumps", items=BASES, default="surface",
                        description="Which normal a height layer bumps")
+    slopes: EnumProperty(name="Slopes", items=SLOPES, default="analytic",
+                         description="How a height layer's slopes are taken (Layers from "
+                                     "Material takes a Bump node's as Cycles does)")
     filter: EnumProperty(name="Filter", items=FILTERS, default="bilinear")
     wrap: EnumProperty(name="Wrap", items=WRAPS, default="repeat")
     tiling: FloatVectorProperty(name="Tiling", size=2, default=(1.0, 1.0),

@@ -129,6 +129,8 @@ def layer_json(layer, uv_index, default_uv=None):
             entry["channel"] = layer.channel
         if layer.base != "surface":
             entry["base"] = layer.base
+        if layer.slopes != "analytic":
+            entry["gradient"] = layer.slopes
     elif layer.type == "normal":
         entry.update(space=layer.space, strength=_number(layer.scale))
         if layer.space == "tangent" and layer.tangent_uv_map:

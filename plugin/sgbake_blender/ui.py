@@ -124,6 +124,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 col.prop(layer, "strength")
                 col.prop(layer, "channel")
                 col.prop(layer, "base")
+                col.prop(layer, "slopes")
             col.prop(layer, "filter")
             col.prop(layer, "wrap")
             col.prop(layer, "tiling")

@@ -92,11 +92,11 @@
    controls and from the add-on's own bake of Blender's level-1 mesh.
    The transformed object's bakes against Cycles' (angles between the decoded normals over
    Cycles' mask less one texel at island borders, as bake_compare.py): median <=
-   WORLD_MEDIAN_DEG (1 deg, Cycles' Bump being a finite difference; measured 0.61 tangent,
-   0.23 object), and the negative control at least WORLD_CONTROL_FACTOR (3) times worse
-   (measured medians 3.0 and 33 deg). The two-material object likewise: median <=
-   MATERIALS_MEDIAN_DEG (measured 0.22 deg) and every texel within MATERIALS_MAX_DEG
-   (measured 6.5 deg), every layer on every face at least MATERIALS_CONTROL_FACTOR times
+   WORLD_MEDIAN_DEG (0.01 deg: Layers from Material takes the Bump node's slopes as Cycles
+   does; measured 0.002), and the negative control at least WORLD_CONTROL_FACTOR (3) times
+   worse (measured medians 2.9 and 33 deg). The two-material object likewise: median <=
+   MATERIALS_MEDIAN_DEG (measured 0.002 deg) and every texel within MATERIALS_MAX_DEG
+   (measured 0.3 deg), every layer on every face at least MATERIALS_CONTROL_FACTOR times
    worse (measured 11 deg).
 
 --sabotage bakes the add-on's tangent-normal cases with green DirectX: the test must FAIL.
@@ -145,28 +145,29 @@ WORLD_LOCATION = (0.5, -1.0, 2.0)
 WORLD_ROTATION = (0.4, 0.2, 0.7)
 WORLD_SCALE = (2.0, 1.0, 0.5)
 WORLD_MAPS = {"tangent-normal": "tangent", "object-normal": "object"}  # -> Cycles' normal_space
-# Cycles' Bump is a finite difference of the height over half a bake texel: the bar of
-# BlenderBakeOracle's height bakes (BAKE_MEDIAN_DEG). Measured at 256^2: median 0.61 (tangent)
-# and 0.23 deg (object); the object unmoved 0.31 deg. Without the transform the median is 3.0
-# (tangent) and 33 deg (object: Blender's baker brings the normal back as a direction, M^-1):
-# the control must be WORLD_CONTROL_FACTOR times worse.
-WORLD_MEDIAN_DEG = 1.0
+# Layers from Material takes a Bump node's slopes as Cycles does (forward differences half a
+# bake texel apart, "gradient": "bump-node"), so the bar is BlenderBakeOracle's (e), float
+# rounding: measured at 256^2 median 0.002 deg, tangent and object (0.61 and 0.23 deg with
+# exact slopes). Without the transform the median is 2.9 (tangent) and 33 deg (object: Blender's
+# baker brings the normal back as a direction, M^-1): the control must be WORLD_CONTROL_FACTOR
+# times worse.
+WORLD_MEDIAN_DEG = 0.01
 WORLD_CONTROL_FACTOR = 3.0
 # The object of two materials against Cycles (materials_case): a copy of Suzanne whose faces of
 # even index are in slot 1, whose material chains a Bump (MATERIALS_CHAIN_DISTANCE, the height
 # image) on a tangent-space Normal Map (normal_field leaning up to MATERIALS_TILT_DEG); the
-# others keep slot 0, the bump material. Same bar as the transformed object: Cycles' Bump is a
-# finite difference (the chain alone: 0.40 deg median in BlenderBakeOracle, the normal map
-# alone ~0.005 deg). The negative control, every layer on every face (the add-on before it
+# others keep slot 0, the bump material. Same bar as the transformed object (measured median
+# 0.002 deg; 0.22 with exact slopes). The negative control, every layer on every face (the add-on before it
 # sent "material"), must be MATERIALS_CONTROL_FACTOR times worse.
 MATERIALS_TILT_DEG = 40.0
 MATERIALS_CHAIN_DISTANCE = 0.05
 MATERIALS_MAP = "tangent-normal"
-MATERIALS_MEDIAN_DEG = 1.0
+MATERIALS_MEDIAN_DEG = 0.01
 # Texels next to an edge between the materials go to the triangle Blender's nudged sample is in
 # (bake.hpp, "Where a texel is sampled"): picked at the texel centre instead, 17 of them came
-# out 5-33 deg off. Every texel must be within MATERIALS_MAX_DEG (measured max 6.5 deg).
-MATERIALS_MAX_DEG = 10.0
+# out 5-33 deg off. Every texel must be within MATERIALS_MAX_DEG (measured max 0.3 deg; 6.5
+# with exact slopes).
+MATERIALS_MAX_DEG = 1.0
 MATERIALS_CONTROL_FACTOR = 3.0
 
 CASES = {
@@ -714,14 +715,14 @@ def udim_case(settings, ob, work, sabotage):
     scale = float(settings.layers[0].scale)
     entry["cli"] = [
         ["bake", "--mesh", "mesh_udim.obj", "--height", "height.exr", "--height-scale",
-         repr(scale), "--filter", "bilinear", "--map", UDIM_MAP, "--size", str(SIZE),
+         repr(scale), "--height-gradient", "bump-node", "--filter", "bilinear", "--map", UDIM_MAP, "--size", str(SIZE),
          "--margin", str(UDIM_MARGIN), "--green", "opengl", "--bit-depth", "32",
          "--no-manifest", "-o", "cli_udim.<UDIM>.exr"],
         ["bake", "udim_1011.json", "--no-manifest"]] + input_cli
     with open(os.path.join(work, "udim_1011.json"), "w", encoding="ascii") as out:
         json.dump({"mesh": "mesh_udim.obj",
                    "layers": [{"type": "height", "image": "height.exr", "scale": scale,
-                               "filter": "bilinear"}],
+                               "filter": "bilinear", "gradient": "bump-node"}],
                    "outputs": [{"map": UDIM_MAP, "size": SIZE, "margin": UDIM_MARGIN,
                                 "green": "opengl", "tile": 1011, "file": "cli_udim.1011.exr",
                                 "format": "exr", "bit_depth": 32}]}, out, indent=1)
@@ -776,7 +777,8 @@ def udim_input_case(settings, work, checks):
         with open(os.path.join(work, f"{name}.json"), "w", encoding="ascii") as out:
             json.dump({"mesh": "mesh_udim.obj",
                        "layers": [{"type": "height", "image": f"{heights_file}.<UDIM>.exr",
-                                   "scale": scale, "filter": "bilinear"}],
+                                   "scale": scale, "filter": "bilinear",
+                                   "gradient": "bump-node"}],
                        "outputs": [{"map": UDIM_MAP, "size": SIZE, "margin": UDIM_MARGIN,
                                     "green": "opengl", "file": f"cli_{name}.<UDIM>.exr",
                                     "bit_depth": 32}]}, out, indent=1)
@@ -961,7 +963,8 @@ def limit_case(settings, ob, work, scale):
     bpy.context.view_layer.objects.active = ob
     def cli(output, uv_smooth="all", with_creases=True):
         args = ["bake", "--mesh", "mesh_limit.obj", "--subdivide", "limit", "--uv-smooth",
-                uv_smooth, "--height", "height.exr", "--height-scale", repr(scale), "--filter",
+                uv_smooth, "--height", "height.exr", "--height-scale", repr(scale),
+                "--height-gradient", "bump-node", "--filter",
                 "bilinear", "--map", LIMIT_MAP, "--size", str(SIZE), "--margin", "0",
                 "--bit-depth", "32", "--no-manifest", "-o", output]
         for a, b, crease in edge_creases if with_creases else []:
@@ -1372,7 +1375,8 @@ def run_cli(cli, work, manifest):
     for case, entry in manifest["cases"].items():
         cmd = [cli, "bake", "--mesh", os.path.join(work, "mesh.obj"),
                "--height", os.path.join(work, "height.exr"),
-               "--height-scale", repr(manifest["scale"]), "--filter", "bilinear",
+               "--height-scale", repr(manifest["scale"]), "--height-gradient", "bump-node",
+               "--filter", "bilinear",
                "--map", entry["map"], "--size", manifest["size"], "--margin", entry["margin"],
                "--padding", entry["padding"],
                "--samples", entry["samples"], "--bit-depth", 32, "--no-manifest",
