@@ -596,6 +596,33 @@ TEST(Scene, SwizzleIsParsedForNormalMapsAndInTheParametersOnlyWhenNotTheDefault)
             "strings such as [\"+X\", \"-Y\", \"+Z\"]");
 }
 
+TEST(Scene, HeightGradientIsParsedAndInTheParametersOnlyWhenNotAnalytic) {
+  Result<Scene> bump =
+      parseScene(withLayer(R"({"type": "height", "image": "h.png", "gradient": "bump-node"})"),
+                 options());
+  ASSERT_TRUE(bump) << bump.error().message;
+  EXPECT_EQ(bump->layers[0].heightGradient, HeightGradient::kBumpNode);
+  EXPECT_NE(layerParametersJson(bump->layers[0]).find(R"("gradient":"bump-node")"),
+            std::string::npos);
+  Result<Scene> exact =
+      parseScene(withLayer(R"({"type": "height", "image": "h.png", "gradient": "analytic"})"),
+                 options());
+  ASSERT_TRUE(exact) << exact.error().message;
+  EXPECT_EQ(exact->layers[0].heightGradient, HeightGradient::kAnalytic);
+  // The default: the text (and manifest hash) of scenes without the key.
+  EXPECT_EQ(layerParametersJson(exact->layers[0]).find("gradient"), std::string::npos);
+
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "gradient": "central"})")),
+            "scene.json: layers[0]: unknown gradient 'central' (expected analytic or bump-node)");
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "volume", "function": "sine", "gradient": "bump-node"})")),
+            "scene.json: layers[0]: unknown gradient 'bump-node' (expected analytic, central or "
+            "tetrahedral)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "gradient": "analytic"})")),
+            "scene.json: layers[0]: key 'gradient' does not apply to a normal layer (it is for "
+            "height or volume layers)");
+}
+
 TEST(Scene, SubdivisionIsParsedAndValidated) {
   Result<Scene> scene = parseScene(
       R"({"mesh": "m.obj", "subdivision": {"level": 2, "uv_smooth": "keep-corners",

@@ -684,6 +684,11 @@ TEST_F(BakeCliTest, OneMapShorthand) {
            "push-pull", "-o", (dir_ / "os.exr").string()});
   ASSERT_EQ(normal.exitCode, 0) << normal.err;
   EXPECT_TRUE(fs::exists(dir_ / "os.exr"));
+  const ProcessResult bumpNode =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--height", (dir_ / "h.png").string(),
+           "--height-gradient", "bump-node", "--size", "8", "-o", (dir_ / "bn.exr").string()});
+  ASSERT_EQ(bumpNode.exitCode, 0) << bumpNode.err;
+  EXPECT_TRUE(fs::exists(dir_ / "bn.exr"));
   const ProcessResult adjacent =
       run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "object-normal", "--size", "8",
            "--margin", "2", "--padding", "adjacent-faces", "-o", (dir_ / "adj.exr").string()});
@@ -740,6 +745,10 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
            // Options that would change nothing: no layer for them, another map, no subdivision.
            {"bake", "--mesh", mesh, "--height-scale", "2", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--filter", "bicubic", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--height-gradient", "bump-node", "-o",
+            (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--height-gradient",
+            "central", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--normal-space",
             "object", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--map", "mask", "--green", "directx", "-o",
