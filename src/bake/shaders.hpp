@@ -427,11 +427,12 @@ void shadeSlowLanes(Shader& shader, const SampleBatch& s, const LaneFlags& slow,
 }
 
 /// The texture samples of UV height layer @p src (non-null texture, UV set on @p tri) at every
-/// sample of @p s: the SurfacePoint's interpolated UV, tiled and offset, through sampleMany for
-/// an image texture (one dispatch on the filter per batch).
+/// sample of @p s: the SurfacePoint's interpolated UV (moved by @p shift when given), tiled and
+/// offset, through sampleMany for an image texture (one dispatch on the filter per batch).
 inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& s,
                                  const UvHeightSource& src,
-                                 std::array<ScalarSample, SampleBatch::kMax>& h) {
+                                 std::array<ScalarSample, SampleBatch::kMax>& h,
+                                 const Vec2d* shift = nullptr) {
   const std::size_t n = static_cast<std::size_t>(s.count);
   const std::array<Vec2d, 3>& uvs = tri.uv[static_cast<std::size_t>(src.uvSet)];
   const Vec2d uv0 = uvs[0], uv1 = uvs[1], uv2 = uvs[2];
@@ -439,7 +440,7 @@ inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& 
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2d uv{s.b0[i] * uv0.x + s.b1[i] * uv1.x + s.b2[i] * uv2.x,
                    s.b0[i] * uv0.y + s.b1[i] * uv1.y + s.b2[i] * uv2.y};
-    st[i] = textureCoordinates(uv, src.tiling, src.offset);
+    st[i] = textureCoordinates(shift != nullptr ? uv + *shift : uv, src.tiling, src.offset);
   }
   if (const auto* image = dynamic_cast<const ImageScalarTexture*>(src.texture)) {
     image->sampleMany({st.data(), n}, {h.data(), n});
@@ -449,12 +450,42 @@ inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& 
 }
 
 /// Whether the batch paths take @p layer whole (batchUvHeightGradient): an unmasked UV height
-/// layer of Strength 1 on the surface, differentiated exactly. Any other takes the per-sample
-/// path.
+/// layer of Strength 1 on the surface. Any other takes the per-sample path.
 inline bool batchesWhole(const Layer& layer) {
   const UvHeightSource* uvHeight = std::get_if<UvHeightSource>(&layer.source);
   return uvHeight != nullptr && layer.mask.texture == nullptr && uvHeight->strength == 1 &&
-         layer.base == LayerBase::kSurface && uvHeight->gradient == HeightGradient::kAnalytic;
+         layer.base == LayerBase::kSurface;
+}
+
+/// batchUvHeightGradient's Γ of a layer read as the Bump node does (usesBumpNode: @p point's
+/// offsets, constant over the triangle, are not empty): gradient_detail::bumpNodeGradient lane
+/// by lane, bit for bit, its three lookups a batch each.
+inline void batchBumpNodeGradient(const ShadingTriangle& tri, const SurfacePoint& point,
+                                  const SampleBatch& s, const UvHeightSource& src,
+                                  const Lanes3& unitN, Lanes3& layer) {
+  const std::size_t n = static_cast<std::size_t>(s.count);
+  const UvFrame& frame = point.uv[static_cast<std::size_t>(src.uvSet)];
+  const Vec2d shiftX = gradient_detail::uvOffsetOf(frame, point.bump.dx);
+  const Vec2d shiftY = gradient_detail::uvOffsetOf(frame, point.bump.dy);
+  std::array<ScalarSample, SampleBatch::kMax> hc, hx, hy;
+  batchUvHeightSamples(tri, s, src, hc);
+  batchUvHeightSamples(tri, s, src, hx, &shiftX);
+  batchUvHeightSamples(tri, s, src, hy, &shiftY);
+  const Vec3d dx = point.bump.dx, dy = point.bump.dy;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3d normal{unitN.x[i], unitN.y[i], unitN.z[i]};
+    const Vec3d rx = cross(dy, normal), ry = cross(normal, dx);
+    const double det = dot(dx, rx);
+    Vec3d gamma{};
+    if (std::abs(det) > 0 && std::isfinite(det)) {
+      gamma = (src.scale / det) *
+              ((hx[i].value - hc[i].value) * rx + (hy[i].value - hc[i].value) * ry);
+      if (!isFinite(gamma)) gamma = {};
+    }
+    layer.x[i] = gamma.x;
+    layer.y[i] = gamma.y;
+    layer.z[i] = gamma.z;
+  }
 }
 
 /// The Γ of an unmasked UV height layer for every sample of @p s on triangle @p tri (whose
@@ -469,7 +500,10 @@ inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint
   const std::size_t n = static_cast<std::size_t>(s.count);
   Lanes3 layer{};
   const std::size_t set = static_cast<std::size_t>(src.uvSet);
-  if (src.texture != nullptr && hasUvSet(point, src.uvSet) && prepared[set].valid) {
+  if (src.texture != nullptr && hasUvSet(point, src.uvSet) &&
+      gradient_detail::usesBumpNode(src, point)) {
+    batchBumpNodeGradient(tri, point, s, src, unitN, layer);
+  } else if (src.texture != nullptr && hasUvSet(point, src.uvSet) && prepared[set].valid) {
     const gradient_detail::PreparedUvFrame& frame = prepared[set];
     std::array<ScalarSample, SampleBatch::kMax> h;
     batchUvHeightSamples(tri, s, src, h);

@@ -157,6 +157,7 @@ class ShadeBatch : public ::testing::Test {
     base.layers = layers;
     base.channels = channels;
     base.world = world;
+    base.bumpTexel = bumpTexel;
     Shader batchShader{base}, sampleShader{base};
     std::mt19937 rng(11);
     int fallbacks = 0;
@@ -209,6 +210,7 @@ class ShadeBatch : public ::testing::Test {
   /// Squashed a hundredfold: normals 60° from N in object space end up far below the surface.
   const WorldSpace squashed = *WorldSpace::of({Mat3::diagonal({10, 1, 0.1}), {}});
   const WorldSpace* world = nullptr;  ///< the placement expectShaderBatchEqualsSamples shades in
+  Vec2d bumpTexel{};  ///< BakeShaderBase::bumpTexel of the shaders compared
   ImageScalarTexture bilinear = *ImageScalarTexture::create(Image(1, 1, 1));
   ImageScalarTexture bicubic = *ImageScalarTexture::create(Image(1, 1, 1));
   DirectionalSine sine = *DirectionalSine::create({});
@@ -230,6 +232,23 @@ TEST_F(ShadeBatch, ImageHeightLayers) {
   expectBatchEqualsSamples(layers, kIdentitySwizzle, "image heights");
   expectBatchEqualsSamples(layers, kDirectXGreen, "image heights, DirectX");
   expectBatchEqualsSamples(layers, kScrambled, "image heights, -Z+X-Y");
+}
+
+TEST_F(ShadeBatch, ImageHeightLayersReadAsTheBumpNodeDoes) {
+  UvHeightSource tiled{&bilinear, 0, 0.02, {2, 3}, {0.25, -0.5}};
+  tiled.gradient = HeightGradient::kBumpNode;
+  UvHeightSource cubic{&bicubic, 0, 0.05};
+  cubic.gradient = HeightGradient::kBumpNode;
+  const std::vector<Layer> layers{
+      Layer{tiled, 1.0, {}},
+      Layer{cubic, -0.5, {}},
+      Layer{UvHeightSource{&bilinear, 0, 0.1}, 0.7, {}},  // exact slopes beside them
+  };
+  bumpTexel = {1.0 / 64, 1.0 / 32};
+  expectBatchEqualsSamples(layers, kIdentitySwizzle, "bump-node heights");
+  expectBatchEqualsSamples(layers, kScrambled, "bump-node heights, -Z+X-Y");
+  bumpTexel = {};  // no offsets: exact slopes
+  expectBatchEqualsSamples(layers, kIdentitySwizzle, "bump-node heights without offsets");
 }
 
 TEST_F(ShadeBatch, OtherLayersTakeThePerSamplePath) {
