@@ -490,14 +490,18 @@ def evaluate(name, r):
             return True
         return False
 
+    def judge(label, s, ok, bars, problem):
+        """Prints a check's line; a failed check appends `problem` with the figures."""
+        print(f"  {label} {fmt(s)} worst at (x, row) {s.get('worst_at')} -> "
+              f"{'ok' if ok else 'FAIL'} {bars}")
+        if not ok:
+            fails.append(f"{name}: {problem}: {fmt(s)}")
+
     if not missing("convert", "convert"):
         s = r["convert"]
-        ok = passes_convert(s)
-        print(f"  (a) convert vs Blender tangent: {fmt(s)} worst at (x, row) {s.get('worst_at')}"
-              f" -> {'ok' if ok else 'FAIL'} (median <= {CONVERT_MEDIAN_DEG}, p99 <= "
-              f"{CONVERT_P99_DEG})")
-        if not ok:
-            fails.append(f"{name}: convert differs from Blender's tangent bake: {fmt(s)}")
+        judge("(a) convert vs Blender tangent:", s, passes_convert(s),
+              f"(median <= {CONVERT_MEDIAN_DEG}, p99 <= {CONVERT_P99_DEG})",
+              "convert differs from Blender's tangent bake")
         if s["outside_max_abs"] > SAME_IMAGE_ABS:
             fails.append(f"{name}: convert changed texels outside the islands "
                          f"(max |diff| {s['outside_max_abs']:.3g})")
@@ -506,13 +510,10 @@ def evaluate(name, r):
                          f"({fmt(s['flipped_green'])})")
     if not missing("bake", "bake"):
         s = r["bake"]
-        ok = passes_bake(s, name)
         p99_bar = f", p99 <= {BAKE_P99_DEG[name]}" if name in BAKE_P99_DEG else ""
         p99_bar += f", max <= {BAKE_MAX_DEG[name]}" if name in BAKE_MAX_DEG else ""
-        print(f"  (b) bake vs Blender tangent:    {fmt(s)} worst at (x, row) {s.get('worst_at')}"
-              f" -> {'ok' if ok else 'FAIL'} (median <= {BAKE_MEDIAN_DEG}{p99_bar})")
-        if not ok:
-            fails.append(f"{name}: bake differs from Blender's tangent bake: {fmt(s)}")
+        judge("(b) bake vs Blender tangent:   ", s, passes_bake(s, name),
+              f"(median <= {BAKE_MEDIAN_DEG}{p99_bar})", "bake differs from Blender's tangent bake")
         if s["outside_max_abs"] > BACKGROUND_ABS:
             fails.append(f"{name}: bake background is not (0.5, 0.5, 1) outside the islands "
                          f"(max |diff| {s['outside_max_abs']:.3g})")
@@ -530,12 +531,9 @@ def evaluate(name, r):
                          f"(max |diff| {same})")
     if not missing("bake_bump_node", "bump-node bake"):
         s = r["bake_bump_node"]
-        ok = passes_bump_node(s)
-        print(f"  (e) bump-node bake vs Blender:  {fmt(s)} worst at (x, row) {s.get('worst_at')}"
-              f" -> {'ok' if ok else 'FAIL'} (median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= "
-              f"{BUMP_NODE_P99_DEG})")
-        if not ok:
-            fails.append(f"{name}: the bump-node bake differs from Blender's: {fmt(s)}")
+        judge("(e) bump-node bake vs Blender: ", s, passes_bump_node(s),
+              f"(median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= {BUMP_NODE_P99_DEG})",
+              "the bump-node bake differs from Blender's")
         if "bake" in r and "error" not in r["bake"] and passes_bump_node(r["bake"]):
             fails.append(f"{name}: negative control: the analytic bake passes the bump-node "
                          f"bars ({fmt(r['bake'])})")
