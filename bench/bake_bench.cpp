@@ -7,6 +7,8 @@
 // Benchmarks (wall time, milliseconds; the argument is the thread count):
 //   - BM_TangentNormal/threads:N — bakeMap(kTangentNormal, 4096², 1 sample) with a bilinear
 //     2048² height map: the speed target (Blender's Cycles bake takes 25–35 s);
+//   - BM_TangentNormalBumpNode/threads:N — the same map with the height's slopes as Cycles'
+//     Bump node takes them ("gradient": "bump-node": three lookups a sample instead of one);
 //   - BM_TangentNormalBands/threads:N — the same map by bakeMapRows (bands of rows in a reused
 //     ring, what the CLI runs), and BM_TangentNormalBandsMargin16/threads:N with each band's
 //     final rows padded in place (extendMarginRowsInPlace, margin 16) as the CLI pads them;
@@ -55,6 +57,7 @@ struct Scene {
   CornerTangents tangents;
   std::optional<ImageScalarTexture> height;
   std::vector<Layer> layers;
+  std::vector<Layer> bumpNodeLayers;  ///< the same height, slopes as Cycles' Bump node takes them
 };
 
 /// Loaded once: the mesh, its tangents and a 2048² height map of a few summed sines.
@@ -86,6 +89,9 @@ const Scene& scene() {
     if (!texture) std::exit(1);
     out->height.emplace(std::move(*texture));
     out->layers.push_back(Layer{UvHeightSource{&*out->height, 0, 0.02}, 1.0, {}});
+    UvHeightSource bumpNode{&*out->height, 0, 0.02};
+    bumpNode.gradient = HeightGradient::kBumpNode;
+    out->bumpNodeLayers.push_back(Layer{bumpNode, 1.0, {}});
     return out;
   }();
   return *s;
@@ -96,14 +102,14 @@ const Scene& scene() {
 const ObjectTransform kStretched{Mat3::diagonal({2, 1, 0.5}), {}};
 
 void bake(benchmark::State& state, MapKind kind, bool withLayers,
-          const ObjectTransform* transform = nullptr) {
+          const ObjectTransform* transform = nullptr, bool bumpNode = false) {
   const Scene& s = scene();
   BakeSettings settings;
   settings.map = kind;
   settings.width = settings.height = kBakeSize;
   settings.threads = static_cast<int>(state.range(0));
-  BakeInput input{&s.mesh, &s.tangents,
-                  withLayers ? std::span<const Layer>(s.layers) : std::span<const Layer>()};
+  const std::span<const Layer> layers = bumpNode ? s.bumpNodeLayers : s.layers;
+  BakeInput input{&s.mesh, &s.tangents, withLayers ? layers : std::span<const Layer>()};
   input.transform = transform;
   for (auto _ : state) {
     Result<FloatImage> image = bakeMap(input, settings);
@@ -153,6 +159,9 @@ void bakeSubdivided(benchmark::State& state, bool exact) {
 void BM_TangentNormal(benchmark::State& state) { bake(state, MapKind::kTangentNormal, true); }
 void BM_TangentNormalLimit(benchmark::State& state) { bakeSubdivided(state, true); }
 void BM_TangentNormalLevel3(benchmark::State& state) { bakeSubdivided(state, false); }
+void BM_TangentNormalBumpNode(benchmark::State& state) {
+  bake(state, MapKind::kTangentNormal, true, nullptr, true);
+}
 void BM_ObjectNormal(benchmark::State& state) { bake(state, MapKind::kObjectNormal, true); }
 void BM_TangentNormalStretched(benchmark::State& state) {
   bake(state, MapKind::kTangentNormal, true, &kStretched);
@@ -230,6 +239,7 @@ void threadArgs(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_TangentNormal)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalBumpNode)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBands)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBandsMargin16)->Apply(threadArgs);
 BENCHMARK(BM_ObjectNormal)->Apply(threadArgs);
