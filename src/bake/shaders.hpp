@@ -157,11 +157,17 @@ struct BakeShaderBase {
   // The world and material cases are out of line (noinline), as the rare cases they are:
   // inlined into shade(), and shade() into the lane-parallel paths' slow lanes, they made the
   // compiler stop inlining batchTexelFrames there (10 % of a one-thread bake).
-  /// Where the Bump node reads heights again on @p t (in its space) when Cycles bakes the map.
-  [[gnu::noinline]] BumpOffsets bumpOffsets(const ShadingTriangle& t) const {
-    if (uvSet < 0 || uvSet >= t.numUvSets) return {};
-    const std::size_t set = static_cast<std::size_t>(uvSet);
-    return gradient_detail::bakeBumpOffsets(t.faceNormal, t.dPdu[set], t.dPdv[set], bumpTexel);
+  /// Where the Bump node reads heights again on @p t (`tri` or its world copy) when Cycles bakes
+  /// the map: a texel's steps along the baked UV map. Where Cycles shades the texel on its own
+  /// triangle (shadedElsewhere), it moves that triangle's corners by the barycentric steps of
+  /// the baker's triangle, whose barycentrics it reads.
+  [[gnu::noinline]] BumpOffsets bumpOffsets(const ShadingTriangle& t) {
+    Vec3d dPdu = t.bakeDPdu, dPdv = t.bakeDPdv;
+    if (shadedElsewhere && uvSet >= 0 && uvSet < t.numUvSets) {
+      triangleDerivatives(t.position, ownTriangle.get().uv[static_cast<std::size_t>(uvSet)], dPdu,
+                          dPdv);
+    }
+    return gradient_detail::bakeBumpOffsets(t.faceNormal, dPdu, dPdv, bumpTexel);
   }
   /// `layers` = those of the material of the face of @p corner (layersByMaterial).
   [[gnu::noinline]] void selectLayersOfFace(std::uint32_t corner) {
