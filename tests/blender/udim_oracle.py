@@ -17,7 +17,8 @@
    over the texels both cover, minus a one-texel border.
 
 Pass: in each tile, median <= 1 deg (Cycles' Bump is a finite difference over about half a
-texel, as in BlenderBakeOracle); negative control: the bake with the two tile files swapped
+texel, as in BlenderBakeOracle), and the bake with "gradient": "bump-node" (the heights' slopes
+as that finite difference takes them) median <= 0.01 deg, p99 <= 0.05 deg; negative control: the bake with the two tile files swapped
 must differ by a median of more than 5 deg in each tile. --sabotage swap runs sgbake on the
 swapped tiles, to see the test fail.
 
@@ -40,6 +41,10 @@ SIZE = 256          # bake size of each tile
 HEIGHT_SIZE = 256   # size of each height tile
 TILES = (1001, 1002)
 MEDIAN_LIMIT_DEG = 1.0
+# The same bake with the heights' slopes as Cycles' Bump node takes them ("gradient":
+# "bump-node"): Cycles' bake to float rounding, as in BlenderBakeOracle (e).
+BUMP_NODE_MEDIAN_DEG = 0.01
+BUMP_NODE_P99_DEG = 0.05
 CONTROL_MIN_DEG = 5.0
 RESULT_TAG = "UDIM_ORACLE_RESULT "
 
@@ -122,12 +127,13 @@ def run_blender(blender, args):
     return objio.run_blender_result(blender, os.path.abspath(__file__), args, RESULT_TAG)
 
 
-def bake(cli, out_dir, heights, prefix):
-    """Bakes PREFIX.<UDIM>.exr and mask.<UDIM>.exr from the tiles HEIGHTS.<UDIM>.exr."""
+def bake(cli, out_dir, heights, prefix, gradient="analytic"):
+    """Bakes PREFIX.<UDIM>.exr and mask.<UDIM>.exr from the tiles HEIGHTS.<UDIM>.exr, the
+    heights' slopes taken by `gradient`."""
     scene = {
         "mesh": "mesh.obj",
         "layers": [{"type": "height", "image": heights + ".<UDIM>.exr", "scale": SCALE,
-                    "filter": "bilinear"}],
+                    "filter": "bilinear", "gradient": gradient}],
         "outputs": [
             {"map": "tangent-normal", "file": prefix + ".<UDIM>.exr", "size": SIZE,
              "margin": 0, "bit_depth": 32},
@@ -150,16 +156,22 @@ def main():
         for tile, other in zip(TILES, reversed(TILES)):
             shutil.copyfile(os.path.join(out_dir, f"height.{other}.exr"),
                             os.path.join(out_dir, f"swapped.{tile}.exr"))
-        if not (bake(args.cli, out_dir, "swapped" if args.sabotage else "height", "ours")
+        heights = "swapped" if args.sabotage else "height"
+        if not (bake(args.cli, out_dir, heights, "ours")
+                and bake(args.cli, out_dir, heights, "ours_bump_node", "bump-node")
                 and bake(args.cli, out_dir, "height" if args.sabotage else "swapped",
                          "control")):
             return 1
-        stats = run_blender(blender, ["compare", out_dir, "ours", "control"])
+        stats = run_blender(blender, ["compare", out_dir, "ours", "ours_bump_node", "control"])
         if stats is None:
             return 1
         passed = [bc.judge_against_control(
             f"tile {tile}", stats["ours"][str(tile)], stats["control"][str(tile)],
             MEDIAN_LIMIT_DEG, CONTROL_MIN_DEG, "swapped tiles") for tile in TILES]
+        passed += [bc.judge_against_control(
+            f"tile {tile}, bump-node slopes", stats["ours_bump_node"][str(tile)],
+            stats["control"][str(tile)], BUMP_NODE_MEDIAN_DEG, CONTROL_MIN_DEG, "swapped tiles",
+            p99_limit=BUMP_NODE_P99_DEG) for tile in TILES]
         failed = not all(passed)
         print("FAILED" if failed else "PASSED")
         return 1 if failed else 0
