@@ -40,7 +40,8 @@ BSDF.
 
 Prints one JSON line:
   cycles_s, cycles_threads, cycles_cpu_over_wall, sgbake_s (all cores), speedup = cycles_s /
-  sgbake_s (target >= 25), write_s (OIIO alone), writer_thread_s, total_over_write = sgbake_s /
+  sgbake_s (target >= 25), bump_node_s and bump_node_speedup (the same bake with
+  --height-gradient bump-node, whose map is Cycles' to float rounding; reported, not judged), write_s (OIIO alone), writer_thread_s, total_over_write = sgbake_s /
   write_s (target <= 2), oiio_start_s, oiio_process_s, total_over_oiio_process,
   t1_s, t2_s (wall, --threads 1 / 2), t1_compute_s, t2_compute_s, scaling = t1_compute_s /
   t2_compute_s, wall_scaling = t1_s / t2_s; one_core_s (--threads 1 pinned to one CPU with
@@ -127,11 +128,12 @@ def run_blender_half(args, work):
     return None
 
 
-def time_sgbake(args, work, scale, threads, one_core=False):
+def time_sgbake(args, work, scale, threads, one_core=False, bump_node=False):
     """Runs the bake --runs times; returns (best wall s, stats of that run) or None. one_core:
-    the process may run on one CPU only (taskset), every thread of it included."""
+    the process may run on one CPU only (taskset), every thread of it included. bump_node: the
+    height's slopes as Cycles' Bump node takes them (--height-gradient bump-node)."""
     out = os.path.join(work, f"sgbake_t{threads or 'all'}{'_1core' if one_core else ''}"
-                             f".{args.format}")
+                             f"{'_bump_node' if bump_node else ''}.{args.format}")
     pin = []
     if one_core:
         pin = ["taskset", "-c", str(min(os.sched_getaffinity(0)))]
@@ -141,6 +143,8 @@ def time_sgbake(args, work, scale, threads, one_core=False):
            "--margin", str(args.margin), "--samples", "1", "-o", out, "--stats",
            "--no-manifest"]  # the manifest would make every run after the first "up to date"
     cmd += ["--bit-depth", str(args.bit_depth)]
+    if bump_node:
+        cmd += ["--height-gradient", "bump-node"]
     if threads:
         cmd += ["--threads", str(threads)]
     best = None
@@ -231,6 +235,9 @@ def main():
             if result is None:
                 return 2
             timed[threads] = result
+        bump_node = time_sgbake(args, work, scale, None, bump_node=True)
+        if bump_node is None:
+            return 2
         one_core = None
         if shutil.which("taskset"):
             one_core = time_sgbake(args, work, scale, 1, one_core=True)
@@ -267,6 +274,8 @@ def main():
         "write_s": write_s,
         "writer_thread_s": stats.get("write_s"),
         "total_over_write": sgbake_s / write_s,
+        "bump_node_s": bump_node[0],
+        "bump_node_speedup": cycles_s / bump_node[0],
         "oiio_start_s": oiio_start_s,
         "oiio_process_s": oiio_start_s + write_s,
         "total_over_oiio_process": sgbake_s / (oiio_start_s + write_s),
