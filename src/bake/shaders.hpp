@@ -506,10 +506,10 @@ inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint
   const std::size_t n = static_cast<std::size_t>(s.count);
   Lanes3 layer{};
   const std::size_t set = static_cast<std::size_t>(src.uvSet);
-  if (src.texture != nullptr && hasUvSet(point, src.uvSet) &&
-      gradient_detail::usesBumpNode(src, point)) {
+  const bool readable = src.texture != nullptr && hasUvSet(point, src.uvSet);
+  if (readable && gradient_detail::usesBumpNode(src, point)) {
     batchBumpNodeGradient(tri, point, s, src, unitN, layer);
-  } else if (src.texture != nullptr && hasUvSet(point, src.uvSet) && prepared[set].valid) {
+  } else if (readable && prepared[set].valid) {
     const gradient_detail::PreparedUvFrame& frame = prepared[set];
     std::array<ScalarSample, SampleBatch::kMax> h;
     batchUvHeightSamples(tri, s, src, h);
