@@ -123,6 +123,7 @@ using gradient_detail::validReflectionNormal;
 /// UV sets, whether there is a tangent frame); surfacePointAt fills in the rest per sample.
 inline void beginSurfacePoint(const ShadingTriangle& t, SurfacePoint& p) {
   p = SurfacePoint{};
+  p.geometricNormal = t.faceNormal;
   p.numUvSets = t.numUvSets;
   for (int s = 0; s < t.numUvSets; ++s) {
     const std::size_t k = static_cast<std::size_t>(s);

@@ -11,6 +11,7 @@
 #include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
+#include "sgbake/gradient/world_shading.hpp"
 
 namespace sgbake {
 namespace {
@@ -72,7 +73,8 @@ Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
 Vec3d evaluate(const VolumeSource& s, const SurfacePoint& point) {
   if (s.volume == nullptr) return {};
   const Vec3d gradient = volumeGradient(*s.volume, point.position, s.scheme, s.step);
-  const Vec3d gamma = s.scale * projectOntoTangentPlane(gradient, point.normal);
+  const Vec3d gamma =
+      s.scale * projectOntoTangentPlaneAlong(gradient, point.normal, point.geometricNormal);
   return isFinite(gamma) ? gamma : Vec3d{};
 }
 
@@ -304,8 +306,10 @@ Vec3d compositeSeen(std::span<const Layer> layers, const SurfacePoint& point, co
                     bool back) {
   const Vec3d incoming = back ? -point.normal : point.normal;
   Vec3d gamma{};
-  for (const Layer& layer : layers) {
-    if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
+  Layer scratch;
+  for (const Layer& given : layers) {
+    if (given.weight == 0 || !std::isfinite(given.weight)) continue;
+    const Layer& layer = back ? gradient_detail::seenFromBehind(given, scratch) : given;
     if (layer.base == LayerBase::kLayersAbove) {
       gamma = stackLayerGradientSeen(layer, point, ng, gamma, incoming);
       continue;
@@ -334,6 +338,21 @@ Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
 }
 
 namespace gradient_detail {
+
+bool readsHeightsAtPosition(const LayerSource& source) {
+  if (std::holds_alternative<VolumeSource>(source)) return true;
+  if (const auto* planar = std::get_if<PlanarSource>(&source))
+    return planar->kind == ProjectedKind::kHeight;
+  if (const auto* triplanar = std::get_if<TriplanarSource>(&source))
+    return triplanar->kind == ProjectedKind::kHeight;
+  return false;
+}
+
+const Layer& seenFromBehind(const Layer& layer, Layer& scratch) {
+  if (!readsHeightsAtPosition(layer.source)) return layer;
+  scratch = withHeightsScaled(layer, -1);
+  return scratch;
+}
 
 Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng) {
   if (!point.bump.empty()) {

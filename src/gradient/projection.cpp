@@ -62,8 +62,8 @@ Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scal
 Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& mapping, double scale,
                            const SurfacePoint& point) {
   const ScalarSample h = texture.sample(planarTextureCoordinates(point.position, mapping));
-  return finiteOrZero(
-      projectOntoTangentPlane(planeVolumeGradient(h.gradient, mapping, scale), point.normal));
+  return finiteOrZero(projectOntoTangentPlaneAlong(planeVolumeGradient(h.gradient, mapping, scale),
+                                                   point.normal, point.geometricNormal));
 }
 
 Vec3d planarTangentNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
@@ -141,7 +141,8 @@ Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptio
       options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
         return planeVolumeGradient(texture.sample(st).gradient, mapping, weightedScale);
       });
-  return finiteOrZero(projectOntoTangentPlane(volumeGradient, point.normal));
+  return finiteOrZero(
+      projectOntoTangentPlaneAlong(volumeGradient, point.normal, point.geometricNormal));
 }
 
 Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,

@@ -141,16 +141,27 @@ inline Vec3d backFacingGuarded(const Vec3d& n, const Vec3d& gamma, const Vec3d& 
   return -validReflectionNormal(normalizeOr(n - gamma, n), ng, -n);
 }
 
+/// @brief Whether @p source reads heights at the point's position (a volume, a planar or
+/// triplanar projection of heights), not through its UVs.
+bool readsHeightsAtPosition(const LayerSource& source);
+
+/// @brief @p layer as a back-facing point sees it (backFacingNormal): @p layer itself, or, when
+/// it reads heights at the position, a copy in @p scratch with its heights negated. Cycles
+/// bumps −N there; heights read through the flipped ∂P/∂u, ∂P/∂v come out with their slopes
+/// negated too, but heights read at positions do not: their bump leans the other way.
+const Layer& seenFromBehind(const Layer& layer, Layer& scratch);
+
 /// @brief The normal Cycles bakes at a back-facing point (backFacing(point.normal, ng)), unit.
 /// Cycles shades it from behind: N, Ng and ∂P/∂u, ∂P/∂v flipped, I = N, and the baked normal
 /// is what its nodes make there. A Normal Map node's result is its front one flipped; a Bump
-/// node bumps −N, but as it looks up the heights through the flipped ∂P/∂u, ∂P/∂v its slopes
-/// come out negated too, so its result is also the front one flipped; every guard sees the
-/// flipped Ng. Seen from the front: the layers' Γ as usual, every guard's incoming direction
-/// −N, and the result negated, so the texel points into the surface. Measured against Cycles
-/// (BlenderBakeOracle sphere_backfacing, 27 % of texels back-facing): bump p99 176° → 5.4°,
-/// normal map p90 96° → 0.0019°. Normal outputs only: derivative and surface-gradient maps
-/// keep the front Γ.
+/// node bumps −N, but as it looks up UV-mapped heights through the flipped ∂P/∂u, ∂P/∂v their
+/// slopes come out negated too, so its result is also the front one flipped; heights read at
+/// the position (seenFromBehind) keep their slopes. Every guard sees the flipped Ng. Seen from
+/// the front: the layers' Γ as usual (position-read heights negated), every guard's incoming
+/// direction −N, and the result negated, so the texel points into the surface. Measured against
+/// Cycles (BlenderBakeOracle sphere_backfacing, 27 % of texels back-facing): bump p99 176° →
+/// 5.4°, normal map p90 96° → 0.0019°. Normal outputs only: derivative and surface-gradient
+/// maps keep the front Γ.
 Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng);
 
 }  // namespace sgbake::gradient_detail

@@ -84,12 +84,13 @@ class WorldLayerEvaluator {
   WorldGradient operator()(const TriplanarSource& s) const { return projected(s.kind, s); }
 
  private:
-  /// A height's object-space surface gradient σ as the world one, P_w(M^{-T} σ): the
-  /// derivatives along the surface are the same, w.r.t. world distances.
+  /// A height's object-space surface gradient σ as the world one: M^{-T} σ projected onto the
+  /// world tangent plane along the world Ng (projectOntoTangentPlaneAlong), as σ was in object
+  /// space: the slopes along the triangle are the same, w.r.t. world distances. (σ differs
+  /// from ∇h by a multiple of Ng, which M^{-T} keeps along Ng and the projection removes.)
   Vec3d heightGradient(const Vec3d& sigma) const {
-    const Vec3d& n = world_.normal;
-    const Vec3d v = space_.normalToWorld * sigma;
-    return v - dot(v, n) * n;
+    return projectOntoTangentPlaneAlong(space_.normalToWorld * sigma, world_.normal,
+                                        world_.geometricNormal);
   }
   /// A normal map's decoded object-space normal (Strength 1): N − Γ_o, or the decoded normal
   /// itself where it lies below the object's surface and Γ_o cannot stand for it.
@@ -237,10 +238,11 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
   auto composite = [&](bool back) {
     const Vec3d incoming = back ? -n : n;
     Vec3d gamma{};
+    Layer scratch;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       if (back) {
-        addWorldLayerGradient(layer, objectPoint,
+        addWorldLayerGradient(seenFromBehind(layer, scratch), objectPoint,
                               worldPoint.bump.empty() ? worldPoint : seenFromBehind(worldPoint), ng,
                               space, preparedWorldUv, incoming, gamma);
         continue;

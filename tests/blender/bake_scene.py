@@ -141,6 +141,20 @@ def transformed_case(name, of_case, location, rotation, scale, size=None):
     TRANSFORMS[name] = (location, rotation, scale)
 
 
+# name -> the axis of a planar case: the mesh of another case whose Bump reads its height through
+# Texture Coordinate Object and a Flat-projected Image Texture, the image at the object's (x, y):
+# sgbake's "planar" height layer on axis z (a height read at a position, not a UV).
+PLANAR = {}
+
+
+def planar_case(name, mesh_case, size, scale):
+    """Registers case `name`: the mesh of case `mesh_case`, its Bump (Distance `scale`) fed by
+    the height image projected along z onto object coordinates."""
+    CASES[name] = (CASES[mesh_case][0], size, scale)
+    SUBDIVISION[name] = SUBDIVISION[mesh_case]
+    PLANAR[name] = "z"
+
+
 def apply_subdivision(ob, levels):
     mod = ob.modifiers.new("Subdivision", "SUBSURF")
     mod.levels = levels
@@ -306,6 +320,10 @@ transformed_case("stretch_sphere_backfacing", "sphere_backfacing", (0.5, -1.0, 2
                  (0.4, 0.2, 0.7), (2.0, 1.0, 0.5), size=512)
 transformed_case("stretch_nmap_sphere_backfacing", "nmap_sphere_backfacing", (0.5, -1.0, 2.0),
                  (0.4, 0.2, 0.7), (2.0, 1.0, 0.5))
+# The height projected onto the object's (x, y): one texture unit per object unit, so a
+# steeper field than on the sphere's UVs (2 pi units around) and a smaller Distance.
+planar_case("planar_sphere", "sphere", 256, 0.02)
+planar_case("planar_sphere_backfacing", "sphere_backfacing", 256, 0.02)
 
 
 def tilt_field(size, tilt_deg):
@@ -480,6 +498,12 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
                                              height_field(height_size))
         bake_common.save_exr(height, os.path.join(out_dir, "height.exr"))
         mat, target = make_material(height, scale)
+        if name in PLANAR:
+            nodes = mat.node_tree.nodes
+            tex = next(n for n in nodes if n.bl_idname == "ShaderNodeTexImage" and n != target)
+            tex.projection = "FLAT"
+            coordinates = nodes.new("ShaderNodeTexCoord")
+            mat.node_tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
     else:
         if nmap["space"] == "TANGENT":
             field = normal_field(height_size, nmap["tilt_deg"])
@@ -514,6 +538,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
              "faces": len(me.polygons), "corners": len(me.loops), "bake_s": {}, "bake_cpu": {},
              "subdivision": SUBDIVISION[name],
              "transform": [list(row) for row in ob.matrix_world]}
+    if name in PLANAR:
+        entry["planar"] = {"axis": PLANAR[name]}
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}

@@ -132,6 +132,19 @@ constexpr Vec3d projectOntoTangentPlane(Vec3d volumeGradient, Vec3d normal) {
   return volumeGradient - dot(volumeGradient, normal) * normal;
 }
 
+/// @brief Γ of a height defined in space on a triangle with unit geometric normal @p along,
+/// shaded with unit normal @p normal, as Cycles' Bump node takes it: the height's slopes along
+/// the triangle's plane (⊥ Ng), carried by the vector ⊥ N that has them,
+/// ∇h − ⟨∇h, N⟩/⟨Ng, N⟩ · Ng (the projection onto the tangent plane along Ng, not along N).
+/// It is projectOntoTangentPlane where N = Ng, and where @p along is zero or orthogonal to N
+/// (a point without a triangle). A UV-mapped height's eq. 31 has the same slopes: its ∂P/∂u,
+/// ∂P/∂v lie in the triangle's plane.
+constexpr Vec3d projectOntoTangentPlaneAlong(Vec3d volumeGradient, Vec3d normal, Vec3d along) {
+  const double cosine = dot(along, normal);
+  if (!(cosine != 0)) return projectOntoTangentPlane(volumeGradient, normal);
+  return volumeGradient - (dot(volumeGradient, normal) / cosine) * along;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tangent-space normal maps → Γ (eq. 14-15)
 // ---------------------------------------------------------------------------------------------

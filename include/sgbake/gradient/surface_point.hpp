@@ -56,6 +56,10 @@ struct SurfacePoint {
   std::array<Vec3d, kMaxUvSets> uvTangent{};
   std::array<double, kMaxUvSets> uvBitangentSign{};
   std::array<bool, kMaxUvSets> hasUvTangentFrame{};
+  /// The unit geometric normal Ng of the triangle the point lies on (heights defined in space
+  /// take their slopes along its plane, projectOntoTangentPlaneAlong); zero where the point has
+  /// no triangle (per-corner tables): their slopes then are along the plane ⊥ N.
+  Vec3d geometricNormal{};
   /// Where a Bump node would read the heights again here (set by the baker for layers that
   /// ask for it, see bakeBumpOffsets); empty elsewhere.
   BumpOffsets bump{};
