@@ -51,6 +51,11 @@
    normals and Cycles' bake (tangent space; object space for ours_nmap_object.exr) over the
    covered texels minus a one-texel border.
 
+The planar cases (planar_sphere, planar_sphere_backfacing: the height projected along z onto
+object coordinates by Texture Coordinate Object into a Flat Image Texture) bake a scene with a
+"planar" height layer instead (ours_bake.exr, ours_bake_x2.exr at twice the scale) and the mask;
+they have no convert, flags, JSON or bump-node checks.
+
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
       (both go through the same per-texel frame: only float rounding and the odd texel whose
@@ -125,6 +130,14 @@ BAKE_MEDIAN_DEG = 1.0
 # back-facing is decided in world space: measured p99 8.9 deg (median 0.57), 179.7 deg (median
 # 1.5) shaded from the front.
 BAKE_P99_DEG = {"sphere_backfacing": 10.0, "stretch_sphere_backfacing": 15.0}
+# Heights read at positions (planar_sphere, planar_sphere_backfacing: the height projected along
+# z onto object coordinates, Cycles' Texture Coordinate Object into a Flat Image Texture, 256^2):
+# their slopes are taken along the triangle's plane and, from behind, keep their sign. Measured:
+# front median 0.66, p90 1.30 deg; back-facing sphere median 0.75, p90 2.5, p99 91 deg (1271 of
+# 58940 texels over 10 deg, where exact slopes and the Bump's differences part most). Projected
+# onto the plane along N instead: back-facing median 2.4, p90 77 deg; with the slopes negated
+# from behind as a UV height's: p90 111 deg.
+BAKE_P90_DEG = {"planar_sphere_backfacing": 5.0}
 # Per-case bars on the worst texel of (b). suzanne_flat: its concave quads 162 and 163, which
 # Cycles shades on the other diagonal's triangles (bake_detail::cyclesShadingTriangles):
 # measured 2.3 deg, 117 deg on 48 texels when shaded on the baker's own triangles.
@@ -181,7 +194,7 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "stretch_sphere", "stretch_cube", "stretch_nmap_sphere",
                  "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
-                 "stretch_nmap_sphere_backfacing")
+                 "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing")
 
 
 def run_blender_script(blender, script, args):
@@ -242,6 +255,21 @@ def sgbake_case(cli, entry, sabotage, threads):
 
     bake_scale = scale * (1.5 if sabotage == "scale" else 1.0)
     green = "directx" if sabotage == "green" else "opengl"
+    if "planar" in entry:  # the height projected at positions: no flags for it, scenes only
+        for name, layer_scale in (("ours_bake", bake_scale), ("ours_bake_x2", 2 * scale)):
+            scene = {"mesh": p("mesh.obj"),
+                     "layers": [{"type": "planar", "image": p("height.exr"), "kind": "height",
+                                 "axis": entry["planar"]["axis"], "scale": layer_scale,
+                                 "filter": entry["filter"]}],
+                     "outputs": [{"map": "tangent-normal", "file": p(name + ".exr"),
+                                  "size": size, "margin": 0, "samples": 1, "green": green,
+                                  "bit_depth": 32}]}
+            if not bc.bake_scene_file(cli, d, name, scene):
+                failed.append(f"sgbake bake {p(name + '.json')}")
+        if not run_sgbake(cli, ["bake", "--mesh", p("mesh.obj"), "--map", "mask", "--size", size,
+                                "-o", p("ours_mask.exr")] + common, log):
+            failed.append(log[-1])
+        return failed
     bake = ["bake", "--mesh", p("mesh.obj"), "--height", p("height.exr"), "--filter",
             entry["filter"], "--map", "tangent-normal", "--size", size, "--green", green] + common
     if transformed(entry) and not run_sgbake(
@@ -371,6 +399,7 @@ def passes_convert(s):
 
 def passes_bake(s, case=None):
     return (s["median_deg"] <= BAKE_MEDIAN_DEG
+            and s["p90_deg"] <= BAKE_P90_DEG.get(case, math.inf)
             and s["p99_deg"] <= BAKE_P99_DEG.get(case, math.inf)
             and s["max_deg"] <= BAKE_MAX_DEG.get(case, math.inf))
 
@@ -473,10 +502,11 @@ def negative_control(name, r, key, label, what, chain, fails, stretched=False):
         fails.append(f"{name}: negative control: {what} still passes ({fmt_nmap(s)})")
 
 
-def evaluate(name, r):
+def evaluate(name, r, planar=False):
     """Prints the figures of one case; returns a list of failure descriptions. (A case with a
     live modifier, which sgbake subdivides itself, is held to the same bars: its subdivided
-    mesh is Blender's, float for float, BlenderSubdivisionOracle.)"""
+    mesh is Blender's, float for float, BlenderSubdivisionOracle.) A planar case has only the
+    bake (a scene), its 2x control and the mask."""
     fails = []
     print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {r['covered']} covered texels, "
           f"{r['compared']} compared; bump tilt from +Z: {fmt(r['tilt'])}")
@@ -497,7 +527,7 @@ def evaluate(name, r):
         if not ok:
             fails.append(f"{name}: {problem}: {fmt(s)}")
 
-    if not missing("convert", "convert"):
+    if not planar and not missing("convert", "convert"):
         s = r["convert"]
         judge("(a) convert vs Blender tangent:", s, passes_convert(s),
               f"(median <= {CONVERT_MEDIAN_DEG}, p99 <= {CONVERT_P99_DEG})",
@@ -510,7 +540,8 @@ def evaluate(name, r):
                          f"({fmt(s['flipped_green'])})")
     if not missing("bake", "bake"):
         s = r["bake"]
-        p99_bar = f", p99 <= {BAKE_P99_DEG[name]}" if name in BAKE_P99_DEG else ""
+        p99_bar = f", p90 <= {BAKE_P90_DEG[name]}" if name in BAKE_P90_DEG else ""
+        p99_bar += f", p99 <= {BAKE_P99_DEG[name]}" if name in BAKE_P99_DEG else ""
         p99_bar += f", max <= {BAKE_MAX_DEG[name]}" if name in BAKE_MAX_DEG else ""
         judge("(b) bake vs Blender tangent:   ", s, passes_bake(s, name),
               f"(median <= {BAKE_MEDIAN_DEG}{p99_bar})", "bake differs from Blender's tangent bake")
@@ -520,7 +551,7 @@ def evaluate(name, r):
         print(f"      control, green flipped:     {fmt(s['flipped_green'])}")
         if passes_bake(s["flipped_green"], name):
             fails.append(f"{name}: negative control: bake with green flipped still passes")
-    if not missing("bake_json", "JSON-scene bake"):
+    if not planar and not missing("bake_json", "JSON-scene bake"):
         s = r["bake_json"]
         same = s.get("json_vs_flags_max_abs")
         print(f"  (b) JSON scene bake:            {fmt(s)}; max |JSON - flags| = {same}")
@@ -529,7 +560,7 @@ def evaluate(name, r):
         if same is None or same > SAME_IMAGE_ABS:
             fails.append(f"{name}: the JSON scene and the flags give different images "
                          f"(max |diff| {same})")
-    if not missing("bake_bump_node", "bump-node bake"):
+    if not planar and not missing("bake_bump_node", "bump-node bake"):
         s = r["bake_bump_node"]
         judge("(e) bump-node bake vs Blender: ", s, passes_bump_node(s),
               f"(median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= {BUMP_NODE_P99_DEG})",
@@ -602,7 +633,7 @@ def main():
                 failures += evaluate_nmap(entry["name"], results[entry["name"]],
                                           entry["normal_map"], transformed(entry))
             else:
-                failures += evaluate(entry["name"], results[entry["name"]])
+                failures += evaluate(entry["name"], results[entry["name"]], "planar" in entry)
         if args.keep:
             print(f"files kept in {work}")
     return bc.report(failures)

@@ -10,6 +10,8 @@
 #include <random>
 #include <vector>
 
+#include "gradient/bump_node.hpp"
+#include "gradient/stacking.hpp"
 #include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/layers.hpp"
@@ -296,6 +298,63 @@ TEST(Layers, VolumeSourceProjectsTheVolumeGradient) {
     const Vec3d central =
         layerGradient(VolumeSource{&*sine, GradientScheme::kCentral, defaultStep(4), 0.5}, p);
     EXPECT_LT(maxAbsDiff(central, expected), 1e-8);
+  }
+}
+
+// On a triangle whose shading normal N leans from its geometric normal Ng, a height defined in
+// space takes its slopes along the triangle's plane, as Cycles' Bump node does (and as eq. 31
+// does for UV heights): Γ ⊥ N with ⟨Γ, a⟩ = ⟨∇h, a⟩ for every a ⊥ Ng. Where N = Ng it is the
+// plain projection.
+TEST(Layers, HeightsInSpaceTakeTheirSlopesAlongTheTrianglesPlane) {
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 100; ++i) {
+    SurfacePoint p = samplePoint(rng);
+    const Vec3d ng = p.normal;  // samplePoint's N is its frame's geometric normal
+    p.geometricNormal = ng;
+    const VolumeSource volume{&*sine, GradientScheme::kAnalytic, 0, 0.5};
+    const Vec3d plain = layerGradient(volume, p);
+    const Vec3d g = 0.5 * sine->analyticGradient(p.position);
+    EXPECT_LT(maxAbsDiff(plain, g - dot(g, ng) * ng), 1e-15);
+    // Lean N by up to ~60 degrees.
+    p.normal = normalizeOr(ng + Vec3d{u(rng), u(rng), u(rng)}, ng);
+    if (dot(p.normal, ng) < 0.3) continue;
+    const Vec3d gamma = layerGradient(volume, p);
+    EXPECT_NEAR(dot(gamma, p.normal), 0, 1e-14);
+    Vec3d a, b;
+    gradient_detail::cyclesOrthonormals(ng, a, b);  // two directions in the triangle's plane
+    EXPECT_NEAR(dot(gamma, a), dot(g, a), 1e-14);
+    EXPECT_NEAR(dot(gamma, b), dot(g, b), 1e-14);
+  }
+}
+
+// Seen from behind (backFacingNormal), Cycles bumps −N: a UV height's slopes, read through the
+// flipped ∂P/∂u, ∂P/∂v, flip with it, so its bump is the front one flipped; a height read at
+// positions keeps its slopes, so its Γ enters negated.
+TEST(Layers, BehindAPointHeightsReadAtPositionsKeepTheirSlopes) {
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  const AnalyticHeight heights(0.3, -0.2, 0.05);
+  std::mt19937_64 rng(43);
+  for (int i = 0; i < 50; ++i) {
+    SurfacePoint p = samplePoint(rng);
+    const Vec3d ng = -p.normal;  // N faces away from its triangle
+    p.geometricNormal = ng;
+    const Layer volume{VolumeSource{&*sine, GradientScheme::kAnalytic, 0, 0.5}, 1.0, {}};
+    const Layer uv{UvHeightSource{&heights, 0, 0.5}, 1.0, {}};
+    const Vec3d volumeGamma = layerGradient(volume.source, p);
+    const Vec3d uvGamma = layerGradient(uv.source, p);
+    const std::vector<Layer> volumes{volume}, uvs{uv};
+    EXPECT_LT(maxAbsDiff(gradient_detail::backFacingNormal(volumes, p, ng),
+                         gradient_detail::backFacingGuarded(p.normal, -volumeGamma, ng)),
+              1e-15);
+    EXPECT_LT(maxAbsDiff(gradient_detail::backFacingNormal(uvs, p, ng),
+                         gradient_detail::backFacingGuarded(p.normal, uvGamma, ng)),
+              1e-15);
+    EXPECT_TRUE(gradient_detail::readsHeightsAtPosition(volume.source));
+    EXPECT_FALSE(gradient_detail::readsHeightsAtPosition(uv.source));
   }
 }
 
