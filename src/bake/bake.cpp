@@ -205,23 +205,14 @@ double heightOf(const UvHeightSource& s, const SurfacePoint& p) {
   return s.scale * s.texture->sample(st).value;
 }
 double heightOf(const VolumeSource& s, const SurfacePoint& p) {
-  return s.volume == nullptr ? 0 : s.scale * s.volume->value(p.position);
+  return s.volume == nullptr
+             ? 0
+             : s.scale * gradient_detail::unscaledHeightAt(s, p.position, p.normal);
 }
-double heightOf(const PlanarSource& s, const SurfacePoint& p) {
+template <class Projection>
+double heightOf(const Projection& s, const SurfacePoint& p) {
   if (s.kind != ProjectedKind::kHeight || s.height == nullptr) return 0;
-  return s.scale * s.height->sample(planarTextureCoordinates(p.position, s.mapping)).value;
-}
-double heightOf(const TriplanarSource& s, const SurfacePoint& p) {
-  if (s.kind != ProjectedKind::kHeight || s.height == nullptr) return 0;
-  const TriplanarWeights w = triplanarWeights(p.normal, s.options.sharpness, s.options.minWeight);
-  double h = 0;
-  for (const ProjectionAxis axis : {ProjectionAxis::kX, ProjectionAxis::kY, ProjectionAxis::kZ}) {
-    const double weight = w.w[static_cast<std::size_t>(axis)];
-    if (weight == 0) continue;  // below the threshold: not sampled (as the gradient)
-    const PlanarMapping mapping{axis, s.options.tiling, s.options.offset};
-    h += weight * s.options.scale * s.height->sample(planarTextureCoordinates(p.position, mapping)).value;
-  }
-  return h;
+  return gradient_detail::heightScale(s) * gradient_detail::unscaledHeightAt(s, p.position, p.normal);
 }
 double heightOf(const TangentNormalSource&, const SurfacePoint&) { return 0; }
 double heightOf(const ObjectNormalSource&, const SurfacePoint&) { return 0; }
@@ -347,8 +338,7 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   }
   // Heights differentiated as the Bump node does read them again half a texel away.
   if (std::ranges::any_of(base.layers, [](const Layer& layer) {
-        const auto* height = std::get_if<UvHeightSource>(&layer.source);
-        return height != nullptr && height->gradient == HeightGradient::kBumpNode;
+        return gradient_detail::readsBumpOffsets(layer.source);
       })) {
     base.bumpTexel = {1.0 / settings.width, 1.0 / settings.height};
   }

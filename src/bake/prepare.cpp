@@ -349,6 +349,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       VolumeSource source;
       source.volume = loaded.volumes.back().get();
       source.scheme = layer.gradient;
+      source.gradient = layer.heightGradient;
       source.step = layer.step ? *layer.step : defaultStep(objectSize);
       result.source = source;
       break;
@@ -363,6 +364,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.mapping.offset = layer.offset;
       source.scale = layer.scale;
       source.normal = projected;
+      source.gradient = layer.heightGradient;
       result.source = source;
       break;
     }
@@ -377,6 +379,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.options.sharpness = layer.sharpness;
       source.options.minWeight = layer.minWeight;
       source.options.normal = projected;
+      source.gradient = layer.heightGradient;
       result.source = source;
       break;
     }

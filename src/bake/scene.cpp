@@ -382,10 +382,10 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "gradient", "step", "base"});
       break;
     case SceneLayerType::kPlanar:
-      add({"kind", "axis", "scale", "green", "base"});
+      add({"kind", "axis", "scale", "green", "base", "gradient"});
       break;
     case SceneLayerType::kTriplanar:
-      add({"kind", "scale", "sharpness", "min_weight", "green", "base"});
+      add({"kind", "scale", "sharpness", "min_weight", "green", "base", "gradient"});
       break;
   }
   return keys;
@@ -714,8 +714,10 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
   reader.optionalName("channel", kChannels, layer.channel);
-  if (layer.type == SceneLayerType::kHeight)
+  if (layer.type == SceneLayerType::kHeight || layer.type == SceneLayerType::kPlanar ||
+      layer.type == SceneLayerType::kTriplanar) {
     reader.optionalName("gradient", kHeightGradients, layer.heightGradient);
+  }
   if (reader.has("tangent_uv"))
     layer.tangentUvSet = reader.smallInteger("tangent_uv", 0, kMaxUvSets - 1);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
@@ -743,7 +745,16 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("phase")) layer.phase = reader.number("phase");
     if (reader.has("seed")) layer.seed = reader.unsignedInteger("seed");
     if (reader.has("octaves")) layer.octaves = reader.smallInteger("octaves", 1, kMaxNoiseOctaves);
-    reader.optionalName("gradient", kSchemes, layer.gradient);
+    // A scheme, or "bump-node": differenced as the Bump node does, analytic where a point has
+    // no bake texel (per-corner tables).
+    constexpr Named<int> kVolumeGradients[] = {
+        {"analytic", 0}, {"central", 1}, {"tetrahedral", 2}, {"bump-node", 3}};
+    int gradient = 0;
+    reader.optionalName("gradient", kVolumeGradients, gradient);
+    layer.gradient = gradient == 1   ? GradientScheme::kCentral
+                     : gradient == 2 ? GradientScheme::kTetrahedral
+                                     : GradientScheme::kAnalytic;
+    if (gradient == 3) layer.heightGradient = HeightGradient::kBumpNode;
     if (reader.has("step")) layer.step = reader.numberAtLeast("step", 0, /*exclusive=*/true);
   }
 
@@ -757,6 +768,10 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
        layer.kind != ProjectedKind::kTangentNormal);
   if (objectSpace && reader.has("green")) {
     fail(where, "key 'green' applies only to tangent-space normal maps");
+  }
+  if ((layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar) &&
+      layer.kind != ProjectedKind::kHeight && reader.has("gradient")) {
+    fail(where, "key 'gradient' applies only to projected heights (kind 'height')");
   }
   if (layer.tangentUvSet && layer.space == NormalSpace::kObject) {
     fail(where, "key 'tangent_uv' applies only to tangent-space normal maps");
@@ -1376,7 +1391,9 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["seed"] = layer.seed;
         j["octaves"] = layer.octaves;
       }
-      j["gradient"] = nameIn(kSchemes, layer.gradient);
+      j["gradient"] = layer.heightGradient == HeightGradient::kBumpNode
+                          ? nameIn(kHeightGradients, layer.heightGradient)
+                          : nameIn(kSchemes, layer.gradient);
       j["step"] = layer.step ? json(*layer.step) : json("default");
       break;
     case SceneLayerType::kPlanar:
@@ -1388,6 +1405,10 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
       j["sharpness"] = layer.sharpness;
       j["min_weight"] = layer.minWeight;
       break;
+  }
+  if (layer.heightGradient != HeightGradient::kAnalytic &&
+      (layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar)) {
+    j["gradient"] = nameIn(kHeightGradients, layer.heightGradient);
   }
   return j.dump();
 }

@@ -18,6 +18,7 @@
 
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/projection.hpp"
 #include "sgbake/gradient/surface_point.hpp"
 #include "sgbake/gradient/texture.hpp"
 
@@ -60,33 +61,102 @@ inline Vec2d uvOffsetOf(const UvFrame& frame, const Vec3d& w) {
   return {(vv * pu - uv * pv) / det, (uu * pv - uv * pu) / det};
 }
 
-/// Γ of a UV height map as the Bump node bumps unit normal @p normal with heights read at
-/// @p frame's UV and @p offsets away, the value there @p hc already known (before its
-/// Strength): with Rx = dP.dy × N, Ry = N × dP.dx and det = ⟨dP.dx, Rx⟩ the node's normal is
+/// Γ of heights @p scale · h as the Bump node bumps unit normal @p normal with them, h read
+/// here (@p hc) and at @p offsets by @p heightAt(offset): with Rx = dP.dy × N, Ry = N × dP.dx
+/// and det = ⟨dP.dx, Rx⟩ the node's normal is
 /// |det|·N − scale·sign(det)·((h_x − h_c)·Rx + (h_y − h_c)·Ry), which is N − Γ scaled.
+template <class HeightAt>
+Vec3d bumpNodeGradientOf(const HeightAt& heightAt, double hc, double scale, const Vec3d& normal,
+                         const BumpOffsets& offsets) {
+  const double hx = heightAt(offsets.dx), hy = heightAt(offsets.dy);
+  const Vec3d rx = cross(offsets.dy, normal), ry = cross(normal, offsets.dx);
+  const double det = dot(offsets.dx, rx);
+  if (!(std::abs(det) > 0) || !std::isfinite(det)) return {};
+  const Vec3d gamma = (scale / det) * ((hx - hc) * rx + (hy - hc) * ry);
+  return isFinite(gamma) ? gamma : Vec3d{};
+}
+
+/// bumpNodeGradientOf a UV height map, read at @p frame's UV, the UV of the triangle's plane
+/// @p offsets (its uvReads) away, and there (@p hc, already known); before its Strength.
 inline Vec3d bumpNodeGradient(const UvHeightSource& s, const UvFrame& frame, const Vec3d& normal,
                               const BumpOffsets& offsets, double hc) {
   const auto heightAt = [&](const Vec3d& w) {
     return s.texture->sample(textureCoordinates(frame.uv + uvOffsetOf(frame, w), s.tiling, s.offset))
         .value;
   };
-  const double hx = heightAt(offsets.dx), hy = heightAt(offsets.dy);
-  const Vec3d rx = cross(offsets.dy, normal), ry = cross(normal, offsets.dx);
-  const double det = dot(offsets.dx, rx);
-  if (!(std::abs(det) > 0) || !std::isfinite(det)) return {};
-  const Vec3d gamma = (s.scale / det) * ((hx - hc) * rx + (hy - hc) * ry);
-  return isFinite(gamma) ? gamma : Vec3d{};
+  return bumpNodeGradientOf(heightAt, hc, s.scale, normal, offsets.uvReads());
 }
 
-/// @p point with the BumpOffsets that give, seen from the front, the bump Cycles makes from
-/// behind (as backFacingNormal reads it). There Cycles flips Ng, N and ∂P/∂u, ∂P/∂v: the first
-/// of its orthonormals flips, the second stays, and solving for the UV offsets with the flipped
-/// derivatives reads the heights at +dP.dx and −dP.dy of the front. Its normal is then the
-/// flipped one of the front bump with offsets (dx, −dy).
+/// @p point as backFacingNormal sees it: its BumpOffsets marked `behind`. There Cycles flips
+/// Ng, N and ∂P/∂u, ∂P/∂v: the first of its orthonormals flips, the second stays. Solving for
+/// the UV offsets with the flipped derivatives reads UV heights at +dP.dx and −dP.dy of the
+/// front (BumpOffsets::uvReads); heights read at positions are read at −dP.dx and +dP.dy
+/// (positionReads).
 inline SurfacePoint seenFromBehind(const SurfacePoint& point) {
   SurfacePoint seen = point;
-  seen.bump.dy = -point.bump.dy;
+  seen.bump.behind = true;
   return seen;
+}
+
+/// The height of a source read at positions, at object position @p position, before its scale
+/// (heightScale): a volume's value, a planar projection's texel, a triplanar projection's
+/// blend with the weights of unit normal @p normal (frozen, as its Γ takes them).
+inline double unscaledHeightAt(const VolumeSource& s, const Vec3d& position, const Vec3d&) {
+  return s.volume->value(position);
+}
+inline double unscaledHeightAt(const PlanarSource& s, const Vec3d& position, const Vec3d&) {
+  return s.height->sample(planarTextureCoordinates(position, s.mapping)).value;
+}
+inline double unscaledHeightAt(const TriplanarSource& s, const Vec3d& position,
+                               const Vec3d& normal) {
+  const TriplanarWeights w =
+      triplanarWeights(normal, s.options.sharpness, s.options.minWeight);
+  double h = 0;
+  for (const ProjectionAxis axis : {ProjectionAxis::kX, ProjectionAxis::kY, ProjectionAxis::kZ}) {
+    const double weight = w.w[static_cast<std::size_t>(axis)];
+    if (weight == 0) continue;  // below the threshold: not sampled (as the gradient)
+    const PlanarMapping mapping{axis, s.options.tiling, s.options.offset};
+    h += weight * s.height->sample(planarTextureCoordinates(position, mapping)).value;
+  }
+  return h;
+}
+inline double heightScale(const VolumeSource& s) { return s.scale; }
+inline double heightScale(const PlanarSource& s) { return s.scale; }
+inline double heightScale(const TriplanarSource& s) { return s.options.scale; }
+
+/// bumpNodeGradientOf a height read at positions (a volume, a height projection with a
+/// texture): read at @p position, and at the offsets (their positionReads) mapped into the
+/// source's space by @p toSource; the Bump node's geometry is @p normal's and the offsets'.
+/// (Object space: @p toSource the identity; world space: M⁻¹, the source reading object
+/// positions.) Triplanar weights are those of @p objectNormal.
+template <class Source, class ToSource>
+Vec3d positionBumpNodeGradient(const Source& s, const Vec3d& position, const Vec3d& objectNormal,
+                               const Vec3d& normal, const BumpOffsets& offsets,
+                               const ToSource& toSource) {
+  const auto heightAt = [&](const Vec3d& w) {
+    return unscaledHeightAt(s, position + toSource(w), objectNormal);
+  };
+  return bumpNodeGradientOf(heightAt, unscaledHeightAt(s, position, objectNormal), heightScale(s),
+                            normal, offsets.positionReads());
+}
+
+/// Whether a height read at positions with @p gradient is differenced as the Bump node does at
+/// @p point.
+inline bool usesBumpNode(HeightGradient gradient, const SurfacePoint& point) {
+  return gradient == HeightGradient::kBumpNode && !point.bump.empty();
+}
+
+/// Whether @p source is a height differenced as the Bump node does (at points with offsets).
+inline bool readsBumpOffsets(const LayerSource& source) {
+  return std::visit(
+      [](const auto& s) {
+        if constexpr (requires { s.gradient; }) {
+          return s.gradient == HeightGradient::kBumpNode;
+        } else {
+          return false;
+        }
+      },
+      source);
 }
 
 /// Whether @p s is differentiated as the Bump node does at @p point.

@@ -70,8 +70,16 @@ Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
   return withNormalMapStrength(isFinite(gamma) ? gamma : Vec3d{}, point.normal, s.strength);
 }
 
+/// The Γ of a height read at positions as the Bump node makes it (object space).
+template <class Source>
+Vec3d bumpNodeInObjectSpace(const Source& s, const SurfacePoint& point) {
+  return gradient_detail::positionBumpNodeGradient(s, point.position, point.normal, point.normal,
+                                                   point.bump, [](const Vec3d& w) { return w; });
+}
+
 Vec3d evaluate(const VolumeSource& s, const SurfacePoint& point) {
   if (s.volume == nullptr) return {};
+  if (gradient_detail::usesBumpNode(s.gradient, point)) return bumpNodeInObjectSpace(s, point);
   const Vec3d gradient = volumeGradient(*s.volume, point.position, s.scheme, s.step);
   const Vec3d gamma =
       s.scale * projectOntoTangentPlaneAlong(gradient, point.normal, point.geometricNormal);
@@ -81,7 +89,9 @@ Vec3d evaluate(const VolumeSource& s, const SurfacePoint& point) {
 Vec3d evaluate(const PlanarSource& s, const SurfacePoint& point) {
   switch (s.kind) {
     case ProjectedKind::kHeight:
-      return s.height ? planarHeightGradient(*s.height, s.mapping, s.scale, point) : Vec3d{};
+      if (s.height == nullptr) return {};
+      if (gradient_detail::usesBumpNode(s.gradient, point)) return bumpNodeInObjectSpace(s, point);
+      return planarHeightGradient(*s.height, s.mapping, s.scale, point);
     case ProjectedKind::kTangentNormal:
       return s.normals
                  ? planarTangentNormalGradient(*s.normals, s.mapping, s.scale, point, s.normal)
@@ -96,7 +106,9 @@ Vec3d evaluate(const PlanarSource& s, const SurfacePoint& point) {
 Vec3d evaluate(const TriplanarSource& s, const SurfacePoint& point) {
   switch (s.kind) {
     case ProjectedKind::kHeight:
-      return s.height ? triplanarHeightGradient(*s.height, s.options, point) : Vec3d{};
+      if (s.height == nullptr) return {};
+      if (gradient_detail::usesBumpNode(s.gradient, point)) return bumpNodeInObjectSpace(s, point);
+      return triplanarHeightGradient(*s.height, s.options, point);
     case ProjectedKind::kTangentNormal:
       return s.normals ? triplanarTangentNormalGradient(*s.normals, s.options, point) : Vec3d{};
     case ProjectedKind::kObjectNormal:

@@ -78,6 +78,8 @@ class WorldLayerEvaluator {
     return decodedNormal(objectNormal(unblended), s.strength);
   }
   WorldGradient operator()(const VolumeSource& s) const {
+    if (s.volume != nullptr && gradient_detail::usesBumpNode(s.gradient, world_))
+      return {bumpNodeInWorld(s)};
     return {heightGradient(layerGradient(s, object_))};
   }
   WorldGradient operator()(const PlanarSource& s) const { return projected(s.kind, s); }
@@ -112,8 +114,20 @@ class WorldLayerEvaluator {
     }
     return g;
   }
+  /// The Γ of a height read at (object) positions as the Bump node makes it in world space: its
+  /// world offsets carried into object space (M⁻¹), the node's geometry the world's.
+  template <class Source>
+  Vec3d bumpNodeInWorld(const Source& s) const {
+    return gradient_detail::positionBumpNodeGradient(
+        s, object_.position, object_.normal, world_.normal, world_.bump,
+        [this](const Vec3d& w) { return space_.directionToObject * w; });
+  }
   template <class Source>
   WorldGradient projected(ProjectedKind kind, const Source& s) const {
+    if (kind == ProjectedKind::kHeight && s.height != nullptr &&
+        gradient_detail::usesBumpNode(s.gradient, world_)) {
+      return {bumpNodeInWorld(s)};
+    }
     const Vec3d gamma = layerGradient(s, object_);
     return kind == ProjectedKind::kHeight ? WorldGradient{heightGradient(gamma)}
                                           : decodedNormal(object_.normal - gamma);

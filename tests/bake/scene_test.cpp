@@ -614,13 +614,28 @@ TEST(Scene, HeightGradientIsParsedAndInTheParametersOnlyWhenNotAnalytic) {
 
   EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "gradient": "central"})")),
             "scene.json: layers[0]: unknown gradient 'central' (expected analytic or bump-node)");
+  // Heights read at positions take it too (a volume among its schemes).
+  for (const char* layer :
+       {R"({"type": "volume", "function": "sine", "gradient": "bump-node"})",
+        R"({"type": "planar", "image": "h.png", "kind": "height", "gradient": "bump-node"})",
+        R"({"type": "triplanar", "image": "h.png", "kind": "height", "gradient": "bump-node"})"}) {
+    Result<Scene> scene = parseScene(withLayer(layer), options());
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->layers[0].heightGradient, HeightGradient::kBumpNode) << layer;
+    EXPECT_NE(layerParametersJson(scene->layers[0]).find(R"("gradient":"bump-node")"),
+              std::string::npos)
+        << layer;
+  }
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "sine", "gradient": "fd"})")),
+            "scene.json: layers[0]: unknown gradient 'fd' (expected analytic, central, "
+            "tetrahedral or bump-node)");
   EXPECT_EQ(parseError(withLayer(
-                R"({"type": "volume", "function": "sine", "gradient": "bump-node"})")),
-            "scene.json: layers[0]: unknown gradient 'bump-node' (expected analytic, central or "
-            "tetrahedral)");
+                R"({"type": "planar", "image": "n.png", "kind": "object-normal", "gradient": "bump-node"})")),
+            "scene.json: layers[0]: key 'gradient' applies only to projected heights (kind "
+            "'height')");
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "gradient": "analytic"})")),
             "scene.json: layers[0]: key 'gradient' does not apply to a normal layer (it is for "
-            "height or volume layers)");
+            "height, volume, planar or triplanar layers)");
 }
 
 TEST(Scene, SubdivisionIsParsedAndValidated) {

@@ -11,6 +11,7 @@
 
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/layers.hpp"
+#include "sgbake/gradient/volume.hpp"
 #include "support/analytic_textures.hpp"
 #include "support/surface_points.hpp"
 
@@ -22,7 +23,8 @@ using test::AnalyticHeight;
 using test::maxAbsDiff;
 using test::samplePoint;
 
-Vec3d heightGradient(const UvHeightSource& s, const SurfacePoint& p) {
+template <class Source>
+Vec3d heightGradient(const Source& s, const SurfacePoint& p) {
   return layerGradient(LayerSource{s}, p);
 }
 
@@ -91,6 +93,46 @@ TEST(BumpNode, CurvedHeightsConvergeToTheExactGradientToFirstOrder) {
     // 16 times smaller steps: about 16 times smaller errors (forward differences).
     EXPECT_LT(error[1], error[0] / 8 + 1e-12) << i;
     EXPECT_LT(error[1], 1e-3) << i;  // |Γ| is ~0.1 here
+  }
+}
+
+// Heights read at positions: a planar projection of an affine height is differenced exactly,
+// on triangles whose N leans from Ng too (the node's slopes along the triangle's plane), and
+// from behind; a volume converges to its exact Γ to first order.
+TEST(BumpNode, HeightsReadAtPositionsAreDifferencedAlongTheTrianglesPlane) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const AnalyticHeight affine(0.7, -0.4, 0);
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  for (int i = 0; i < 50; ++i) {
+    SurfacePoint p = samplePoint(rng);
+    const Vec3d ng = p.normal;
+    p.geometricNormal = ng;
+    p.normal = normalizeOr(ng + 0.5 * Vec3d{u(rng), u(rng), u(rng)}, ng);
+    PlanarSource planar;
+    planar.height = &affine;
+    planar.mapping = {ProjectionAxis::kY, {1.5, 0.5}, {0.1, 0}};
+    planar.scale = 0.3;
+    const Vec3d exact = heightGradient(planar, p);
+    planar.gradient = HeightGradient::kBumpNode;
+    p.bump = bakeBumpOffsets(ng, p.uv[0].dPdu, p.uv[0].dPdv, {1.0 / 64, 1.0 / 64});
+    EXPECT_LT(maxAbsDiff(heightGradient(planar, p), exact), 1e-12 * (1 + length(exact))) << i;
+    // From behind it reads at −dx, +dy; on an affine height that changes nothing.
+    EXPECT_LT(maxAbsDiff(heightGradient(planar, gradient_detail::seenFromBehind(p)), exact),
+              1e-12 * (1 + length(exact)))
+        << i;
+
+    VolumeSource volume{&*sine, GradientScheme::kAnalytic, 0, 0.5};
+    const Vec3d volumeExact = heightGradient(volume, p);
+    volume.gradient = HeightGradient::kBumpNode;
+    double error[2];
+    for (const int k : {0, 1}) {
+      const double texel = k == 0 ? 1.0 / 128 : 1.0 / 2048;
+      p.bump = bakeBumpOffsets(ng, p.uv[0].dPdu, p.uv[0].dPdv, {texel, texel});
+      error[k] = length(heightGradient(volume, p) - volumeExact);
+    }
+    EXPECT_LT(error[1], error[0] / 8 + 1e-12) << i;
   }
 }
 

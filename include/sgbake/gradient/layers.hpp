@@ -86,6 +86,9 @@ struct VolumeSource {
   /// Finite-difference step, object units (ignored by kAnalytic); use defaultStep(objectSize).
   double step = 0;
   double scale = 1;  ///< multiplies the height
+  /// kBumpNode: the volume read again at the point's BumpOffsets, as the Bump node reads a
+  /// height at positions (Texture Coordinate Object); `scheme` where the point has none.
+  HeightGradient gradient = HeightGradient::kAnalytic;
 };
 
 /// @brief What a projected texture holds.
@@ -103,6 +106,7 @@ struct PlanarSource {
   PlanarMapping mapping{};
   double scale = 1;  ///< height scale (kHeight) or strength (normal maps)
   ProjectedNormalOptions normal{};
+  HeightGradient gradient = HeightGradient::kAnalytic;  ///< of kHeight, as VolumeSource's
 };
 
 /// @brief A texture projected on the three axis planes and blended (seed 003, eq. 45-50); see
@@ -112,6 +116,7 @@ struct TriplanarSource {
   const ScalarTexture* height = nullptr;   ///< for kHeight; not owned
   const VectorTexture* normals = nullptr;  ///< for the normal kinds; not owned
   TriplanarOptions options{};              ///< scale, tiling, offset, sharpness, minWeight, decode
+  HeightGradient gradient = HeightGradient::kAnalytic;  ///< of kHeight, as VolumeSource's
 };
 
 /// @brief One of the source kinds.

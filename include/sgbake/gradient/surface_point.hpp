@@ -32,7 +32,15 @@ struct UvFrame {
 /// (heights are then differentiated exactly).
 struct BumpOffsets {
   Vec3d dx{}, dy{};
+  /// Seen from behind (a back-facing point): Cycles flips Ng, so dP.dx flips, and UV heights
+  /// are read through the flipped ∂P/∂u, ∂P/∂v. See uvReads and positionReads.
+  bool behind = false;
   bool empty() const { return dx == Vec3d{} && dy == Vec3d{}; }
+  /// The offsets whose front bump is what a UV-mapped height makes here: (dx, −dy) behind.
+  BumpOffsets uvReads() const { return {dx, behind ? -dy : dy}; }
+  /// The offsets whose front bump, its heights negated, is what a height read at positions
+  /// makes here: (−dx, dy) behind.
+  BumpOffsets positionReads() const { return {behind ? -dx : dx, dy}; }
 };
 
 /// @brief A point on the surface, in object space.
