@@ -414,6 +414,16 @@ def _not_image(socket):
     return f"{socket.name} is not an Image Texture node"
 
 
+def _object_projected(tex):
+    """Whether Image Texture node `tex` reads the baked object's own coordinates projected
+    along z: its Vector straight from a Texture Coordinate node's Object output (no other
+    object named), Flat projection. Its height is then sgbake's planar layer on axis z."""
+    link = _source_link(tex.inputs["Vector"])
+    return (link is not None and link.from_node.type == "TEX_COORD"
+            and link.from_socket.name == "Object" and link.from_node.object is None
+            and tex.projection == "FLAT")
+
+
 def _ignored(node, tex, inputs, socket):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
@@ -430,7 +440,8 @@ def _ignored(node, tex, inputs, socket):
     if link is not None:
         uv = link.from_node.type == "UVMAP" or (link.from_node.type == "TEX_COORD"
                                                  and link.from_socket.name == "UV")
-        if not uv:
+        planar = node.type == "BUMP" and _object_projected(tex)
+        if not uv and not planar:
             notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
     if tex.projection != "FLAT":
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
@@ -491,7 +502,17 @@ def material_layers(node_tree, render_uv=None):
             values.update(type="height", scale=-scale if node.invert else scale,
                           strength=max(node.inputs["Strength"].default_value, 0.0),
                           slopes="bump-node")
-            if _source_link(node.inputs["Height"]).from_socket.name == "Alpha":
+            alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
+            if _object_projected(tex):
+                # Object coordinates, Flat: the height projected along z onto the object.
+                values.pop("uv_map", None)
+                values.update(type="planar", kind="height", axis="z")
+                if values.pop("strength") != 1.0:
+                    ignored.append(f"'{node.name}' Strength (a planar layer bumps fully)")
+                if alpha:
+                    ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a planar "
+                                   "layer reads the luminance)")
+            elif alpha:
                 values["channel"] = "a"
         else:
             tex = _linked_image_node(node.inputs["Color"])

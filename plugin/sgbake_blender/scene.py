@@ -127,10 +127,6 @@ def layer_json(layer, uv_index, default_uv=None):
             entry["strength"] = _number(layer.strength)
         if layer.channel != "luminance":
             entry["channel"] = layer.channel
-        if layer.base != "surface":
-            entry["base"] = layer.base
-        if layer.slopes != "analytic":
-            entry["gradient"] = layer.slopes
     elif layer.type == "normal":
         entry.update(space=layer.space, strength=_number(layer.scale))
         if layer.space == "tangent" and layer.tangent_uv_map:
@@ -152,6 +148,11 @@ def layer_json(layer, uv_index, default_uv=None):
                      sharpness=_number(layer.sharpness), min_weight=_number(layer.min_weight))
     if reads_tangent_normals(layer):
         entry["green"] = layer.green
+    if layer.type == "height" or (layer.type in ("planar", "triplanar") and layer.kind == "height"):
+        if layer.base != "surface":
+            entry["base"] = layer.base
+        if layer.slopes != "analytic":
+            entry["gradient"] = layer.slopes
     return entry
 
 

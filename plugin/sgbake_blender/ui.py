@@ -123,6 +123,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             if layer.type == "height":
                 col.prop(layer, "strength")
                 col.prop(layer, "channel")
+            if layer.type == "height" or (layer.type in ("planar", "triplanar")
+                                          and layer.kind == "height"):
                 col.prop(layer, "base")
                 col.prop(layer, "slopes")
             col.prop(layer, "filter")

@@ -276,6 +276,23 @@ def layers_from_material(settings, distance):
             or none_ignored:
         entry["error"] = (f"a Mapping node should be named as ignored (and nothing without "
                           f"it): {ignored}, then {none_ignored}")
+    # Object coordinates into a Flat Image Texture: the height projected along z, a planar
+    # layer (sgbake's "planar", which BlenderBakeOracle's planar cases check against Cycles),
+    # nothing named; another object's coordinates are named instead.
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+    planar, _, planar_ignored = operators.material_layers(tree)
+    coordinates.object = bpy.context.active_object
+    _, _, other_ignored = operators.material_layers(tree)
+    tree.nodes.remove(coordinates)
+    expected_planar = {"type": "planar", "kind": "height", "axis": "z", "slopes": "bump-node"}
+    if (len(planar) != 1 or any(planar[0].get(k) != v for k, v in expected_planar.items())
+            or "uv_map" in planar[0] or abs(planar[0]["scale"] - distance) > 1e-7
+            or planar_ignored
+            or not any("Vector from 'Texture Coordinate'" in n for n in other_ignored)):
+        entry["error"] = (f"Object coordinates should make one {expected_planar} layer of "
+                          f"scale {distance}, nothing named: {planar}, {planar_ignored}; "
+                          f"another object's named: {other_ignored}")
     return entry
 
 
