@@ -484,8 +484,8 @@ inline void batchBumpNodeGradient(const ShadingTriangle& tri, const SurfacePoint
     const double det = dot(dx, rx);
     Vec3d gamma{};
     if (std::abs(det) > 0 && std::isfinite(det)) {
-      gamma = (src.scale / det) *
-              ((hx[i].value - hc[i].value) * rx + (hy[i].value - hc[i].value) * ry);
+      gamma =
+          (src.scale / det) * ((hx[i].value - hc[i].value) * rx + (hy[i].value - hc[i].value) * ry);
       if (!isFinite(gamma)) gamma = {};
     }
     layer.x[i] = gamma.x;

@@ -81,7 +81,8 @@ Vec3d bumpNodeGradientOf(const HeightAt& heightAt, double hc, double scale, cons
 inline Vec3d bumpNodeGradient(const UvHeightSource& s, const UvFrame& frame, const Vec3d& normal,
                               const BumpOffsets& offsets, double hc) {
   const auto heightAt = [&](const Vec3d& w) {
-    return s.texture->sample(textureCoordinates(frame.uv + uvOffsetOf(frame, w), s.tiling, s.offset))
+    return s.texture
+        ->sample(textureCoordinates(frame.uv + uvOffsetOf(frame, w), s.tiling, s.offset))
         .value;
   };
   return bumpNodeGradientOf(heightAt, hc, s.scale, normal, offsets.uvReads());
@@ -109,8 +110,7 @@ inline double unscaledHeightAt(const PlanarSource& s, const Vec3d& position, con
 }
 inline double unscaledHeightAt(const TriplanarSource& s, const Vec3d& position,
                                const Vec3d& normal) {
-  const TriplanarWeights w =
-      triplanarWeights(normal, s.options.sharpness, s.options.minWeight);
+  const TriplanarWeights w = triplanarWeights(normal, s.options.sharpness, s.options.minWeight);
   double h = 0;
   for (const ProjectionAxis axis : {ProjectionAxis::kX, ProjectionAxis::kY, ProjectionAxis::kZ}) {
     const double weight = w.w[static_cast<std::size_t>(axis)];

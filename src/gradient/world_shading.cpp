@@ -56,9 +56,9 @@ class WorldLayerEvaluator {
     const ScalarSample h =
         s.texture->sample(textureCoordinates(world_.uv[set].uv, s.tiling, s.offset));
     if (gradient_detail::usesBumpNode(s, world_)) {
-      return {gradient_detail::bumpNodeGradient(s, world_.uv[set], world_.normal, world_.bump,
-                                                h.value),
-              s.strength};
+      return {
+          gradient_detail::bumpNodeGradient(s, world_.uv[set], world_.normal, world_.bump, h.value),
+          s.strength};
     }
     const gradient_detail::PreparedUvFrame frame =
         prepared_ != nullptr ? prepared_[set] : gradient_detail::prepareUvFrame(world_.uv[set]);

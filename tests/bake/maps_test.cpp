@@ -177,8 +177,8 @@ TEST(Maps, BackFacingTexelsBakeWhatCyclesShadesFromBehind) {
 }
 
 TEST(Maps, LinearHeightOnAPlaneBakesTheAnalyticConstant) {
-  // h = scale·(a·u + b·v) on P = (Lx u, Ly v, 0): Γ = scale·(a/Lx, b/Ly, 0), N' = normalize(−Γ + ẑ),
-  // MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself. The
+  // h = scale·(a·u + b·v) on P = (Lx u, Ly v, 0): Γ = scale·(a/Lx, b/Ly, 0), N' = normalize(−Γ +
+  // ẑ), MikkTSpace frame of the plane = (x̂, ŷ, ẑ), so the tangent-space normal is N' itself. The
   // Bump node's forward differences are exact on a linear height: the same maps.
   const double lx = 2, ly = 0.5, a = 0.3, b = -0.2, scale = 0.7;
   const Mesh mesh = scaledPlane(lx, ly);

@@ -597,16 +597,14 @@ TEST(Scene, SwizzleIsParsedForNormalMapsAndInTheParametersOnlyWhenNotTheDefault)
 }
 
 TEST(Scene, HeightGradientIsParsedAndInTheParametersOnlyWhenNotAnalytic) {
-  Result<Scene> bump =
-      parseScene(withLayer(R"({"type": "height", "image": "h.png", "gradient": "bump-node"})"),
-                 options());
+  Result<Scene> bump = parseScene(
+      withLayer(R"({"type": "height", "image": "h.png", "gradient": "bump-node"})"), options());
   ASSERT_TRUE(bump) << bump.error().message;
   EXPECT_EQ(bump->layers[0].heightGradient, HeightGradient::kBumpNode);
   EXPECT_NE(layerParametersJson(bump->layers[0]).find(R"("gradient":"bump-node")"),
             std::string::npos);
-  Result<Scene> exact =
-      parseScene(withLayer(R"({"type": "height", "image": "h.png", "gradient": "analytic"})"),
-                 options());
+  Result<Scene> exact = parseScene(
+      withLayer(R"({"type": "height", "image": "h.png", "gradient": "analytic"})"), options());
   ASSERT_TRUE(exact) << exact.error().message;
   EXPECT_EQ(exact->layers[0].heightGradient, HeightGradient::kAnalytic);
   // The default: the text (and manifest hash) of scenes without the key.
@@ -629,13 +627,15 @@ TEST(Scene, HeightGradientIsParsedAndInTheParametersOnlyWhenNotAnalytic) {
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "sine", "gradient": "fd"})")),
             "scene.json: layers[0]: unknown gradient 'fd' (expected analytic, central, "
             "tetrahedral or bump-node)");
-  EXPECT_EQ(parseError(withLayer(
-                R"({"type": "planar", "image": "n.png", "kind": "object-normal", "gradient": "bump-node"})")),
-            "scene.json: layers[0]: key 'gradient' applies only to projected heights (kind "
-            "'height')");
-  EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "gradient": "analytic"})")),
-            "scene.json: layers[0]: key 'gradient' does not apply to a normal layer (it is for "
-            "height, volume, planar or triplanar layers)");
+  EXPECT_EQ(
+      parseError(withLayer(
+          R"({"type": "planar", "image": "n.png", "kind": "object-normal", "gradient": "bump-node"})")),
+      "scene.json: layers[0]: key 'gradient' applies only to projected heights (kind "
+      "'height')");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "normal", "image": "n.png", "gradient": "analytic"})")),
+      "scene.json: layers[0]: key 'gradient' does not apply to a normal layer (it is for "
+      "height, volume, planar or triplanar layers)");
 }
 
 TEST(Scene, SubdivisionIsParsedAndValidated) {

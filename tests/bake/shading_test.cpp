@@ -210,7 +210,7 @@ class ShadeBatch : public ::testing::Test {
   /// Squashed a hundredfold: normals 60° from N in object space end up far below the surface.
   const WorldSpace squashed = *WorldSpace::of({Mat3::diagonal({10, 1, 0.1}), {}});
   const WorldSpace* world = nullptr;  ///< the placement expectShaderBatchEqualsSamples shades in
-  Vec2d bumpTexel{};  ///< BakeShaderBase::bumpTexel of the shaders compared
+  Vec2d bumpTexel{};                  ///< BakeShaderBase::bumpTexel of the shaders compared
   ImageScalarTexture bilinear = *ImageScalarTexture::create(Image(1, 1, 1));
   ImageScalarTexture bicubic = *ImageScalarTexture::create(Image(1, 1, 1));
   DirectionalSine sine = *DirectionalSine::create({});
@@ -240,8 +240,7 @@ TEST_F(ShadeBatch, ImageHeightLayersReadAsTheBumpNodeDoes) {
   UvHeightSource cubic{&bicubic, 0, 0.05};
   cubic.gradient = HeightGradient::kBumpNode;
   const std::vector<Layer> layers{
-      Layer{tiled, 1.0, {}},
-      Layer{cubic, -0.5, {}},
+      Layer{tiled, 1.0, {}}, Layer{cubic, -0.5, {}},
       Layer{UvHeightSource{&bilinear, 0, 0.1}, 0.7, {}},  // exact slopes beside them
   };
   bumpTexel = {1.0 / 64, 1.0 / 32};
