@@ -258,9 +258,10 @@ double secondsSince(Clock::time_point start) {
 
 /// Everything an ImageFileWriter owns. Queued strips are written by tasks enqueued in the task
 /// arena open() was called in (see writeRows), which hold the state by a shared_ptr, and the
-/// state holds that arena: a task that runs after the writer is gone (it may, since nothing
-/// waits for an enqueued task to start) finds the queue empty and returns, and the arena it
-/// runs in outlives a temporary task_arena that made it.
+/// state holds that arena, so that the arena a task runs in outlives a temporary task_arena
+/// that made it. finish (or the writer's destruction) waits until every task enqueued for the
+/// strips has started: none holds the state past the writer (a task that starts once the
+/// strips are written finds the queue empty and returns).
 struct ImageFileWriter::State : std::enable_shared_from_this<ImageFileWriter::State> {
   std::filesystem::path path;
   AtomicFile file;
