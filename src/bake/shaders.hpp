@@ -211,7 +211,7 @@ struct BakeShaderBase {
     if (s.texture == nullptr || !hasUvSet(p, s.uvSet)) return {};
     const std::size_t set = static_cast<std::size_t>(s.uvSet);
     const ScalarSample h = s.texture->sample(textureCoordinates(p.uv[set].uv, s.tiling, s.offset));
-    if (gradient_detail::usesBumpNode(s, p)) [[unlikely]] {
+    if (gradient_detail::usesBumpNode(s.gradient, p)) [[unlikely]] {
       return withNormalMapStrength(
           gradient_detail::bumpNodeGradient(s, p.uv[set], p.normal, p.bump, h.value), p.normal,
           s.strength);
@@ -464,8 +464,9 @@ inline bool batchesWhole(const Layer& layer) {
 }
 
 /// batchUvHeightGradient's Γ of a layer read as the Bump node does (usesBumpNode: @p point's
-/// offsets, constant over the triangle, are not empty): gradient_detail::bumpNodeGradient lane
-/// by lane, bit for bit, its three lookups a batch each.
+/// offsets, constant over the triangle, are not empty; seen from the front, as the lanes the
+/// batch keeps are): gradient_detail::bumpNodeGradient lane by lane, bit for bit, its three
+/// lookups a batch each.
 inline void batchBumpNodeGradient(const ShadingTriangle& tri, const SurfacePoint& point,
                                   const SampleBatch& s, const UvHeightSource& src,
                                   const Lanes3& unitN, Lanes3& layer) {
@@ -477,17 +478,10 @@ inline void batchBumpNodeGradient(const ShadingTriangle& tri, const SurfacePoint
   batchUvHeightSamples(tri, s, src, hc);
   batchUvHeightSamples(tri, s, src, hx, &shiftX);
   batchUvHeightSamples(tri, s, src, hy, &shiftY);
-  const Vec3d dx = point.bump.dx, dy = point.bump.dy;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3d normal{unitN.x[i], unitN.y[i], unitN.z[i]};
-    const Vec3d rx = cross(dy, normal), ry = cross(normal, dx);
-    const double det = dot(dx, rx);
-    Vec3d gamma{};
-    if (std::abs(det) > 0 && std::isfinite(det)) {
-      gamma =
-          (src.scale / det) * ((hx[i].value - hc[i].value) * rx + (hy[i].value - hc[i].value) * ry);
-      if (!isFinite(gamma)) gamma = {};
-    }
+    const Vec3d gamma =
+        gradient_detail::bumpNodeGradientFrom(hc[i].value, hx[i].value, hy[i].value, src.scale,
+                                              {unitN.x[i], unitN.y[i], unitN.z[i]}, point.bump);
     layer.x[i] = gamma.x;
     layer.y[i] = gamma.y;
     layer.z[i] = gamma.z;
@@ -507,7 +501,7 @@ inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint
   Lanes3 layer{};
   const std::size_t set = static_cast<std::size_t>(src.uvSet);
   const bool readable = src.texture != nullptr && hasUvSet(point, src.uvSet);
-  if (readable && gradient_detail::usesBumpNode(src, point)) {
+  if (readable && gradient_detail::usesBumpNode(src.gradient, point)) {
     batchBumpNodeGradient(tri, point, s, src, unitN, layer);
   } else if (readable && prepared[set].valid) {
     const gradient_detail::PreparedUvFrame& frame = prepared[set];

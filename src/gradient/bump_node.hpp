@@ -61,19 +61,25 @@ inline Vec2d uvOffsetOf(const UvFrame& frame, const Vec3d& w) {
   return {(vv * pu - uv * pv) / det, (uu * pv - uv * pu) / det};
 }
 
-/// Γ of heights @p scale · h as the Bump node bumps unit normal @p normal with them, h read
-/// here (@p hc) and at @p offsets by @p heightAt(offset): with Rx = dP.dy × N, Ry = N × dP.dx
-/// and det = ⟨dP.dx, Rx⟩ the node's normal is
+/// Γ of heights @p scale · h as the Bump node bumps unit normal @p normal with them, h being
+/// @p hc here and @p hx, @p hy at @p offsets dx, dy: with Rx = dP.dy × N, Ry = N × dP.dx and
+/// det = ⟨dP.dx, Rx⟩ the node's normal is
 /// |det|·N − scale·sign(det)·((h_x − h_c)·Rx + (h_y − h_c)·Ry), which is N − Γ scaled.
-template <class HeightAt>
-Vec3d bumpNodeGradientOf(const HeightAt& heightAt, double hc, double scale, const Vec3d& normal,
-                         const BumpOffsets& offsets) {
-  const double hx = heightAt(offsets.dx), hy = heightAt(offsets.dy);
+inline Vec3d bumpNodeGradientFrom(double hc, double hx, double hy, double scale,
+                                  const Vec3d& normal, const BumpOffsets& offsets) {
   const Vec3d rx = cross(offsets.dy, normal), ry = cross(normal, offsets.dx);
   const double det = dot(offsets.dx, rx);
   if (!(std::abs(det) > 0) || !std::isfinite(det)) return {};
   const Vec3d gamma = (scale / det) * ((hx - hc) * rx + (hy - hc) * ry);
   return isFinite(gamma) ? gamma : Vec3d{};
+}
+
+/// bumpNodeGradientFrom with h read at the offsets by @p heightAt(offset).
+template <class HeightAt>
+Vec3d bumpNodeGradientOf(const HeightAt& heightAt, double hc, double scale, const Vec3d& normal,
+                         const BumpOffsets& offsets) {
+  const double hx = heightAt(offsets.dx), hy = heightAt(offsets.dy);
+  return bumpNodeGradientFrom(hc, hx, hy, scale, normal, offsets);
 }
 
 /// bumpNodeGradientOf a UV height map, read at @p frame's UV, the UV of the triangle's plane
@@ -140,8 +146,7 @@ Vec3d positionBumpNodeGradient(const Source& s, const Vec3d& position, const Vec
                             normal, offsets.positionReads());
 }
 
-/// Whether a height read at positions with @p gradient is differenced as the Bump node does at
-/// @p point.
+/// Whether a height with @p gradient is differenced as the Bump node does at @p point.
 inline bool usesBumpNode(HeightGradient gradient, const SurfacePoint& point) {
   return gradient == HeightGradient::kBumpNode && !point.bump.empty();
 }
@@ -157,11 +162,6 @@ inline bool readsBumpOffsets(const LayerSource& source) {
         }
       },
       source);
-}
-
-/// Whether @p s is differentiated as the Bump node does at @p point.
-inline bool usesBumpNode(const UvHeightSource& s, const SurfacePoint& point) {
-  return s.gradient == HeightGradient::kBumpNode && !point.bump.empty();
 }
 
 }  // namespace sgbake::gradient_detail

@@ -29,7 +29,7 @@ Vec3d unblendedGradient(const UvHeightSource& s, const SurfacePoint& point) {
   if (s.texture == nullptr || !hasUvSet(point, s.uvSet)) return {};
   const UvFrame& frame = uvFrame(point, s.uvSet);
   const ScalarSample h = s.texture->sample(textureCoordinates(frame.uv, s.tiling, s.offset));
-  if (gradient_detail::usesBumpNode(s, point))
+  if (gradient_detail::usesBumpNode(s.gradient, point))
     return gradient_detail::bumpNodeGradient(s, frame, point.normal, point.bump, h.value);
   return gradientFromUvDerivatives(frame, point.normal,
                                    uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
@@ -367,11 +367,8 @@ const Layer& seenFromBehind(const Layer& layer, Layer& scratch) {
 }
 
 Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng) {
-  if (!point.bump.empty()) {
-    const SurfacePoint seen = seenFromBehind(point);
-    return backFacingGuarded(point.normal, compositeSeen(layers, seen, ng, true), ng);
-  }
-  return backFacingGuarded(point.normal, compositeSeen(layers, point, ng, true), ng);
+  return backFacingGuarded(point.normal, compositeSeen(layers, seenFromBehind(point), ng, true),
+                           ng);
 }
 
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,

@@ -55,7 +55,7 @@ class WorldLayerEvaluator {
     const std::size_t set = static_cast<std::size_t>(s.uvSet);
     const ScalarSample h =
         s.texture->sample(textureCoordinates(world_.uv[set].uv, s.tiling, s.offset));
-    if (gradient_detail::usesBumpNode(s, world_)) {
+    if (gradient_detail::usesBumpNode(s.gradient, world_)) {
       return {
           gradient_detail::bumpNodeGradient(s, world_.uv[set], world_.normal, world_.bump, h.value),
           s.strength};
@@ -251,14 +251,15 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
   HandedNormal handed;
   auto composite = [&](bool back) {
     const Vec3d incoming = back ? -n : n;
+    const std::optional<SurfacePoint> behind =
+        back ? std::optional<SurfacePoint>(seenFromBehind(worldPoint)) : std::nullopt;
     Vec3d gamma{};
     Layer scratch;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       if (back) {
-        addWorldLayerGradient(seenFromBehind(layer, scratch), objectPoint,
-                              worldPoint.bump.empty() ? worldPoint : seenFromBehind(worldPoint), ng,
-                              space, preparedWorldUv, incoming, gamma);
+        addWorldLayerGradient(seenFromBehind(layer, scratch), objectPoint, *behind, ng, space,
+                              preparedWorldUv, incoming, gamma);
         continue;
       }
       NormalBelowSurface step;
