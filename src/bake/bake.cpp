@@ -205,14 +205,15 @@ double heightOf(const UvHeightSource& s, const SurfacePoint& p) {
   return s.scale * s.texture->sample(st).value;
 }
 double heightOf(const VolumeSource& s, const SurfacePoint& p) {
-  return s.volume == nullptr ? 0
-                             : s.scale * gradient_detail::unscaledHeightAt(s, p.position, p.normal);
+  return s.volume == nullptr
+             ? 0
+             : s.scale * gradient_detail::unscaledHeightAt(s, p.position, p.seenNormal());
 }
 template <class Projection>
 double heightOf(const Projection& s, const SurfacePoint& p) {
   if (s.kind != ProjectedKind::kHeight || s.height == nullptr) return 0;
   return gradient_detail::heightScale(s) *
-         gradient_detail::unscaledHeightAt(s, p.position, p.normal);
+         gradient_detail::unscaledHeightAt(s, p.position, p.seenNormal());
 }
 double heightOf(const TangentNormalSource&, const SurfacePoint&) { return 0; }
 double heightOf(const ObjectNormalSource&, const SurfacePoint&) { return 0; }

@@ -913,7 +913,13 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
   }
   for (const PlannedLayer& layer : plan.layers) {
     const SceneLayer& source = scene.layers[layer.sceneLayer];
-    if (source.type == SceneLayerType::kTriplanar) {
+    if (source.type == SceneLayerType::kTriplanar &&
+        source.projection == TriplanarProjection::kBox) {
+      plan.skipped.push_back({"Box planes of " + layerLabel(layer.sceneLayer) +
+                                  " outside their blend (box_blend " +
+                                  formatNumber(source.boxBlend) + ")",
+                              "not sampled by the kernel (weight 0, as in Cycles)"});
+    } else if (source.type == SceneLayerType::kTriplanar) {
       plan.skipped.push_back({"triplanar planes of " + layerLabel(layer.sceneLayer) +
                                   " with blend weight below " + formatNumber(source.minWeight),
                               "not sampled by the kernel (the other planes are renormalized)"});

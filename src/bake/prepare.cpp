@@ -378,6 +378,8 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.options.scale = layer.scale;
       source.options.sharpness = layer.sharpness;
       source.options.minWeight = layer.minWeight;
+      source.options.projection = layer.projection;
+      source.options.boxBlend = layer.boxBlend;
       source.options.normal = projected;
       source.gradient = layer.heightGradient;
       result.source = source;

@@ -97,6 +97,8 @@ constexpr Named<NormalMapGreen> kGreens[] = {{"opengl", NormalMapGreen::kOpenGL}
 constexpr Named<ProjectedKind> kKinds[] = {{"height", ProjectedKind::kHeight},
                                            {"tangent-normal", ProjectedKind::kTangentNormal},
                                            {"object-normal", ProjectedKind::kObjectNormal}};
+constexpr Named<TriplanarProjection> kProjections[] = {{"blended", TriplanarProjection::kBlended},
+                                                       {"box", TriplanarProjection::kBox}};
 constexpr Named<ProjectionAxis> kAxes[] = {
     {"x", ProjectionAxis::kX}, {"y", ProjectionAxis::kY}, {"z", ProjectionAxis::kZ}};
 constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
@@ -385,7 +387,8 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"kind", "axis", "scale", "green", "base", "gradient"});
       break;
     case SceneLayerType::kTriplanar:
-      add({"kind", "scale", "sharpness", "min_weight", "green", "base", "gradient"});
+      add({"kind", "scale", "projection", "sharpness", "min_weight", "box_blend", "green", "base",
+           "gradient"});
       break;
   }
   return keys;
@@ -714,14 +717,15 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
   reader.optionalName("channel", kChannels, layer.channel);
-  if (layer.type == SceneLayerType::kHeight || layer.type == SceneLayerType::kPlanar ||
-      layer.type == SceneLayerType::kTriplanar) {
+  if (layer.type == SceneLayerType::kHeight || layer.projected()) {
     reader.optionalName("gradient", kHeightGradients, layer.heightGradient);
   }
   if (reader.has("tangent_uv"))
     layer.tangentUvSet = reader.smallInteger("tangent_uv", 0, kMaxUvSets - 1);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
   if (reader.has("min_weight")) layer.minWeight = reader.numberAtLeast("min_weight", 0, false);
+  reader.optionalName("projection", kProjections, layer.projection);
+  if (reader.has("box_blend")) layer.boxBlend = reader.numberAtLeast("box_blend", 0, false);
 
   if (layer.type == SceneLayerType::kVolume) {
     reader.optionalName("function", kFunctions, layer.function);
@@ -764,14 +768,28 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   }
   const bool objectSpace =
       (layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kObject) ||
-      ((layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar) &&
-       layer.kind != ProjectedKind::kTangentNormal);
+      (layer.projected() && layer.kind != ProjectedKind::kTangentNormal);
   if (objectSpace && reader.has("green")) {
     fail(where, "key 'green' applies only to tangent-space normal maps");
   }
-  if ((layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar) &&
-      layer.kind != ProjectedKind::kHeight && reader.has("gradient")) {
+  if (layer.projected() && layer.kind != ProjectedKind::kHeight && reader.has("gradient")) {
     fail(where, "key 'gradient' applies only to projected heights (kind 'height')");
+  }
+  const bool box = layer.projection == TriplanarProjection::kBox;
+  for (const char* key : {"sharpness", "min_weight"}) {
+    if (box && reader.has(key)) {
+      fail(where, "key " + quote(key) +
+                      " applies only to 'projection': 'blended' (Blender's Box projection "
+                      "blends by 'box_blend')");
+    }
+  }
+  if (!box && reader.has("box_blend")) {
+    fail(where, "key 'box_blend' applies only to 'projection': 'box'");
+  }
+  if (box && layer.kind == ProjectedKind::kTangentNormal) {
+    fail(where,
+         "'projection': 'box' takes kind 'height' or 'object-normal' (Blender's Box planes are "
+         "mirrored per side and give a tangent-space map no frame)");
   }
   if (layer.tangentUvSet && layer.space == NormalSpace::kObject) {
     fail(where, "key 'tangent_uv' applies only to tangent-space normal maps");
@@ -1027,6 +1045,9 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   if (!(layer.sharpness >= 0) || !std::isfinite(layer.sharpness)) {
     return "sharpness must be a finite number >= 0";
   }
+  if (!(layer.boxBlend >= 0 && layer.boxBlend <= 1)) {
+    return "box_blend must be a number from 0 to 1 (Blender's Blend)";
+  }
   if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
     return "step must be a finite number > 0";
   }
@@ -1199,8 +1220,11 @@ bool SceneLayer::readsNormals() const {
 
 bool SceneLayer::hasHeight() const {
   return type == SceneLayerType::kHeight || type == SceneLayerType::kVolume ||
-         ((type == SceneLayerType::kPlanar || type == SceneLayerType::kTriplanar) &&
-          kind == ProjectedKind::kHeight);
+         (projected() && kind == ProjectedKind::kHeight);
+}
+
+bool SceneLayer::projected() const {
+  return type == SceneLayerType::kPlanar || type == SceneLayerType::kTriplanar;
 }
 
 ImageFormat SceneOutput::resolvedFormat() const {
@@ -1363,8 +1387,7 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   }
   const bool tangentNormals =
       (layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent) ||
-      ((layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar) &&
-       layer.kind == ProjectedKind::kTangentNormal);
+      (layer.projected() && layer.kind == ProjectedKind::kTangentNormal);
   if (tangentNormals) j["green"] = nameIn(kGreens, layer.green);
   switch (layer.type) {
     case SceneLayerType::kHeight:
@@ -1402,12 +1425,16 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
       break;
     case SceneLayerType::kTriplanar:
       j["kind"] = nameIn(kKinds, layer.kind);
-      j["sharpness"] = layer.sharpness;
-      j["min_weight"] = layer.minWeight;
+      if (layer.projection == TriplanarProjection::kBox) {
+        j["projection"] = nameIn(kProjections, layer.projection);
+        j["box_blend"] = layer.boxBlend;
+      } else {  // (no "projection" key: the manifests of scenes before it stay valid)
+        j["sharpness"] = layer.sharpness;
+        j["min_weight"] = layer.minWeight;
+      }
       break;
   }
-  if (layer.heightGradient != HeightGradient::kAnalytic &&
-      (layer.type == SceneLayerType::kPlanar || layer.type == SceneLayerType::kTriplanar)) {
+  if (layer.heightGradient != HeightGradient::kAnalytic && layer.projected()) {
     j["gradient"] = nameIn(kHeightGradients, layer.heightGradient);
   }
   return j.dump();

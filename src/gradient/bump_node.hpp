@@ -107,7 +107,8 @@ inline SurfacePoint seenFromBehind(const SurfacePoint& point) {
 
 /// The height of a source read at positions, at object position @p position, before its scale
 /// (heightScale): a volume's value, a planar projection's texel, a triplanar projection's
-/// blend with the weights of unit normal @p normal (frozen, as its Γ takes them).
+/// blend over the planes Cycles shades normal @p seenNormal with (triplanarPlanes: weights and
+/// Box mirrors frozen, as its Γ takes them).
 inline double unscaledHeightAt(const VolumeSource& s, const Vec3d& position, const Vec3d&) {
   return s.volume->value(position);
 }
@@ -115,15 +116,10 @@ inline double unscaledHeightAt(const PlanarSource& s, const Vec3d& position, con
   return s.height->sample(planarTextureCoordinates(position, s.mapping)).value;
 }
 inline double unscaledHeightAt(const TriplanarSource& s, const Vec3d& position,
-                               const Vec3d& normal) {
-  const TriplanarWeights w = triplanarWeights(normal, s.options.sharpness, s.options.minWeight);
+                               const Vec3d& seenNormal) {
   double h = 0;
-  for (const ProjectionAxis axis : {ProjectionAxis::kX, ProjectionAxis::kY, ProjectionAxis::kZ}) {
-    const double weight = w.w[static_cast<std::size_t>(axis)];
-    if (weight == 0) continue;  // below the threshold: not sampled (as the gradient)
-    const PlanarMapping mapping{axis, s.options.tiling, s.options.offset};
-    h += weight * s.height->sample(planarTextureCoordinates(position, mapping)).value;
-  }
+  for (const WeightedPlane& plane : triplanarPlanes(s.options, seenNormal))
+    h += plane.weight * s.height->sample(planarTextureCoordinates(position, plane.mapping)).value;
   return h;
 }
 inline double heightScale(const VolumeSource& s) { return s.scale; }
@@ -134,16 +130,16 @@ inline double heightScale(const TriplanarSource& s) { return s.options.scale; }
 /// texture): read at @p position, and at the offsets (their positionReads) mapped into the
 /// source's space by @p toSource; the Bump node's geometry is @p normal's and the offsets'.
 /// (Object space: @p toSource the identity; world space: M⁻¹, the source reading object
-/// positions.) Triplanar weights are those of @p objectNormal.
+/// positions.) Triplanar planes are those of @p seenObjectNormal (SurfacePoint::seenNormal).
 template <class Source, class ToSource>
-Vec3d positionBumpNodeGradient(const Source& s, const Vec3d& position, const Vec3d& objectNormal,
-                               const Vec3d& normal, const BumpOffsets& offsets,
-                               const ToSource& toSource) {
+Vec3d positionBumpNodeGradient(const Source& s, const Vec3d& position,
+                               const Vec3d& seenObjectNormal, const Vec3d& normal,
+                               const BumpOffsets& offsets, const ToSource& toSource) {
   const auto heightAt = [&](const Vec3d& w) {
-    return unscaledHeightAt(s, position + toSource(w), objectNormal);
+    return unscaledHeightAt(s, position + toSource(w), seenObjectNormal);
   };
-  return bumpNodeGradientOf(heightAt, unscaledHeightAt(s, position, objectNormal), heightScale(s),
-                            normal, offsets.positionReads());
+  return bumpNodeGradientOf(heightAt, unscaledHeightAt(s, position, seenObjectNormal),
+                            heightScale(s), normal, offsets.positionReads());
 }
 
 /// Whether a height with @p gradient is differenced as the Bump node does at @p point.

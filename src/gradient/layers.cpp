@@ -73,8 +73,9 @@ Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
 /// The Γ of a height read at positions as the Bump node makes it (object space).
 template <class Source>
 Vec3d bumpNodeInObjectSpace(const Source& s, const SurfacePoint& point) {
-  return gradient_detail::positionBumpNodeGradient(s, point.position, point.normal, point.normal,
-                                                   point.bump, [](const Vec3d& w) { return w; });
+  return gradient_detail::positionBumpNodeGradient(s, point.position, point.seenNormal(),
+                                                   point.normal, point.bump,
+                                                   [](const Vec3d& w) { return w; });
 }
 
 Vec3d evaluate(const VolumeSource& s, const SurfacePoint& point) {

@@ -24,37 +24,58 @@ Vec3d finiteOrZero(Vec3d gamma) { return isFinite(gamma) ? gamma : Vec3d{}; }
 
 }  // namespace
 
-PlaneAxes planeAxes(ProjectionAxis axis) {
-  switch (axis) {
-    case ProjectionAxis::kX:
-      return {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
-    case ProjectionAxis::kY:
-      return {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
-    case ProjectionAxis::kZ:
-      break;
+PlaneAxes planeAxes(ProjectionAxis axis) { return planeAxes(PlanarMapping{axis}); }
+
+PlaneAxes planeAxes(const PlanarMapping& mapping) {
+  const Vec3d ex{1, 0, 0}, ey{0, 1, 0}, ez{0, 0, 1};
+  PlaneAxes a;
+  if (mapping.layout == PlaneLayout::kBox) {
+    switch (mapping.axis) {
+      case ProjectionAxis::kX:
+        a = {ey, ez, {}};
+        break;
+      case ProjectionAxis::kY:
+        a = {ex, ez, {}};
+        break;
+      case ProjectionAxis::kZ:
+        a = {ey, ex, {}};
+        break;
+    }
+  } else {
+    switch (mapping.axis) {
+      case ProjectionAxis::kX:
+        a = {ey, ez, {}};
+        break;
+      case ProjectionAxis::kY:
+        a = {ez, ex, {}};
+        break;
+      case ProjectionAxis::kZ:
+        a = {ex, ey, {}};
+        break;
+    }
   }
-  return {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  if (mapping.mirrored) a.s = -a.s;
+  a.n = cross(a.s, a.t);
+  return a;
 }
 
 Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis) {
-  switch (axis) {
-    case ProjectionAxis::kX:
-      return {position.y, position.z};
-    case ProjectionAxis::kY:
-      return {position.z, position.x};
-    case ProjectionAxis::kZ:
-      break;
-  }
-  return {position.x, position.y};
+  return planeCoordinates(position, PlanarMapping{axis});
+}
+
+Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping) {
+  // The axes are unit coordinate axes (or their negatives), so each coordinate is a dot
+  // product; a mirrored plane's first coordinate is 1 − s (Cycles' Box), not −s.
+  const PlaneAxes a = planeAxes(mapping);
+  return {dot(a.s, position) + (mapping.mirrored ? 1.0 : 0.0), dot(a.t, position)};
 }
 
 Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping) {
-  return textureCoordinates(planeCoordinates(position, mapping.axis), mapping.tiling,
-                            mapping.offset);
+  return textureCoordinates(planeCoordinates(position, mapping), mapping.tiling, mapping.offset);
 }
 
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale) {
-  const PlaneAxes axes = planeAxes(mapping.axis);
+  const PlaneAxes axes = planeAxes(mapping);
   return (scale * mapping.tiling.x * dhdst.x) * axes.s +
          (scale * mapping.tiling.y * dhdst.y) * axes.t;
 }
@@ -113,22 +134,93 @@ TriplanarWeights triplanarWeights(Vec3d normal, double sharpness, double minWeig
   return result;
 }
 
-namespace {
+bool boxPlaneMirrored(ProjectionAxis axis, Vec3d seenNormal) {
+  switch (axis) {
+    case ProjectionAxis::kX:
+      return seenNormal.x < 0;
+    case ProjectionAxis::kY:
+      return seenNormal.y > 0;
+    case ProjectionAxis::kZ:
+      break;
+  }
+  return seenNormal.z > 0;
+}
 
-/// Σ over the planes with a nonzero triplanar weight w of plane(mapping, st, w · scale), st being
-/// the point's texture coordinates in that plane: the loop the three triplanar kinds share.
-/// Planes below the weight threshold are not sampled at all.
-template <class PlaneTerm>
-Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
-                    const PlaneTerm& plane) {
+TriplanarWeights boxProjectionWeights(Vec3d normal, double blend) {
+  TriplanarWeights result;
+  if (!isFinite(normal)) return result;
+  const double total = std::abs(normal.x) + std::abs(normal.y) + std::abs(normal.z);
+  if (!(total > 0) || !std::isfinite(total)) return result;
+  // a: N's place in the triangle whose corners are the three planes (barycentric).
+  const std::array<double, 3> a{std::abs(normal.x) / total, std::abs(normal.y) / total,
+                                std::abs(normal.z) / total};
+  const double b = blend > 0 ? std::min(blend, 1.0) : 0.0;  // NaN → 0
+  const double limit = 0.5 * (1 + b);
+  std::array<double, 3>& w = result.w;
+
+  // A plane alone, where it outweighs both others by more than the limit.
+  const auto alone = [&](std::size_t i, std::size_t j, std::size_t k) {
+    return a[i] > limit * (a[i] + a[j]) && a[i] > limit * (a[i] + a[k]);
+  };
+  // Planes i and j, where plane k lies below the band it would blend in.
+  const auto pair = [&](std::size_t i, std::size_t j, std::size_t k) {
+    if (!(a[k] < (1 - limit) * (a[i] + a[j]))) return false;
+    w[i] = std::clamp((a[i] / (a[i] + a[j]) - 0.5 * (1 - b)) / b, 0.0, 1.0);
+    w[j] = 1 - w[i];
+    return true;
+  };
+  if (alone(0, 1, 2)) {
+    w[0] = 1;
+  } else if (alone(1, 0, 2)) {
+    w[1] = 1;
+  } else if (alone(2, 0, 1)) {
+    w[2] = 1;
+  } else if (b > 0) {
+    if (!pair(0, 1, 2) && !pair(1, 2, 0) && !pair(0, 2, 1)) {
+      for (std::size_t i = 0; i < 3; ++i)
+        w[i] = ((2 - limit) * a[i] + (limit - 1)) / (2 * limit - 1);
+    }
+  } else {
+    w[0] = 1;  // blend 0 and no plane ahead: the tie goes to X, as in Cycles
+  }
+  for (double& weight : w) {
+    if (!(weight > 0)) weight = 0;  // not sampled (Cycles samples only positive weights)
+    if (weight > 0) ++result.active;
+  }
+  return result;
+}
+
+TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNormal) {
+  const bool box = options.projection == TriplanarProjection::kBox;
   const TriplanarWeights weights =
-      triplanarWeights(point.normal, options.sharpness, options.minWeight);
-  Vec3d sum{};
+      box ? boxProjectionWeights(seenNormal, options.boxBlend)
+          : triplanarWeights(seenNormal, options.sharpness, options.minWeight);
+  TriplanarPlanes planes;
   for (const ProjectionAxis axis : kAxes) {
     const double w = weights.w[index(axis)];
     if (w == 0) continue;
-    const PlanarMapping mapping{axis, options.tiling, options.offset};
-    sum += plane(mapping, planarTextureCoordinates(point.position, mapping), w * options.scale);
+    PlanarMapping mapping{axis, options.tiling, options.offset};
+    if (box) {
+      mapping.layout = PlaneLayout::kBox;
+      mapping.mirrored = boxPlaneMirrored(axis, seenNormal);
+    }
+    planes.plane[static_cast<std::size_t>(planes.count++)] = {mapping, w};
+  }
+  return planes;
+}
+
+namespace {
+
+/// Σ over the planes of triplanarPlanes at the point of plane(mapping, st, w · scale), st being
+/// the point's texture coordinates in that plane: the loop the three triplanar kinds share.
+/// Planes of weight 0 are not sampled at all.
+template <class PlaneTerm>
+Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
+                    const PlaneTerm& plane) {
+  Vec3d sum{};
+  for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal())) {
+    sum += plane(p.mapping, planarTextureCoordinates(point.position, p.mapping),
+                 p.weight * options.scale);
   }
   return sum;
 }

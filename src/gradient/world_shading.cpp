@@ -119,7 +119,7 @@ class WorldLayerEvaluator {
   template <class Source>
   Vec3d bumpNodeInWorld(const Source& s) const {
     return gradient_detail::positionBumpNodeGradient(
-        s, object_.position, object_.normal, world_.normal, world_.bump,
+        s, object_.position, object_.seenNormal(), world_.normal, world_.bump,
         [this](const Vec3d& w) { return space_.directionToObject * w; });
   }
   template <class Source>
@@ -253,12 +253,14 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
     const Vec3d incoming = back ? -n : n;
     const std::optional<SurfacePoint> behind =
         back ? std::optional<SurfacePoint>(seenFromBehind(worldPoint)) : std::nullopt;
+    const std::optional<SurfacePoint> objectBehind =
+        back ? std::optional<SurfacePoint>(seenFromBehind(objectPoint)) : std::nullopt;
     Vec3d gamma{};
     Layer scratch;
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       if (back) {
-        addWorldLayerGradient(seenFromBehind(layer, scratch), objectPoint, *behind, ng, space,
+        addWorldLayerGradient(seenFromBehind(layer, scratch), *objectBehind, *behind, ng, space,
                               preparedWorldUv, incoming, gamma);
         continue;
       }

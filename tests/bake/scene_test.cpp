@@ -638,6 +638,47 @@ TEST(Scene, HeightGradientIsParsedAndInTheParametersOnlyWhenNotAnalytic) {
       "height, volume, planar or triplanar layers)");
 }
 
+TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
+  Result<Scene> box = parseScene(
+      withLayer(
+          R"({"type": "triplanar", "image": "h.png", "projection": "box", "box_blend": 0.25})"),
+      options());
+  ASSERT_TRUE(box) << box.error().message;
+  EXPECT_EQ(box->layers[0].projection, TriplanarProjection::kBox);
+  EXPECT_EQ(box->layers[0].boxBlend, 0.25);
+  const std::string parameters = layerParametersJson(box->layers[0]);
+  EXPECT_NE(parameters.find(R"("projection":"box")"), std::string::npos) << parameters;
+  EXPECT_NE(parameters.find(R"("box_blend":0.25)"), std::string::npos) << parameters;
+  EXPECT_EQ(parameters.find("sharpness"), std::string::npos) << parameters;
+  Result<Scene> blended = parseScene(
+      withLayer(R"({"type": "triplanar", "image": "h.png", "projection": "blended"})"), options());
+  ASSERT_TRUE(blended) << blended.error().message;
+  EXPECT_EQ(blended->layers[0].projection, TriplanarProjection::kBlended);
+  // The default: the text (and manifest hash) of scenes without the key.
+  EXPECT_EQ(layerParametersJson(blended->layers[0]).find("projection"), std::string::npos);
+
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "triplanar", "image": "h.png", "projection": "box", "sharpness": 2})")),
+            "scene.json: layers[0]: key 'sharpness' applies only to 'projection': 'blended' "
+            "(Blender's Box projection blends by 'box_blend')");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "triplanar", "image": "h.png", "box_blend": 0.2})")),
+            "scene.json: layers[0]: key 'box_blend' applies only to 'projection': 'box'");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "triplanar", "image": "n.png", "projection": "box",
+                                     "kind": "tangent-normal"})")),
+            "scene.json: layers[0]: 'projection': 'box' takes kind 'height' or 'object-normal' "
+            "(Blender's Box planes are mirrored per side and give a tangent-space map no frame)");
+  EXPECT_EQ(
+      parseError(withLayer(
+          R"({"type": "triplanar", "image": "h.png", "projection": "box", "box_blend": 1.5})")),
+      "scene.json: layers[0]: box_blend must be a number from 0 to 1 (Blender's Blend)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "triplanar", "image": "h.png", "projection": "flat"})")),
+      "scene.json: layers[0]: unknown projection 'flat' (expected blended or box)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "planar", "image": "h.png", "projection": "box"})")),
+            "scene.json: layers[0]: key 'projection' does not apply to a planar layer (it is for "
+            "triplanar layers)");
+}
+
 TEST(Scene, SubdivisionIsParsedAndValidated) {
   Result<Scene> scene = parseScene(
       R"({"mesh": "m.obj", "subdivision": {"level": 2, "uv_smooth": "keep-corners",

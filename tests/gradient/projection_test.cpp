@@ -416,5 +416,147 @@ TEST(Triplanar, GrazingNormalsAndExtremeScalesAreFinite) {
   EXPECT_EQ(n, 5 * 5 * 40 * 3);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Blender's Box projection
+// ---------------------------------------------------------------------------------------------
+
+/// The texture coordinates Cycles' Box projection reads plane @p axis at, for object position
+/// @p q and the normal it shades with @p n, written out from Blender's rule (not from
+/// planeAxes): X (±y, z), Y (±x, z), Z (±y, x), mirrored as 1 − s on −X, +Y, +Z.
+Vec2d boxCoordinates(Vec3d q, ProjectionAxis axis, Vec3d n) {
+  switch (axis) {
+    case ProjectionAxis::kX:
+      return {n.x < 0 ? 1 - q.y : q.y, q.z};
+    case ProjectionAxis::kY:
+      return {n.y > 0 ? 1 - q.x : q.x, q.z};
+    case ProjectionAxis::kZ:
+      break;
+  }
+  return {n.z > 0 ? 1 - q.y : q.y, q.x};
+}
+
+TEST(BoxProjection, WeightsAtHandComputedNormals) {
+  // a = |N| / Σ|N| = (0.6, 0.3, 0.1), blend 0.4 (limit 0.7): no plane alone (0.6 ≤ 0.7·0.9),
+  // Z below the band (0.1 < 0.3·0.9): X and Y blend, w_x = (0.6/0.9 − 0.3)/0.4 = 11/12.
+  const TriplanarWeights xy = boxProjectionWeights({-0.6, 0.3, 0.1}, 0.4);
+  EXPECT_NEAR(xy.w[0], 11.0 / 12, 1e-15);
+  EXPECT_NEAR(xy.w[1], 1.0 / 12, 1e-15);
+  EXPECT_EQ(xy.w[2], 0);
+  EXPECT_EQ(xy.active, 2);
+  // (1, 1, 1): all three, ((2 − L)/3 + L − 1)/(2L − 1) = 1/3 at any blend.
+  for (const double blend : {0.1, 0.5, 1.0}) {
+    const TriplanarWeights all = boxProjectionWeights({1, -1, 1}, blend);
+    for (const double w : all.w) EXPECT_NEAR(w, 1.0 / 3, 1e-15) << blend;
+    EXPECT_EQ(all.active, 3);
+  }
+  // Within the limit of an axis: that plane alone.
+  const TriplanarWeights z = boxProjectionWeights({0.1, -0.2, -0.9}, 0.3);
+  EXPECT_EQ(z.w[2], 1);
+  EXPECT_EQ(z.active, 1);
+  // Blend 0: the largest component alone; on a tie no plane is ahead and X takes it (Cycles).
+  EXPECT_EQ(boxProjectionWeights({0.3, -0.5, 0.4}, 0).w[1], 1);
+  EXPECT_EQ(boxProjectionWeights({0, 0.7, 0.7}, 0).w[0], 1);
+  EXPECT_EQ(boxProjectionWeights({0, 0, 0}, 0.2).active, 0);
+  EXPECT_EQ(boxProjectionWeights({std::nan(""), 0, 1}, 0.2).active, 0);
+}
+
+// The seven zones meet without jumps (blend > 0), the weights are a partition of unity, and
+// permuting N's components permutes them (away from Cycles' tie-breaking order).
+TEST(BoxProjection, WeightsAreContinuousSymmetricAndSumToOne) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double blends[] = {0.05, 0.2, 0.5, 0.9, 1.0};
+  double worstJump = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3d n{u(rng), u(rng), u(rng)};
+    const double blend = blends[static_cast<std::size_t>(i) % 5];
+    const TriplanarWeights w = boxProjectionWeights(n, blend);
+    double sum = 0;
+    for (const double wi : w.w) {
+      EXPECT_GE(wi, 0);
+      EXPECT_LE(wi, 1);
+      sum += wi;
+    }
+    EXPECT_NEAR(sum, 1, 1e-12);
+    const Vec3d near = n + 1e-9 * Vec3d{u(rng), u(rng), u(rng)};
+    const TriplanarWeights v = boxProjectionWeights(near, blend);
+    for (std::size_t k = 0; k < 3; ++k) worstJump = std::max(worstJump, std::abs(w.w[k] - v.w[k]));
+    const TriplanarWeights turned = boxProjectionWeights({n.y, n.z, n.x}, blend);
+    EXPECT_NEAR(turned.w[0], w.w[1], 1e-12);
+    EXPECT_NEAR(turned.w[1], w.w[2], 1e-12);
+    EXPECT_NEAR(turned.w[2], w.w[0], 1e-12);
+  }
+  // A step of 1e-9 in N moves a weight by at most ~1e-9 / blend: no zone's formula jumps.
+  EXPECT_LT(worstJump, 1e-6);
+}
+
+// Each plane reads Blender's coordinates, mirrored on the sides Cycles mirrors, by the normal it
+// shades with: seen from behind (−N), the other side's mirror.
+TEST(BoxProjection, PlanesReadBlendersMirroredCoordinates) {
+  TriplanarOptions o;
+  o.projection = TriplanarProjection::kBox;
+  o.tiling = {2, 3};
+  o.offset = {0.25, -0.5};
+  const Vec3d q{0.3, -0.2, 0.7};
+  const Vec3d normals[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const bool behind : {false, true}) {
+    for (const Vec3d& n : normals) {
+      SineTexture tex;
+      SurfacePoint p = pointAt(q, n);
+      p.bump.behind = behind;
+      triplanarHeightGradient(tex, o, p);
+      ASSERT_EQ(tex.count, 1);
+      const ProjectionAxis axis = std::abs(n.x) > 0   ? ProjectionAxis::kX
+                                  : std::abs(n.y) > 0 ? ProjectionAxis::kY
+                                                      : ProjectionAxis::kZ;
+      const Vec2d st = boxCoordinates(q, axis, behind ? -n : n);
+      EXPECT_NEAR(tex.last.x, o.tiling.x * st.x + o.offset.x, 1e-15) << n.x << n.y << n.z;
+      EXPECT_NEAR(tex.last.y, o.tiling.y * st.y + o.offset.y, 1e-15) << n.x << n.y << n.z;
+    }
+  }
+}
+
+// Γ of a Box-projected height is the tangential part of the gradient of the blended volume
+// Σ w_i · scale · h(tiling ∘ boxCoordinates_i(P) + offset), weights and mirrors frozen at the
+// point, checked against central differences of that volume; front and behind.
+TEST(BoxProjection, HeightIsTheProjectedGradientOfTheBlendedVolume) {
+  SineTexture tex;
+  TriplanarOptions o;
+  o.projection = TriplanarProjection::kBox;
+  o.boxBlend = 0.6;
+  o.tiling = {1.3, 0.7};
+  o.offset = {0.2, -0.1};
+  o.scale = 0.5;
+  std::mt19937_64 rng(32);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int blended = 0;
+  for (int i = 0; i < 400; ++i) {
+    SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+    p.bump.behind = i % 2 == 1;
+    const Vec3d seen = p.bump.behind ? -p.normal : p.normal;
+    const TriplanarWeights w = boxProjectionWeights(seen, o.boxBlend);
+    if (w.active > 1) ++blended;
+    auto volume = [&](Vec3d x) {
+      double h = 0;
+      for (const ProjectionAxis axis : kAxes) {
+        const Vec2d st = boxCoordinates(x, axis, seen);
+        h += w.w[static_cast<std::size_t>(axis)] * o.scale *
+             tex.sample({o.tiling.x * st.x + o.offset.x, o.tiling.y * st.y + o.offset.y}).value;
+      }
+      return h;
+    };
+    const double e = 1e-6;
+    Vec3d grad{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      Vec3d d{};
+      d[k] = e;
+      grad[k] = (volume(p.position + d) - volume(p.position - d)) / (2 * e);
+    }
+    const Vec3d expected = grad - dot(grad, p.normal) * p.normal;
+    EXPECT_LT(maxAbsDiff(triplanarHeightGradient(tex, o, p), expected), 1e-8);
+  }
+  EXPECT_GT(blended, 100);  // the blend zones are exercised, not only single planes
+}
+
 }  // namespace
 }  // namespace sgbake

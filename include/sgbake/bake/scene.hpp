@@ -156,6 +156,10 @@ struct SceneLayer {
   ProjectionAxis axis = ProjectionAxis::kZ;        ///< "axis" (planar)
   double sharpness = kDefaultTriplanarSharpness;   ///< "sharpness" (triplanar)
   double minWeight = kDefaultMinTriplanarWeight;   ///< "min_weight" (triplanar)
+  /// "projection" (triplanar): "blended" (seed 003's planes and weights, the default) or "box"
+  /// (Blender's Image Texture Box projection, kinds height and object-normal)
+  TriplanarProjection projection = TriplanarProjection::kBlended;
+  double boxBlend = kDefaultBoxBlend;  ///< "box_blend" (triplanar box): Blender's Blend, 0 … 1
   /// "base" (heights): "surface" (N, the default) or "above" (the normal the layers above make,
   /// as a Bump node whose Normal input is linked to them; LayerBase::kLayersAbove)
   LayerBase base = LayerBase::kSurface;
@@ -183,6 +187,8 @@ struct SceneLayer {
   /// @brief Whether the layer has a height (a height map can bake it): height, volume, and
   /// planar/triplanar of kind height. Normal maps have slopes only.
   bool hasHeight() const;
+  /// @brief Whether the layer projects its image at positions: planar or triplanar.
+  bool projected() const;
 };
 
 /// @brief What an output writes.

@@ -25,6 +25,13 @@
 /// projects once. There are no per-side sign flips: the height always displaces along the
 /// surface normal, so faces looking down −axis see the image mirrored, with bumps still outward.
 /// Object-space normal maps are blended as surface gradients (eq. 45).
+///
+/// **Blender's Box projection** (TriplanarProjection::kBox, PlaneLayout::kBox) is the other
+/// triplanar: Cycles' Image Texture with Projection "Box", as a technical artist sets it up in
+/// Blender. Its planes are textured at (y, z) on X, (x, z) on Y and (y, x) on Z, the first
+/// coordinate mirrored (s ↦ 1 − s) on the −X, +Y and +Z sides of the normal Cycles shades with,
+/// so no side sees its image mirrored; its weights are boxProjectionWeights. Its slopes are
+/// taken as the blended ones (frozen weights; a mirrored plane's s axis is −e_s).
 #pragma once
 
 #include <array>
@@ -52,18 +59,37 @@ PlaneAxes planeAxes(ProjectionAxis axis);
 /// (z, x) for Y.
 Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis);
 
-/// @brief How a plane is textured: (s, t) = tiling ∘ planeCoordinates(P) + offset.
+/// @brief Which object coordinates texture a plane (before tiling).
+enum class PlaneLayout {
+  kCyclic,  ///< the cyclic pairs of the table above: (y, z), (z, x), (x, y)
+  /// Blender's Box projection: (y, z) on X, (x, z) on Y, (y, x) on Z; see PlanarMapping::mirrored
+  kBox,
+};
+
+/// @brief How a plane is textured: (s, t) = tiling ∘ planeCoordinates(P, mapping) + offset.
 struct PlanarMapping {
   ProjectionAxis axis = ProjectionAxis::kZ;
   Vec2d tiling{1, 1};  ///< repeats per object unit along s and t
   Vec2d offset{0, 0};  ///< texture units
+  PlaneLayout layout = PlaneLayout::kCyclic;
+  /// The first plane coordinate is 1 − s (its axis −e_s): a Box plane seen from the side that
+  /// Cycles mirrors (boxPlaneMirrored). Only kBox mappings are mirrored.
+  bool mirrored = false;
 };
+
+/// @brief The axes of a plane as @p mapping lays it out: s and t the object-space directions
+/// its two texture coordinates grow along (before tiling), n = s × t (±the plane's axis).
+PlaneAxes planeAxes(const PlanarMapping& mapping);
+
+/// @brief Plane coordinates of an object-space point under @p mapping, before tiling.
+Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping);
 
 /// @brief Texture coordinates of @p position under @p mapping.
 Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping);
 
-/// @brief Volume gradient of `scale · h(tiling ∘ planeCoordinates(P) + offset)`:
-/// scale · (tiling.x · dhdst.x · e_s + tiling.y · dhdst.y · e_t), object units per object unit.
+/// @brief Volume gradient of `scale · h(tiling ∘ planeCoordinates(P, mapping) + offset)`:
+/// scale · (tiling.x · dhdst.x · s + tiling.y · dhdst.y · t) with s, t = planeAxes(mapping),
+/// object units per object unit.
 ///
 /// @param[in] dhdst (∂h/∂s, ∂h/∂t) at the point, per texture unit
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale);
@@ -127,6 +153,36 @@ struct TriplanarWeights {
 TriplanarWeights triplanarWeights(Vec3d normal, double sharpness = kDefaultTriplanarSharpness,
                                   double minWeight = kDefaultMinTriplanarWeight);
 
+/// @brief Whether Blender's Box projection mirrors the plane perpendicular to @p axis where
+/// Cycles shades with normal @p seenNormal (object space; −N seen from behind): on the −X, +Y and
+/// +Z sides.
+bool boxPlaneMirrored(ProjectionAxis axis, Vec3d seenNormal);
+
+/// @brief Blend weights of Blender's Box projection (Cycles' Image Texture, Projection "Box")
+/// at @p normal, with its Blend @p blend ∈ [0, 1].
+///
+/// With a_i = |n_i| / Σ|n_j| and L = (1 + blend)/2, a plane whose ratio a_i/(a_i + a_j) exceeds
+/// L against both others is used alone; else, with blend > 0, where one plane k has
+/// a_k < (1 − L)(a_i + a_j) the two others blend as clamp((a_i/(a_i + a_j) − (1 − blend)/2) /
+/// blend, 0, 1) and its complement; else all three take ((2 − L)·a_i + L − 1) / (2L − 1). With
+/// blend 0 the largest component wins alone (X on ties, where no plane exceeds another). The
+/// zones are tested in Cycles' order (X, Y, Z alone; then without Z, X, Y), so points on their
+/// borders get what Cycles gives them. Planes with weight ≤ 0 are not counted or sampled. A
+/// zero or non-finite N gives no active plane; blend is clamped to [0, 1] (NaN → 0).
+TriplanarWeights boxProjectionWeights(Vec3d normal, double blend);
+
+/// @brief How a triplanar projection lays out and blends its planes.
+enum class TriplanarProjection {
+  /// Seed 003: the cyclic planes (PlaneLayout::kCyclic), weights triplanarWeights (sharpness,
+  /// minWeight).
+  kBlended,
+  /// Blender's Box projection: PlaneLayout::kBox, weights boxProjectionWeights (boxBlend).
+  kBox,
+};
+
+/// Default Blend of a Box projection, Blender's.
+inline constexpr double kDefaultBoxBlend = 0;
+
 /// @brief Options of a triplanar lookup (the same mapping on all three planes).
 struct TriplanarOptions {
   Vec2d tiling{1, 1};  ///< repeats per object unit, on every plane
@@ -137,7 +193,27 @@ struct TriplanarOptions {
   double sharpness = kDefaultTriplanarSharpness;  ///< see triplanarWeights
   double minWeight = kDefaultMinTriplanarWeight;  ///< see triplanarWeights
   ProjectedNormalOptions normal{};                ///< decoding of normal maps
+  TriplanarProjection projection = TriplanarProjection::kBlended;
+  double boxBlend = kDefaultBoxBlend;  ///< kBox: Blender's Blend, see boxProjectionWeights
 };
+
+/// @brief One plane of a triplanar lookup: how it is textured and its weight (> 0).
+struct WeightedPlane {
+  PlanarMapping mapping{};
+  double weight = 0;
+};
+
+/// @brief The planes a triplanar lookup samples at a point whose normal Cycles shades with is
+/// @p seenNormal (object space; N, or −N seen from behind), with their weights; planes of zero
+/// weight are left out (not sampled). The one place the three kinds, the height map and the
+/// Bump node's reads agree on planes, weights and mirrors.
+struct TriplanarPlanes {
+  std::array<WeightedPlane, 3> plane{};
+  int count = 0;
+  const WeightedPlane* begin() const { return plane.data(); }
+  const WeightedPlane* end() const { return plane.data() + count; }
+};
+TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNormal);
 
 /// @brief Γ of a height map by triplanar projection (seed 003; eq. 46-49 then eq. 30):
 /// ∇h = Σ_i w_i · planeVolumeGradient_i, Γ = ∇h − ⟨∇h, N⟩N.

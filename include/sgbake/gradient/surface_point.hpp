@@ -71,6 +71,10 @@ struct SurfacePoint {
   /// Where a Bump node would read the heights again here (set by the baker for layers that
   /// ask for it, see bakeBumpOffsets); empty elsewhere.
   BumpOffsets bump{};
+
+  /// The normal Cycles shades with here: N, or −N at a point seen from behind (bump.behind,
+  /// where Cycles flips N before any node runs). Box projections pick their mirrors by it.
+  Vec3d seenNormal() const { return bump.behind ? -normal : normal; }
 };
 
 }  // namespace sgbake
