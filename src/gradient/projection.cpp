@@ -248,6 +248,17 @@ Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const Triplan
 
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
                                     const SurfacePoint& point) {
+  if (options.projection == TriplanarProjection::kBox) {
+    // Cycles blends the texels' colours and a Normal Map node decodes the blend: one normal,
+    // Σ w_i n_i (the decoding is affine and the weights sum to 1).
+    Vec3d blend{};
+    for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal())) {
+      blend += p.weight * decodeNormalTexel(
+                              texture.sample(planarTextureCoordinates(point.position, p.mapping)));
+    }
+    return finiteOrZero(options.scale *
+                        gradientFromObjectNormal(blend, point.normal, options.normal.minCosine));
+  }
   return finiteOrZero(sumOverPlanes(
       options, point, [&](const PlanarMapping&, Vec2d st, double weightedScale) {
         const Vec3d n = decodeNormalTexel(texture.sample(st));

@@ -56,7 +56,10 @@ The planar cases (planar_sphere, planar_sphere_backfacing: the height projected 
 object coordinates by Texture Coordinate Object into a Flat Image Texture) bake a scene with a
 "planar" height layer instead (ours_bake.exr, ours_bake_x2.exr at twice the scale) and the mask;
 its bump-node bake (ours_bake_bump_node.exr) is judged as (e); they have no convert, flags or
-JSON checks.
+JSON checks. The Box cases (box_sphere, box_sphere_backfacing, box_stretch_sphere: Blender's Image
+Texture Box projection with Blend 0.3 on object coordinates) bake a "triplanar" layer with
+"projection": "box" the same way; their control ours_bake_blended.exr, sgbake's own triplanar
+blend (seed 003), must fail both (b) and (e).
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -144,9 +147,14 @@ BAKE_P99_DEG = {"sphere_backfacing": 10.0, "stretch_sphere_backfacing": 15.0}
 # 58940 texels over 10 deg, where exact slopes and the Bump's differences part most). Projected
 # onto the plane along N instead: back-facing median 2.4, p90 77 deg; with the slopes negated
 # from behind as a UV height's: p90 111 deg.
-BAKE_P90_DEG = {"planar_sphere_backfacing": 5.0}
+BAKE_P90_DEG = {"planar_sphere_backfacing": 5.0, "box_sphere_backfacing": 5.0}
 # With the Bump node's differences ("gradient": "bump-node"), (e) holds them too: median 0.0016,
 # p99 0.0018 and 0.0021 deg (56 texels over 10 deg on the back-facing sphere).
+# Blender's Box projection (box_*, Blend 0.3: one, two and three planes, each side's mirror):
+# exact slopes median 0.76 / 0.75 / 0.67 deg (front, back-facing p90 under 5, stretched p99
+# 4.8); bump-node median 0.0016 deg, p99 0.0018 / 0.0028 / 0.0023 deg (49 texels over 10 deg
+# on the back-facing sphere, as the planar one's). The stretched sphere's planes are picked by
+# the world normal taken back to object space: by the object's own normal, p99 0.30 deg.
 # Per-case bars on the worst texel of (b). suzanne_flat: its concave quads 162 and 163, which
 # Cycles shades on the other diagonal's triangles (bake_detail::cyclesShadingTriangles):
 # measured 2.3 deg, 117 deg on 48 texels when shaded on the baker's own triangles.
@@ -203,7 +211,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "stretch_sphere", "stretch_cube", "stretch_nmap_sphere",
                  "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
-                 "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing")
+                 "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
+                 "box_sphere", "box_sphere_backfacing", "box_stretch_sphere")
 
 
 def run_blender_script(blender, script, args):
@@ -265,16 +274,25 @@ def sgbake_case(cli, entry, sabotage, threads):
     bake_scale = scale * (1.5 if sabotage == "scale" else 1.0)
     green = "directx" if sabotage == "green" else "opengl"
     if "planar" in entry:  # the height projected at positions: no flags for it, scenes only
-        for name, layer_scale, gradient in (("ours_bake", bake_scale, "analytic"),
-                                            ("ours_bake_x2", 2 * scale, "analytic"),
-                                            ("ours_bake_bump_node", bake_scale, "bump-node")):
-            scene = {"mesh": p("mesh.obj"),
-                     "layers": [{"type": "planar", "image": p("height.exr"), "kind": "height",
-                                 "axis": entry["planar"]["axis"], "scale": layer_scale,
-                                 "filter": entry["filter"], "gradient": gradient}],
+        box = entry["planar"]["projection"] == "box"
+        bakes = [("ours_bake", bake_scale, "analytic"), ("ours_bake_x2", 2 * scale, "analytic"),
+                 ("ours_bake_bump_node", bake_scale, "bump-node")]
+        if box:
+            bakes.append(("ours_bake_blended", bake_scale, "bump-node"))
+        for name, layer_scale, gradient in bakes:
+            layer = {"type": "planar", "image": p("height.exr"), "kind": "height", "axis": "z",
+                     "scale": layer_scale, "filter": entry["filter"], "gradient": gradient}
+            if box:  # Blender's Box projection; the control: sgbake's own triplanar blend
+                del layer["axis"]
+                layer["type"] = "triplanar"
+                if name != "ours_bake_blended":
+                    layer.update(projection="box", box_blend=entry["planar"]["blend"])
+            scene = {"mesh": p("mesh.obj"), "layers": [layer],
                      "outputs": [{"map": "tangent-normal", "file": p(name + ".exr"),
                                   "size": size, "margin": 0, "samples": 1, "green": green,
                                   "bit_depth": 32}]}
+            if transformed(entry):
+                scene["transform"] = entry["transform"]
             if not bc.bake_scene_file(cli, d, name, scene):
                 failed.append(f"sgbake bake {p(name + '.json')}")
         if not run_sgbake(cli, ["bake", "--mesh", p("mesh.obj"), "--map", "mask", "--size", size,
@@ -579,6 +597,12 @@ def evaluate(name, r, planar=False):
         if "bake" in r and "error" not in r["bake"] and passes_bump_node(r["bake"]):
             fails.append(f"{name}: negative control: the analytic bake passes the bump-node "
                          f"bars ({fmt(r['bake'])})")
+    if "bake_blended" in r:
+        s = r["bake_blended"]
+        print(f"      control, sgbake's blend:    {fmt(s)}")
+        if "error" in s or passes_bump_node(s) or passes_bake(s, name):
+            fails.append(f"{name}: negative control: the bake with sgbake's own triplanar "
+                         f"blend instead of Blender's Box still passes ({fmt(s)})")
     if not missing("bake_x2", "2x-scale bake"):
         s = r["bake_x2"]
         print(f"      control, scale x2:          {fmt(s)}")

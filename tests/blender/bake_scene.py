@@ -141,18 +141,22 @@ def transformed_case(name, of_case, location, rotation, scale, size=None):
     TRANSFORMS[name] = (location, rotation, scale)
 
 
-# name -> the axis of a planar case: the mesh of another case whose Bump reads its height through
-# Texture Coordinate Object and a Flat-projected Image Texture, the image at the object's (x, y):
-# sgbake's "planar" height layer on axis z (a height read at a position, not a UV).
+# name -> how a projected case reads its height: the mesh of another case whose Bump reads its
+# height through Texture Coordinate Object into an Image Texture, not through a UV map (a height
+# read at a position). {"projection": "FLAT"}: the image at the object's (x, y), sgbake's
+# "planar" height layer on axis z. {"projection": "BOX", "blend": b}: Blender's Box projection
+# with Blend b, sgbake's "triplanar" layer with "projection": "box".
 PLANAR = {}
 
 
-def planar_case(name, mesh_case, size, scale):
-    """Registers case `name`: the mesh of case `mesh_case`, its Bump (Distance `scale`) fed by
-    the height image projected along z onto object coordinates."""
+def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0):
+    """Registers case `name`: the mesh (and transform) of case `mesh_case`, its Bump (Distance
+    `scale`) fed by the height image projected onto object coordinates (`projection`)."""
     CASES[name] = (CASES[mesh_case][0], size, scale)
     SUBDIVISION[name] = SUBDIVISION[mesh_case]
-    PLANAR[name] = "z"
+    if mesh_case in TRANSFORMS:
+        TRANSFORMS[name] = TRANSFORMS[mesh_case]
+    PLANAR[name] = {"projection": projection, "blend": blend}
 
 
 def apply_subdivision(ob, levels):
@@ -324,6 +328,12 @@ transformed_case("stretch_nmap_sphere_backfacing", "nmap_sphere_backfacing", (0.
 # steeper field than on the sphere's UVs (2 pi units around) and a smaller Distance.
 planar_case("planar_sphere", "sphere", 256, 0.02)
 planar_case("planar_sphere_backfacing", "sphere_backfacing", 256, 0.02)
+# Blender's Box projection, Blend 0.3: every zone of its weights (one plane, two, three) and
+# every side's mirror on the sphere; from behind, the mirrors of the sides seen; on the
+# stretched sphere, in world space (the weights and mirrors still from the object's normal).
+planar_case("box_sphere", "sphere", 256, 0.02, "BOX", 0.3)
+planar_case("box_sphere_backfacing", "sphere_backfacing", 256, 0.02, "BOX", 0.3)
+planar_case("box_stretch_sphere", "stretch_sphere", 512, 0.02, "BOX", 0.3)
 
 
 def tilt_field(size, tilt_deg):
@@ -501,7 +511,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
         if name in PLANAR:
             nodes = mat.node_tree.nodes
             tex = next(n for n in nodes if n.bl_idname == "ShaderNodeTexImage" and n != target)
-            tex.projection = "FLAT"
+            tex.projection = PLANAR[name]["projection"]
+            tex.projection_blend = PLANAR[name]["blend"]
             coordinates = nodes.new("ShaderNodeTexCoord")
             mat.node_tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
     else:
@@ -539,7 +550,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
              "subdivision": SUBDIVISION[name],
              "transform": [list(row) for row in ob.matrix_world]}
     if name in PLANAR:
-        entry["planar"] = {"axis": PLANAR[name]}
+        entry["planar"] = {"projection": PLANAR[name]["projection"].lower(),
+                           "blend": PLANAR[name]["blend"]}
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}

@@ -558,5 +558,24 @@ TEST(BoxProjection, HeightIsTheProjectedGradientOfTheBlendedVolume) {
   EXPECT_GT(blended, 100);  // the blend zones are exercised, not only single planes
 }
 
+// Box-projected object-space normals blend as Cycles blends texels: one decoded normal
+// Σ w_i n_i, which the layer resolves to (not the blend of each plane's surface gradient).
+TEST(BoxProjection, ObjectNormalsBlendTexelsThenDecode) {
+  ObjectNormalTexture tex;
+  TriplanarOptions o;
+  o.projection = TriplanarProjection::kBox;
+  o.boxBlend = 0.8;
+  const SurfacePoint p = pointAt({0.3, -0.2, 0.5}, {0.5, -0.55, 0.6});
+  const TriplanarWeights w = boxProjectionWeights(p.normal, o.boxBlend);
+  ASSERT_EQ(w.active, 3);
+  Vec3d blend{};
+  for (const ProjectionAxis axis : kAxes) {
+    const Vec2d st = boxCoordinates(p.position, axis, p.normal);
+    blend += w.w[static_cast<std::size_t>(axis)] * (2 * tex.sample(st) - Vec3d{1, 1, 1});
+  }
+  const Vec3d resolved = resolveNormal(p.normal, triplanarObjectNormalGradient(tex, o, p));
+  EXPECT_LT(maxAbsDiff(resolved, normalizeOr(blend, Vec3d{})), 1e-14);
+}
+
 }  // namespace
 }  // namespace sgbake

@@ -229,7 +229,9 @@ Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const Triplan
                                      const SurfacePoint& point);
 
 /// @brief Γ of an object-space normal map by triplanar projection (eq. 45):
-/// Γ = scale · Σ_i w_i · gradientFromObjectNormal(N_i, N).
+/// Γ = scale · Σ_i w_i · gradientFromObjectNormal(N_i, N). Blender's Box projection blends the
+/// texels and decodes once, as Cycles' Image Texture feeds a Normal Map node:
+/// Γ = scale · gradientFromObjectNormal(Σ_i w_i N_i, N).
 /// @note Samples @p texture once per active plane.
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
                                     const SurfacePoint& point);
