@@ -415,20 +415,22 @@ def _not_image(socket):
 
 
 def _object_projected(tex):
-    """Whether Image Texture node `tex` reads the baked object's own coordinates projected
-    along z: its Vector straight from a Texture Coordinate node's Object output (no other
-    object named), Flat projection. Its height is then sgbake's planar layer on axis z."""
+    """Whether Image Texture node `tex` reads the baked object's own coordinates: its Vector
+    straight from a Texture Coordinate node's Object output (no other object named), Flat or
+    Box projection. Its height is then sgbake's planar layer on axis z (Flat) or its triplanar
+    layer with Blender's Box projection (Box)."""
     link = _source_link(tex.inputs["Vector"])
     return (link is not None and link.from_node.type == "TEX_COORD"
             and link.from_socket.name == "Object" and link.from_node.object is None
-            and tex.projection == "FLAT")
+            and tex.projection in ("FLAT", "BOX"))
 
 
 def _ignored(node, tex, inputs, socket):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
-    input other than a UV map (a Mapping node, object or generated coordinates), a projection
-    other than Flat, Closest interpolation (read bilinear), and node-driven `inputs` (of which
+    input other than a UV map (a Mapping node, object or generated coordinates; a Bump's own
+    object coordinates are taken), a projection other than Flat (a Bump's Box on object
+    coordinates is taken), Closest interpolation (read bilinear), and node-driven `inputs` (of which
     the layer takes the unconnected value)."""
     notes = []
     if node.type != "BUMP" and _source_link(node.inputs[socket]).from_socket.name == "Alpha":
@@ -443,7 +445,7 @@ def _ignored(node, tex, inputs, socket):
         planar = node.type == "BUMP" and _object_projected(tex)
         if not uv and not planar:
             notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
-    if tex.projection != "FLAT":
+    if tex.projection != "FLAT" and not (node.type == "BUMP" and _object_projected(tex)):
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
     for name in inputs:
         if node.inputs[name].is_linked:
@@ -504,13 +506,19 @@ def material_layers(node_tree, render_uv=None):
                           slopes="bump-node")
             alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
             if _object_projected(tex):
-                # Object coordinates, Flat: the height projected along z onto the object.
+                # Object coordinates: the height projected along z onto the object (Flat), or
+                # on the three axis planes as Blender's Box projection blends them (Box).
                 values.pop("uv_map", None)
-                values.update(type="planar", kind="height", axis="z")
+                if tex.projection == "BOX":
+                    values.update(type="triplanar", kind="height", projection="box",
+                                  box_blend=tex.projection_blend)
+                else:
+                    values.update(type="planar", kind="height", axis="z")
+                kind = values["type"]
                 if values.pop("strength") != 1.0:
-                    ignored.append(f"'{node.name}' Strength (a planar layer bumps fully)")
+                    ignored.append(f"'{node.name}' Strength (a {kind} layer bumps fully)")
                 if alpha:
-                    ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a planar "
+                    ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {kind} "
                                    "layer reads the luminance)")
             elif alpha:
                 values["channel"] = "a"

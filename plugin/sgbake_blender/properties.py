@@ -58,6 +58,11 @@ KINDS = (
     ("tangent-normal", "Tangent Normal", "The image holds tangent-space normals"),
     ("object-normal", "Object Normal", "The image holds object-space normals"),
 )
+PROJECTIONS = (
+    ("blended", "Blended", "sgbake's triplanar: each plane weighted by |normal|^Sharpness"),
+    ("box", "Box", "Blender's Image Texture Box projection with its Blend (kinds Height and "
+                   "Object Normal): what Cycles bakes"),
+)
 AXES = (("x", "X", "Project along X"), ("y", "Y", "Project along Y"),
         ("z", "Z", "Project along Z"))
 FUNCTIONS = (
@@ -127,6 +132,11 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     kind: EnumProperty(name="Kind", items=KINDS, default="height",
                        description="What the projected image holds")
     axis: EnumProperty(name="Axis", items=AXES, default="z")
+    projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
+                             description="How a triplanar layer lays out and blends its planes")
+    box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",
+                             description="Box projection: the Image Texture node's Blend, the "
+                                         "width of the seams where the planes mix")
     sharpness: FloatProperty(name="Sharpness", default=4.0, min=0.0,
                              description="Exponent of the triplanar blend weights")
     min_weight: FloatProperty(name="Minimum Weight", default=0.001, min=0.0, precision=4,

@@ -144,8 +144,11 @@ def layer_json(layer, uv_index, default_uv=None):
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
     elif layer.type == "triplanar":
-        entry.update(kind=layer.kind, scale=_number(layer.scale),
-                     sharpness=_number(layer.sharpness), min_weight=_number(layer.min_weight))
+        entry.update(kind=layer.kind, scale=_number(layer.scale))
+        if layer.projection == "box":
+            entry.update(projection="box", box_blend=_number(layer.box_blend))
+        else:
+            entry.update(sharpness=_number(layer.sharpness), min_weight=_number(layer.min_weight))
     if reads_tangent_normals(layer):
         entry["green"] = layer.green
     if layer.type == "height" or (layer.type in ("planar", "triplanar") and layer.kind == "height"):

@@ -146,8 +146,12 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 else:
                     col.prop(layer, "tangent_uv_map")
         if layer.type == "triplanar":
-            col.prop(layer, "sharpness")
-            col.prop(layer, "min_weight")
+            col.prop(layer, "projection")
+            if layer.projection == "box":
+                col.prop(layer, "box_blend")
+            else:
+                col.prop(layer, "sharpness")
+                col.prop(layer, "min_weight")
         if scene.reads_tangent_normals(layer):
             col.prop(layer, "green")
         if layer.type == "volume":

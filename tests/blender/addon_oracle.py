@@ -282,6 +282,11 @@ def layers_from_material(settings, distance):
     coordinates = tree.nodes.new("ShaderNodeTexCoord")
     tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
     planar, _, planar_ignored = operators.material_layers(tree)
+    # Box projection there: sgbake's triplanar with "projection": "box" and the node's Blend
+    # (BlenderBakeOracle's box cases check it against Cycles).
+    tex.projection, tex.projection_blend = "BOX", 0.25
+    box, _, box_ignored = operators.material_layers(tree)
+    tex.projection = "FLAT"
     coordinates.object = bpy.context.active_object
     _, _, other_ignored = operators.material_layers(tree)
     tree.nodes.remove(coordinates)
@@ -293,6 +298,14 @@ def layers_from_material(settings, distance):
         entry["error"] = (f"Object coordinates should make one {expected_planar} layer of "
                           f"scale {distance}, nothing named: {planar}, {planar_ignored}; "
                           f"another object's named: {other_ignored}")
+    expected_box = {"type": "triplanar", "kind": "height", "projection": "box",
+                    "slopes": "bump-node"}
+    if (len(box) != 1 or any(box[0].get(k) != v for k, v in expected_box.items())
+            or abs(box[0].get("box_blend", -1) - 0.25) > 1e-7 or "uv_map" in box[0]
+            or box_ignored):
+        entry["error"] = (f"a Box projection on object coordinates should make one "
+                          f"{expected_box} layer with box_blend 0.25, nothing named: {box}, "
+                          f"{box_ignored}")
     return entry
 
 
@@ -865,6 +878,15 @@ def options_case(settings, height, work):
                "expected": json.dumps(expected),
                "message": f"sent {json.dumps(sent)}; wrong (layer, key, sent, expected) "
                           f"{wrong}"}]
+    # Projection Box sends Blender's Blend instead of the blended projection's keys.
+    tri.projection, tri.box_blend = "box", 0.4
+    sent_box = operators.BakeJob(bpy.context).scene["layers"][2]
+    tri.projection = "blended"
+    want_box = {"projection": "box", "box_blend": f(tri.box_blend)}
+    checks.append({"name": "a triplanar layer's Projection Box in the add-on's scene JSON",
+                   "ok": all(sent_box.get(k) == v for k, v in want_box.items())
+                   and "sharpness" not in sent_box and "min_weight" not in sent_box,
+                   "expected": json.dumps(want_box), "message": f"sent {json.dumps(sent_box)}"})
     # The output's Swizzle: sent as "swizzle" (a DirectX green folded into its G), not "green";
     # the default sends "green" alone, as before. (BlenderSwizzleOracle checks the bake.)
     for kind, axes, green, want in (
