@@ -285,6 +285,13 @@ Result<int> layerMaterial(const Scene& scene, std::size_t index, Loaded& loaded)
   return *layer.material;
 }
 
+/// The object coordinates a projection layer reads (its "mapping", or P itself).
+CoordinateMapping coordinateMapping(const SceneLayer& layer) {
+  if (!layer.mapping) return {};
+  return CoordinateMapping::fromMappingNode(layer.mapping->location, layer.mapping->rotation,
+                                            layer.mapping->scale);
+}
+
 /// The library Layer of a planned layer (textures and volumes must be loaded).
 Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& loaded,
                         double objectSize) {
@@ -362,6 +369,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.mapping.axis = layer.axis;
       source.mapping.tiling = layer.tiling;
       source.mapping.offset = layer.offset;
+      source.mapping.coordinates = coordinateMapping(layer);
       source.scale = layer.scale;
       source.normal = projected;
       source.gradient = layer.heightGradient;
@@ -380,6 +388,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.options.minWeight = layer.minWeight;
       source.options.projection = layer.projection;
       source.options.boxBlend = layer.boxBlend;
+      source.options.coordinates = coordinateMapping(layer);
       source.options.normal = projected;
       source.gradient = layer.heightGradient;
       result.source = source;

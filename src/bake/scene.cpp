@@ -361,6 +361,7 @@ const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",  
                                                    "type",        "auto_smooth",
                                                    "sharp_edges"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
+const std::vector<std::string> kMappingKeys = {"location", "rotation", "scale"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask", "material"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
 
@@ -384,11 +385,11 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "gradient", "step", "base"});
       break;
     case SceneLayerType::kPlanar:
-      add({"kind", "axis", "scale", "green", "base", "gradient"});
+      add({"kind", "axis", "scale", "mapping", "green", "base", "gradient"});
       break;
     case SceneLayerType::kTriplanar:
-      add({"kind", "scale", "projection", "sharpness", "min_weight", "box_blend", "green", "base",
-           "gradient"});
+      add({"kind", "scale", "mapping", "projection", "sharpness", "min_weight", "box_blend",
+           "green", "base", "gradient"});
       break;
   }
   return keys;
@@ -667,6 +668,16 @@ SceneMask parseMask(const json& value, const std::string& where, const InputPath
   return mask;
 }
 
+SceneMapping parseMapping(const json& value, const std::string& where) {
+  const ObjectReader reader(value, where, "a mapping");
+  reader.checkKeys(kMappingKeys);
+  SceneMapping mapping;
+  if (reader.has("location")) mapping.location = reader.vec3("location");
+  if (reader.has("rotation")) mapping.rotation = reader.vec3("rotation");
+  if (reader.has("scale")) mapping.scale = reader.vec3("scale");
+  return mapping;
+}
+
 SceneLayer parseLayer(const json& value, const std::string& where, const InputPaths& paths,
                       int defaultUv) {
   SceneLayer layer;
@@ -725,6 +736,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
   if (reader.has("min_weight")) layer.minWeight = reader.numberAtLeast("min_weight", 0, false);
   reader.optionalName("projection", kProjections, layer.projection);
+  if (reader.has("mapping"))
+    layer.mapping = parseMapping(reader.at("mapping"), appendPath(where, "mapping"));
   if (reader.has("box_blend")) layer.boxBlend = reader.numberAtLeast("box_blend", 0, false);
 
   if (layer.type == SceneLayerType::kVolume) {
@@ -1433,6 +1446,12 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["min_weight"] = layer.minWeight;
       }
       break;
+  }
+  if (layer.mapping) {
+    const auto triple = [](const Vec3d& v) { return json::array({v.x, v.y, v.z}); };
+    j["mapping"] = {{"location", triple(layer.mapping->location)},
+                    {"rotation", triple(layer.mapping->rotation)},
+                    {"scale", triple(layer.mapping->scale)}};
   }
   if (layer.heightGradient != HeightGradient::kAnalytic && layer.projected()) {
     j["gradient"] = nameIn(kHeightGradients, layer.heightGradient);

@@ -24,6 +24,31 @@ Vec3d finiteOrZero(Vec3d gamma) { return isFinite(gamma) ? gamma : Vec3d{}; }
 
 }  // namespace
 
+CoordinateMapping CoordinateMapping::fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale) {
+  const auto turn = [](double angle, int axis) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    Mat3 r;
+    const std::size_t i = static_cast<std::size_t>((axis + 1) % 3),
+                      j = static_cast<std::size_t>((axis + 2) % 3);
+    r.col[i][i] = c;
+    r.col[i][j] = s;
+    r.col[j][i] = -s;
+    r.col[j][j] = c;
+    return r;
+  };
+  CoordinateMapping m;
+  m.linear =
+      turn(rotation.z, 2) * turn(rotation.y, 1) * turn(rotation.x, 0) * Mat3::diagonal(scale);
+  m.translation = location;
+  m.identity = location == Vec3d{} && rotation == Vec3d{} && scale == Vec3d{1, 1, 1};
+  return m;
+}
+
+Vec3d CoordinateMapping::pullBack(Vec3d gradient) const {
+  if (identity) return gradient;
+  return {dot(linear.col[0], gradient), dot(linear.col[1], gradient), dot(linear.col[2], gradient)};
+}
+
 PlaneAxes planeAxes(ProjectionAxis axis) { return planeAxes(PlanarMapping{axis}); }
 
 PlaneAxes planeAxes(const PlanarMapping& mapping) {
@@ -71,13 +96,14 @@ Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping) {
 }
 
 Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping) {
-  return textureCoordinates(planeCoordinates(position, mapping), mapping.tiling, mapping.offset);
+  return textureCoordinates(planeCoordinates(mapping.coordinates.apply(position), mapping),
+                            mapping.tiling, mapping.offset);
 }
 
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale) {
   const PlaneAxes axes = planeAxes(mapping);
-  return (scale * mapping.tiling.x * dhdst.x) * axes.s +
-         (scale * mapping.tiling.y * dhdst.y) * axes.t;
+  return mapping.coordinates.pullBack((scale * mapping.tiling.x * dhdst.x) * axes.s +
+                                      (scale * mapping.tiling.y * dhdst.y) * axes.t);
 }
 
 Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& mapping, double scale,
@@ -200,6 +226,7 @@ TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNorma
     const double w = weights.w[index(axis)];
     if (w == 0) continue;
     PlanarMapping mapping{axis, options.tiling, options.offset};
+    mapping.coordinates = options.coordinates;
     if (box) {
       mapping.layout = PlaneLayout::kBox;
       mapping.mirrored = boxPlaneMirrored(axis, seenNormal);

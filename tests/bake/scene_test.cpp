@@ -679,6 +679,34 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
             "triplanar layers)");
 }
 
+TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
+  Result<Scene> mapped = parseScene(withLayer(R"({"type": "planar", "image": "h.png",
+                    "mapping": {"location": [1, 2, 3], "rotation": [0, 0.5, 0]}})"),
+                                    options());
+  ASSERT_TRUE(mapped) << mapped.error().message;
+  ASSERT_TRUE(mapped->layers[0].mapping);
+  EXPECT_EQ(mapped->layers[0].mapping->location, (Vec3d{1, 2, 3}));
+  EXPECT_EQ(mapped->layers[0].mapping->rotation, (Vec3d{0, 0.5, 0}));
+  EXPECT_EQ(mapped->layers[0].mapping->scale, (Vec3d{1, 1, 1}));
+  EXPECT_NE(layerParametersJson(mapped->layers[0]).find(R"("mapping":)"), std::string::npos);
+  Result<Scene> plain =
+      parseScene(withLayer(R"({"type": "triplanar", "image": "h.png"})"), options());
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_FALSE(plain->layers[0].mapping);
+  EXPECT_EQ(layerParametersJson(plain->layers[0]).find("mapping"), std::string::npos);
+
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "triplanar", "image": "h.png", "mapping": {"rotate": [0, 0, 1]}})")),
+            "scene.json: layers[0].mapping: unknown key 'rotate' (expected location, rotation or "
+            "scale)");
+  EXPECT_EQ(parseError(
+                withLayer(R"({"type": "planar", "image": "h.png", "mapping": {"scale": [1, 2]}})")),
+            "scene.json: layers[0].mapping: 'scale' must be an array of 3 numbers, not an array");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "mapping": {}})")),
+            "scene.json: layers[0]: key 'mapping' does not apply to a height layer (it is for "
+            "planar or triplanar layers)");
+}
+
 TEST(Scene, SubdivisionIsParsedAndValidated) {
   Result<Scene> scene = parseScene(
       R"({"mesh": "m.obj", "subdivision": {"level": 2, "uv_smooth": "keep-corners",

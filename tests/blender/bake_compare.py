@@ -16,6 +16,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                      as Cycles' Bump node does)
   ours_bake_blended.exr  a Box-projection case's bump-node bake with sgbake's own triplanar
                      (projection "blended") instead (a negative control)
+  ours_bake_unmapped.exr  a mapped case's bump-node bake without its "mapping" (a negative
+                     control)
   ours_mask.exr      `sgbake bake --map mask`
   ours_nmap_tangent.exr, ours_nmap_object.exr   a normal-map case's scene (normal layer,
                      tangent- and object-normal outputs), against Blender's tangent and
@@ -111,6 +113,7 @@ def compare_case(entry):
                       ("bake_x2", "ours_bake_x2.exr"),
                       ("bake_bump_node", "ours_bake_bump_node.exr"),
                       ("bake_blended", "ours_bake_blended.exr"),
+                      ("bake_unmapped", "ours_bake_unmapped.exr"),
                       ("bake_object_space", "ours_bake_object_space.exr")):
         img = load_if(os.path.join(d, name))
         if img is None:

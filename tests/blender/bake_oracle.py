@@ -59,7 +59,9 @@ its bump-node bake (ours_bake_bump_node.exr) is judged as (e); they have no conv
 JSON checks. The Box cases (box_sphere, box_sphere_backfacing, box_stretch_sphere: Blender's Image
 Texture Box projection with Blend 0.3 on object coordinates) bake a "triplanar" layer with
 "projection": "box" the same way; their control ours_bake_blended.exr, sgbake's own triplanar
-blend (seed 003), must fail both (b) and (e).
+blend (seed 003), must fail both (b) and (e). box_mapped_sphere puts a Mapping node (Point: moved,
+turned, unevenly scaled) between the coordinates and the texture, the layer's "mapping"; its
+control ours_bake_unmapped.exr, the layer without it, must fail them too.
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -212,7 +214,7 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
                  "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
-                 "box_sphere", "box_sphere_backfacing", "box_stretch_sphere")
+                 "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere")
 
 
 def run_blender_script(blender, script, args):
@@ -279,9 +281,13 @@ def sgbake_case(cli, entry, sabotage, threads):
                  ("ours_bake_bump_node", bake_scale, "bump-node")]
         if box:
             bakes.append(("ours_bake_blended", bake_scale, "bump-node"))
+        if "mapping" in entry["planar"]:
+            bakes.append(("ours_bake_unmapped", bake_scale, "bump-node"))
         for name, layer_scale, gradient in bakes:
             layer = {"type": "planar", "image": p("height.exr"), "kind": "height", "axis": "z",
                      "scale": layer_scale, "filter": entry["filter"], "gradient": gradient}
+            if "mapping" in entry["planar"] and name != "ours_bake_unmapped":
+                layer["mapping"] = entry["planar"]["mapping"]
             if box:  # Blender's Box projection; the control: sgbake's own triplanar blend
                 del layer["axis"]
                 layer["type"] = "triplanar"
@@ -597,12 +603,16 @@ def evaluate(name, r, planar=False):
         if "bake" in r and "error" not in r["bake"] and passes_bump_node(r["bake"]):
             fails.append(f"{name}: negative control: the analytic bake passes the bump-node "
                          f"bars ({fmt(r['bake'])})")
-    if "bake_blended" in r:
-        s = r["bake_blended"]
-        print(f"      control, sgbake's blend:    {fmt(s)}")
+    for key, label, what in (("bake_blended", "sgbake's blend:   ",
+                              "sgbake's own triplanar blend instead of Blender's Box"),
+                             ("bake_unmapped", "without Mapping:  ", "its Mapping node left out")):
+        if key not in r:
+            continue
+        s = r[key]
+        print(f"      control, {label} {fmt(s)}")
         if "error" in s or passes_bump_node(s) or passes_bake(s, name):
-            fails.append(f"{name}: negative control: the bake with sgbake's own triplanar "
-                         f"blend instead of Blender's Box still passes ({fmt(s)})")
+            fails.append(f"{name}: negative control: the bake with {what} still passes "
+                         f"({fmt(s)})")
     if not missing("bake_x2", "2x-scale bake"):
         s = r["bake_x2"]
         print(f"      control, scale x2:          {fmt(s)}")

@@ -149,14 +149,18 @@ def transformed_case(name, of_case, location, rotation, scale, size=None):
 PLANAR = {}
 
 
-def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0):
+def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapping=None):
     """Registers case `name`: the mesh (and transform) of case `mesh_case`, its Bump (Distance
-    `scale`) fed by the height image projected onto object coordinates (`projection`)."""
+    `scale`) fed by the height image projected onto object coordinates (`projection`), moved
+    first by a Mapping node (Point) when `mapping` = (location, rotation, scale)."""
     CASES[name] = (CASES[mesh_case][0], size, scale)
     SUBDIVISION[name] = SUBDIVISION[mesh_case]
     if mesh_case in TRANSFORMS:
         TRANSFORMS[name] = TRANSFORMS[mesh_case]
     PLANAR[name] = {"projection": projection, "blend": blend}
+    if mapping is not None:
+        PLANAR[name]["mapping"] = {"location": list(mapping[0]), "rotation": list(mapping[1]),
+                                   "scale": list(mapping[2])}
 
 
 def apply_subdivision(ob, levels):
@@ -334,6 +338,9 @@ planar_case("planar_sphere_backfacing", "sphere_backfacing", 256, 0.02)
 planar_case("box_sphere", "sphere", 256, 0.02, "BOX", 0.3)
 planar_case("box_sphere_backfacing", "sphere_backfacing", 256, 0.02, "BOX", 0.3)
 planar_case("box_stretch_sphere", "stretch_sphere", 512, 0.02, "BOX", 0.3)
+# A Mapping node between the coordinates and the Box projection: moved, turned, unevenly scaled.
+planar_case("box_mapped_sphere", "sphere", 256, 0.02, "BOX", 0.3,
+            ((0.3, -0.2, 0.1), (0.4, 0.2, 0.7), (1.5, 0.8, 1.2)))
 
 
 def tilt_field(size, tilt_deg):
@@ -514,7 +521,16 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             tex.projection = PLANAR[name]["projection"]
             tex.projection_blend = PLANAR[name]["blend"]
             coordinates = nodes.new("ShaderNodeTexCoord")
-            mat.node_tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+            mapping = PLANAR[name].get("mapping")
+            if mapping is None:
+                mat.node_tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+            else:
+                node = nodes.new("ShaderNodeMapping")
+                node.vector_type = "POINT"
+                for key in ("location", "rotation", "scale"):
+                    node.inputs[key.title()].default_value = mapping[key]
+                mat.node_tree.links.new(coordinates.outputs["Object"], node.inputs["Vector"])
+                mat.node_tree.links.new(node.outputs["Vector"], tex.inputs["Vector"])
     else:
         if nmap["space"] == "TANGENT":
             field = normal_field(height_size, nmap["tilt_deg"])
@@ -552,6 +568,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
     if name in PLANAR:
         entry["planar"] = {"projection": PLANAR[name]["projection"].lower(),
                            "blend": PLANAR[name]["blend"]}
+        if "mapping" in PLANAR[name]:
+            entry["planar"]["mapping"] = PLANAR[name]["mapping"]
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}

@@ -577,5 +577,60 @@ TEST(BoxProjection, ObjectNormalsBlendTexelsThenDecode) {
   EXPECT_LT(maxAbsDiff(resolved, normalizeOr(blend, Vec3d{})), 1e-14);
 }
 
+// Blender's Mapping node (Point): scale, then the XYZ Euler rotation (x first), then location.
+TEST(CoordinateMapping, IsBlendersMappingNode) {
+  const double q = kPi / 2;
+  const CoordinateMapping turn = CoordinateMapping::fromMappingNode({}, {q, 0, q}, {1, 1, 1});
+  EXPECT_LT(maxAbsDiff(turn.apply({0, 1, 0}), Vec3d{0, 0, 1}), 1e-15);  // z first: (−1, 0, 0)
+  const CoordinateMapping scaled =
+      CoordinateMapping::fromMappingNode({0.5, -1, 2}, {0, 0, q}, {2, 1, 1});
+  EXPECT_LT(maxAbsDiff(scaled.apply({1, 0, 0}), Vec3d{0.5, 1, 2}), 1e-15);
+  EXPECT_TRUE(CoordinateMapping::fromMappingNode({}, {}, {1, 1, 1}).identity);
+  EXPECT_FALSE(scaled.identity);
+}
+
+// With a mapping, Γ is still the projected gradient of the height the planes read at P', checked
+// by central differences through planarTextureCoordinates, for planar and Box projections.
+TEST(CoordinateMapping, SlopesAreThoseOfTheMappedCoordinates) {
+  SineTexture tex;
+  const CoordinateMapping m =
+      CoordinateMapping::fromMappingNode({0.3, -0.2, 0.1}, {0.4, 0.2, 0.7}, {1.5, 0.8, 1.2});
+  std::mt19937_64 rng(33);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 100; ++i) {
+    const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+    const PlanarMapping planar{kAxes[i % 3],         {1.3, 0.7}, {0.2, -0.1},
+                               PlaneLayout::kCyclic, false,      m};
+    TriplanarOptions box;
+    box.projection = TriplanarProjection::kBox;
+    box.boxBlend = 0.5;
+    box.coordinates = m;
+    const TriplanarPlanes planes = triplanarPlanes(box, p.normal);
+    const auto planarHeight = [&](Vec3d x) {
+      return 0.5 * tex.sample(planarTextureCoordinates(x, planar)).value;
+    };
+    const auto boxHeight = [&](Vec3d x) {
+      double h = 0;
+      for (const WeightedPlane& plane : planes)
+        h += plane.weight * tex.sample(planarTextureCoordinates(x, plane.mapping)).value;
+      return h;
+    };
+    const auto projectedGradient = [&](const auto& height) {
+      const double e = 1e-6;
+      Vec3d grad{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        Vec3d d{};
+        d[k] = e;
+        grad[k] = (height(p.position + d) - height(p.position - d)) / (2 * e);
+      }
+      return grad - dot(grad, p.normal) * p.normal;
+    };
+    EXPECT_LT(
+        maxAbsDiff(planarHeightGradient(tex, planar, 0.5, p), projectedGradient(planarHeight)),
+        1e-8);
+    EXPECT_LT(maxAbsDiff(triplanarHeightGradient(tex, box, p), projectedGradient(boxHeight)), 1e-8);
+  }
+}
+
 }  // namespace
 }  // namespace sgbake

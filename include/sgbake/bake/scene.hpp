@@ -112,6 +112,16 @@ struct SceneSubdivision {
   }
 };
 
+/// @brief A projection's optional "mapping": Blender's Mapping node (type Point) between a
+/// Texture Coordinate node's Object output and the Image Texture: the projection reads
+/// R · (scale ∘ P) + location (CoordinateMapping). {"location", "rotation" (radians, XYZ Euler),
+/// "scale"}, each optional.
+struct SceneMapping {
+  Vec3d location{};
+  Vec3d rotation{};
+  Vec3d scale{1, 1, 1};
+};
+
 /// @brief A layer's optional "mask": a scalar image on a UV set that scales its Γ (LayerMask).
 /// Written either as a file name or as {"image", "uv", "tiling", "offset", "filter"}.
 struct SceneMask {
@@ -160,6 +170,7 @@ struct SceneLayer {
   /// (Blender's Image Texture Box projection, kinds height and object-normal)
   TriplanarProjection projection = TriplanarProjection::kBlended;
   double boxBlend = kDefaultBoxBlend;  ///< "box_blend" (triplanar box): Blender's Blend, 0 … 1
+  std::optional<SceneMapping> mapping;  ///< "mapping" (planar, triplanar)
   /// "base" (heights): "surface" (N, the default) or "above" (the normal the layers above make,
   /// as a Bump node whose Normal input is linked to them; LayerBase::kLayersAbove)
   LayerBase base = LayerBase::kSurface;

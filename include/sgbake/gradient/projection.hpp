@@ -59,6 +59,26 @@ PlaneAxes planeAxes(ProjectionAxis axis);
 /// (z, x) for Y.
 Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis);
 
+/// @brief Object coordinates moved before a projection reads them, as Blender's Mapping node
+/// (type Point) moves a Texture Coordinate node's Object output: P' = linear · P + translation,
+/// linear = R · diag(scale) with R the rotation of an XYZ Euler (x first, then y, then z).
+/// A projection's planes and slopes are those of P' (the slopes pulled back by linearᵀ); a
+/// Box projection still picks its planes by the object's normal, as Cycles does.
+struct CoordinateMapping {
+  Mat3 linear = Mat3::identity();
+  Vec3d translation{};
+  bool identity = true;  ///< linear the identity and no translation: P' = P, nothing to do
+
+  /// The Mapping node's Location, Rotation (radians, XYZ Euler) and Scale.
+  static CoordinateMapping fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale);
+  /// P'.
+  Vec3d apply(Vec3d position) const {
+    return identity ? position : linear * position + translation;
+  }
+  /// The object-space gradient of a function of P' whose gradient w.r.t. P' is @p gradient.
+  Vec3d pullBack(Vec3d gradient) const;
+};
+
 /// @brief Which object coordinates texture a plane (before tiling).
 enum class PlaneLayout {
   kCyclic,  ///< the cyclic pairs of the table above: (y, z), (z, x), (x, y)
@@ -75,6 +95,7 @@ struct PlanarMapping {
   /// The first plane coordinate is 1 − s (its axis −e_s): a Box plane seen from the side that
   /// Cycles mirrors (boxPlaneMirrored). Only kBox mappings are mirrored.
   bool mirrored = false;
+  CoordinateMapping coordinates{};  ///< applied to P before the plane reads it
 };
 
 /// @brief The axes of a plane as @p mapping lays it out: s and t the object-space directions
@@ -84,12 +105,12 @@ PlaneAxes planeAxes(const PlanarMapping& mapping);
 /// @brief Plane coordinates of an object-space point under @p mapping, before tiling.
 Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping);
 
-/// @brief Texture coordinates of @p position under @p mapping.
+/// @brief Texture coordinates of @p position under @p mapping (its coordinates first).
 Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping);
 
-/// @brief Volume gradient of `scale · h(tiling ∘ planeCoordinates(P, mapping) + offset)`:
+/// @brief Volume gradient of `scale · h(planarTextureCoordinates(P, mapping))`:
 /// scale · (tiling.x · dhdst.x · s + tiling.y · dhdst.y · t) with s, t = planeAxes(mapping),
-/// object units per object unit.
+/// pulled back through mapping.coordinates; object units per object unit.
 ///
 /// @param[in] dhdst (∂h/∂s, ∂h/∂t) at the point, per texture unit
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale);
@@ -195,6 +216,7 @@ struct TriplanarOptions {
   ProjectedNormalOptions normal{};                ///< decoding of normal maps
   TriplanarProjection projection = TriplanarProjection::kBlended;
   double boxBlend = kDefaultBoxBlend;  ///< kBox: Blender's Blend, see boxProjectionWeights
+  CoordinateMapping coordinates{};     ///< applied to P before every plane reads it
 };
 
 /// @brief One plane of a triplanar lookup: how it is textured and its weight (> 0).
