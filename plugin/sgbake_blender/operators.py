@@ -414,15 +414,37 @@ def _not_image(socket):
     return f"{socket.name} is not an Image Texture node"
 
 
-def _object_projected(tex):
-    """Whether Image Texture node `tex` reads the baked object's own coordinates: its Vector
-    straight from a Texture Coordinate node's Object output (no other object named), Flat or
-    Box projection. Its height is then sgbake's planar layer on axis z (Flat) or its triplanar
-    layer with Blender's Box projection (Box)."""
+MAPPING_INPUTS = ("Location", "Rotation", "Scale")
+
+
+def _object_coordinates(tex):
+    """How Image Texture node `tex` reads the baked object's own coordinates: None when it
+    does not; else the layer settings of a Mapping node between them (empty without one). It
+    does when its projection is Flat or Box and its Vector comes from a Texture Coordinate
+    node's Object output (no other object named), straight or through one Mapping node of type
+    Point whose Location, Rotation and Scale are its own values. Its height is then sgbake's
+    planar layer on axis z (Flat) or its triplanar layer with Blender's Box projection (Box)."""
+    if tex.projection not in ("FLAT", "BOX"):
+        return None
     link = _source_link(tex.inputs["Vector"])
-    return (link is not None and link.from_node.type == "TEX_COORD"
-            and link.from_socket.name == "Object" and link.from_node.object is None
-            and tex.projection in ("FLAT", "BOX"))
+    settings = {}
+    if link is not None and link.from_node.type == "MAPPING":
+        node = link.from_node
+        if node.vector_type != "POINT" or any(node.inputs[n].is_linked for n in MAPPING_INPUTS):
+            return None
+        for name in MAPPING_INPUTS:
+            settings[f"mapping_{name.lower()}"] = tuple(node.inputs[name].default_value)
+        link = _source_link(node.inputs["Vector"])
+    if (link is None or link.from_node.type != "TEX_COORD" or link.from_socket.name != "Object"
+            or link.from_node.object is not None):
+        return None
+    return settings
+
+
+def _object_projected(tex):
+    """Whether Image Texture node `tex` reads the baked object's own coordinates
+    (_object_coordinates)."""
+    return _object_coordinates(tex) is not None
 
 
 def _ignored(node, tex, inputs, socket):
@@ -509,6 +531,7 @@ def material_layers(node_tree, render_uv=None):
                 # Object coordinates: the height projected along z onto the object (Flat), or
                 # on the three axis planes as Blender's Box projection blends them (Box).
                 values.pop("uv_map", None)
+                values.update(_object_coordinates(tex))
                 if tex.projection == "BOX":
                     values.update(type="triplanar", kind="height", projection="box",
                                   box_blend=tex.projection_blend)

@@ -132,6 +132,17 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     kind: EnumProperty(name="Kind", items=KINDS, default="height",
                        description="What the projected image holds")
     axis: EnumProperty(name="Axis", items=AXES, default="z")
+    mapping_location: FloatVectorProperty(
+        name="Location", size=3, default=(0.0, 0.0, 0.0), subtype="TRANSLATION",
+        description="Projections: a Mapping node's Location, added to the object coordinates "
+                    "after its Rotation and Scale")
+    mapping_rotation: FloatVectorProperty(
+        name="Rotation", size=3, default=(0.0, 0.0, 0.0), subtype="EULER",
+        description="Projections: a Mapping node's Rotation (XYZ Euler) of the object "
+                    "coordinates")
+    mapping_scale: FloatVectorProperty(
+        name="Scale", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ",
+        description="Projections: a Mapping node's Scale of the object coordinates")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",

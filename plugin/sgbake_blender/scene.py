@@ -149,6 +149,12 @@ def layer_json(layer, uv_index, default_uv=None):
             entry.update(projection="box", box_blend=_number(layer.box_blend))
         else:
             entry.update(sharpness=_number(layer.sharpness), min_weight=_number(layer.min_weight))
+    if layer.type in ("planar", "triplanar"):
+        mapping = {"location": [_number(c) for c in layer.mapping_location],
+                   "rotation": [_number(c) for c in layer.mapping_rotation],
+                   "scale": [_number(c) for c in layer.mapping_scale]}
+        if mapping != {"location": [0.0] * 3, "rotation": [0.0] * 3, "scale": [1.0] * 3}:
+            entry["mapping"] = mapping  # a Mapping node before the projection
     if reads_tangent_normals(layer):
         entry["green"] = layer.green
     if layer.type == "height" or (layer.type in ("planar", "triplanar") and layer.kind == "height"):

@@ -119,6 +119,11 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 col.prop(layer, "kind")
             if layer.type == "planar":
                 col.prop(layer, "axis")
+            if layer.type in ("planar", "triplanar"):
+                box = col.box()
+                box.label(text="Mapping")
+                for name in ("mapping_location", "mapping_rotation", "mapping_scale"):
+                    box.prop(layer, name)
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
             if layer.type == "height":
                 col.prop(layer, "strength")

@@ -286,6 +286,16 @@ def layers_from_material(settings, distance):
     # (BlenderBakeOracle's box cases check it against Cycles).
     tex.projection, tex.projection_blend = "BOX", 0.25
     box, _, box_ignored = operators.material_layers(tree)
+    # A Mapping node (Point) between them: its Location, Rotation and Scale, nothing named.
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    moved = {"Location": (0.5, -0.25, 1.0), "Rotation": (0.1, 0.2, 0.3), "Scale": (2.0, 1.0, 0.5)}
+    for name, value in moved.items():
+        mapping.inputs[name].default_value = value
+    tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    mapped, _, mapped_ignored = operators.material_layers(tree)
+    tree.nodes.remove(mapping)
+    tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
     tex.projection = "FLAT"
     coordinates.object = bpy.context.active_object
     _, _, other_ignored = operators.material_layers(tree)
@@ -306,6 +316,13 @@ def layers_from_material(settings, distance):
         entry["error"] = (f"a Box projection on object coordinates should make one "
                           f"{expected_box} layer with box_blend 0.25, nothing named: {box}, "
                           f"{box_ignored}")
+    got = mapped[0] if len(mapped) == 1 else {}
+    if (got.get("type") != "triplanar" or mapped_ignored
+            or any(max((abs(a - b) for a, b in zip(got.get(f"mapping_{name.lower()}", ()),
+                                                   value)), default=1) > 1e-6
+                   for name, value in moved.items())):
+        entry["error"] = (f"a Mapping node between the coordinates and the Box projection should "
+                          f"give its {moved}, nothing named: {mapped}, {mapped_ignored}")
     return entry
 
 
@@ -879,11 +896,14 @@ def options_case(settings, height, work):
                "message": f"sent {json.dumps(sent)}; wrong (layer, key, sent, expected) "
                           f"{wrong}"}]
     # Projection Box sends Blender's Blend instead of the blended projection's keys.
-    tri.projection, tri.box_blend = "box", 0.4
+    tri.projection, tri.box_blend, tri.mapping_rotation = "box", 0.4, (0.0, 0.5, 0.0)
     sent_box = operators.BakeJob(bpy.context).scene["layers"][2]
-    tri.projection = "blended"
-    want_box = {"projection": "box", "box_blend": f(tri.box_blend)}
-    checks.append({"name": "a triplanar layer's Projection Box in the add-on's scene JSON",
+    want_box = {"projection": "box", "box_blend": f(tri.box_blend),
+                "mapping": {"location": [0.0] * 3, "rotation": [0.0, f(tri.mapping_rotation[1]), 0.0],
+                            "scale": [1.0] * 3}}
+    tri.projection, tri.mapping_rotation = "blended", (0.0, 0.0, 0.0)
+    checks.append({"name": "a triplanar layer's Projection Box and Mapping in the add-on's "
+                           "scene JSON",
                    "ok": all(sent_box.get(k) == v for k, v in want_box.items())
                    and "sharpness" not in sent_box and "min_weight" not in sent_box,
                    "expected": json.dumps(want_box), "message": f"sent {json.dumps(sent_box)}"})
