@@ -272,7 +272,7 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             return {"CANCELLED"}
         render_uv = (gather.render_uv_name(ob.data)
                      if ob.type == "MESH" and ob.data.uv_layers else None)
-        found, more_skipped, ignored = object_layers(sources, render_uv)
+        found, more_skipped, ignored = object_layers(sources, render_uv, ob)
         skipped += more_skipped
         single = sources[0][0] is None  # one material for every face
         if not found:
@@ -329,7 +329,7 @@ def material_sources(ob):
     return sources, skipped
 
 
-def object_layers(sources, render_uv=None):
+def object_layers(sources, render_uv=None, ob=None):
     """material_layers of every (slot, material) of `sources` (material_sources), in slot
     order: (layer settings, skipped, ignored). With several slots each layer gets its slot as
     material_index (libsgbake applies it to that slot's faces only) and each note names its
@@ -339,7 +339,7 @@ def object_layers(sources, render_uv=None):
     material only."""
     found, skipped, ignored = [], [], []
     for slot, material in sources:
-        values, slot_skipped, slot_ignored = material_layers(material.node_tree, render_uv)
+        values, slot_skipped, slot_ignored = material_layers(material.node_tree, render_uv, ob)
         if slot is not None:
             where = f"material '{material.name}' (slot {slot})"
             for entry in values:
@@ -417,13 +417,38 @@ def _not_image(socket):
 MAPPING_INPUTS = ("Location", "Rotation", "Scale")
 
 
-def _object_coordinates(tex):
-    """How Image Texture node `tex` reads the baked object's own coordinates: None when it
-    does not; else the layer settings of a Mapping node between them (empty without one). It
-    does when its projection is Flat or Box and its Vector comes from a Texture Coordinate
-    node's Object output (no other object named), straight or through one Mapping node of type
-    Point whose Location, Rotation and Scale are its own values. Its height is then sgbake's
-    planar layer on axis z (Flat) or its triplanar layer with Blender's Box projection (Box)."""
+def _coordinates_matrix(link, ob):
+    """The coordinates a Texture Coordinate node's output `link` gives on object `ob`, as an
+    affine map of `ob`'s own (12 numbers, row by row); None when they are not one (or `ob` is
+    not known), the identity (None too) for its Object output without another object. Object
+    with another object named: inverse(its matrix_world) @ ob.matrix_world. Generated: the
+    texture space of ob's mesh (the bounding box, by default) to [0, 1]. Both as they are now:
+    moving the other object or the mesh later needs Layers from Material again."""
+    node, output = link.from_node, link.from_socket.name
+    if output == "Object" and node.object is not None and ob is not None:
+        m = node.object.matrix_world.inverted_safe() @ ob.matrix_world
+        return tuple(m[r][c] for r in range(3) for c in range(4))
+    if output == "Generated" and ob is not None and ob.type == "MESH":
+        loc, size = ob.data.texspace_location, ob.data.texspace_size
+        if any(s == 0 for s in size):
+            return None
+        rows = [[0.0] * 4 for _ in range(3)]
+        for i in range(3):
+            rows[i][i] = 0.5 / size[i]
+            rows[i][3] = 0.5 - 0.5 * loc[i] / size[i]
+        return tuple(v for row in rows for v in row)
+    return None
+
+
+def _object_coordinates(tex, ob=None):
+    """How Image Texture node `tex` reads object coordinates: None when it does not; else the
+    layer settings of what lies between (empty for the object's own). It does when its
+    projection is Flat or Box and its Vector comes from a Texture Coordinate node's Object
+    output (the baked object's own coordinates; another object's, or its Generated output, when
+    the baked object `ob` is known: mapping_matrix), straight or through one Mapping node of
+    type Point whose Location, Rotation and Scale are its own values. Its height is then
+    sgbake's planar layer on axis z (Flat) or its triplanar layer with Blender's Box projection
+    (Box)."""
     if tex.projection not in ("FLAT", "BOX"):
         return None
     link = _source_link(tex.inputs["Vector"])
@@ -435,19 +460,23 @@ def _object_coordinates(tex):
         for name in MAPPING_INPUTS:
             settings[f"mapping_{name.lower()}"] = tuple(node.inputs[name].default_value)
         link = _source_link(node.inputs["Vector"])
-    if (link is None or link.from_node.type != "TEX_COORD" or link.from_socket.name != "Object"
-            or link.from_node.object is not None):
+    if link is None or link.from_node.type != "TEX_COORD":
         return None
+    own = link.from_socket.name == "Object" and link.from_node.object is None
+    matrix = None if own else _coordinates_matrix(link, ob)
+    if not own and matrix is None:
+        return None
+    if matrix is not None:
+        settings["mapping_matrix"] = matrix
     return settings
 
 
-def _object_projected(tex):
-    """Whether Image Texture node `tex` reads the baked object's own coordinates
-    (_object_coordinates)."""
-    return _object_coordinates(tex) is not None
+def _object_projected(tex, ob=None):
+    """Whether Image Texture node `tex` reads object coordinates (_object_coordinates)."""
+    return _object_coordinates(tex, ob) is not None
 
 
-def _ignored(node, tex, inputs, socket):
+def _ignored(node, tex, inputs, socket, ob=None):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
     input other than a UV map (a Mapping node, object or generated coordinates; a Bump's own
@@ -464,10 +493,10 @@ def _ignored(node, tex, inputs, socket):
     if link is not None:
         uv = link.from_node.type == "UVMAP" or (link.from_node.type == "TEX_COORD"
                                                  and link.from_socket.name == "UV")
-        planar = node.type == "BUMP" and _object_projected(tex)
+        planar = node.type == "BUMP" and _object_projected(tex, ob)
         if not uv and not planar:
             notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
-    if tex.projection != "FLAT" and not (node.type == "BUMP" and _object_projected(tex)):
+    if tex.projection != "FLAT" and not (node.type == "BUMP" and _object_projected(tex, ob)):
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
     for name in inputs:
         if node.inputs[name].is_linked:
@@ -491,12 +520,13 @@ def _texture_settings(node, render_uv=None):
     return values
 
 
-def material_layers(node_tree, render_uv=None):
+def material_layers(node_tree, render_uv=None, ob=None):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
     and each Normal Map node whose Color input is an Image Texture node, among the nodes that
     reach the Surface of the material's output; and notes on the Bump and Normal Map nodes that
     were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV map
-    active for rendering (what Cycles reads a texture without a UV Map node on).
+    active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
+    object baked (for textures on another object's or Generated coordinates).
 
     Bump: scale = Distance, negated when Invert is on, and its Strength (the blend of the bumped
     normal with the original one, as Cycles' Bump node does it); when its Normal input comes
@@ -518,7 +548,7 @@ def material_layers(node_tree, render_uv=None):
             if tex is None:
                 skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
                 continue
-            ignored += _ignored(node, tex, ("Strength", "Distance"), "Height")
+            ignored += _ignored(node, tex, ("Strength", "Distance"), "Height", ob)
             scale = node.inputs["Distance"].default_value
             values = _texture_settings(tex, render_uv)
             # The node's slopes as Cycles takes them when it bakes (forward differences half
@@ -527,11 +557,11 @@ def material_layers(node_tree, render_uv=None):
                           strength=max(node.inputs["Strength"].default_value, 0.0),
                           slopes="bump-node")
             alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
-            if _object_projected(tex):
+            if _object_projected(tex, ob):
                 # Object coordinates: the height projected along z onto the object (Flat), or
                 # on the three axis planes as Blender's Box projection blends them (Box).
                 values.pop("uv_map", None)
-                values.update(_object_coordinates(tex))
+                values.update(_object_coordinates(tex, ob))
                 if tex.projection == "BOX":
                     values.update(type="triplanar", kind="height", projection="box",
                                   box_blend=tex.projection_blend)

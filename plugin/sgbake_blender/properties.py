@@ -143,6 +143,12 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     mapping_scale: FloatVectorProperty(
         name="Scale", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ",
         description="Projections: a Mapping node's Scale of the object coordinates")
+    mapping_matrix: FloatVectorProperty(
+        name="Coordinates", size=12, default=(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+                                              0.0, 0.0, 1.0, 0.0),
+        description="Projections: the coordinates read, as an affine map of the object's own "
+                    "(3 rows of 4; set by Layers from Material from another object's or the "
+                    "Generated coordinates), before the Mapping")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",

@@ -153,8 +153,11 @@ def layer_json(layer, uv_index, default_uv=None):
         mapping = {"location": [_number(c) for c in layer.mapping_location],
                    "rotation": [_number(c) for c in layer.mapping_rotation],
                    "scale": [_number(c) for c in layer.mapping_scale]}
+        matrix = [_number(c) for c in layer.mapping_matrix]
+        if matrix != [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]:
+            mapping["matrix"] = [matrix[0:4], matrix[4:8], matrix[8:12]]
         if mapping != {"location": [0.0] * 3, "rotation": [0.0] * 3, "scale": [1.0] * 3}:
-            entry["mapping"] = mapping  # a Mapping node before the projection
+            entry["mapping"] = mapping  # other coordinates, a Mapping node before the projection
     if reads_tangent_normals(layer):
         entry["green"] = layer.green
     if layer.type == "height" or (layer.type in ("planar", "triplanar") and layer.kind == "height"):

@@ -124,6 +124,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 box.label(text="Mapping")
                 for name in ("mapping_location", "mapping_rotation", "mapping_scale"):
                     box.prop(layer, name)
+                if tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0):
+                    box.label(text="Coordinates: another object's or Generated")
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
             if layer.type == "height":
                 col.prop(layer, "strength")

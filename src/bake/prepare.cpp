@@ -288,8 +288,11 @@ Result<int> layerMaterial(const Scene& scene, std::size_t index, Loaded& loaded)
 /// The object coordinates a projection layer reads (its "mapping", or P itself).
 CoordinateMapping coordinateMapping(const SceneLayer& layer) {
   if (!layer.mapping) return {};
-  return CoordinateMapping::fromMappingNode(layer.mapping->location, layer.mapping->rotation,
-                                            layer.mapping->scale);
+  const SceneMapping& m = *layer.mapping;
+  const CoordinateMapping node =
+      CoordinateMapping::fromMappingNode(m.location, m.rotation, m.scale);
+  if (!m.matrix) return node;
+  return node.after(CoordinateMapping::affine(*m.matrix, m.matrixTranslation));
 }
 
 /// The library Layer of a planned layer (textures and volumes must be loaded).

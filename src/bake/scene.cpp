@@ -361,7 +361,7 @@ const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",  
                                                    "type",        "auto_smooth",
                                                    "sharp_edges"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
-const std::vector<std::string> kMappingKeys = {"location", "rotation", "scale"};
+const std::vector<std::string> kMappingKeys = {"location", "rotation", "scale", "matrix"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask", "material"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
 
@@ -675,6 +675,31 @@ SceneMapping parseMapping(const json& value, const std::string& where) {
   if (reader.has("location")) mapping.location = reader.vec3("location");
   if (reader.has("rotation")) mapping.rotation = reader.vec3("rotation");
   if (reader.has("scale")) mapping.scale = reader.vec3("scale");
+  if (reader.has("matrix")) {
+    const json& rows = reader.at("matrix");
+    const auto bad = [&](const std::string& why) { fail(where, "matrix " + why); };
+    if (!rows.is_array() || (rows.size() != 3 && rows.size() != 4)) {
+      bad("must be 3 rows of 4 numbers (or 4, the last [0, 0, 0, 1])");
+    }
+    double m[4][4] = {};
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      if (!rows[r].is_array() || rows[r].size() != 4) {
+        bad("row " + std::to_string(r) + " must be 4 numbers");
+      }
+      for (std::size_t c = 0; c < 4; ++c) {
+        if (!rows[r][c].is_number() || !std::isfinite(rows[r][c].get<double>())) {
+          bad("[" + std::to_string(r) + "][" + std::to_string(c) + "] must be a finite number");
+        }
+        m[r][c] = rows[r][c].get<double>();
+      }
+    }
+    if (rows.size() == 4 && (m[3][0] != 0 || m[3][1] != 0 || m[3][2] != 0 || m[3][3] != 1)) {
+      bad("row 3 must be [0, 0, 0, 1] (an affine map)");
+    }
+    mapping.matrix = Mat3::fromColumns({m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
+                                       {m[0][2], m[1][2], m[2][2]});
+    mapping.matrixTranslation = {m[0][3], m[1][3], m[2][3]};
+  }
   return mapping;
 }
 
@@ -1452,6 +1477,12 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     j["mapping"] = {{"location", triple(layer.mapping->location)},
                     {"rotation", triple(layer.mapping->rotation)},
                     {"scale", triple(layer.mapping->scale)}};
+    if (const std::optional<Mat3>& a = layer.mapping->matrix) {
+      const Vec3d& t = layer.mapping->matrixTranslation;
+      j["mapping"]["matrix"] = {{(*a)(0, 0), (*a)(0, 1), (*a)(0, 2), t.x},
+                                {(*a)(1, 0), (*a)(1, 1), (*a)(1, 2), t.y},
+                                {(*a)(2, 0), (*a)(2, 1), (*a)(2, 2), t.z}};
+    }
   }
   if (layer.heightGradient != HeightGradient::kAnalytic && layer.projected()) {
     j["gradient"] = nameIn(kHeightGradients, layer.heightGradient);

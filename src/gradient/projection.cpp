@@ -44,6 +44,22 @@ CoordinateMapping CoordinateMapping::fromMappingNode(Vec3d location, Vec3d rotat
   return m;
 }
 
+CoordinateMapping CoordinateMapping::affine(const Mat3& linear, Vec3d translation) {
+  CoordinateMapping m;
+  m.linear = linear;
+  m.translation = translation;
+  const Mat3 one = Mat3::identity();
+  m.identity = translation == Vec3d{} && linear.col[0] == one.col[0] &&
+               linear.col[1] == one.col[1] && linear.col[2] == one.col[2];
+  return m;
+}
+
+CoordinateMapping CoordinateMapping::after(const CoordinateMapping& first) const {
+  if (identity) return first;
+  if (first.identity) return *this;
+  return affine(linear * first.linear, linear * first.translation + translation);
+}
+
 Vec3d CoordinateMapping::pullBack(Vec3d gradient) const {
   if (identity) return gradient;
   return {dot(linear.col[0], gradient), dot(linear.col[1], gradient), dot(linear.col[2], gradient)};

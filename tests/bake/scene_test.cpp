@@ -697,11 +697,29 @@ TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
 
   EXPECT_EQ(parseError(withLayer(
                 R"({"type": "triplanar", "image": "h.png", "mapping": {"rotate": [0, 0, 1]}})")),
-            "scene.json: layers[0].mapping: unknown key 'rotate' (expected location, rotation or "
-            "scale)");
+            "scene.json: layers[0].mapping: unknown key 'rotate' (expected location, rotation, "
+            "scale or matrix)");
   EXPECT_EQ(parseError(
                 withLayer(R"({"type": "planar", "image": "h.png", "mapping": {"scale": [1, 2]}})")),
             "scene.json: layers[0].mapping: 'scale' must be an array of 3 numbers, not an array");
+  Result<Scene> matrix = parseScene(withLayer(R"({"type": "triplanar", "image": "h.png",
+                    "mapping": {"matrix": [[0, 1, 0, 5], [2, 0, 0, 6], [0, 0, 3, 7]]}})"),
+                                    options());
+  ASSERT_TRUE(matrix) << matrix.error().message;
+  ASSERT_TRUE(matrix->layers[0].mapping->matrix);
+  EXPECT_EQ((*matrix->layers[0].mapping->matrix)(1, 0), 2);  // row 1, column 0
+  EXPECT_EQ((*matrix->layers[0].mapping->matrix)(0, 1), 1);
+  EXPECT_EQ(matrix->layers[0].mapping->matrixTranslation, (Vec3d{5, 6, 7}));
+  EXPECT_NE(layerParametersJson(matrix->layers[0]).find(R"("matrix":[[0.0,1.0,0.0,5.0])"),
+            std::string::npos)
+      << layerParametersJson(matrix->layers[0]);
+  EXPECT_EQ(parseError(withLayer(R"({"type": "planar", "image": "h.png",
+                                     "mapping": {"matrix": [[1, 0, 0, 0], [0, 1, 0, 0]]}})")),
+            "scene.json: layers[0].mapping: matrix must be 3 rows of 4 numbers (or 4, the last "
+            "[0, 0, 0, 1])");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "planar", "image": "h.png", "mapping": {"matrix":
+                [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]}})")),
+            "scene.json: layers[0].mapping: matrix row 3 must be [0, 0, 0, 1] (an affine map)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "mapping": {}})")),
             "scene.json: layers[0]: key 'mapping' does not apply to a height layer (it is for "
             "planar or triplanar layers)");

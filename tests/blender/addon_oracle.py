@@ -295,7 +295,33 @@ def layers_from_material(settings, distance):
     tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
     mapped, _, mapped_ignored = operators.material_layers(tree)
     tree.nodes.remove(mapping)
+    # Another object's coordinates (an Empty as a projector) and the Generated ones, given the
+    # baked object: an affine map of its own, row by row (BlenderBakeOracle's box_empty_sphere
+    # and box_generated_sphere check such maps against Cycles).
+    ob = bpy.context.active_object
+    empty = bpy.data.objects.new("projector", None)
+    bpy.context.scene.collection.objects.link(empty)
+    empty.location, empty.rotation_euler, empty.scale = (0.2, 0.4, -0.3), (0.3, -0.5, 0.2), \
+        (0.7, 1.3, 0.9)
+    bpy.context.view_layer.update()
+    coordinates.object = empty
     tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+    projector, _, projector_ignored = operators.material_layers(tree, None, ob)
+    want = empty.matrix_world.inverted() @ ob.matrix_world
+    coordinates.object = None
+    tree.links.new(coordinates.outputs["Generated"], tex.inputs["Vector"])
+    generated, _, _ = operators.material_layers(tree, None, ob)
+    bpy.data.objects.remove(empty)
+    tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+    got = projector[0].get("mapping_matrix", ()) if len(projector) == 1 else ()
+    size = ob.data.texspace_size
+    gen = generated[0].get("mapping_matrix", ()) if len(generated) == 1 else ()
+    if (len(got) != 12 or projector_ignored
+            or max(abs(got[4 * r + c] - want[r][c]) for r in range(3) for c in range(4)) > 1e-6
+            or len(gen) != 12 or abs(gen[0] - 0.5 / size[0]) > 1e-6):
+        entry["error"] = (f"an Empty's coordinates should give mapping_matrix {list(want)} and "
+                          f"nothing named, the Generated ones 0.5 / size first: {projector}, "
+                          f"{projector_ignored}, {generated}")
     tex.projection = "FLAT"
     coordinates.object = bpy.context.active_object
     _, _, other_ignored = operators.material_layers(tree)

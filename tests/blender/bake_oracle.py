@@ -214,7 +214,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
                  "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
-                 "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere")
+                 "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
+                 "box_empty_sphere", "box_generated_sphere")
 
 
 def run_blender_script(blender, script, args):

@@ -77,6 +77,7 @@ import sys
 import time
 
 import bpy
+import mathutils
 
 sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -149,10 +150,13 @@ def transformed_case(name, of_case, location, rotation, scale, size=None):
 PLANAR = {}
 
 
-def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapping=None):
+def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapping=None,
+                coordinates=None):
     """Registers case `name`: the mesh (and transform) of case `mesh_case`, its Bump (Distance
     `scale`) fed by the height image projected onto object coordinates (`projection`), moved
-    first by a Mapping node (Point) when `mapping` = (location, rotation, scale)."""
+    first by a Mapping node (Point) when `mapping` = (location, rotation, scale). `coordinates`:
+    ("EMPTY", (location, rotation, scale)), the Object coordinates of an Empty placed so, or
+    ("GENERATED",), the Generated ones, instead of the object's own."""
     CASES[name] = (CASES[mesh_case][0], size, scale)
     SUBDIVISION[name] = SUBDIVISION[mesh_case]
     if mesh_case in TRANSFORMS:
@@ -161,6 +165,8 @@ def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapp
     if mapping is not None:
         PLANAR[name]["mapping"] = {"location": list(mapping[0]), "rotation": list(mapping[1]),
                                    "scale": list(mapping[2])}
+    if coordinates is not None:
+        PLANAR[name]["coordinates"] = coordinates
 
 
 def apply_subdivision(ob, levels):
@@ -341,6 +347,13 @@ planar_case("box_stretch_sphere", "stretch_sphere", 512, 0.02, "BOX", 0.3)
 # A Mapping node between the coordinates and the Box projection: moved, turned, unevenly scaled.
 planar_case("box_mapped_sphere", "sphere", 256, 0.02, "BOX", 0.3,
             ((0.3, -0.2, 0.1), (0.4, 0.2, 0.7), (1.5, 0.8, 1.2)))
+# Coordinates other than the object's own, into the Box projection: an Empty's (the stretched
+# sphere read in the frame of an Empty moved, turned and scaled), and the Generated ones (the
+# texture space, the bounding box to [0, 1]), after a Mapping node's scale.
+planar_case("box_empty_sphere", "stretch_sphere", 512, 0.02, "BOX", 0.3,
+            coordinates=("EMPTY", ((0.2, 0.4, -0.3), (0.3, -0.5, 0.2), (0.7, 1.3, 0.9))))
+planar_case("box_generated_sphere", "sphere", 512, 0.02, "BOX", 0.3,
+            ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (3.0, 2.0, 2.5)), coordinates=("GENERATED",))
 
 
 def tilt_field(size, tilt_deg):
@@ -521,15 +534,35 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             tex.projection = PLANAR[name]["projection"]
             tex.projection_blend = PLANAR[name]["blend"]
             coordinates = nodes.new("ShaderNodeTexCoord")
+            source = coordinates.outputs["Object"]
+            matrix = None  # what the coordinates are, as a map of the object's own
+            kind = PLANAR[name].get("coordinates", ("OBJECT",))
+            if kind[0] == "EMPTY":
+                empty = bpy.data.objects.new("projector", None)
+                bpy.context.scene.collection.objects.link(empty)
+                empty.location, empty.rotation_euler, empty.scale = kind[1]
+                bpy.context.view_layer.update()
+                coordinates.object = empty
+                matrix = empty.matrix_world.inverted() @ ob.matrix_world
+            elif kind[0] == "GENERATED":
+                source = coordinates.outputs["Generated"]
+                # Generated: the texture space (auto: the bounding box) to [0, 1].
+                space_loc, space_size = me.texspace_location, me.texspace_size
+                matrix = mathutils.Matrix.Identity(4)
+                for i in range(3):
+                    matrix[i][i] = 0.5 / space_size[i]
+                    matrix[i][3] = 0.5 - 0.5 * space_loc[i] / space_size[i]
+            if matrix is not None:
+                PLANAR[name]["matrix"] = [list(matrix[r]) for r in range(3)]
             mapping = PLANAR[name].get("mapping")
             if mapping is None:
-                mat.node_tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+                mat.node_tree.links.new(source, tex.inputs["Vector"])
             else:
                 node = nodes.new("ShaderNodeMapping")
                 node.vector_type = "POINT"
                 for key in ("location", "rotation", "scale"):
                     node.inputs[key.title()].default_value = mapping[key]
-                mat.node_tree.links.new(coordinates.outputs["Object"], node.inputs["Vector"])
+                mat.node_tree.links.new(source, node.inputs["Vector"])
                 mat.node_tree.links.new(node.outputs["Vector"], tex.inputs["Vector"])
     else:
         if nmap["space"] == "TANGENT":
@@ -568,8 +601,10 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
     if name in PLANAR:
         entry["planar"] = {"projection": PLANAR[name]["projection"].lower(),
                            "blend": PLANAR[name]["blend"]}
-        if "mapping" in PLANAR[name]:
-            entry["planar"]["mapping"] = PLANAR[name]["mapping"]
+        if "mapping" in PLANAR[name] or "matrix" in PLANAR[name]:
+            entry["planar"]["mapping"] = dict(PLANAR[name].get("mapping", {}))
+            if "matrix" in PLANAR[name]:
+                entry["planar"]["mapping"]["matrix"] = PLANAR[name]["matrix"]
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}

@@ -587,6 +587,13 @@ TEST(CoordinateMapping, IsBlendersMappingNode) {
   EXPECT_LT(maxAbsDiff(scaled.apply({1, 0, 0}), Vec3d{0.5, 1, 2}), 1e-15);
   EXPECT_TRUE(CoordinateMapping::fromMappingNode({}, {}, {1, 1, 1}).identity);
   EXPECT_FALSE(scaled.identity);
+  // An affine map first (another object's coordinates, the texture space), then the node.
+  const CoordinateMapping first =
+      CoordinateMapping::affine(Mat3::fromColumns({0, 2, 0}, {1, 0, 0}, {0, 0, -1}), {1, 2, 3});
+  const Vec3d p{0.3, -0.7, 1.1};
+  EXPECT_LT(maxAbsDiff(scaled.after(first).apply(p), scaled.apply(first.apply(p))), 1e-15);
+  EXPECT_EQ(maxAbsDiff(CoordinateMapping{}.after(first).apply(p), first.apply(p)), 0);
+  EXPECT_TRUE(CoordinateMapping::affine(Mat3::identity(), {}).identity);
 }
 
 // With a mapping, Γ is still the projected gradient of the height the planes read at P', checked

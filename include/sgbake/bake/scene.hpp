@@ -115,11 +115,16 @@ struct SceneSubdivision {
 /// @brief A projection's optional "mapping": Blender's Mapping node (type Point) between a
 /// Texture Coordinate node's Object output and the Image Texture: the projection reads
 /// R · (scale ∘ P) + location (CoordinateMapping). {"location", "rotation" (radians, XYZ Euler),
-/// "scale"}, each optional.
+/// "scale", "matrix"}, each optional. "matrix" (3 rows of 4 numbers, or 4 with the last
+/// [0, 0, 0, 1]) moves P first: the coordinates Blender's Texture Coordinate node gives instead
+/// of the object's own (Object with another object named: inverse(its matrix_world) ·
+/// matrix_world; Generated: the texture space).
 struct SceneMapping {
   Vec3d location{};
   Vec3d rotation{};
   Vec3d scale{1, 1, 1};
+  std::optional<Mat3> matrix;  ///< "matrix"'s 3 × 3 part
+  Vec3d matrixTranslation{};   ///< "matrix"'s last column
 };
 
 /// @brief A layer's optional "mask": a scalar image on a UV set that scales its Γ (LayerMask).

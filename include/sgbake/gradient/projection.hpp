@@ -71,6 +71,11 @@ struct CoordinateMapping {
 
   /// The Mapping node's Location, Rotation (radians, XYZ Euler) and Scale.
   static CoordinateMapping fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale);
+  /// P' = @p linear · P + @p translation: any affine map, e.g. the coordinates another object
+  /// (Texture Coordinate Object with an object) or the texture space (Generated) gives P.
+  static CoordinateMapping affine(const Mat3& linear, Vec3d translation);
+  /// This mapping applied after @p first.
+  CoordinateMapping after(const CoordinateMapping& first) const;
   /// P'.
   Vec3d apply(Vec3d position) const {
     return identity ? position : linear * position + translation;
