@@ -68,33 +68,16 @@ Vec3d CoordinateMapping::pullBack(Vec3d gradient) const {
 PlaneAxes planeAxes(ProjectionAxis axis) { return planeAxes(PlanarMapping{axis}); }
 
 PlaneAxes planeAxes(const PlanarMapping& mapping) {
-  const Vec3d ex{1, 0, 0}, ey{0, 1, 0}, ez{0, 0, 1};
-  PlaneAxes a;
-  if (mapping.layout == PlaneLayout::kBox) {
-    switch (mapping.axis) {
-      case ProjectionAxis::kX:
-        a = {ey, ez, {}};
-        break;
-      case ProjectionAxis::kY:
-        a = {ex, ez, {}};
-        break;
-      case ProjectionAxis::kZ:
-        a = {ey, ex, {}};
-        break;
-    }
-  } else {
-    switch (mapping.axis) {
-      case ProjectionAxis::kX:
-        a = {ey, ez, {}};
-        break;
-      case ProjectionAxis::kY:
-        a = {ez, ex, {}};
-        break;
-      case ProjectionAxis::kZ:
-        a = {ex, ey, {}};
-        break;
-    }
-  }
+  // The object axes (0 = x, 1 = y, 2 = z) each plane's s and t grow along, by layout.
+  constexpr int kCyclic[3][2] = {{1, 2}, {2, 0}, {0, 1}};  // X (y, z), Y (z, x), Z (x, y)
+  constexpr int kBox[3][2] = {{1, 2}, {0, 2}, {1, 0}};     // X (y, z), Y (x, z), Z (y, x)
+  const int(&st)[2] = (mapping.layout == PlaneLayout::kBox ? kBox : kCyclic)[index(mapping.axis)];
+  const auto unit = [](int k) {
+    Vec3d e{};
+    e[static_cast<std::size_t>(k)] = 1;
+    return e;
+  };
+  PlaneAxes a{unit(st[0]), unit(st[1]), {}};
   if (mapping.mirrored) a.s = -a.s;
   a.n = cross(a.s, a.t);
   return a;
