@@ -107,7 +107,8 @@ struct PlanarMapping {
 /// its two texture coordinates grow along (before tiling), n = s × t (±the plane's axis).
 PlaneAxes planeAxes(const PlanarMapping& mapping);
 
-/// @brief Plane coordinates of an object-space point under @p mapping, before tiling.
+/// @brief Plane coordinates of @p position under @p mapping's layout and mirror, before tiling
+/// (mapping.coordinates are not applied here: planarTextureCoordinates applies them first).
 Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping);
 
 /// @brief Texture coordinates of @p position under @p mapping (its coordinates first).
