@@ -847,6 +847,41 @@ std::vector<float> readPixels(const fs::path& path) {
   return pixels;
 }
 
+TEST_F(BakeCliTest, ProjectionsReadBlendersBoxPlanesAndMappedCoordinates) {
+  // On the plane z = 0 (N = +z) a triplanar layer reads its Z plane alone: sgbake's blend at
+  // (x, y), Blender's Box at (1 − y, x) (mirrored on the +z side), and the blend after a Mapping
+  // node's quarter turn about z at (−y, x), the Box's lookup on the repeating image. h.png
+  // ramps along its s, so the blend's height map ramps along x, the others along y.
+  const auto bake = [&](const std::string& extra, const std::string& file) {
+    const ProcessResult r =
+        bakeScene(planeScene(R"({"type": "triplanar", "image": "h.png", "scale": 1)" + extra + "}",
+                             R"({"map": "height", "file": ")" + file +
+                                 R"(", "size": 16, "margin": 0, "bit_depth": 32})"),
+                  {"--no-manifest"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return readPixels(dir_ / file);
+  };
+  const std::vector<float> blended = bake("", "blended.exr");
+  const std::vector<float> box = bake(R"(, "projection": "box")", "box.exr");
+  const std::vector<float> turned =
+      bake(R"(, "mapping": {"rotation": [0, 0, 1.5707963267948966]})", "turned.exr");
+  ASSERT_EQ(blended.size(), 256u);
+  ASSERT_EQ(box.size(), 256u);
+  ASSERT_EQ(turned.size(), 256u);
+  const auto at = [](const std::vector<float>& h, int x, int row) {
+    return h[static_cast<std::size_t>(row * 16 + x)];
+  };
+  // The ramp: 0.5 per unit of s, 0.25 across 8 texels.
+  EXPECT_NEAR(at(blended, 12, 8) - at(blended, 4, 8), 0.25, 1e-3);
+  EXPECT_NEAR(at(blended, 8, 12) - at(blended, 8, 4), 0, 1e-6);
+  EXPECT_NEAR(at(box, 8, 12) - at(box, 8, 4), 0.25, 1e-3);  // rows go down in y: s = 1 − y up
+  EXPECT_NEAR(at(box, 12, 8) - at(box, 4, 8), 0, 1e-6);
+  float worst = 0;
+  for (std::size_t i = 0; i < box.size(); ++i)
+    worst = std::max(worst, std::abs(box[i] - turned[i]));
+  EXPECT_LT(worst, 1e-5);
+}
+
 TEST_F(BakeCliTest, SubdivisionFromSceneAndFlags) {
   writeFile(dir_ / "cube.obj", kCubeObj);
   const std::string mesh = (dir_ / "cube.obj").string();
