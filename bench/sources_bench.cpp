@@ -18,6 +18,9 @@
 ///   - `ObjectNormal`: ObjectNormalSource (eq. 38)
 ///   - `TriplanarHeight/planes:N`: triplanar heights with normals chosen so that N = 1, 2 or 3
 ///     planes pass the weight threshold (the others are not sampled)
+///   - `TriplanarBoxHeight/planes:N`: the same with Blender's Box projection (Blend 0.3), normals
+///     in its one-, two- and three-plane zones; `TriplanarBoxHeight/mapped` three planes after a
+///     Mapping node (CoordinateMapping)
 ///   - `Composite3`: UV height + tangent-space map + triplanar height (all 3 planes) together,
 ///     resolved to the perturbed normal (perturbedNormal)
 
@@ -143,6 +146,39 @@ void TriplanarHeight(benchmark::State& state) {
   runLayers(state, {{tri, 1, {}}}, points);
 }
 BENCHMARK(TriplanarHeight)->ArgName("planes")->Arg(1)->Arg(2)->Arg(3);
+
+/// Normals in the zone of Blender's Box projection (Blend 0.3) with `planes` planes.
+std::vector<SurfacePoint> boxPoints(int planes) {
+  return makePoints([planes](Vec3d, std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(0.95, 1.05);
+    return Vec3d{u(rng), planes >= 2 ? u(rng) : 0.0, planes >= 3 ? u(rng) : 0.0};
+  });
+}
+
+void runBox(benchmark::State& state, int planes, const CoordinateMapping& coordinates) {
+  TriplanarSource tri;
+  tri.height = &kHeight;
+  tri.options.tiling = {2, 2};
+  tri.options.projection = TriplanarProjection::kBox;
+  tri.options.boxBlend = 0.3;
+  tri.options.coordinates = coordinates;
+  const std::vector<SurfacePoint> points = boxPoints(planes);
+  int active = 0;
+  for (const SurfacePoint& p : points) active += boxProjectionWeights(p.normal, 0.3).active;
+  if (active != planes * static_cast<int>(points.size())) state.SkipWithError("wrong plane count");
+  runLayers(state, {{tri, 1, {}}}, points);
+}
+
+void TriplanarBoxHeight(benchmark::State& state) {
+  runBox(state, static_cast<int>(state.range(0)), {});
+}
+BENCHMARK(TriplanarBoxHeight)->ArgName("planes")->Arg(1)->Arg(2)->Arg(3);
+
+void TriplanarBoxHeightMapped(benchmark::State& state) {
+  runBox(state, 3,
+         CoordinateMapping::fromMappingNode({0.3, -0.2, 0.1}, {0.4, 0.2, 0.7}, {1.5, 0.8, 1.2}));
+}
+BENCHMARK(TriplanarBoxHeightMapped)->Name("TriplanarBoxHeight/mapped");
 
 void Composite3(benchmark::State& state) {
   const std::vector<SurfacePoint> points = triplanarPoints(3);
