@@ -62,6 +62,10 @@
    (every layer on every face: the negative control) and by Cycles (the bake target active in
    both materials; tangent and an EMIT mask, 256^2). Back on the one-material Suzanne, the
    layers must have no slot (-1) and send no "material"; a hand-made layer's slot is -1.
+   Projector (projector_case): the bump material's Image Texture read with Box projection on an
+   Empty's coordinates through a Mapping node (PROJECTOR_*). Layers from Material must make one
+   triplanar Box layer (bump-node slopes); its tangent-normal bake must be Cycles' (median <=
+   PROJECTOR_MEDIAN_DEG), and the same job with sgbake's own triplanar blend must not.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -169,6 +173,16 @@ MATERIALS_MEDIAN_DEG = 0.01
 # with exact slopes).
 MATERIALS_MAX_DEG = 1.0
 MATERIALS_CONTROL_FACTOR = 3.0
+# The projector case (projector_case): the bump material's Image Texture read with Box
+# projection (Blend PROJECTOR_BLEND) on the coordinates of an Empty placed so, through a
+# Mapping node; Layers from Material must make it a triplanar Box layer whose bake is Cycles'
+# (bump-node slopes) to float rounding. Its control: the same layer with sgbake's own blend.
+PROJECTOR_EMPTY = ((0.2, 0.4, -0.3), (0.3, -0.5, 0.2), (0.7, 1.3, 0.9))
+PROJECTOR_MAPPING = ((0.1, 0.0, -0.2), (0.0, 0.3, 0.0), (1.2, 1.0, 0.8))
+PROJECTOR_BLEND = 0.3
+PROJECTOR_DISTANCE = 0.01
+PROJECTOR_MEDIAN_DEG = 0.01
+PROJECTOR_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -1270,6 +1284,89 @@ def materials_case(settings, ob, height, work, sabotage):
     return entry
 
 
+def projector_case(settings, ob, work):
+    """The bump material's Image Texture switched to Box projection on an Empty's coordinates
+    through a Mapping node (PROJECTOR_*), Distance PROJECTOR_DISTANCE: Layers from Material,
+    then the add-on's tangent-normal bake (addon_projector.npy), the same job with its layer's
+    projection "blended" (addon_projector_control.npy) and Cycles' (cycles_projector.npy, its
+    mask cycles_projector_mask.npy). The material is put back afterwards. Returns the manifest
+    entry (result, the layer made, checks)."""
+    import bpy
+    import numpy as np
+    import bake_scene
+    from sgbake_blender import operators
+    mat = ob.active_material
+    tree = mat.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    distance = bump.inputs["Distance"].default_value
+    empty = bpy.data.objects.new("projector", None)
+    bpy.context.scene.collection.objects.link(empty)
+    empty.location, empty.rotation_euler, empty.scale = PROJECTOR_EMPTY
+    bpy.context.view_layer.update()
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    coordinates.object = empty
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    for name, value in zip(("Location", "Rotation", "Scale"), PROJECTOR_MAPPING):
+        mapping.inputs[name].default_value = value
+    tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    tex.projection, tex.projection_blend = "BOX", PROJECTOR_BLEND
+    bump.inputs["Distance"].default_value = PROJECTOR_DISTANCE
+    entry = {"result": None, "checks": []}
+    try:
+        bpy.ops.object.sgbake_layers_from_material()
+        layer = settings.layers[0]
+        entry["layer"] = {"type": layer.type, "projection": layer.projection,
+                          "box_blend": layer.box_blend, "slopes": layer.slopes}
+        entry["checks"].append({
+            "name": "projector: Layers from Material makes one triplanar Box layer",
+            "ok": (len(settings.layers) == 1 and layer.type == "triplanar"
+                   and layer.projection == "box" and layer.slopes == "bump-node"),
+            "expected": "one triplanar layer, projection box, slopes bump-node",
+            "message": str(entry["layer"])})
+        settings.target_image = None
+        settings.width = settings.height = SIZE
+        settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+        settings.padding, settings.surface, settings.green = "extend", "mesh", "opengl"
+        settings.map = "tangent-normal"
+        job = operators.BakeJob(bpy.context)
+        try:
+            entry["result"] = sorted(bpy.ops.object.sgbake_bake())
+        except RuntimeError as exc:
+            entry["result"] = ["ERROR", str(exc).strip()]
+        image = bpy.data.images.get(f"{ob.name}_tangent-normal")
+        if entry["result"] == ["FINISHED"]:
+            np.save(os.path.join(work, "addon_projector.npy"), bc.image_array(image))
+            for scene_of_tile in job.scenes.values():
+                for sent in scene_of_tile["layers"]:
+                    sent.pop("projection", None)
+                    sent.pop("box_blend", None)
+            job.run()
+            if job.error is None:
+                image, _ = job.finish()
+                np.save(os.path.join(work, "addon_projector_control.npy"), bc.image_array(image))
+        scene = bpy.context.scene
+        engine = scene.render.engine
+        bc.setup_cycles(scene)
+        target = tree.nodes["bake_target"]
+        for space in ("tangent", "mask"):
+            cycles = bc.new_float_image(f"cycles_projector_{space}", SIZE, SIZE)
+            bake_scene.bake_pass(ob, mat, target, cycles, space, 0)
+            name = "cycles_projector" + ("" if space == "tangent" else "_mask")
+            np.save(os.path.join(work, f"{name}.npy"), bc.image_array(cycles))
+            bpy.data.images.remove(cycles)
+        target.image = None
+        scene.render.engine = engine
+    finally:
+        tree.nodes.remove(mapping)
+        tree.nodes.remove(coordinates)
+        tex.projection = "FLAT"
+        bump.inputs["Distance"].default_value = distance
+        bpy.data.objects.remove(empty)
+    return entry
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -1291,6 +1388,8 @@ def blender_make(work, library_path, sabotage):
     manifest["limit"] = limit_case(settings, ob, work, manifest["scale"])
     manifest["world"] = world_case(settings, ob, work, sabotage)
     manifest["materials"] = materials_case(settings, ob, height, work, sabotage)
+    manifest["projector"] = projector_case(settings, ob, work)
+    layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
@@ -1335,6 +1434,7 @@ def blender_compare(work):
     results["extra"] = extra_comparisons(work, manifest)
     results["world"] = world_comparisons(work, manifest)
     results["materials"] = materials_comparisons(work)
+    results["projector"] = projector_comparisons(work)
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -1430,6 +1530,21 @@ def materials_comparisons(work):
     import numpy as np
     files = {"addon": "addon_materials.npy", "control": "addon_materials_control.npy",
              "cycles": "cycles_materials.npy", "mask": "cycles_materials_mask.npy"}
+    missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
+    if missing:
+        return {"error": f"missing {', '.join(missing)}"}
+    inner = bc.erode(np.load(os.path.join(work, files["mask"]))[..., 0] > 0.5, 1)
+    cycles = bc.decode_normals(np.load(os.path.join(work, files["cycles"])))
+    return {which: bc.angle_stats(bc.angle_deg(
+        bc.decode_normals(np.load(os.path.join(work, files[which]))), cycles)[inner])
+        for which in ("addon", "control")}
+
+
+def projector_comparisons(work):
+    """The projector case's bakes (projector_case) against Cycles', as materials_comparisons."""
+    import numpy as np
+    files = {"addon": "addon_projector.npy", "control": "addon_projector_control.npy",
+             "cycles": "cycles_projector.npy", "mask": "cycles_projector_mask.npy"}
     missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
     if missing:
         return {"error": f"missing {', '.join(missing)}"}
@@ -1538,9 +1653,11 @@ def evaluate(manifest, results):
                             f"{'be within' if equal else 'exceed'} {tolerance:g}")
     failures += evaluate_world(manifest["world"], results["world"])
     failures += evaluate_materials(manifest["materials"], results["materials"])
+    failures += evaluate_projector(manifest["projector"], results["projector"])
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
-                  + manifest["materials"]["checks"] + manifest["errors"]):
+                  + manifest["materials"]["checks"] + manifest["projector"]["checks"]
+                  + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
@@ -1615,6 +1732,23 @@ def evaluate_materials(entry, r):
         failures.append(f"materials: a texel {worst:.1f} deg from Cycles (bar "
                         f"{MATERIALS_MAX_DEG}: is it on the other side of an edge?)")
     return failures
+
+
+def evaluate_projector(entry, r):
+    """Prints the projector case's angles to Cycles; returns failures: a median over
+    PROJECTOR_MEDIAN_DEG, or a control (sgbake's own blend) less than PROJECTOR_CONTROL_FACTOR
+    times worse."""
+    print(f"  Box projection on an Empty's coordinates through a Mapping node ({entry.get('layer')})"
+          " vs Cycles:")
+    failures = []
+    if entry["result"] != ["FINISHED"]:
+        failures.append(f"projector: the add-on's bake returned {entry['result']}")
+    if "error" in r:
+        print(f"    {r['error']}")
+        return failures + [f"projector: {r['error']}"]
+    return failures + judge_against_cycles("projector", "", r["addon"], r["control"],
+                                           "with sgbake's own triplanar blend",
+                                           PROJECTOR_MEDIAN_DEG, PROJECTOR_CONTROL_FACTOR)
 
 
 def main():
