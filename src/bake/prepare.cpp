@@ -372,7 +372,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.mapping.axis = layer.axis;
       source.mapping.tiling = layer.tiling;
       source.mapping.offset = layer.offset;
-      source.mapping.coordinates = coordinateMapping(layer);
+      source.coordinates = coordinateMapping(layer);
       source.scale = layer.scale;
       source.normal = projected;
       source.gradient = layer.heightGradient;

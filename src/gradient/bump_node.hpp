@@ -113,13 +113,14 @@ inline double unscaledHeightAt(const VolumeSource& s, const Vec3d& position, con
   return s.volume->value(position);
 }
 inline double unscaledHeightAt(const PlanarSource& s, const Vec3d& position, const Vec3d&) {
-  return s.height->sample(planarTextureCoordinates(position, s.mapping)).value;
+  return s.height->sample(planarTextureCoordinates(s.coordinates.apply(position), s.mapping)).value;
 }
 inline double unscaledHeightAt(const TriplanarSource& s, const Vec3d& position,
                                const Vec3d& seenNormal) {
+  const Vec3d mapped = s.options.coordinates.apply(position);
   double h = 0;
   for (const WeightedPlane& plane : triplanarPlanes(s.options, seenNormal))
-    h += plane.weight * s.height->sample(planarTextureCoordinates(position, plane.mapping)).value;
+    h += plane.weight * s.height->sample(planarTextureCoordinates(mapped, plane.mapping)).value;
   return h;
 }
 inline double heightScale(const VolumeSource& s) { return s.scale; }

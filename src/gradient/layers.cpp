@@ -92,13 +92,14 @@ Vec3d evaluate(const PlanarSource& s, const SurfacePoint& point) {
     case ProjectedKind::kHeight:
       if (s.height == nullptr) return {};
       if (gradient_detail::usesBumpNode(s.gradient, point)) return bumpNodeInObjectSpace(s, point);
-      return planarHeightGradient(*s.height, s.mapping, s.scale, point);
+      return planarHeightGradient(*s.height, s.mapping, s.scale, point, s.coordinates);
     case ProjectedKind::kTangentNormal:
-      return s.normals
-                 ? planarTangentNormalGradient(*s.normals, s.mapping, s.scale, point, s.normal)
-                 : Vec3d{};
+      return s.normals ? planarTangentNormalGradient(*s.normals, s.mapping, s.scale, point,
+                                                     s.normal, s.coordinates)
+                       : Vec3d{};
     case ProjectedKind::kObjectNormal:
-      return s.normals ? planarObjectNormalGradient(*s.normals, s.mapping, s.scale, point, s.normal)
+      return s.normals ? planarObjectNormalGradient(*s.normals, s.mapping, s.scale, point, s.normal,
+                                                    s.coordinates)
                        : Vec3d{};
   }
   return {};

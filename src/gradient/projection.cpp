@@ -60,25 +60,27 @@ CoordinateMapping CoordinateMapping::after(const CoordinateMapping& first) const
   return affine(linear * first.linear, linear * first.translation + translation);
 }
 
-Vec3d CoordinateMapping::pullBack(Vec3d gradient) const {
-  if (identity) return gradient;
-  return {dot(linear.col[0], gradient), dot(linear.col[1], gradient), dot(linear.col[2], gradient)};
-}
-
 PlaneAxes planeAxes(ProjectionAxis axis) { return planeAxes(PlanarMapping{axis}); }
 
+namespace {
+
+/// The object axes (0 = x, 1 = y, 2 = z) a plane's s and t grow along, by layout.
+struct PlaneIndices {
+  std::size_t s, t;
+};
+PlaneIndices planeIndices(const PlanarMapping& mapping) {
+  constexpr PlaneIndices kCyclic[3] = {{1, 2}, {2, 0}, {0, 1}};  // X (y, z), Y (z, x), Z (x, y)
+  constexpr PlaneIndices kBox[3] = {{1, 2}, {0, 2}, {1, 0}};     // X (y, z), Y (x, z), Z (y, x)
+  return (mapping.layout == PlaneLayout::kBox ? kBox : kCyclic)[index(mapping.axis)];
+}
+
+}  // namespace
+
 PlaneAxes planeAxes(const PlanarMapping& mapping) {
-  // The object axes (0 = x, 1 = y, 2 = z) each plane's s and t grow along, by layout.
-  constexpr int kCyclic[3][2] = {{1, 2}, {2, 0}, {0, 1}};  // X (y, z), Y (z, x), Z (x, y)
-  constexpr int kBox[3][2] = {{1, 2}, {0, 2}, {1, 0}};     // X (y, z), Y (x, z), Z (y, x)
-  const int(&st)[2] = (mapping.layout == PlaneLayout::kBox ? kBox : kCyclic)[index(mapping.axis)];
-  const auto unit = [](int k) {
-    Vec3d e{};
-    e[static_cast<std::size_t>(k)] = 1;
-    return e;
-  };
-  PlaneAxes a{unit(st[0]), unit(st[1]), {}};
-  if (mapping.mirrored) a.s = -a.s;
+  const PlaneIndices i = planeIndices(mapping);
+  PlaneAxes a;
+  a.s[i.s] = mapping.mirrored ? -1 : 1;
+  a.t[i.t] = 1;
   a.n = cross(a.s, a.t);
   return a;
 }
@@ -88,44 +90,50 @@ Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis) {
 }
 
 Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping) {
-  // The axes are unit coordinate axes (or their negatives), so each coordinate is a dot
-  // product; a mirrored plane's first coordinate is 1 − s (Cycles' Box), not −s.
-  const PlaneAxes a = planeAxes(mapping);
-  return {dot(a.s, position) + (mapping.mirrored ? 1.0 : 0.0), dot(a.t, position)};
+  // A mirrored plane's first coordinate is 1 − s (Cycles' Box), not −s.
+  const PlaneIndices i = planeIndices(mapping);
+  const double s = position[i.s];
+  return {mapping.mirrored ? 1 - s : s, position[i.t]};
 }
 
 Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping) {
-  return textureCoordinates(planeCoordinates(mapping.coordinates.apply(position), mapping),
-                            mapping.tiling, mapping.offset);
+  return textureCoordinates(planeCoordinates(position, mapping), mapping.tiling, mapping.offset);
 }
 
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale) {
-  const PlaneAxes axes = planeAxes(mapping);
-  return mapping.coordinates.pullBack((scale * mapping.tiling.x * dhdst.x) * axes.s +
-                                      (scale * mapping.tiling.y * dhdst.y) * axes.t);
+  const PlaneIndices i = planeIndices(mapping);
+  Vec3d g{};
+  const double alongS = scale * mapping.tiling.x * dhdst.x;
+  g[i.s] = mapping.mirrored ? -alongS : alongS;
+  g[i.t] = scale * mapping.tiling.y * dhdst.y;
+  return g;
 }
 
 Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& mapping, double scale,
-                           const SurfacePoint& point) {
-  const ScalarSample h = texture.sample(planarTextureCoordinates(point.position, mapping));
-  return finiteOrZero(projectOntoTangentPlaneAlong(planeVolumeGradient(h.gradient, mapping, scale),
-                                                   point.normal, point.geometricNormal));
+                           const SurfacePoint& point, const CoordinateMapping& coordinates) {
+  const ScalarSample h =
+      texture.sample(planarTextureCoordinates(coordinates.apply(point.position), mapping));
+  return finiteOrZero(projectOntoTangentPlaneAlong(
+      coordinates.pullBack(planeVolumeGradient(h.gradient, mapping, scale)), point.normal,
+      point.geometricNormal));
 }
 
 Vec3d planarTangentNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
                                   double strength, const SurfacePoint& point,
-                                  const ProjectedNormalOptions& options) {
-  const Vec2d slopes =
-      planeSlopes(texture, planarTextureCoordinates(point.position, mapping), options);
-  return finiteOrZero(
-      projectOntoTangentPlane(planeVolumeGradient(slopes, mapping, strength), point.normal));
+                                  const ProjectedNormalOptions& options,
+                                  const CoordinateMapping& coordinates) {
+  const Vec2d slopes = planeSlopes(
+      texture, planarTextureCoordinates(coordinates.apply(point.position), mapping), options);
+  return finiteOrZero(projectOntoTangentPlane(
+      coordinates.pullBack(planeVolumeGradient(slopes, mapping, strength)), point.normal));
 }
 
 Vec3d planarObjectNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
                                  double strength, const SurfacePoint& point,
-                                 const ProjectedNormalOptions& options) {
-  const Vec3d n =
-      decodeNormalTexel(texture.sample(planarTextureCoordinates(point.position, mapping)));
+                                 const ProjectedNormalOptions& options,
+                                 const CoordinateMapping& coordinates) {
+  const Vec3d n = decodeNormalTexel(
+      texture.sample(planarTextureCoordinates(coordinates.apply(point.position), mapping)));
   return finiteOrZero(strength * gradientFromObjectNormal(n, point.normal, options.minCosine));
 }
 
@@ -225,7 +233,6 @@ TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNorma
     const double w = weights.w[index(axis)];
     if (w == 0) continue;
     PlanarMapping mapping{axis, options.tiling, options.offset};
-    mapping.coordinates = options.coordinates;
     if (box) {
       mapping.layout = PlaneLayout::kBox;
       mapping.mirrored = boxPlaneMirrored(axis, seenNormal);
@@ -243,10 +250,11 @@ namespace {
 template <class PlaneTerm>
 Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
                     const PlaneTerm& plane) {
+  const Vec3d position = options.coordinates.apply(point.position);  // P', once for the planes
   Vec3d sum{};
   for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal())) {
-    sum += plane(p.mapping, planarTextureCoordinates(point.position, p.mapping),
-                 p.weight * options.scale);
+    sum +=
+        plane(p.mapping, planarTextureCoordinates(position, p.mapping), p.weight * options.scale);
   }
   return sum;
 }
@@ -259,8 +267,8 @@ Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptio
       options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
         return planeVolumeGradient(texture.sample(st).gradient, mapping, weightedScale);
       });
-  return finiteOrZero(
-      projectOntoTangentPlaneAlong(volumeGradient, point.normal, point.geometricNormal));
+  return finiteOrZero(projectOntoTangentPlaneAlong(options.coordinates.pullBack(volumeGradient),
+                                                   point.normal, point.geometricNormal));
 }
 
 Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
@@ -269,7 +277,8 @@ Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const Triplan
       options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
         return planeVolumeGradient(planeSlopes(texture, st, options.normal), mapping, weightedScale);
       });
-  return finiteOrZero(projectOntoTangentPlane(volumeGradient, point.normal));
+  return finiteOrZero(
+      projectOntoTangentPlane(options.coordinates.pullBack(volumeGradient), point.normal));
 }
 
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
@@ -277,10 +286,11 @@ Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const Triplana
   if (options.projection == TriplanarProjection::kBox) {
     // Cycles blends the texels' colours and a Normal Map node decodes the blend: one normal,
     // Σ w_i n_i (the decoding is affine and the weights sum to 1).
+    const Vec3d position = options.coordinates.apply(point.position);
     Vec3d blend{};
     for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal())) {
-      blend += p.weight * decodeNormalTexel(
-                              texture.sample(planarTextureCoordinates(point.position, p.mapping)));
+      blend += p.weight *
+               decodeNormalTexel(texture.sample(planarTextureCoordinates(position, p.mapping)));
     }
     return finiteOrZero(options.scale *
                         gradientFromObjectNormal(blend, point.normal, options.normal.minCosine));

@@ -606,23 +606,22 @@ TEST(CoordinateMapping, SlopesAreThoseOfTheMappedCoordinates) {
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < 100; ++i) {
     const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
-    const PlanarMapping planar{kAxes[i % 3],         {1.3, 0.7}, {0.2, -0.1},
-                               PlaneLayout::kCyclic, false,      m};
+    const PlanarMapping planar{kAxes[i % 3], {1.3, 0.7}, {0.2, -0.1}};
     TriplanarOptions box;
     box.projection = TriplanarProjection::kBox;
     box.boxBlend = 0.5;
     box.coordinates = m;
     const TriplanarPlanes planes = triplanarPlanes(box, p.normal);
     const auto planarHeight = [&](Vec3d x) {
-      return 0.5 * tex.sample(planarTextureCoordinates(x, planar)).value;
+      return 0.5 * tex.sample(planarTextureCoordinates(m.apply(x), planar)).value;
     };
     const auto boxHeight = [&](Vec3d x) {
       double h = 0;
       for (const WeightedPlane& plane : planes)
-        h += plane.weight * tex.sample(planarTextureCoordinates(x, plane.mapping)).value;
+        h += plane.weight * tex.sample(planarTextureCoordinates(m.apply(x), plane.mapping)).value;
       return h;
     };
-    EXPECT_LT(maxAbsDiff(planarHeightGradient(tex, planar, 0.5, p),
+    EXPECT_LT(maxAbsDiff(planarHeightGradient(tex, planar, 0.5, p, m),
                          projectedCentralGradient(planarHeight, p)),
               1e-8);
     EXPECT_LT(

@@ -104,6 +104,7 @@ struct PlanarSource {
   const ScalarTexture* height = nullptr;   ///< for kHeight; not owned
   const VectorTexture* normals = nullptr;  ///< for the normal kinds; not owned
   PlanarMapping mapping{};
+  CoordinateMapping coordinates{};  ///< the coordinates the plane reads (the object's own)
   double scale = 1;  ///< height scale (kHeight) or strength (normal maps)
   ProjectedNormalOptions normal{};
   HeightGradient gradient = HeightGradient::kAnalytic;  ///< of kHeight, as VolumeSource's

@@ -80,8 +80,13 @@ struct CoordinateMapping {
   Vec3d apply(Vec3d position) const {
     return identity ? position : linear * position + translation;
   }
-  /// The object-space gradient of a function of P' whose gradient w.r.t. P' is @p gradient.
-  Vec3d pullBack(Vec3d gradient) const;
+  /// The object-space gradient of a function of P' whose gradient w.r.t. P' is @p gradient:
+  /// linearᵀ · gradient.
+  Vec3d pullBack(Vec3d gradient) const {
+    if (identity) return gradient;
+    return {dot(linear.col[0], gradient), dot(linear.col[1], gradient),
+            dot(linear.col[2], gradient)};
+  }
 };
 
 /// @brief Which object coordinates texture a plane (before tiling).
@@ -100,23 +105,26 @@ struct PlanarMapping {
   /// The first plane coordinate is 1 − s (its axis −e_s): a Box plane seen from the side that
   /// Cycles mirrors (boxPlaneMirrored). Only kBox mappings are mirrored.
   bool mirrored = false;
-  CoordinateMapping coordinates{};  ///< applied to P before the plane reads it
 };
+
+/// The object's own coordinates: P' = P.
+inline const CoordinateMapping kObjectCoordinates{};
 
 /// @brief The axes of a plane as @p mapping lays it out: s and t the object-space directions
 /// its two texture coordinates grow along (before tiling), n = s × t (±the plane's axis).
 PlaneAxes planeAxes(const PlanarMapping& mapping);
 
-/// @brief Plane coordinates of @p position under @p mapping's layout and mirror, before tiling
-/// (mapping.coordinates are not applied here: planarTextureCoordinates applies them first).
+/// @brief Plane coordinates of @p position (P', after any CoordinateMapping) under @p mapping's
+/// layout and mirror, before tiling.
 Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping);
 
-/// @brief Texture coordinates of @p position under @p mapping (its coordinates first).
+/// @brief Texture coordinates of @p position (P', after any CoordinateMapping) under
+/// @p mapping.
 Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping);
 
-/// @brief Volume gradient of `scale · h(planarTextureCoordinates(P, mapping))`:
-/// scale · (tiling.x · dhdst.x · s + tiling.y · dhdst.y · t) with s, t = planeAxes(mapping),
-/// pulled back through mapping.coordinates; object units per object unit.
+/// @brief Volume gradient of `scale · h(planarTextureCoordinates(P', mapping))` w.r.t. P':
+/// scale · (tiling.x · dhdst.x · s + tiling.y · dhdst.y · t) with s, t = planeAxes(mapping)
+/// (CoordinateMapping::pullBack takes it to P); object units per object unit.
 ///
 /// @param[in] dhdst (∂h/∂s, ∂h/∂t) at the point, per texture unit
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale);
@@ -128,11 +136,13 @@ struct ProjectedNormalOptions {
   double minCosine = kMinObjectNormalCosine;  ///< object-space guard (gradientFromObjectNormal)
 };
 
-/// @brief Γ of a height map projected on one axis plane (eq. 39-44, 50).
+/// @brief Γ of a height map projected on one axis plane (eq. 39-44, 50), read at the point's
+/// @p coordinates (the object's own by default).
 /// @param[in] scale object units of height per texture unit of value
 /// @note Samples @p texture once.
 Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& mapping, double scale,
-                           const SurfacePoint& point);
+                           const SurfacePoint& point,
+                           const CoordinateMapping& coordinates = kObjectCoordinates);
 
 /// @brief Γ of a tangent-space normal map projected on one axis plane (eq. 42-44): the decoded
 /// normal, read in the plane's frame (x along e_s, y along e_t, z along e_n), gives the slopes of
@@ -141,7 +151,8 @@ Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& ma
 /// @note Samples @p texture once.
 Vec3d planarTangentNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
                                   double strength, const SurfacePoint& point,
-                                  const ProjectedNormalOptions& options = {});
+                                  const ProjectedNormalOptions& options = {},
+                                  const CoordinateMapping& coordinates = kObjectCoordinates);
 
 /// @brief Γ of an object-space normal map looked up through a planar projection (eq. 38): the
 /// decoded normal is an object-space normal whatever the projection, so tiling moves the lookup
@@ -149,7 +160,8 @@ Vec3d planarTangentNormalGradient(const VectorTexture& texture, const PlanarMapp
 /// @note Samples @p texture once.
 Vec3d planarObjectNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
                                  double strength, const SurfacePoint& point,
-                                 const ProjectedNormalOptions& options = {});
+                                 const ProjectedNormalOptions& options = {},
+                                 const CoordinateMapping& coordinates = kObjectCoordinates);
 
 // ---------------------------------------------------------------------------------------------
 // Triplanar
