@@ -1239,16 +1239,9 @@ def materials_case(settings, ob, height, work, sabotage):
     except RuntimeError as exc:
         entry["result"] = ["ERROR", str(exc).strip()]
     if entry["result"] == ["FINISHED"]:
-        image = bpy.data.images[f"{multi.name}_{MATERIALS_MAP}"]
-        np.save(os.path.join(work, "addon_materials.npy"), bc.image_array(image))
         # The negative control: the same job with every layer on every face.
-        for scene_of_tile in job.scenes.values():
-            for layer in scene_of_tile["layers"]:
-                layer.pop("material", None)
-        job.run()
-        if job.error is None:
-            image, _ = job.finish()
-            np.save(os.path.join(work, "addon_materials_control.npy"), bc.image_array(image))
+        save_with_control(job, bpy.data.images[f"{multi.name}_{MATERIALS_MAP}"], work,
+                          "materials", ("material",))
 
     # Cycles: each face with its material; the target node active in both.
     scene = bpy.context.scene
@@ -1282,6 +1275,22 @@ def materials_case(settings, ob, height, work, sabotage):
           "material_index -1", str(settings.layers[-1].material_index))
     settings.layers.remove(len(settings.layers) - 1)
     return entry
+
+
+def save_with_control(job, image, work, case, keys):
+    """Saves the add-on's bake `image` as addon_CASE.npy, then runs the same `job` with `keys`
+    taken out of every layer it sends (a negative control) and saves that as
+    addon_CASE_control.npy."""
+    import numpy as np
+    np.save(os.path.join(work, f"addon_{case}.npy"), bc.image_array(image))
+    for scene_of_tile in job.scenes.values():
+        for layer in scene_of_tile["layers"]:
+            for key in keys:
+                layer.pop(key, None)
+    job.run()
+    if job.error is None:
+        control, _ = job.finish()
+        np.save(os.path.join(work, f"addon_{case}_control.npy"), bc.image_array(control))
 
 
 def projector_case(settings, ob, work):
@@ -1335,17 +1344,9 @@ def projector_case(settings, ob, work):
             entry["result"] = sorted(bpy.ops.object.sgbake_bake())
         except RuntimeError as exc:
             entry["result"] = ["ERROR", str(exc).strip()]
-        image = bpy.data.images.get(f"{ob.name}_tangent-normal")
         if entry["result"] == ["FINISHED"]:
-            np.save(os.path.join(work, "addon_projector.npy"), bc.image_array(image))
-            for scene_of_tile in job.scenes.values():
-                for sent in scene_of_tile["layers"]:
-                    sent.pop("projection", None)
-                    sent.pop("box_blend", None)
-            job.run()
-            if job.error is None:
-                image, _ = job.finish()
-                np.save(os.path.join(work, "addon_projector_control.npy"), bc.image_array(image))
+            save_with_control(job, bpy.data.images[f"{ob.name}_tangent-normal"], work,
+                              "projector", ("projection", "box_blend"))
         scene = bpy.context.scene
         engine = scene.render.engine
         bc.setup_cycles(scene)
@@ -1434,7 +1435,7 @@ def blender_compare(work):
     results["extra"] = extra_comparisons(work, manifest)
     results["world"] = world_comparisons(work, manifest)
     results["materials"] = materials_comparisons(work)
-    results["projector"] = projector_comparisons(work)
+    results["projector"] = against_cycles(work, "projector")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -1525,26 +1526,17 @@ def world_comparisons(work, manifest):
 
 
 def materials_comparisons(work):
-    """The two-material object's bakes (materials_case) against Cycles', as world_comparisons:
-    {"addon": stats, "control": stats}, or {"error": ...} for a missing file."""
-    import numpy as np
-    files = {"addon": "addon_materials.npy", "control": "addon_materials_control.npy",
-             "cycles": "cycles_materials.npy", "mask": "cycles_materials_mask.npy"}
-    missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
-    if missing:
-        return {"error": f"missing {', '.join(missing)}"}
-    inner = bc.erode(np.load(os.path.join(work, files["mask"]))[..., 0] > 0.5, 1)
-    cycles = bc.decode_normals(np.load(os.path.join(work, files["cycles"])))
-    return {which: bc.angle_stats(bc.angle_deg(
-        bc.decode_normals(np.load(os.path.join(work, files[which]))), cycles)[inner])
-        for which in ("addon", "control")}
+    """The two-material object's bakes (materials_case) against Cycles' (against_cycles)."""
+    return against_cycles(work, "materials")
 
 
-def projector_comparisons(work):
-    """The projector case's bakes (projector_case) against Cycles', as materials_comparisons."""
+def against_cycles(work, case):
+    """A case's add-on bake and its control (addon_CASE.npy, addon_CASE_control.npy) against
+    Cycles' (cycles_CASE.npy, mask cycles_CASE_mask.npy), as world_comparisons: {"addon":
+    stats, "control": stats}, or {"error": ...} for a missing file."""
     import numpy as np
-    files = {"addon": "addon_projector.npy", "control": "addon_projector_control.npy",
-             "cycles": "cycles_projector.npy", "mask": "cycles_projector_mask.npy"}
+    files = {"addon": f"addon_{case}.npy", "control": f"addon_{case}_control.npy",
+             "cycles": f"cycles_{case}.npy", "mask": f"cycles_{case}_mask.npy"}
     missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
     if missing:
         return {"error": f"missing {', '.join(missing)}"}
