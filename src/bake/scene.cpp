@@ -824,11 +824,6 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (!box && reader.has("box_blend")) {
     fail(where, "key 'box_blend' applies only to 'projection': 'box'");
   }
-  if (box && layer.kind == ProjectedKind::kTangentNormal) {
-    fail(where,
-         "'projection': 'box' takes kind 'height' or 'object-normal' (Blender's Box planes are "
-         "mirrored per side and give a tangent-space map no frame)");
-  }
   if (layer.tangentUvSet && layer.space == NormalSpace::kObject) {
     fail(where, "key 'tangent_uv' applies only to tangent-space normal maps");
   }
@@ -1085,6 +1080,11 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   }
   if (!(layer.boxBlend >= 0 && layer.boxBlend <= 1)) {
     return "box_blend must be a number from 0 to 1 (Blender's Blend)";
+  }
+  if (layer.type == SceneLayerType::kTriplanar && layer.projection == TriplanarProjection::kBox &&
+      layer.kind == ProjectedKind::kTangentNormal) {
+    return "'projection': 'box' takes kind 'height' or 'object-normal' (Blender's Box planes are "
+           "mirrored per side and give a tangent-space map no frame)";
   }
   if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
     return "step must be a finite number > 0";

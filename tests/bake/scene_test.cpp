@@ -1028,6 +1028,18 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   status = validateScene(scene);
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message, "layers[0]: weight must be a finite number");
+  // A Box projection of a tangent-space map, built in code as in a scene file, is refused.
+  scene.layers[0].weight = 1;
+  scene.layers[0].type = SceneLayerType::kTriplanar;
+  scene.layers[0].kind = ProjectedKind::kTangentNormal;
+  scene.layers[0].projection = TriplanarProjection::kBox;
+  status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message,
+            "layers[0]: 'projection': 'box' takes kind 'height' or 'object-normal' (Blender's "
+            "Box planes are mirrored per side and give a tangent-space map no frame)");
+  scene.layers[0].kind = ProjectedKind::kObjectNormal;
+  EXPECT_TRUE(validateScene(scene));
 }
 
 TEST(Scene, PaddingModesAreParsedByTheirSceneNames) {
