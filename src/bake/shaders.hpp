@@ -193,8 +193,8 @@ struct BakeShaderBase {
     const SurfacePoint& w =
         surfacePointAt(scratch.tri, b, texelFrame(scratch.tri, b), scratch.point);
     if (layers.empty()) return {w.normal, w.normal};
-    return gradient_detail::shadeLayersInWorld(layers, objectPoint, w, scratch.tri.faceNormal,
-                                               *world, scratch.preparedUv.data());
+    return gradient_detail::shadeLayersInWorld(layers, objectPoint, w, *world,
+                                               scratch.preparedUv.data());
   }
   /// The object-space Γ of the world shading at @p b (objectSpaceGradient).
   [[gnu::noinline]] Vec3d worldGradient(const Vec3d& b, const TexelFrame& f) {
@@ -223,7 +223,7 @@ struct BakeShaderBase {
         p.normal, s.strength);
   }
 
-  /// compositeGradient(layers, p, tri.faceNormal) bit for bit: the same sum in the same order, with
+  /// compositeGradient(layers, p) bit for bit: the same sum in the same order, with
   /// UV height layers through uvHeightGradient (no per-texel std::visit, no per-texel frame
   /// normalizations) and the mask looked up only when the layer has one (factor 1 otherwise).
   Vec3d gradient(const SurfacePoint& p) const {
@@ -244,9 +244,9 @@ struct BakeShaderBase {
                         gradient_detail::NormalBelowSurface* below = nullptr,
                         const Vec3d* aboveNormal = nullptr) const {
     if (layer.base == LayerBase::kLayersAbove) {
-      gamma = below == nullptr ? stackLayerGradient(layer, p, tri.faceNormal, gamma)
-                               : gradient_detail::stackLayerGradientOn(
-                                     layer, p, tri.faceNormal, gamma, p.normal, aboveNormal, below);
+      gamma = below == nullptr ? stackLayerGradient(layer, p, gamma)
+                               : gradient_detail::stackLayerGradientOn(layer, p, gamma, p.normal,
+                                                                       aboveNormal, below);
       return;
     }
     if (below != nullptr) *below = {};
@@ -307,7 +307,7 @@ struct BakeShaderBase {
   }
   /// gradient_detail::backFacingNormal with the triangle's layers and Ng (out of line: rare).
   [[gnu::noinline]] Vec3d backFacingNormal(const SurfacePoint& p) const {
-    return gradient_detail::backFacingNormal(layers, p, tri.faceNormal);
+    return gradient_detail::backFacingNormal(layers, p);
   }
   /// A normal map's channels of the normal (x, y, z): 0.5·(±n[axis]) + 0.5 each, by `channels`
   /// (+X+Y+Z: encodeNormal's n/2 + 0.5).
@@ -660,9 +660,8 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
         const SurfacePoint& worldPoint = surfacePointAt(w.tri, b, texelFrame(w.tri, b), w.point);
         Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};
         gradient_detail::NormalBelowSurface below;
-        gradient_detail::addWorldLayerGradient(layer, objectPoint, worldPoint, w.tri.faceNormal,
-                                               *shader.world, w.preparedUv.data(),
-                                               worldPoint.normal, g, &below);
+        gradient_detail::addWorldLayerGradient(layer, objectPoint, worldPoint, *shader.world,
+                                               w.preparedUv.data(), worldPoint.normal, g, &below);
         slow[i] = slow[i] | below.found;  // shadeLayersInWorld shades it from the decoded normal
         gamma.x[i] = g.x;
         gamma.y[i] = g.y;

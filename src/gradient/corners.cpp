@@ -183,11 +183,11 @@ Result<std::vector<CornerSample>> evaluateCorners(const Mesh& mesh, std::span<co
               s.normal = point.normal;
               s.uv = point.numUvSets > 0 ? point.uv[0].uv : Vec2d{};
               if (options.world != nullptr) {
-                // A corner has no triangle: its own normal is its Ng, as compositeGradient's.
+                // A corner has no triangle: its own normal is its Ng (planeNormal).
                 const SurfacePoint world = worldSurfacePoint(point, *options.world);
-                s.gradient = objectSpaceGradient(
-                    shadeLayersInWorld(shading, point, world, world.normal, *options.world), point,
-                    *options.world);
+                s.gradient =
+                    objectSpaceGradient(shadeLayersInWorld(shading, point, world, *options.world),
+                                        point, *options.world);
                 s.perturbed = resolveNormal(point.normal, s.gradient);
               } else {
                 s.gradient = compositeGradient(shading, point);

@@ -256,8 +256,8 @@ Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
   return layerGradient(source, point);
 }
 
-Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
-                           const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const Vec3d& gammaAbove,
+                           const Vec3d& incoming, const Vec3d* aboveNormal,
                            NormalBelowSurface* below) {
   if (below != nullptr) *below = {};
   const double factor = layer.weight * layerMask(layer.mask, point);
@@ -273,8 +273,8 @@ Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const 
   }
   const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
                                                     : layerGradient(layer.source, point));
-  return stackGradientNoting(gamma, strength, point.normal, ng, gammaAbove, incoming, aboveNormal,
-                             below);
+  return stackGradientNoting(gamma, strength, point.normal, point.planeNormal(), gammaAbove,
+                             incoming, aboveNormal, below);
 }
 
 Vec3d stackGradientNoting(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,
@@ -308,16 +308,15 @@ double layerMask(const LayerMask& mask, const SurfacePoint& point) {
 namespace {
 
 /// stackLayerGradient with the guards seeing @p incoming.
-Vec3d stackLayerGradientSeen(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
-                             const Vec3d& gammaAbove, const Vec3d& incoming) {
-  return gradient_detail::stackLayerGradientOn(layer, point, ng, gammaAbove, incoming, nullptr,
+Vec3d stackLayerGradientSeen(const Layer& layer, const SurfacePoint& point, const Vec3d& gammaAbove,
+                             const Vec3d& incoming) {
+  return gradient_detail::stackLayerGradientOn(layer, point, gammaAbove, incoming, nullptr,
                                                nullptr);
 }
 
 /// compositeGradient, its stacked layers' guards seeing the incoming direction N, or −N at a
 /// back-facing point (backFacingNormal).
-Vec3d compositeSeen(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng,
-                    bool back) {
+Vec3d compositeSeen(std::span<const Layer> layers, const SurfacePoint& point, bool back) {
   const Vec3d incoming = back ? -point.normal : point.normal;
   Vec3d gamma{};
   Layer scratch;
@@ -325,7 +324,7 @@ Vec3d compositeSeen(std::span<const Layer> layers, const SurfacePoint& point, co
     if (given.weight == 0 || !std::isfinite(given.weight)) continue;
     const Layer& layer = back ? gradient_detail::seenFromBehind(given, scratch) : given;
     if (layer.base == LayerBase::kLayersAbove) {
-      gamma = stackLayerGradientSeen(layer, point, ng, gamma, incoming);
+      gamma = stackLayerGradientSeen(layer, point, gamma, incoming);
       continue;
     }
     const double factor = layer.weight * layerMask(layer.mask, point);
@@ -337,18 +336,12 @@ Vec3d compositeSeen(std::span<const Layer> layers, const SurfacePoint& point, co
 
 }  // namespace
 
-Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point,
-                        const Vec3d& geometricNormal) {
-  return compositeSeen(layers, point, geometricNormal, false);
-}
-
 Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point) {
-  return compositeGradient(layers, point, point.normal);
+  return compositeSeen(layers, point, false);
 }
 
-Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
-                         const Vec3d& geometricNormal, const Vec3d& gammaAbove) {
-  return stackLayerGradientSeen(layer, point, geometricNormal, gammaAbove, point.normal);
+Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point, const Vec3d& gammaAbove) {
+  return stackLayerGradientSeen(layer, point, gammaAbove, point.normal);
 }
 
 namespace gradient_detail {
@@ -368,9 +361,9 @@ const Layer& seenFromBehind(const Layer& layer, Layer& scratch) {
   return scratch;
 }
 
-Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng) {
-  return backFacingGuarded(point.normal, compositeSeen(layers, seenFromBehind(point), ng, true),
-                           ng);
+Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point) {
+  return backFacingGuarded(point.normal, compositeSeen(layers, seenFromBehind(point), true),
+                           point.planeNormal());
 }
 
 Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const Vec3d& ng,

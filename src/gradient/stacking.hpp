@@ -113,8 +113,8 @@ Vec3d stackGradient(const Vec3d& gamma, double strength, const Vec3d& n, const V
 /// @brief stackLayerGradient seen from @p incoming, with stackGradient's @p aboveNormal, and
 /// @p below set (when non-null) when @p aboveNormal is given and what the layer makes of it
 /// lies below the surface too.
-Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const Vec3d& ng,
-                           const Vec3d& gammaAbove, const Vec3d& incoming, const Vec3d* aboveNormal,
+Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const Vec3d& gammaAbove,
+                           const Vec3d& incoming, const Vec3d* aboveNormal,
                            NormalBelowSurface* below);
 
 /// @brief layerGradient, and @p below (non-null) set when the source is a normal map that
@@ -151,7 +151,8 @@ bool readsHeightsAtPosition(const LayerSource& source);
 /// negated too, but heights read at positions do not: their bump leans the other way.
 const Layer& seenFromBehind(const Layer& layer, Layer& scratch);
 
-/// @brief The normal Cycles bakes at a back-facing point (backFacing(point.normal, ng)), unit.
+/// @brief The normal Cycles bakes at a back-facing point (backFacing(point.normal,
+/// point.planeNormal())), unit.
 /// Cycles shades it from behind: N, Ng and ∂P/∂u, ∂P/∂v flipped, I = N, and the baked normal
 /// is what its nodes make there. A Normal Map node's result is its front one flipped; a Bump
 /// node bumps −N, but as it looks up UV-mapped heights through the flipped ∂P/∂u, ∂P/∂v their
@@ -162,6 +163,6 @@ const Layer& seenFromBehind(const Layer& layer, Layer& scratch);
 /// Cycles (BlenderBakeOracle sphere_backfacing, 27 % of texels back-facing): bump p99 176° →
 /// 5.4°, normal map p90 96° → 0.0019°. Normal outputs only: derivative and surface-gradient
 /// maps keep the front Γ.
-Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point, const Vec3d& ng);
+Vec3d backFacingNormal(std::span<const Layer> layers, const SurfacePoint& point);
 
 }  // namespace sgbake::gradient_detail

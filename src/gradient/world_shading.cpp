@@ -245,20 +245,17 @@ Result<WorldSpace> WorldSpace::of(const ObjectTransform& transform) {
 }
 
 WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
-                                     const SurfacePoint& worldPoint,
-                                     const Vec3d& worldGeometricNormal, const WorldSpace& space) {
-  return gradient_detail::shadeLayersInWorld(layers, objectPoint, worldPoint, worldGeometricNormal,
-                                             space, nullptr);
+                                     const SurfacePoint& worldPoint, const WorldSpace& space) {
+  return gradient_detail::shadeLayersInWorld(layers, objectPoint, worldPoint, space, nullptr);
 }
 
 namespace gradient_detail {
 
 WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
-                                     const SurfacePoint& worldPoint,
-                                     const Vec3d& worldGeometricNormal, const WorldSpace& space,
+                                     const SurfacePoint& worldPoint, const WorldSpace& space,
                                      const PreparedUvFrame* preparedWorldUv) {
   const Vec3d& n = worldPoint.normal;
-  const Vec3d& ng = worldGeometricNormal;
+  const Vec3d& ng = worldPoint.planeNormal();
   // The layers' Γ seen from the front, or as backFacingNormal sums it at a back-facing point.
   // From the front, also the normal the layers hand on when it lies below the surface, where
   // no Γ stands for it (NormalBelowSurface): a normal map first, then the layers on it.
@@ -274,13 +271,13 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
     for (const Layer& layer : layers) {
       if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
       if (back) {
-        addWorldLayerGradient(seenFromBehind(layer, scratch), *objectBehind, *behind, ng, space,
+        addWorldLayerGradient(seenFromBehind(layer, scratch), *objectBehind, *behind, space,
                               preparedWorldUv, incoming, gamma);
         continue;
       }
       NormalBelowSurface step;
-      addWorldLayerGradient(layer, objectPoint, worldPoint, ng, space, preparedWorldUv, incoming,
-                            gamma, &step, handed.givenTo(layer));
+      addWorldLayerGradient(layer, objectPoint, worldPoint, space, preparedWorldUv, incoming, gamma,
+                            &step, handed.givenTo(layer));
       handed.add(layer, step, n);
     }
     return isFinite(gamma) ? gamma : Vec3d{};  // overflow of absurd weights/scales: unperturbed
@@ -302,10 +299,9 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
 }
 
 void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
-                           const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
-                           const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
-                           const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below,
-                           const Vec3d* aboveNormal) {
+                           const SurfacePoint& worldPoint, const WorldSpace& space,
+                           const PreparedUvFrame* preparedWorldUv, const Vec3d& incoming,
+                           Vec3d& gamma, NormalBelowSurface* below, const Vec3d* aboveNormal) {
   if (below != nullptr) *below = {};
   const double factor = layer.weight * layerMask(layer.mask, objectPoint);
   if (factor == 0) {  // masked out: the source is not sampled
@@ -318,7 +314,7 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
   if (below != nullptr && g.belowSurface && factor == 1 && layer.base == LayerBase::kSurface)
     *below = {true, g.decoded, g.strength};
   if (layer.base == LayerBase::kLayersAbove) {
-    gamma = stackGradientNoting(factor * g.gamma, g.strength, n, worldGeometricNormal, gamma,
+    gamma = stackGradientNoting(factor * g.gamma, g.strength, n, worldPoint.planeNormal(), gamma,
                                 incoming, aboveNormal, below);
     return;
   }
@@ -331,6 +327,7 @@ SurfacePoint worldSurfacePoint(const SurfacePoint& point, const WorldSpace& spac
   SurfacePoint world = point;
   world.position = space.toWorld * point.position + space.translation;
   world.normal = normalizeOr(space.normalToWorld * point.normal, point.normal);
+  world.geometricNormal = normalizeOr(space.normalToWorld * point.geometricNormal, Vec3d{});
   for (std::size_t set = 0; set < static_cast<std::size_t>(point.numUvSets); ++set) {
     world.uv[set].dPdu = space.toWorld * point.uv[set].dPdu;
     world.uv[set].dPdv = space.toWorld * point.uv[set].dPdv;

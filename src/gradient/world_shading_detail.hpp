@@ -15,8 +15,7 @@ namespace sgbake::gradient_detail {
 /// @brief sgbake::shadeLayersInWorld, bit for bit, with @p preparedWorldUv[s] =
 /// prepareUvFrame(worldPoint.uv[s]) for every UV set s of the point (or null: prepared here).
 WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
-                                     const SurfacePoint& worldPoint,
-                                     const Vec3d& worldGeometricNormal, const WorldSpace& space,
+                                     const SurfacePoint& worldPoint, const WorldSpace& space,
                                      const PreparedUvFrame* preparedWorldUv);
 
 /// @brief One layer's step of shadeLayersInWorld's sum, bit for bit: @p gamma, the world Γ of
@@ -27,9 +26,9 @@ WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const Surfac
 /// @param aboveNormal for a layer on the layers above: when non-null, the normal they hand on
 ///        (stackGradient's), when no Γ stands for it
 void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
-                           const SurfacePoint& worldPoint, const Vec3d& worldGeometricNormal,
-                           const WorldSpace& space, const PreparedUvFrame* preparedWorldUv,
-                           const Vec3d& incoming, Vec3d& gamma, NormalBelowSurface* below = nullptr,
+                           const SurfacePoint& worldPoint, const WorldSpace& space,
+                           const PreparedUvFrame* preparedWorldUv, const Vec3d& incoming,
+                           Vec3d& gamma, NormalBelowSurface* below = nullptr,
                            const Vec3d* aboveNormal = nullptr);
 
 }  // namespace sgbake::gradient_detail

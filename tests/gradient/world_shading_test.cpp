@@ -67,7 +67,7 @@ TEST(WorldShading, RampOnAStretchedPlaneFollowsTheWorldSlope) {
   object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
   const SurfacePoint world = worldSurfacePoint(object, space);
   const std::vector<Layer> layers{{UvHeightSource{&ramp, 0, 1.0}, 1.0, {}}};
-  const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
+  const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, space);
   EXPECT_LT(maxAbsDiff(objectSpaceGradient(shaded, object, space), Vec3d{2 * a, 0, 0}), 1e-15);
   EXPECT_LT(maxAbsDiff(shaded.normal, normalizeOr(Vec3d{-a / 2, 0, 1}, {})), 1e-15);
   // The framework's object-space composite would give a here, and the cofactor a/4 in world.
@@ -86,8 +86,7 @@ TEST(WorldShading, ASimilarityIsObjectSpaceWithHeightsDividedByTheScale) {
       const SurfacePoint world = worldSurfacePoint(object, space);
       const std::vector<Layer> inWorld{{UvHeightSource{&h, 0, 0.2}, 1.0, {}}};
       const std::vector<Layer> inObject{{UvHeightSource{&h, 0, 0.2 / s}, 1.0, {}}};
-      const WorldShadedNormal shaded =
-          shadeLayersInWorld(inWorld, object, world, world.normal, space);
+      const WorldShadedNormal shaded = shadeLayersInWorld(inWorld, object, world, space);
       EXPECT_LT(maxAbsDiff(objectSpaceGradient(shaded, object, space),
                            compositeGradient(inObject, object)),
                 1e-12);
@@ -113,7 +112,7 @@ TEST(WorldShading, ANormalMapComesBackUnchangedThroughAnyTransform) {
     const SurfacePoint object = samplePoint(rng);
     const SurfacePoint world = worldSurfacePoint(object, space);
     const std::vector<Layer> layers{{TangentNormalSource{&map, 0, {}}, 1.0, {}}};
-    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, world.normal, space);
+    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, space);
     EXPECT_LT(maxAbsDiff(normalizeOr(space.normalToObject * shaded.normal, {}),
                          perturbedNormal(object, layers)),
               1e-12);
@@ -136,9 +135,9 @@ TEST(WorldShading, StrengthBlendsTheWorldNormals) {
   half.strength = 0.5;
   const Vec3d n = world.normal;
   const Vec3d bumped =
-      shadeLayersInWorld(std::vector<Layer>{{full, 1.0, {}}}, object, world, n, space).normal;
+      shadeLayersInWorld(std::vector<Layer>{{full, 1.0, {}}}, object, world, space).normal;
   const Vec3d blended =
-      shadeLayersInWorld(std::vector<Layer>{{half, 1.0, {}}}, object, world, n, space).normal;
+      shadeLayersInWorld(std::vector<Layer>{{half, 1.0, {}}}, object, world, space).normal;
   EXPECT_LT(maxAbsDiff(blended, normalizeOr(0.5 * bumped + 0.5 * n, {})), 1e-15);
 }
 
@@ -163,7 +162,7 @@ TEST(WorldShading, ANormalMapDecodedBelowTheSurfaceIsGuardedAsItIs) {
     ObjectNormalSource source{&map, 0};
     source.strength = strength;
     const std::vector<Layer> layers{{source, 1.0, {}}};
-    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, n, space);
+    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, space);
     const Vec3d unguarded = strength == 1 ? decoded : normalizeOr(n + strength * (decoded - n), {});
     EXPECT_LT(maxAbsDiff(shaded.unguarded, unguarded), 1e-15) << strength;
     EXPECT_LT(maxAbsDiff(shaded.normal, gradient_detail::validReflectionNormal(unguarded, n, n)),
@@ -173,12 +172,12 @@ TEST(WorldShading, ANormalMapDecodedBelowTheSurfaceIsGuardedAsItIs) {
   // Strength 1: 35° below the plane, its reflection of I rises: kept (the mirror image the Γ
   // resolves to lies 35° above it).
   const std::vector<Layer> alone{{ObjectNormalSource{&map, 0}, 1.0, {}}};
-  EXPECT_LT(maxAbsDiff(shadeLayersInWorld(alone, object, world, n, space).normal, decoded), 1e-15);
+  EXPECT_LT(maxAbsDiff(shadeLayersInWorld(alone, object, world, space).normal, decoded), 1e-15);
   // Strength 0.6: 5° below, turned up to the guard's 44.7° from N, towards +x.
   ObjectNormalSource weak{&map, 0};
   weak.strength = 0.6;
   const Vec3d turned =
-      shadeLayersInWorld(std::vector<Layer>{{weak, 1.0, {}}}, object, world, n, space).normal;
+      shadeLayersInWorld(std::vector<Layer>{{weak, 1.0, {}}}, object, world, space).normal;
   EXPECT_NEAR(std::acos(turned.z), std::acos(0.01) / 2, 1e-12);
   EXPECT_GT(turned.x, 0.7);
 }
@@ -193,9 +192,8 @@ TEST(WorldShading, AHeightOnANormalMapDecodedBelowTheSurfaceBumpsThatNormal) {
   object.numUvSets = 1;
   object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
   const SurfacePoint world = worldSurfacePoint(object, space);
-  const Vec3d n = world.normal;
   const Vec3d alone = shadeLayersInWorld(std::vector<Layer>{{ObjectNormalSource{&map, 0}, 1.0, {}}},
-                                         object, world, n, space)
+                                         object, world, space)
                           .normal;
   ASSERT_LT(alone.z, -0.8);  // kept below the surface (see the test above)
   for (const double slope : {0.0, 0.02}) {
@@ -203,7 +201,7 @@ TEST(WorldShading, AHeightOnANormalMapDecodedBelowTheSurfaceBumpsThatNormal) {
     Layer bump{UvHeightSource{&ramp, 0, 1.0}, 1.0, {}};
     bump.base = LayerBase::kLayersAbove;
     const std::vector<Layer> chain{{ObjectNormalSource{&map, 0}, 1.0, {}}, bump};
-    const Vec3d bumped = shadeLayersInWorld(chain, object, world, n, space).normal;
+    const Vec3d bumped = shadeLayersInWorld(chain, object, world, space).normal;
     const double degrees = std::acos(std::min(1.0, dot(bumped, alone))) * 180 / kPi;
     EXPECT_LT(degrees, slope == 0 ? 1e-6 : 3.0) << slope;
     EXPECT_GT(degrees, slope == 0 ? -1.0 : 0.1) << slope;
@@ -222,12 +220,14 @@ TEST(WorldShading, BackFacingPointsBakeTheFrontNormalReversed) {
   for (const double lean : {0.3, 2.0}) {  // radians from Ng: in front, then behind
     SurfacePoint object;
     object.normal = Vec3d{std::sin(lean), 0, std::cos(lean)};
+    object.geometricNormal = Vec3d{0, 0, 1};
     object.numUvSets = 1;
     object.uv[0] = {{0.25, 0.5}, {1, 0, 0}, {0, 1, 0}};
     const SurfacePoint world = worldSurfacePoint(object, space);
+    ASSERT_LT(maxAbsDiff(world.geometricNormal, ng), 1e-15);  // carried to world as a normal
     const bool back = dot(world.normal, ng) < 0;
     EXPECT_EQ(back, lean > 1.6) << lean;
-    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, ng, space);
+    const WorldShadedNormal shaded = shadeLayersInWorld(layers, object, world, space);
     const Vec3d expected = back ? -shaded.unguarded : shaded.unguarded;
     EXPECT_LT(maxAbsDiff(shaded.normal, expected), 1e-15) << lean;
     // The unguarded normal is the front one either way: N − Γ with the world ramp's Γ ⊥ N.

@@ -187,12 +187,9 @@ double layerMask(const LayerMask& mask, const SurfacePoint& point);
 ///
 /// Layers with weight 0, a non-finite weight, or mask 0 are skipped without sampling their
 /// source. Without kLayersAbove layers, order does not matter up to round-off.
-/// @param[in] geometricNormal the unit normal of the surface's plane at the point (a mesh
-///            triangle's Ng), for kLayersAbove layers; N where there is none (a corner, a limit
-///            surface), which the two-argument form uses
+/// kLayersAbove layers bump along the point's plane, point.planeNormal() (a mesh triangle's Ng;
+/// N where there is none: a corner, a limit surface).
 /// @return Γ, object space; 0 for an empty span.
-Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point,
-                        const Vec3d& geometricNormal);
 Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point);
 
 /// @brief Γ after a layer based on kLayersAbove (finite nonzero weight), from @p gammaAbove,
@@ -207,8 +204,8 @@ Vec3d compositeGradient(std::span<const Layer> layers, const SurfacePoint& point
 /// spanning the plane). Then n₂ = normalize(n₁ − σ), blended with n₁ by the layer's Strength (UV
 /// height maps), guarded as the closure guards it; returned as the Γ that resolves to it, N − n₂ /
 /// ⟨n₂, N⟩ (gammaAbove where ⟨n₂, N⟩ ≤ 0: no Γ stands for a normal below the surface).
-Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point,
-                         const Vec3d& geometricNormal, const Vec3d& gammaAbove);
+/// Ng is point.planeNormal().
+Vec3d stackLayerGradient(const Layer& layer, const SurfacePoint& point, const Vec3d& gammaAbove);
 
 /// @brief The perturbed normal resolveNormal(N, compositeGradient(layers, point), cof) (eq. 33).
 /// @param[in] objectScaleCofactor cof(M) of the object's transform; identity = object space

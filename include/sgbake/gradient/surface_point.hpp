@@ -64,9 +64,10 @@ struct SurfacePoint {
   std::array<Vec3d, kMaxUvSets> uvTangent{};
   std::array<double, kMaxUvSets> uvBitangentSign{};
   std::array<bool, kMaxUvSets> hasUvTangentFrame{};
-  /// The unit geometric normal Ng of the triangle the point lies on (heights defined in space
-  /// take their slopes along its plane, projectOntoTangentPlaneAlong); zero where the point has
-  /// no triangle (per-corner tables): their slopes then are along the plane ⊥ N.
+  /// The unit geometric normal Ng of the triangle the point lies on: heights defined in space
+  /// take their slopes along its plane (projectOntoTangentPlaneAlong), a layer on the layers
+  /// above bumps along it, and Cycles' guards and back-facing test read it. Zero where the
+  /// point has no triangle (per-corner tables, limit surfaces): N serves then (planeNormal).
   Vec3d geometricNormal{};
   /// Where a Bump node would read the heights again here (set by the baker for layers that
   /// ask for it, see bakeBumpOffsets); empty elsewhere.
@@ -75,6 +76,9 @@ struct SurfacePoint {
   /// The normal Cycles shades with here: N, or −N at a point seen from behind (bump.behind,
   /// where Cycles flips N before any node runs). Box projections pick their mirrors by it.
   Vec3d seenNormal() const { return bump.behind ? -normal : normal; }
+  /// Ng, or N where the point has no triangle (geometricNormal zero): the plane's normal every
+  /// guard and stacked layer takes.
+  const Vec3d& planeNormal() const { return geometricNormal == Vec3d{} ? normal : geometricNormal; }
 };
 
 }  // namespace sgbake

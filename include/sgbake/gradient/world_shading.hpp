@@ -106,13 +106,12 @@ Vec3d objectSpaceGradient(const WorldShadedNormal& shaded, const SurfacePoint& o
 /// @param[in] objectPoint the point in object space (normal-map layers decode there; volumes and
 ///            projections read its position and normal)
 /// @param[in] worldPoint  the same point in world space: unit normal interpolated from the
-///            world corner normals, world ∂P/∂u, ∂P/∂v (UV height layers are evaluated there)
-/// @param[in] worldGeometricNormal the world triangle's unit normal (the guard's Ng, and the
-///            plane a layer on the layers above bumps along)
+///            world corner normals, world ∂P/∂u, ∂P/∂v (UV height layers are evaluated there),
+///            and the world triangle's unit normal as its geometricNormal (the guard's Ng, and
+///            the plane a layer on the layers above bumps along; N where it is zero)
 /// Layers are skipped, weighted, masked and stacked (LayerBase::kLayersAbove) as
 /// compositeGradient does, with every layer's Γ taken in world space and summed there.
 WorldShadedNormal shadeLayersInWorld(std::span<const Layer> layers, const SurfacePoint& objectPoint,
-                                     const SurfacePoint& worldPoint,
-                                     const Vec3d& worldGeometricNormal, const WorldSpace& space);
+                                     const SurfacePoint& worldPoint, const WorldSpace& space);
 
 }  // namespace sgbake
