@@ -446,7 +446,8 @@ def _object_coordinates(tex, ob=None):
     projection is Flat or Box and its Vector comes from a Texture Coordinate node's Object
     output (the baked object's own coordinates; another object's, or its Generated output, when
     the baked object `ob` is known: mapping_matrix), straight or through one Mapping node of
-    type Point whose Location, Rotation and Scale are its own values. Its height is then
+    type Point, Texture or Vector whose Location, Rotation and Scale are its own values (not
+    Normal, which normalizes the coordinates). Its height is then
     sgbake's planar layer on axis z (Flat) or its triplanar layer with Blender's Box projection
     (Box)."""
     if tex.projection not in ("FLAT", "BOX"):
@@ -455,8 +456,9 @@ def _object_coordinates(tex, ob=None):
     settings = {}
     if link is not None and link.from_node.type == "MAPPING":
         node = link.from_node
-        if node.vector_type != "POINT" or any(node.inputs[n].is_linked for n in MAPPING_INPUTS):
+        if node.vector_type == "NORMAL" or any(node.inputs[n].is_linked for n in MAPPING_INPUTS):
             return None
+        settings["mapping_type"] = node.vector_type
         for name in MAPPING_INPUTS:
             settings[f"mapping_{name.lower()}"] = tuple(node.inputs[name].default_value)
         link = _source_link(node.inputs["Vector"])

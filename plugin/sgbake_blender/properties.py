@@ -58,6 +58,12 @@ KINDS = (
     ("tangent-normal", "Tangent Normal", "The image holds tangent-space normals"),
     ("object-normal", "Object Normal", "The image holds object-space normals"),
 )
+MAPPING_TYPES = (
+    ("POINT", "Point", "Scale, rotate, then move the coordinates (the Mapping node's Point)"),
+    ("TEXTURE", "Texture", "The inverse of Point: move back, rotate back, divide by the scale"),
+    ("VECTOR", "Vector", "Scale and rotate the coordinates; the Location is not used"),
+)
+
 PROJECTIONS = (
     ("blended", "Blended", "sgbake's triplanar: each plane weighted by |normal|^Sharpness"),
     ("box", "Box", "Blender's Image Texture Box projection with its Blend (kinds Height and "
@@ -132,6 +138,10 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     kind: EnumProperty(name="Kind", items=KINDS, default="height",
                        description="What the projected image holds")
     axis: EnumProperty(name="Axis", items=AXES, default="z")
+    mapping_type: EnumProperty(
+        name="Type", items=MAPPING_TYPES, default="POINT",
+        description="Projections: the Mapping node's type (how Location, Rotation and Scale "
+                    "move the object coordinates)")
     mapping_location: FloatVectorProperty(
         name="Location", size=3, default=(0.0, 0.0, 0.0), subtype="TRANSLATION",
         description="Projections: a Mapping node's Location, added to the object coordinates "

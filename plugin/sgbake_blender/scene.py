@@ -157,6 +157,8 @@ def layer_json(layer, uv_index, default_uv=None):
         if matrix != [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]:
             mapping["matrix"] = [matrix[0:4], matrix[4:8], matrix[8:12]]
         if mapping != {"location": [0.0] * 3, "rotation": [0.0] * 3, "scale": [1.0] * 3}:
+            if layer.mapping_type != "POINT":
+                mapping["type"] = layer.mapping_type.lower()
             entry["mapping"] = mapping  # other coordinates, a Mapping node before the projection
     if reads_tangent_normals(layer):
         entry["green"] = layer.green

@@ -122,7 +122,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             if layer.type in ("planar", "triplanar"):
                 box = col.box()
                 box.label(text="Mapping")
-                for name in ("mapping_location", "mapping_rotation", "mapping_scale"):
+                for name in ("mapping_type", "mapping_location", "mapping_rotation",
+                             "mapping_scale"):
                     box.prop(layer, name)
                 if tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0):
                     box.label(text="Coordinates: another object's or Generated")

@@ -290,7 +290,7 @@ CoordinateMapping coordinateMapping(const SceneLayer& layer) {
   if (!layer.mapping) return {};
   const SceneMapping& m = *layer.mapping;
   const CoordinateMapping node =
-      CoordinateMapping::fromMappingNode(m.location, m.rotation, m.scale);
+      CoordinateMapping::fromMappingNode(m.location, m.rotation, m.scale, m.type);
   if (!m.matrix) return node;
   return node.after(CoordinateMapping::affine(*m.matrix, m.matrixTranslation));
 }

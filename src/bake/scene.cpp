@@ -99,6 +99,9 @@ constexpr Named<ProjectedKind> kKinds[] = {{"height", ProjectedKind::kHeight},
                                            {"object-normal", ProjectedKind::kObjectNormal}};
 constexpr Named<TriplanarProjection> kProjections[] = {{"blended", TriplanarProjection::kBlended},
                                                        {"box", TriplanarProjection::kBox}};
+constexpr Named<MappingType> kMappingTypes[] = {{"point", MappingType::kPoint},
+                                                {"texture", MappingType::kTexture},
+                                                {"vector", MappingType::kVector}};
 constexpr Named<ProjectionAxis> kAxes[] = {
     {"x", ProjectionAxis::kX}, {"y", ProjectionAxis::kY}, {"z", ProjectionAxis::kZ}};
 constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
@@ -361,7 +364,7 @@ const std::vector<std::string> kSubdivisionKeys = {"level",       "uv_smooth",  
                                                    "type",        "auto_smooth",
                                                    "sharp_edges"};
 const std::vector<std::string> kMaskKeys = {"image", "uv", "tiling", "offset", "filter"};
-const std::vector<std::string> kMappingKeys = {"location", "rotation", "scale", "matrix"};
+const std::vector<std::string> kMappingKeys = {"type", "location", "rotation", "scale", "matrix"};
 const std::vector<std::string> kLayerCommonKeys = {"type", "name", "weight", "mask", "material"};
 const std::vector<std::string> kImageLayerKeys = {"image", "filter", "wrap", "tiling", "offset"};
 
@@ -672,6 +675,7 @@ SceneMapping parseMapping(const json& value, const std::string& where) {
   const ObjectReader reader(value, where, "a mapping");
   reader.checkKeys(kMappingKeys);
   SceneMapping mapping;
+  reader.optionalName("type", kMappingTypes, mapping.type);
   if (reader.has("location")) mapping.location = reader.vec3("location");
   if (reader.has("rotation")) mapping.rotation = reader.vec3("rotation");
   if (reader.has("scale")) mapping.scale = reader.vec3("scale");
@@ -1477,6 +1481,9 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     j["mapping"] = {{"location", triple(layer.mapping->location)},
                     {"rotation", triple(layer.mapping->rotation)},
                     {"scale", triple(layer.mapping->scale)}};
+    if (layer.mapping->type != MappingType::kPoint) {
+      j["mapping"]["type"] = nameIn(kMappingTypes, layer.mapping->type);
+    }
     if (const std::optional<Mat3>& a = layer.mapping->matrix) {
       const Vec3d& t = layer.mapping->matrixTranslation;
       j["mapping"]["matrix"] = {{(*a)(0, 0), (*a)(0, 1), (*a)(0, 2), t.x},

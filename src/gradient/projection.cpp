@@ -24,7 +24,8 @@ Vec3d finiteOrZero(Vec3d gamma) { return isFinite(gamma) ? gamma : Vec3d{}; }
 
 }  // namespace
 
-CoordinateMapping CoordinateMapping::fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale) {
+CoordinateMapping CoordinateMapping::fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale,
+                                                     MappingType type) {
   const auto turn = [](double angle, int axis) {
     const double c = std::cos(angle), s = std::sin(angle);
     Mat3 r;
@@ -36,11 +37,25 @@ CoordinateMapping CoordinateMapping::fromMappingNode(Vec3d location, Vec3d rotat
     r.col[j][j] = c;
     return r;
   };
+  const Mat3 r = turn(rotation.z, 2) * turn(rotation.y, 1) * turn(rotation.x, 0);
   CoordinateMapping m;
-  m.linear =
-      turn(rotation.z, 2) * turn(rotation.y, 1) * turn(rotation.x, 0) * Mat3::diagonal(scale);
-  m.translation = location;
-  m.identity = location == Vec3d{} && rotation == Vec3d{} && scale == Vec3d{1, 1, 1};
+  switch (type) {
+    case MappingType::kPoint:
+    case MappingType::kVector:
+      m.linear = r * Mat3::diagonal(scale);
+      m.translation = type == MappingType::kPoint ? location : Vec3d{};
+      break;
+    case MappingType::kTexture: {
+      // Cycles' safe_divide: a zero scale gives 0, not infinity.
+      const auto inverse = [](double s) { return s != 0 ? 1 / s : 0.0; };
+      m.linear =
+          Mat3::diagonal({inverse(scale.x), inverse(scale.y), inverse(scale.z)}) * transpose(r);
+      m.translation = -(m.linear * location);
+      break;
+    }
+  }
+  m.identity = (type == MappingType::kVector || location == Vec3d{}) && rotation == Vec3d{} &&
+               scale == Vec3d{1, 1, 1};
   return m;
 }
 

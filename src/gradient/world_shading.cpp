@@ -19,11 +19,6 @@ namespace {
 
 using gradient_detail::PreparedUvFrame;
 
-Mat3 transpose(const Mat3& m) {
-  return Mat3::fromColumns({m(0, 0), m(0, 1), m(0, 2)}, {m(1, 0), m(1, 1), m(1, 2)},
-                           {m(2, 0), m(2, 1), m(2, 2)});
-}
-
 bool isFinite(const Mat3& m) {
   return sgbake::isFinite(m.col[0]) && sgbake::isFinite(m.col[1]) && sgbake::isFinite(m.col[2]);
 }

@@ -697,8 +697,21 @@ TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
 
   EXPECT_EQ(parseError(withLayer(
                 R"({"type": "triplanar", "image": "h.png", "mapping": {"rotate": [0, 0, 1]}})")),
-            "scene.json: layers[0].mapping: unknown key 'rotate' (expected location, rotation, "
-            "scale or matrix)");
+            "scene.json: layers[0].mapping: unknown key 'rotate' (expected type, location, "
+            "rotation, scale or matrix)");
+  // The Mapping node's type: Point unless given, and written only when it is not.
+  EXPECT_EQ(mapped->layers[0].mapping->type, MappingType::kPoint);
+  EXPECT_EQ(layerParametersJson(mapped->layers[0]).find(R"("type":"point")"), std::string::npos);
+  Result<Scene> texture = parseScene(withLayer(R"({"type": "planar", "image": "h.png",
+                    "mapping": {"type": "texture", "location": [1, 2, 3]}})"),
+                                     options());
+  ASSERT_TRUE(texture) << texture.error().message;
+  EXPECT_EQ(texture->layers[0].mapping->type, MappingType::kTexture);
+  EXPECT_NE(layerParametersJson(texture->layers[0]).find(R"("type":"texture")"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "planar", "image": "h.png", "mapping": {"type": "normal"}})")),
+            "scene.json: layers[0].mapping: unknown type 'normal' (expected point, texture or "
+            "vector)");
   EXPECT_EQ(parseError(
                 withLayer(R"({"type": "planar", "image": "h.png", "mapping": {"scale": [1, 2]}})")),
             "scene.json: layers[0].mapping: 'scale' must be an array of 3 numbers, not an array");

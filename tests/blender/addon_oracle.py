@@ -63,8 +63,8 @@
    both materials; tangent and an EMIT mask, 256^2). Back on the one-material Suzanne, the
    layers must have no slot (-1) and send no "material"; a hand-made layer's slot is -1.
    Projector (projector_case): the bump material's Image Texture read with Box projection on an
-   Empty's coordinates through a Mapping node (PROJECTOR_*). Layers from Material must make one
-   triplanar Box layer (bump-node slopes); its tangent-normal bake must be Cycles' (median <=
+   Empty's coordinates through a Mapping node of type Texture (PROJECTOR_*). Layers from
+   Material must make one triplanar Box layer (bump-node slopes, the node's type); its tangent-normal bake must be Cycles' (median <=
    PROJECTOR_MEDIAN_DEG), and the same job with sgbake's own triplanar blend must not.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
@@ -175,10 +175,12 @@ MATERIALS_MAX_DEG = 1.0
 MATERIALS_CONTROL_FACTOR = 3.0
 # The projector case (projector_case): the bump material's Image Texture read with Box
 # projection (Blend PROJECTOR_BLEND) on the coordinates of an Empty placed so, through a
-# Mapping node; Layers from Material must make it a triplanar Box layer whose bake is Cycles'
+# Mapping node of type PROJECTOR_MAPPING_TYPE (the inverse of the Point the bake oracle's
+# box_mapped_sphere checks); Layers from Material must make it a triplanar Box layer whose bake is Cycles'
 # (bump-node slopes) to float rounding. Its control: the same layer with sgbake's own blend.
 PROJECTOR_EMPTY = ((0.2, 0.4, -0.3), (0.3, -0.5, 0.2), (0.7, 1.3, 0.9))
 PROJECTOR_MAPPING = ((0.1, 0.0, -0.2), (0.0, 0.3, 0.0), (1.2, 1.0, 0.8))
+PROJECTOR_MAPPING_TYPE = "TEXTURE"
 PROJECTOR_BLEND = 0.3
 PROJECTOR_DISTANCE = 0.01
 PROJECTOR_MEDIAN_DEG = 0.01
@@ -308,6 +310,11 @@ def layers_from_material(settings, distance):
     tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
     mapped, _, mapped_ignored = operators.material_layers(tree)
+    # Its type goes along (Vector: no Location); Normal, which normalizes, is named instead.
+    mapping.vector_type = "VECTOR"
+    vector, _, _ = operators.material_layers(tree)
+    mapping.vector_type = "NORMAL"
+    normal, _, normal_ignored = operators.material_layers(tree)
     tree.nodes.remove(mapping)
     # Another object's coordinates (an Empty as a projector) and the Generated ones, given the
     # baked object: an affine map of its own, row by row (BlenderBakeOracle's box_empty_sphere
@@ -363,6 +370,11 @@ def layers_from_material(settings, distance):
                    for name, value in moved.items())):
         entry["error"] = (f"a Mapping node between the coordinates and the Box projection should "
                           f"give its {moved}, nothing named: {mapped}, {mapped_ignored}")
+    if (got.get("mapping_type") != "POINT" or len(vector) != 1
+            or vector[0].get("mapping_type") != "VECTOR"
+            or not any("Vector from 'Mapping'" in n for n in normal_ignored)):
+        entry["error"] = (f"a Mapping node's type should go along (POINT, VECTOR: {mapped}, "
+                          f"{vector}) and type Normal be named: {normal}, {normal_ignored}")
     return entry
 
 
@@ -937,11 +949,12 @@ def options_case(settings, height, work):
                           f"{wrong}"}]
     # Projection Box sends Blender's Blend instead of the blended projection's keys.
     tri.projection, tri.box_blend, tri.mapping_rotation = "box", 0.4, (0.0, 0.5, 0.0)
+    tri.mapping_type = "TEXTURE"
     sent_box = operators.BakeJob(bpy.context).scene["layers"][2]
     want_box = {"projection": "box", "box_blend": f(tri.box_blend),
                 "mapping": {"location": [0.0] * 3, "rotation": [0.0, f(tri.mapping_rotation[1]), 0.0],
-                            "scale": [1.0] * 3}}
-    tri.projection, tri.mapping_rotation = "blended", (0.0, 0.0, 0.0)
+                            "scale": [1.0] * 3, "type": "texture"}}
+    tri.projection, tri.mapping_rotation, tri.mapping_type = "blended", (0.0, 0.0, 0.0), "POINT"
     checks.append({"name": "a triplanar layer's Projection Box and Mapping in the add-on's "
                            "scene JSON",
                    "ok": all(sent_box.get(k) == v for k, v in want_box.items())
@@ -1316,6 +1329,7 @@ def projector_case(settings, ob, work):
     coordinates = tree.nodes.new("ShaderNodeTexCoord")
     coordinates.object = empty
     mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.vector_type = PROJECTOR_MAPPING_TYPE
     for name, value in zip(("Location", "Rotation", "Scale"), PROJECTOR_MAPPING):
         mapping.inputs[name].default_value = value
     tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
@@ -1327,12 +1341,15 @@ def projector_case(settings, ob, work):
         bpy.ops.object.sgbake_layers_from_material()
         layer = settings.layers[0]
         entry["layer"] = {"type": layer.type, "projection": layer.projection,
-                          "box_blend": layer.box_blend, "slopes": layer.slopes}
+                          "box_blend": layer.box_blend, "slopes": layer.slopes,
+                          "mapping_type": layer.mapping_type}
         entry["checks"].append({
             "name": "projector: Layers from Material makes one triplanar Box layer",
             "ok": (len(settings.layers) == 1 and layer.type == "triplanar"
-                   and layer.projection == "box" and layer.slopes == "bump-node"),
-            "expected": "one triplanar layer, projection box, slopes bump-node",
+                   and layer.projection == "box" and layer.slopes == "bump-node"
+                   and layer.mapping_type == PROJECTOR_MAPPING_TYPE),
+            "expected": f"one triplanar layer, projection box, slopes bump-node, mapping type "
+                        f"{PROJECTOR_MAPPING_TYPE}",
             "message": str(entry["layer"])})
         settings.target_image = None
         settings.width = settings.height = SIZE

@@ -596,6 +596,32 @@ TEST(CoordinateMapping, IsBlendersMappingNode) {
   EXPECT_TRUE(CoordinateMapping::affine(Mat3::identity(), {}).identity);
 }
 
+// The node's other types: Texture undoes Point (Cycles' mapping_texture), and divides by a zero
+// scale as Cycles' safe_divide does (to 0); Vector is Point without the location.
+TEST(CoordinateMapping, TextureUndoesPointAndVectorDropsTheLocation) {
+  const Vec3d location{0.5, -1, 2}, rotation{0.4, -0.3, 1.2}, scale{2, 0.5, 1.5};
+  const CoordinateMapping point = CoordinateMapping::fromMappingNode(location, rotation, scale);
+  const CoordinateMapping texture =
+      CoordinateMapping::fromMappingNode(location, rotation, scale, MappingType::kTexture);
+  const CoordinateMapping vector =
+      CoordinateMapping::fromMappingNode(location, rotation, scale, MappingType::kVector);
+  std::mt19937_64 rng(34);
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (int i = 0; i < 20; ++i) {
+    const Vec3d p{u(rng), u(rng), u(rng)};
+    EXPECT_LT(maxAbsDiff(texture.apply(point.apply(p)), p), 1e-14);
+    EXPECT_LT(maxAbsDiff(point.apply(texture.apply(p)), p), 1e-14);
+    EXPECT_LT(maxAbsDiff(vector.apply(p), point.apply(p) - location), 1e-15);
+  }
+  const CoordinateMapping flat =
+      CoordinateMapping::fromMappingNode({1, 2, 3}, {}, {2, 0, 4}, MappingType::kTexture);
+  EXPECT_LT(maxAbsDiff(flat.apply({5, 7, 11}), Vec3d{2, 0, 2}), 1e-15);
+  EXPECT_TRUE(
+      CoordinateMapping::fromMappingNode({1, 2, 3}, {}, {1, 1, 1}, MappingType::kVector).identity);
+  EXPECT_FALSE(
+      CoordinateMapping::fromMappingNode({1, 2, 3}, {}, {1, 1, 1}, MappingType::kTexture).identity);
+}
+
 // With a mapping, Γ is still the projected gradient of the height the planes read at P', checked
 // by central differences through planarTextureCoordinates, for planar and Box projections.
 TEST(CoordinateMapping, SlopesAreThoseOfTheMappedCoordinates) {

@@ -112,14 +112,16 @@ struct SceneSubdivision {
   }
 };
 
-/// @brief A projection's optional "mapping": Blender's Mapping node (type Point) between a
-/// Texture Coordinate node's Object output and the Image Texture: the projection reads
-/// R · (scale ∘ P) + location (CoordinateMapping). {"location", "rotation" (radians, XYZ Euler),
-/// "scale", "matrix"}, each optional. "matrix" (3 rows of 4 numbers, or 4 with the last
+/// @brief A projection's optional "mapping": Blender's Mapping node between a Texture
+/// Coordinate node's Object output and the Image Texture: of type "point" (the default) the
+/// projection reads R · (scale ∘ P) + location, of type "texture" its inverse, of type "vector"
+/// R · (scale ∘ P) (CoordinateMapping, MappingType). {"type", "location", "rotation" (radians,
+/// XYZ Euler), "scale", "matrix"}, each optional. "matrix" (3 rows of 4 numbers, or 4 with the last
 /// [0, 0, 0, 1]) moves P first: the coordinates Blender's Texture Coordinate node gives instead
 /// of the object's own (Object with another object named: inverse(its matrix_world) ·
 /// matrix_world; Generated: the texture space).
 struct SceneMapping {
+  MappingType type = MappingType::kPoint;  ///< "type": "point" | "texture" | "vector"
   Vec3d location{};
   Vec3d rotation{};
   Vec3d scale{1, 1, 1};

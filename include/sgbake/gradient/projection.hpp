@@ -59,9 +59,17 @@ PlaneAxes planeAxes(ProjectionAxis axis);
 /// (z, x) for Y.
 Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis);
 
+/// @brief How Blender's Mapping node moves a vector (its type; Normal, which normalizes, does
+/// not keep coordinates affine and is not one).
+enum class MappingType {
+  kPoint,    ///< R · (scale ∘ P) + location
+  kTexture,  ///< the inverse of Point: (Rᵀ · (P − location)) / scale (a zero scale gives 0)
+  kVector,   ///< R · (scale ∘ P): Point without the location
+};
+
 /// @brief Object coordinates moved before a projection reads them, as Blender's Mapping node
-/// (type Point) moves a Texture Coordinate node's Object output: P' = linear · P + translation,
-/// linear = R · diag(scale) with R the rotation of an XYZ Euler (x first, then y, then z).
+/// moves a Texture Coordinate node's Object output: P' = linear · P + translation; for type
+/// Point linear = R · diag(scale), R the rotation of an XYZ Euler (x first, then y, then z).
 /// A projection's planes and slopes are those of P' (the slopes pulled back by linearᵀ); a
 /// Box projection still picks its planes by the object's normal, as Cycles does.
 struct CoordinateMapping {
@@ -69,8 +77,9 @@ struct CoordinateMapping {
   Vec3d translation{};
   bool identity = true;  ///< linear the identity and no translation: P' = P, nothing to do
 
-  /// The Mapping node's Location, Rotation (radians, XYZ Euler) and Scale.
-  static CoordinateMapping fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale);
+  /// The Mapping node of type @p type with Location, Rotation (radians, XYZ Euler) and Scale.
+  static CoordinateMapping fromMappingNode(Vec3d location, Vec3d rotation, Vec3d scale,
+                                           MappingType type = MappingType::kPoint);
   /// P' = @p linear · P + @p translation: any affine map, e.g. the coordinates another object
   /// (Texture Coordinate Object with an object) or the texture space (Generated) gives P.
   static CoordinateMapping affine(const Mat3& linear, Vec3d translation);

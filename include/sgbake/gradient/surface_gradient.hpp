@@ -75,6 +75,12 @@ struct Mat3 {
   }
 };
 
+/// @brief Mᵀ.
+constexpr Mat3 transpose(const Mat3& m) {
+  return Mat3::fromColumns({m(0, 0), m(0, 1), m(0, 2)}, {m(1, 0), m(1, 1), m(1, 2)},
+                           {m(2, 0), m(2, 1), m(2, 2)});
+}
+
 /// @brief det(M) = ⟨c0 × c1, c2⟩.
 double determinant(const Mat3& m);
 
