@@ -82,9 +82,7 @@ std::string whyNotRead(const SceneOutput& output, const SceneLayer& layer) {
 
 /// Whether a layer read by a baked map needs MikkTSpace frames: a tangent-space normal map on
 /// UV set 0 is decoded in them (TangentFrameChoice::kAuto).
-bool layerNeedsTangents(const SceneLayer& layer) {
-  return layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent;
-}
+bool layerNeedsTangents(const SceneLayer& layer) { return layer.decodesInUvTangentFrames(); }
 
 std::string describeOutput(const SceneOutput& output) {
   if (output.kind == OutputKind::kCorners) return "the corner table " + output.file.string();
@@ -1126,10 +1124,9 @@ Result<Plan> makePlan(Scene scene, const PlanOptions& options) {
     for (const std::size_t l : output.layers) {
       used.insert(l);
       if (out.kind == OutputKind::kMap && layerNeedsTangents(s.layers[l]) && !limitFrames) {
-        tangentReasons.push_back(layerLabel(l) + ", a tangent-space normal map on UV set " +
-                                 std::to_string(s.layers[l].uvSet) +
-                                 ", is decoded in them (those of the loop triangles) for " +
-                                 out.file.string());
+        tangentReasons.push_back(layerLabel(l) + ", a tangent-space normal map, is decoded in " +
+                                 "those of UV set " + std::to_string(s.layers[l].frameUvSet()) +
+                                 " (of the loop triangles) for " + out.file.string());
       }
     }
   }

@@ -111,6 +111,10 @@ Status checkUvSets(const Plan& plan, const Mesh& mesh) {
     if (uvLayer && !mesh.hasUvSet(static_cast<std::size_t>(layer.uvSet))) {
       return missing(layerLabel(planned.sceneLayer), layer.uvSet);
     }
+    if (layer.decodesInUvTangentFrames() &&
+        !mesh.hasUvSet(static_cast<std::size_t>(layer.frameUvSet()))) {
+      return missing(layerLabel(planned.sceneLayer) + "'s tangent frames", layer.frameUvSet());
+    }
     if (layer.mask && !mesh.hasUvSet(static_cast<std::size_t>(layer.mask->uvSet))) {
       return missing(layerLabel(planned.sceneLayer) + ".mask", layer.mask->uvSet);
     }
@@ -295,6 +299,42 @@ CoordinateMapping coordinateMapping(const SceneLayer& layer) {
   return node.after(CoordinateMapping::affine(*m.matrix, m.matrixTranslation));
 }
 
+/// A triplanar layer's options (the Box projection's too).
+TriplanarOptions triplanarOptions(const SceneLayer& layer) {
+  TriplanarOptions options;
+  options.tiling = layer.tiling;
+  options.offset = layer.offset;
+  options.scale = layer.scale;
+  options.sharpness = layer.sharpness;
+  options.minWeight = layer.minWeight;
+  options.projection = layer.projection;
+  options.boxBlend = layer.boxBlend;
+  options.coordinates = coordinateMapping(layer);
+  options.normal.green = layer.green;
+  return options;
+}
+
+/// A triplanar normal-map layer with Blender's Box projection: what Cycles bakes, a Normal Map
+/// node (Strength = the layer's scale) decoding the colour an Image Texture's Box projection
+/// reads. The normal-map source with its texels read by that projection (TangentNormalSource::
+/// box): Strength, guards and normals below the surface as a UV normal map's.
+LayerSource boxNormalSource(const SceneLayer& layer, const VectorTexture* texture) {
+  if (layer.kind == ProjectedKind::kTangentNormal) {
+    TangentNormalSource source;
+    source.texture = texture;
+    source.uvSet = layer.frameUvSet();
+    source.options.green = layer.green;
+    source.options.strength = layer.scale;
+    source.box = triplanarOptions(layer);
+    return source;
+  }
+  ObjectNormalSource source;
+  source.texture = texture;
+  source.strength = layer.scale;
+  source.box = triplanarOptions(layer);
+  return source;
+}
+
 /// The library Layer of a planned layer (textures and volumes must be loaded).
 Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& loaded,
                         double objectSize) {
@@ -380,19 +420,15 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       break;
     }
     case SceneLayerType::kTriplanar: {
+      if (layer.projection == TriplanarProjection::kBox && layer.readsNormals()) {
+        result.source = boxNormalSource(layer, vector);
+        break;
+      }
       TriplanarSource source;
       source.kind = layer.kind;
       source.height = scalar;
       source.normals = vector;
-      source.options.tiling = layer.tiling;
-      source.options.offset = layer.offset;
-      source.options.scale = layer.scale;
-      source.options.sharpness = layer.sharpness;
-      source.options.minWeight = layer.minWeight;
-      source.options.projection = layer.projection;
-      source.options.boxBlend = layer.boxBlend;
-      source.options.coordinates = coordinateMapping(layer);
-      source.options.normal = projected;
+      source.options = triplanarOptions(layer);
       source.gradient = layer.heightGradient;
       result.source = source;
       break;

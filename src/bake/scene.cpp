@@ -392,7 +392,7 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       break;
     case SceneLayerType::kTriplanar:
       add({"kind", "scale", "mapping", "projection", "sharpness", "min_weight", "box_blend",
-           "green", "base", "gradient"});
+           "green", "base", "gradient", "tangent_uv"});
       break;
   }
   return keys;
@@ -828,9 +828,6 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (!box && reader.has("box_blend")) {
     fail(where, "key 'box_blend' applies only to 'projection': 'box'");
   }
-  if (layer.tangentUvSet && layer.space == NormalSpace::kObject) {
-    fail(where, "key 'tangent_uv' applies only to tangent-space normal maps");
-  }
   if (layer.base == LayerBase::kLayersAbove && layer.readsNormals()) {
     fail(where,
          "'base': 'above' applies only to heights (a normal map has no normal to start from)");
@@ -1085,10 +1082,9 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   if (!(layer.boxBlend >= 0 && layer.boxBlend <= 1)) {
     return "box_blend must be a number from 0 to 1 (Blender's Blend)";
   }
-  if (layer.type == SceneLayerType::kTriplanar && layer.projection == TriplanarProjection::kBox &&
-      layer.kind == ProjectedKind::kTangentNormal) {
-    return "'projection': 'box' takes kind 'height' or 'object-normal' (Blender's Box planes are "
-           "mirrored per side and give a tangent-space map no frame)";
+  if (layer.tangentUvSet && !layer.decodesInUvTangentFrames()) {
+    return "key 'tangent_uv' applies only to tangent-space normal maps (normal layers, and "
+           "triplanar ones with 'projection': 'box')";
   }
   if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
     return "step must be a finite number > 0";
@@ -1258,6 +1254,12 @@ bool SceneLayer::readsNormals() const {
       break;
   }
   return false;
+}
+
+bool SceneLayer::decodesInUvTangentFrames() const {
+  if (type == SceneLayerType::kNormal) return space == NormalSpace::kTangent;
+  return type == SceneLayerType::kTriplanar && projection == TriplanarProjection::kBox &&
+         kind == ProjectedKind::kTangentNormal;
 }
 
 bool SceneLayer::hasHeight() const {
@@ -1431,6 +1433,8 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
       (layer.type == SceneLayerType::kNormal && layer.space == NormalSpace::kTangent) ||
       (layer.projected() && layer.kind == ProjectedKind::kTangentNormal);
   if (tangentNormals) j["green"] = nameIn(kGreens, layer.green);
+  if (layer.tangentUvSet) j["tangent_uv"] = *layer.tangentUvSet;
+  if (layer.decodesInUvTangentFrames() && layer.projected()) j["uv"] = layer.uvSet;
   switch (layer.type) {
     case SceneLayerType::kHeight:
       j["uv"] = layer.uvSet;
@@ -1443,7 +1447,6 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     case SceneLayerType::kNormal:
       j["uv"] = layer.uvSet;
       j["space"] = nameIn(kSpaces, layer.space);
-      if (layer.tangentUvSet) j["tangent_uv"] = *layer.tangentUvSet;
       break;
     case SceneLayerType::kVolume:
       j["function"] = nameIn(kFunctions, layer.function);

@@ -296,17 +296,20 @@ Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const Triplan
       projectOntoTangentPlane(options.coordinates.pullBack(volumeGradient), point.normal));
 }
 
+Vec3d boxTexel(const VectorTexture& texture, const TriplanarOptions& options,
+               const SurfacePoint& point) {
+  const Vec3d position = options.coordinates.apply(point.position);
+  Vec3d blend{};
+  for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal()))
+    blend += p.weight * texture.sample(planarTextureCoordinates(position, p.mapping));
+  return blend;
+}
+
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
                                     const SurfacePoint& point) {
   if (options.projection == TriplanarProjection::kBox) {
-    // Cycles blends the texels' colours and a Normal Map node decodes the blend: one normal,
-    // Σ w_i n_i (the decoding is affine and the weights sum to 1).
-    const Vec3d position = options.coordinates.apply(point.position);
-    Vec3d blend{};
-    for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal())) {
-      blend += p.weight *
-               decodeNormalTexel(texture.sample(planarTextureCoordinates(position, p.mapping)));
-    }
+    // Cycles blends the texels' colours and a Normal Map node decodes the blend: one normal.
+    const Vec3d blend = decodeNormalTexel(boxTexel(texture, options, point));
     return finiteOrZero(options.scale *
                         gradientFromObjectNormal(blend, point.normal, options.normal.minCosine));
   }

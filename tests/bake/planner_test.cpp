@@ -187,10 +187,22 @@ TEST_F(PlannerTest, TangentsForTangentNormalMapsAndTangentSpaceLayers) {
   // A tangent-space normal map on UV set 0 is decoded in the MikkTSpace frame.
   const Plan p = plan(planeScene(kNormalLayer, R"({"map": "object-normal", "file": "o.png"})"));
   EXPECT_TRUE(p.computeTangents);
-  EXPECT_NE(explainPlan(p).find("layers[0], a tangent-space normal map on UV set 0, is decoded"),
-            std::string::npos);
-  // ... but not an object-space one.
+  EXPECT_NE(
+      explainPlan(p).find("layers[0], a tangent-space normal map, is decoded in those of UV set 0"),
+      std::string::npos)
+      << explainPlan(p);
+  // ... and so is one Blender's Box projection reads (a Normal Map node after the Image
+  // Texture), on its "tangent_uv" ...
+  const Plan box = plan(planeScene(R"({"type": "triplanar", "image": "n.png", "projection": "box",
+                                       "kind": "tangent-normal"})",
+                                   R"({"map": "object-normal", "file": "o.png"})"));
+  EXPECT_TRUE(box.computeTangents);
+  // ... but not an object-space one, nor sgbake's blended triplanar (each plane's own frame).
   EXPECT_FALSE(plan(planeScene(R"({"type": "normal", "image": "n.png", "space": "object"})",
+                               R"({"map": "object-normal", "file": "o.png"})"))
+                   .computeTangents);
+  EXPECT_FALSE(plan(planeScene(R"({"type": "triplanar", "image": "n.png",
+                                   "kind": "tangent-normal"})",
                                R"({"map": "object-normal", "file": "o.png"})"))
                    .computeTangents);
   const ExecuteReport report =

@@ -541,7 +541,8 @@ TEST(Scene, InvalidCombinations) {
       "normal to start from)");
   EXPECT_EQ(parseError(withLayer(
                 R"({"type": "normal", "image": "n.png", "space": "object", "tangent_uv": 1})")),
-            "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps");
+            "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps "
+            "(normal layers, and triplanar ones with 'projection': 'box')");
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "base": "above"})")),
             "scene.json: layers[0]: key 'base' does not apply to a normal layer (it is for "
             "height, volume, planar or triplanar layers)");
@@ -663,10 +664,23 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
             "(Blender's Box projection blends by 'box_blend')");
   EXPECT_EQ(parseError(withLayer(R"({"type": "triplanar", "image": "h.png", "box_blend": 0.2})")),
             "scene.json: layers[0]: key 'box_blend' applies only to 'projection': 'box'");
-  EXPECT_EQ(parseError(withLayer(R"({"type": "triplanar", "image": "n.png", "projection": "box",
-                                     "kind": "tangent-normal"})")),
-            "scene.json: layers[0]: 'projection': 'box' takes kind 'height' or 'object-normal' "
-            "(Blender's Box planes are mirrored per side and give a tangent-space map no frame)");
+  // A Box-projected tangent-space map decodes in a UV set's frames, "tangent_uv" else "uv".
+  Result<Scene> tangent = parseScene(withLayer(R"({"type": "triplanar", "image": "n.png",
+                    "projection": "box", "kind": "tangent-normal", "tangent_uv": 1})"),
+                                     options());
+  ASSERT_TRUE(tangent) << tangent.error().message;
+  EXPECT_TRUE(tangent->layers[0].decodesInUvTangentFrames());
+  EXPECT_EQ(tangent->layers[0].frameUvSet(), 1);
+  EXPECT_NE(layerParametersJson(tangent->layers[0]).find(R"("tangent_uv":1)"), std::string::npos);
+  EXPECT_FALSE(box->layers[0].decodesInUvTangentFrames());
+  for (const char* kind :
+       {R"("projection": "box", "kind": "object-normal")", R"("kind": "tangent-normal")"}) {
+    EXPECT_EQ(parseError(withLayer(std::string(R"({"type": "triplanar", "image": "n.png", )") +
+                                   kind + R"(, "tangent_uv": 1})")),
+              "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps "
+              "(normal layers, and triplanar ones with 'projection': 'box')")
+        << kind;
+  }
   EXPECT_EQ(
       parseError(withLayer(
           R"({"type": "triplanar", "image": "h.png", "projection": "box", "box_blend": 1.5})")),
@@ -1041,17 +1055,19 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   status = validateScene(scene);
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message, "layers[0]: weight must be a finite number");
-  // A Box projection of a tangent-space map, built in code as in a scene file, is refused.
+  // Tangent frames named for a layer that decodes in none, built in code as in a scene file,
+  // are refused.
   scene.layers[0].weight = 1;
   scene.layers[0].type = SceneLayerType::kTriplanar;
-  scene.layers[0].kind = ProjectedKind::kTangentNormal;
+  scene.layers[0].kind = ProjectedKind::kObjectNormal;
   scene.layers[0].projection = TriplanarProjection::kBox;
+  scene.layers[0].tangentUvSet = 0;
   status = validateScene(scene);
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message,
-            "layers[0]: 'projection': 'box' takes kind 'height' or 'object-normal' (Blender's "
-            "Box planes are mirrored per side and give a tangent-space map no frame)");
-  scene.layers[0].kind = ProjectedKind::kObjectNormal;
+            "layers[0]: key 'tangent_uv' applies only to tangent-space normal maps (normal "
+            "layers, and triplanar ones with 'projection': 'box')");
+  scene.layers[0].kind = ProjectedKind::kTangentNormal;
   EXPECT_TRUE(validateScene(scene));
 }
 

@@ -380,6 +380,70 @@ TEST(Layers, PlanarAndObjectSpaceSourcesDispatchToTheirKernels) {
 
 // No NaN from any layer kind at random points with extreme parameters (1e±8 scales, tilings and
 // weights, grazing normals, degenerate frames).
+// A normal map whose texels Blender's Box projection reads (TangentNormalSource::box,
+// ObjectNormalSource::box: an Image Texture with Projection Box before a Normal Map node)
+// decodes the blended colour exactly as the same map read through a UV set decodes a texel of
+// that colour: Strength, frames and guards are the normal map's, and the colour is blended
+// before it is decoded.
+TEST(Layers, ABoxReadNormalMapDecodesTheBlendedColourAsAUvTexel) {
+  class Colour final : public VectorTexture {
+   public:
+    Vec3d colour;
+    Vec3d sample(Vec2d) const override { return colour; }
+  };
+  WavyNormalTexture wavy;
+  TriplanarOptions box;
+  box.projection = TriplanarProjection::kBox;
+  box.boxBlend = 0.4;
+  box.tiling = {1.5, 0.5};
+  box.coordinates = CoordinateMapping::fromMappingNode({0.1, 0.2, 0}, {0.3, 0, 0.2}, {1, 2, 1});
+  std::mt19937_64 rng(61);
+  int blended = 0;
+  std::uniform_real_distribution<double> angle(-kPi, kPi);
+  for (int i = 0; i < 60; ++i) {
+    // samplePoint's normals are near z: turned, to face every side of the box.
+    SurfacePoint p = samplePoint(rng);
+    const Mat3 r =
+        CoordinateMapping::fromMappingNode({}, {angle(rng), angle(rng), 0}, {1, 1, 1}).linear;
+    p.normal = r * p.normal;
+    p.tangent = r * p.tangent;
+    for (UvFrame& frame : p.uv) {
+      frame.dPdu = r * frame.dPdu;
+      frame.dPdv = r * frame.dPdv;
+    }
+    Colour same;
+    same.colour = boxTexel(wavy, box, p);
+    blended += triplanarPlanes(box, p.normal).count > 1;
+    TangentNormalSource tangentBox{&wavy, 1, {}};
+    tangentBox.options.strength = 0.7;
+    tangentBox.box = box;
+    TangentNormalSource tangentUv{&same, 1, {}};
+    tangentUv.options.strength = 0.7;
+    EXPECT_EQ(layerGradient(tangentBox, p), layerGradient(tangentUv, p)) << i;
+    ObjectNormalSource objectBox{&wavy};
+    objectBox.strength = 1.3;
+    objectBox.box = box;
+    ObjectNormalSource objectUv{&same};
+    objectUv.strength = 1.3;
+    EXPECT_EQ(layerGradient(objectBox, p), layerGradient(objectUv, p)) << i;
+    EXPECT_GT(length(layerGradient(objectBox, p)), 0) << i;
+    // An object-space map read by the projection needs no UV set; a tangent-space one its frame.
+    SurfacePoint bare = p;
+    bare.numUvSets = 0;
+    EXPECT_EQ(layerGradient(objectBox, bare), layerGradient(objectBox, p)) << i;
+    EXPECT_EQ(layerGradient(tangentBox, bare), Vec3d{}) << i;
+  }
+  EXPECT_GT(blended, 10);  // points where the Box blends planes were among them
+  // Only Blender's Box projection reads a normal map's texels.
+  TangentNormalSource blendedRead{&wavy, 0, {}};
+  blendedRead.box = box;
+  blendedRead.box->projection = TriplanarProjection::kBlended;
+  const Status status = validateLayers(std::vector<Layer>{{blendedRead, 1.0, {}}}, 2);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message,
+            "layer 0 (tangent-space normal map): its projected read must be a Box projection");
+}
+
 TEST(Layers, NoNanForExtremeParameters) {
   AnalyticHeight h(0.5, -0.2, 0.1);
   WavyNormalTexture ts;

@@ -165,8 +165,8 @@ struct SceneLayer {
   /// half a texel apart that Blender's Bump node takes when Cycles bakes (HeightGradient)
   HeightGradient heightGradient = HeightGradient::kAnalytic;
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
-  /// "tangent_uv" (tangent-space normal layers): the UV set whose tangent frames decode the
-  /// map, when not its "uv" (TangentNormalSource::tangentUvSet)
+  /// "tangent_uv" (tangent-space normal layers, and Box-projected ones): the UV set whose
+  /// tangent frames decode the map, when not its "uv" (TangentNormalSource::tangentUvSet)
   std::optional<int> tangentUvSet;
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps, all projections)
   ProjectedKind kind = ProjectedKind::kHeight;     ///< "kind" (planar, triplanar)
@@ -207,6 +207,13 @@ struct SceneLayer {
   bool hasHeight() const;
   /// @brief Whether the layer projects its image at positions: planar or triplanar.
   bool projected() const;
+  /// @brief Whether the layer decodes a tangent-space normal map in the MikkTSpace frames of a
+  /// UV set (frameUvSet): a tangent-space normal layer, or a triplanar one with Blender's Box
+  /// projection (a Normal Map node decoding what an Image Texture's Box projection reads).
+  /// sgbake's blended triplanar decodes in each plane's own frame instead.
+  bool decodesInUvTangentFrames() const;
+  /// @brief The UV set whose frames decode its tangent-space normals: "tangent_uv", else "uv".
+  int frameUvSet() const { return tangentUvSet.value_or(uvSet); }
 };
 
 /// @brief What an output writes.
