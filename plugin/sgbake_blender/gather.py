@@ -44,8 +44,8 @@ def uv_sets(mesh, bake_uv_name, layers):
     wanted = [("the bake", bake_uv_name)]
     wanted += [(f"layer '{layer.name}'", layer.uv_map or render_uv) for layer in layers
                if layer.type in scene.UV_LAYER_TYPES]
-    wanted += [(f"the tangents of layer '{layer.name}'", layer.tangent_uv_map) for layer in layers
-               if layer.type == "normal" and layer.space == "tangent" and layer.tangent_uv_map]
+    wanted += [(f"the tangents of layer '{layer.name}'", scene.tangent_frames_uv(layer, render_uv))
+               for layer in layers if scene.tangent_frames_uv(layer, render_uv)]
     wanted += [(f"the mask of layer '{layer.name}'", layer.mask_uv_map) for layer in layers
                if layer.mask_image is not None and layer.mask_uv_map]
     for user, name in wanted:

@@ -57,6 +57,7 @@ class BakeJob:
                 try:
                     uv_names, bake_uv = gather.uv_sets(mesh, settings.uv_map, layers)
                     render_uv = gather.render_uv_name(mesh)
+                    self.uv_names = uv_names  # the mesh's UV maps sent, in their set order
                 except gather.BakeInputError as exc:
                     raise gather.BakeInputError(f"object '{ob.name}' {exc}") from None
                 if len(mesh.polygons) == 0:
@@ -478,12 +479,23 @@ def _object_projected(tex, ob=None):
     return _object_coordinates(tex, ob) is not None
 
 
+def _projection_taken(node, tex, ob=None):
+    """Whether a layer takes over how Image Texture node `tex` feeding Bump or Normal Map node
+    `node` reads object coordinates: a Bump's Flat (a planar layer) or Box (a triplanar one)
+    projection; a Normal Map's Box projection (a triplanar layer of a normal kind, decoded as the
+    node decodes the colour the projection reads). A Normal Map's Flat projection is not: a
+    planar layer decodes tangent-space normals in its plane's frame, not in the UV map's."""
+    if not _object_projected(tex, ob):
+        return False
+    return node.type == "BUMP" or tex.projection == "BOX"
+
+
 def _ignored(node, tex, inputs, socket, ob=None):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
-    input other than a UV map (a Mapping node, object or generated coordinates; a Bump's own
-    object coordinates are taken), a projection other than Flat (a Bump's Box on object
-    coordinates is taken), Closest interpolation (read bilinear), and node-driven `inputs` (of which
+    input other than a UV map (a Mapping node, object or generated coordinates; those of a
+    projection a layer takes, _projection_taken, are not named), a projection other than Flat
+    (but a Box one a layer takes), Closest interpolation (read bilinear), and node-driven `inputs` (of which
     the layer takes the unconnected value)."""
     notes = []
     if node.type != "BUMP" and _source_link(node.inputs[socket]).from_socket.name == "Alpha":
@@ -495,10 +507,9 @@ def _ignored(node, tex, inputs, socket, ob=None):
     if link is not None:
         uv = link.from_node.type == "UVMAP" or (link.from_node.type == "TEX_COORD"
                                                  and link.from_socket.name == "UV")
-        planar = node.type == "BUMP" and _object_projected(tex, ob)
-        if not uv and not planar:
+        if not uv and not _projection_taken(node, tex, ob):
             notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
-    if tex.projection != "FLAT" and not (node.type == "BUMP" and _object_projected(tex, ob)):
+    if tex.projection != "FLAT" and not _projection_taken(node, tex, ob):
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
     for name in inputs:
         if node.inputs[name].is_linked:
@@ -585,10 +596,19 @@ def material_layers(node_tree, render_uv=None, ob=None):
                        else f"space {node.space} is not Tangent or Object")
                 skipped.append(f"'{node.name}': {why}")
                 continue
-            ignored += _ignored(node, tex, ("Strength",), "Color")
+            ignored += _ignored(node, tex, ("Strength",), "Color", ob)
             values = _texture_settings(tex, render_uv)
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
-            if space == "tangent":
+            if _projection_taken(node, tex, ob):
+                # Box projection on object coordinates: the colour it reads, decoded by the node
+                # (tangent space: in the frames of the node's UV map, else the render UV map's).
+                values.pop("uv_map", None)
+                values.update(_object_coordinates(tex, ob))
+                values.update(type="triplanar", kind=f"{space}-normal", projection="box",
+                              box_blend=tex.projection_blend)
+                if space == "tangent" and node.uv_map:
+                    values["tangent_uv_map"] = node.uv_map
+            elif space == "tangent":
                 # Cycles takes the tangents from the node's UV map (empty: the render UV map)
                 # and reads the image on the texture's.
                 frames = node.uv_map or render_uv

@@ -66,8 +66,8 @@ MAPPING_TYPES = (
 
 PROJECTIONS = (
     ("blended", "Blended", "sgbake's triplanar: each plane weighted by |normal|^Sharpness"),
-    ("box", "Box", "Blender's Image Texture Box projection with its Blend (kinds Height and "
-                   "Object Normal): what Cycles bakes"),
+    ("box", "Box", "Blender's Image Texture Box projection with its Blend: what Cycles bakes "
+                   "(normal kinds as a Normal Map node decodes the colour it reads)"),
 )
 AXES = (("x", "X", "Project along X"), ("y", "Y", "Project along Y"),
         ("z", "Z", "Project along Z"))
@@ -131,8 +131,9 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     space: EnumProperty(name="Space", items=SPACES, default="tangent")
     tangent_uv_map: StringProperty(
         name="Tangent UV Map",
-        description="Tangent-space normal layers: the UV map whose tangents decode the map (the "
-                    "Normal Map node's UV Map); empty: the layer's UV Map")
+        description="Tangent-space normal layers (and Box-projected ones): the UV map whose "
+                    "tangents decode the map (the Normal Map node's UV Map); empty: the layer's "
+                    "UV Map (a projection's: the UV map active for rendering)")
     green: EnumProperty(name="Green", items=GREENS, default="opengl",
                         description="Green channel convention of the normal map image")
     kind: EnumProperty(name="Kind", items=KINDS, default="height",

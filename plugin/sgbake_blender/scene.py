@@ -104,6 +104,18 @@ def reads_tangent_normals(layer):
     return False
 
 
+def tangent_frames_uv(layer, default_uv=None):
+    """The UV map whose tangent frames decode the layer's tangent-space normals when it is not
+    the layer's own UV map, or None: a normal layer's Tangent UV Map; a triplanar Box layer's
+    (the Normal Map node's UV map decoding what the Box projection reads), else `default_uv`,
+    the render UV map Cycles' Normal Map node takes when its own is empty."""
+    if layer.type == "normal" and layer.space == "tangent":
+        return layer.tangent_uv_map or None
+    if layer.type == "triplanar" and layer.projection == "box" and layer.kind == "tangent-normal":
+        return layer.tangent_uv_map or default_uv or None
+    return None
+
+
 def layer_json(layer, uv_index, default_uv=None):
     """One entry of "layers". uv_index(name) gives the UV set of a UV map name (for height and
     normal layers: the layer's own UV map, else `default_uv`, the render UV map, else the
@@ -121,6 +133,8 @@ def layer_json(layer, uv_index, default_uv=None):
         entry["mask"] = mask_json(layer, uv_index)
     if layer.type in UV_LAYER_TYPES and (layer.uv_map or default_uv):
         entry["uv"] = uv_index(layer.uv_map or default_uv)
+    if tangent_frames_uv(layer, default_uv):
+        entry["tangent_uv"] = uv_index(tangent_frames_uv(layer, default_uv))
     if layer.type == "height":
         entry["scale"] = _number(layer.scale)
         if layer.strength != 1.0:  # the Bump node's blend of normals (1: none)
@@ -129,8 +143,6 @@ def layer_json(layer, uv_index, default_uv=None):
             entry["channel"] = layer.channel
     elif layer.type == "normal":
         entry.update(space=layer.space, strength=_number(layer.scale))
-        if layer.space == "tangent" and layer.tangent_uv_map:
-            entry["tangent_uv"] = uv_index(layer.tangent_uv_map)
     elif layer.type == "volume":
         entry.update(function=layer.function, amplitude=_number(layer.amplitude),
                      frequency=_number(layer.frequency), gradient=layer.gradient)

@@ -147,12 +147,14 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 col.prop(layer, "uv_map")
         if layer.type == "normal":
             col.prop(layer, "space")
-            if layer.space == "tangent":
-                ob = context.active_object
-                if ob is not None and ob.type == "MESH":
-                    col.prop_search(layer, "tangent_uv_map", ob.data, "uv_layers")
-                else:
-                    col.prop(layer, "tangent_uv_map")
+        if (layer.type == "normal" and layer.space == "tangent") or (
+                layer.type == "triplanar" and layer.projection == "box"
+                and layer.kind == "tangent-normal"):
+            ob = context.active_object
+            if ob is not None and ob.type == "MESH":
+                col.prop_search(layer, "tangent_uv_map", ob.data, "uv_layers")
+            else:
+                col.prop(layer, "tangent_uv_map")
         if layer.type == "triplanar":
             col.prop(layer, "projection")
             if layer.projection == "box":

@@ -510,6 +510,27 @@ def material_checks(settings, ob, distance):
           normal.get("uv_map") == "UV2" and normal.get("tangent_uv_map") == "UVMap",
           "uv_map 'UV2', tangent_uv_map 'UVMap'", str(normal))
     tree.nodes.remove(uvmap)
+    # Its image read with Box projection on object coordinates: a triplanar Box layer of the
+    # node's space, decoded in the frames of the node's UV map (BlenderBakeOracle's
+    # box_nmap_sphere checks such a layer against Cycles); Flat projection is named instead.
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
+    tex.projection, tex.projection_blend, nmap.uv_map = "BOX", 0.2, "UV2"
+    boxed, _, boxed_ignored = operators.material_layers(tree, "UVMap")
+    boxed_normal = next((v for v in boxed if v["type"] != "height"), {})
+    tex.projection = "FLAT"
+    _, _, flat_ignored = operators.material_layers(tree, "UVMap")
+    tex.projection, nmap.uv_map = "FLAT", ""
+    tree.nodes.remove(coordinates)
+    want = {"type": "triplanar", "kind": "tangent-normal", "projection": "box",
+            "tangent_uv_map": "UV2"}
+    check("Layers from Material: a Normal Map of a Box-projected image",
+          all(boxed_normal.get(k) == v for k, v in want.items())
+          and abs(boxed_normal.get("box_blend", -1) - 0.2) < 1e-6 and "uv_map" not in boxed_normal
+          and not any(tex.name in note for note in boxed_ignored)
+          and any(f"'{tex.name}' Vector from" in note for note in flat_ignored),
+          f"{want}, box_blend 0.2, nothing named; the Flat projection named",
+          f"{boxed_normal}; named {boxed_ignored}; Flat: named {flat_ignored}")
     tree.nodes.remove(nmap)
     # A Bump node linked to nothing makes no layer.
     stray = tree.nodes.new("ShaderNodeBump")
@@ -954,12 +975,25 @@ def options_case(settings, height, work):
     want_box = {"projection": "box", "box_blend": f(tri.box_blend),
                 "mapping": {"location": [0.0] * 3, "rotation": [0.0, f(tri.mapping_rotation[1]), 0.0],
                             "scale": [1.0] * 3, "type": "texture"}}
+    # A Box-projected tangent-space map sends the UV set whose frames decode it: the render
+    # UV map's, as Cycles' Normal Map node takes them when its own UV Map is empty.
+    tri.kind = "tangent-normal"
+    job = operators.BakeJob(bpy.context)
+    sent_frames = job.scene["layers"][2].get("tangent_uv")
+    render_uv = next((uv.name for uv in bpy.context.active_object.data.uv_layers
+                      if uv.active_render), None)
+    want_frames = job.uv_names.index(render_uv) if render_uv in job.uv_names else "(none)"
+    tri.kind = "height"
     tri.projection, tri.mapping_rotation, tri.mapping_type = "blended", (0.0, 0.0, 0.0), "POINT"
     checks.append({"name": "a triplanar layer's Projection Box and Mapping in the add-on's "
                            "scene JSON",
                    "ok": all(sent_box.get(k) == v for k, v in want_box.items())
                    and "sharpness" not in sent_box and "min_weight" not in sent_box,
                    "expected": json.dumps(want_box), "message": f"sent {json.dumps(sent_box)}"})
+    checks.append({"name": "a Box-projected tangent-space layer's tangent frames in the add-on's "
+                           "scene JSON",
+                   "ok": sent_frames == want_frames, "expected": f"tangent_uv {want_frames}",
+                   "message": f"tangent_uv {sent_frames}"})
     # The output's Swizzle: sent as "swizzle" (a DirectX green folded into its G), not "green";
     # the default sends "green" alone, as before. (BlenderSwizzleOracle checks the bake.)
     for kind, axes, green, want in (

@@ -24,6 +24,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                      object bakes
   ours_nmap_flags.exr  the same tangent-normal bake from --normal flags (Strength 1 cases)
   ours_nmap_weak.exr   the scene's tangent-normal bake at 0.9 x Strength (negative control)
+  ours_nmap_uv.exr     a Box-projected normal map's case: the map read through the UV map
+                       instead (negative control)
   ours_bake_object_space.exr, ours_nmap_object_space.exr   a transformed case's bake
                        without its transform (in object space: a negative control)
   ours_nmap_sum.exr    a chain case's bake with the bump added to the normal map's surface
@@ -135,6 +137,7 @@ def compare_case(entry):
                              ("nmap_object", "ours_nmap_object.exr", "object"),
                              ("nmap_flags", "ours_nmap_flags.exr", "tangent"),
                              ("nmap_weak", "ours_nmap_weak.exr", "tangent"),
+                             ("nmap_uv", "ours_nmap_uv.exr", "tangent"),
                              ("nmap_sum", "ours_nmap_sum.exr", "tangent"),
                              ("nmap_bump_node", "ours_nmap_bump_node.exr", "tangent"),
                              ("nmap_object_space", "ours_nmap_object_space.exr", "tangent")):

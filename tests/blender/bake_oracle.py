@@ -215,7 +215,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
                  "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
                  "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
-                 "box_empty_sphere", "box_generated_sphere")
+                 "box_empty_sphere", "box_generated_sphere", "box_nmap_sphere",
+                 "box_nmap_sphere_object")
 
 
 def run_blender_script(blender, script, args):
@@ -359,10 +360,17 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     map_green = "directx" if sabotage == "normal-green" else "opengl"
     green = "directx" if sabotage == "green" else "opengl"
 
+    box = "planar" in entry  # read by Blender's Box projection, not through the UV map
+
     def scene_file(name, layer_strength, outputs, base="above", transform=True,
-                   gradient="analytic"):
+                   gradient="analytic", through_uvs=False):
         layer = {"type": "normal", "image": p("normal.exr"), "space": nmap["space"],
                  "strength": layer_strength, "filter": "bilinear", "uv": 0, "weight": 1.0}
+        if box and not through_uvs:
+            layer = {"type": "triplanar", "image": p("normal.exr"),
+                     "kind": f"{nmap['space']}-normal", "scale": layer_strength,
+                     "projection": "box", "box_blend": entry["planar"]["blend"],
+                     "filter": "bilinear", "weight": 1.0}
         if nmap["space"] == "tangent":
             layer["green"] = map_green
         layers = [layer]
@@ -389,6 +397,10 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
                             [("tangent-normal", "ours_nmap_weak.exr")])):
         if not run_sgbake(cli, args, log):
             failed.append(log[-1])
+    if box and not run_sgbake(  # the control: the same map read through the UV map
+            cli, scene_file("scene_uv.json", strength, [("tangent-normal", "ours_nmap_uv.exr")],
+                            through_uvs=True), log):
+        failed.append(log[-1])
     if transformed(entry) and not run_sgbake(
             cli, scene_file("scene_object_space.json", strength,
                             [("tangent-normal", "ours_nmap_object_space.exr")],
@@ -403,7 +415,8 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
                             [("tangent-normal", "ours_nmap_bump_node.exr")],
                             gradient="bump-node"), log):
         failed.append(log[-1])
-    if nmap["strength"] == 1.0 and "bump" not in nmap:  # the flags have no Strength or chain
+    if nmap["strength"] == 1.0 and "bump" not in nmap and not box:
+        # (the flags have no Strength, chain or projection)
         flags = ["bake", "--mesh", p("mesh.obj"), "--normal", p("normal.exr"), "--normal-space",
                  nmap["space"], "--map", "tangent-normal", "--size", size, "--green", green,
                  "-o", p("ours_nmap_flags.exr")] + common + transform_flags(entry)
@@ -461,6 +474,7 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
     stretched = stretched_case
     print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {nmap['space']}-space normal map "
           f"(tilts up to {nmap['tilt_deg']:g} deg), Strength {nmap['strength']:g}"
+          + (f", read by the Box projection with Blend {nmap['box']:g}" if "box" in nmap else "")
           + (f", then a Bump node of Distance {nmap['bump']:g} on its output" if chain else "")
           + f", {r['covered']} covered texels, {r['compared']} compared; Blender's tangent bake "
           f"tilt from +Z: {fmt_nmap(r['tilt'])}")
@@ -507,7 +521,10 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
         negative_control(name, r, "nmap_sum", "bump added, not stacked:  ",
                          "the bake with the bump added to the normal map's gradient", chain,
                          fails, stretched)
-    if nmap["strength"] == 1.0 and not chain:
+    if "box" in nmap:
+        negative_control(name, r, "nmap_uv", "read through the UV map:  ",
+                         "the bake of the map read through the UV map", chain, fails, stretched)
+    elif nmap["strength"] == 1.0 and not chain:
         s = r.get("nmap_flags")
         same = s.get("json_vs_flags_max_abs") if s else None
         if s is None or "error" in s:
@@ -676,8 +693,11 @@ def main():
                   f"bakes {', '.join(f'{k} {v:.2f} s' for k, v in entry['bake_s'].items())}")
         for entry in entries:
             if "normal_map" in entry:
-                failures += evaluate_nmap(entry["name"], results[entry["name"]],
-                                          entry["normal_map"], transformed(entry))
+                nmap = dict(entry["normal_map"])
+                if "planar" in entry:
+                    nmap["box"] = entry["planar"]["blend"]
+                failures += evaluate_nmap(entry["name"], results[entry["name"]], nmap,
+                                          transformed(entry))
             else:
                 failures += evaluate(entry["name"], results[entry["name"]], "planar" in entry)
         if args.keep:

@@ -169,6 +169,15 @@ def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapp
         PLANAR[name]["coordinates"] = coordinates
 
 
+def box_normal_map_case(name, mesh_case, size, space, strength, tilt_deg, blend):
+    """Registers case `name`: normal_map_case's, its Image Texture read with Box projection
+    (Blend `blend`) on the object's coordinates instead of its UV map (sgbake's triplanar
+    layer with "projection": "box" of kind tangent-normal or object-normal). Its image is
+    normal_field in either space: as object-space normals they lean up to `tilt_deg` from +z."""
+    normal_map_case(name, mesh_case, size, space, strength, tilt_deg)
+    PLANAR[name] = {"projection": "BOX", "blend": blend}
+
+
 def apply_subdivision(ob, levels):
     mod = ob.modifiers.new("Subdivision", "SUBSURF")
     mod.levels = levels
@@ -356,6 +365,11 @@ planar_case("box_empty_sphere", "stretch_sphere", 256, 0.01, "BOX", 0.3,
             coordinates=("EMPTY", ((0.2, 0.4, -0.3), (0.3, -0.5, 0.2), (0.7, 1.3, 0.9))))
 planar_case("box_generated_sphere", "sphere", 256, 0.01, "BOX", 0.3,
             ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (3.0, 2.0, 2.5)), coordinates=("GENERATED",))
+# Normal maps read by the Box projection (Blend 0.3) into a Normal Map node: decoded in the UV
+# map's tangent frames, and in object space (Strength 0.3, so that normals leaning from +z stay
+# above the sphere's lower half).
+box_normal_map_case("box_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, 0.3)
+box_normal_map_case("box_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, 0.3)
 
 
 def tilt_field(size, tilt_deg):
@@ -497,6 +511,47 @@ def bake_pass(ob, mat, target, image, kind, margin, margin_type="EXTEND",
     return seconds
 
 
+def project_texture(name, mat, tex, ob):
+    """Reads Image Texture node `tex` of `mat` as case `name`'s PLANAR entry says: its
+    projection and Blend on the object's coordinates (or an Empty's, or the Generated ones),
+    through a Mapping node when given. Records the coordinates' affine map in PLANAR[name]."""
+    me = ob.data
+    nodes = mat.node_tree.nodes
+    tex.projection = PLANAR[name]["projection"]
+    tex.projection_blend = PLANAR[name]["blend"]
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    source = coordinates.outputs["Object"]
+    matrix = None  # what the coordinates are, as a map of the object's own
+    kind = PLANAR[name].get("coordinates", ("OBJECT",))
+    if kind[0] == "EMPTY":
+        empty = bpy.data.objects.new("projector", None)
+        bpy.context.scene.collection.objects.link(empty)
+        empty.location, empty.rotation_euler, empty.scale = kind[1]
+        bpy.context.view_layer.update()
+        coordinates.object = empty
+        matrix = empty.matrix_world.inverted() @ ob.matrix_world
+    elif kind[0] == "GENERATED":
+        source = coordinates.outputs["Generated"]
+        # Generated: the texture space (auto: the bounding box) to [0, 1].
+        space_loc, space_size = me.texspace_location, me.texspace_size
+        matrix = mathutils.Matrix.Identity(4)
+        for i in range(3):
+            matrix[i][i] = 0.5 / space_size[i]
+            matrix[i][3] = 0.5 - 0.5 * space_loc[i] / space_size[i]
+    if matrix is not None:
+        PLANAR[name]["matrix"] = [list(matrix[r]) for r in range(3)]
+    mapping = PLANAR[name].get("mapping")
+    if mapping is None:
+        mat.node_tree.links.new(source, tex.inputs["Vector"])
+    else:
+        node = nodes.new("ShaderNodeMapping")
+        node.vector_type = "POINT"
+        for key in ("location", "rotation", "scale"):
+            node.inputs[key.title()].default_value = mapping[key]
+        mat.node_tree.links.new(source, node.inputs["Vector"])
+        mat.node_tree.links.new(node.outputs["Vector"], tex.inputs["Vector"])
+
+
 def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), margin=0,
                height_size=HEIGHT_SIZE, save_bakes=True, runs=1, margin_type="EXTEND",
                scale=None, swizzle=("POS_X", "POS_Y", "POS_Z")):
@@ -531,43 +586,11 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
         bake_common.save_exr(height, os.path.join(out_dir, "height.exr"))
         mat, target = make_material(height, scale)
         if name in PLANAR:
-            nodes = mat.node_tree.nodes
-            tex = next(n for n in nodes if n.bl_idname == "ShaderNodeTexImage" and n != target)
-            tex.projection = PLANAR[name]["projection"]
-            tex.projection_blend = PLANAR[name]["blend"]
-            coordinates = nodes.new("ShaderNodeTexCoord")
-            source = coordinates.outputs["Object"]
-            matrix = None  # what the coordinates are, as a map of the object's own
-            kind = PLANAR[name].get("coordinates", ("OBJECT",))
-            if kind[0] == "EMPTY":
-                empty = bpy.data.objects.new("projector", None)
-                bpy.context.scene.collection.objects.link(empty)
-                empty.location, empty.rotation_euler, empty.scale = kind[1]
-                bpy.context.view_layer.update()
-                coordinates.object = empty
-                matrix = empty.matrix_world.inverted() @ ob.matrix_world
-            elif kind[0] == "GENERATED":
-                source = coordinates.outputs["Generated"]
-                # Generated: the texture space (auto: the bounding box) to [0, 1].
-                space_loc, space_size = me.texspace_location, me.texspace_size
-                matrix = mathutils.Matrix.Identity(4)
-                for i in range(3):
-                    matrix[i][i] = 0.5 / space_size[i]
-                    matrix[i][3] = 0.5 - 0.5 * space_loc[i] / space_size[i]
-            if matrix is not None:
-                PLANAR[name]["matrix"] = [list(matrix[r]) for r in range(3)]
-            mapping = PLANAR[name].get("mapping")
-            if mapping is None:
-                mat.node_tree.links.new(source, tex.inputs["Vector"])
-            else:
-                node = nodes.new("ShaderNodeMapping")
-                node.vector_type = "POINT"
-                for key in ("location", "rotation", "scale"):
-                    node.inputs[key.title()].default_value = mapping[key]
-                mat.node_tree.links.new(source, node.inputs["Vector"])
-                mat.node_tree.links.new(node.outputs["Vector"], tex.inputs["Vector"])
+            tex = next(n for n in mat.node_tree.nodes
+                       if n.bl_idname == "ShaderNodeTexImage" and n != target)
+            project_texture(name, mat, tex, ob)
     else:
-        if nmap["space"] == "TANGENT":
+        if nmap["space"] == "TANGENT" or name in PLANAR:
             field = normal_field(height_size, nmap["tilt_deg"])
         else:
             # The mesh's own normals, baked with a plain material (margin: the texels the
@@ -591,6 +614,10 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             bake_common.save_exr(height, os.path.join(out_dir, "height.exr"))
         mat, target = make_normal_material(normal, nmap["space"], nmap["strength"],
                                            me.uv_layers[0].name, height, nmap.get("bump"))
+        if name in PLANAR:
+            tex = next(n for n in mat.node_tree.nodes
+                       if n.bl_idname == "ShaderNodeTexImage" and n.image == normal)
+            project_texture(name, mat, tex, ob)
     me.materials.clear()
     me.materials.append(mat)
 
