@@ -581,8 +581,6 @@ def material_layers(node_tree, render_uv=None, ob=None):
                 else:
                     values.update(type="planar", kind="height", axis="z")
                 kind = values["type"]
-                if values.pop("strength") != 1.0:
-                    ignored.append(f"'{node.name}' Strength (a {kind} layer bumps fully)")
                 if alpha:
                     ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {kind} "
                                    "layer reads the luminance)")

@@ -108,8 +108,9 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                     "value (Kind Height), or strength")
     strength: FloatProperty(
         name="Strength", default=1.0, min=0.0, soft_max=1.0, precision=3,
-        description="Height layers: the Bump node's Strength, which blends the bumped normal "
-                    "with the unbumped one (0: no bump, 1: the full bump)")
+        description="Heights (height and volume layers, projections of Kind Height): the Bump "
+                    "node's Strength, which blends the bumped normal with the unbumped one (0: "
+                    "no bump, 1: the full bump)")
     channel: EnumProperty(name="Channel", items=CHANNELS, default="luminance",
                           description="What of a height layer's image is the height")
     base: EnumProperty(name="Bumps", items=BASES, default="surface",

@@ -104,6 +104,13 @@ def reads_tangent_normals(layer):
     return False
 
 
+def bumps_height(layer):
+    """Whether the layer is a height a Bump node bumps (so it has its Strength): height and
+    volume layers, and projections of Kind Height."""
+    return layer.type in ("height", "volume") or (layer.type in ("planar", "triplanar")
+                                                  and layer.kind == "height")
+
+
 def tangent_frames_uv(layer, default_uv=None):
     """The UV map whose tangent frames decode the layer's tangent-space normals when it is not
     the layer's own UV map, or None: a normal layer's Tangent UV Map; a triplanar Box layer's
@@ -135,10 +142,10 @@ def layer_json(layer, uv_index, default_uv=None):
         entry["uv"] = uv_index(layer.uv_map or default_uv)
     if tangent_frames_uv(layer, default_uv):
         entry["tangent_uv"] = uv_index(tangent_frames_uv(layer, default_uv))
+    if bumps_height(layer) and layer.strength != 1.0:  # the Bump's blend of normals (1: none)
+        entry["strength"] = _number(layer.strength)
     if layer.type == "height":
         entry["scale"] = _number(layer.scale)
-        if layer.strength != 1.0:  # the Bump node's blend of normals (1: none)
-            entry["strength"] = _number(layer.strength)
         if layer.channel != "luminance":
             entry["channel"] = layer.channel
     elif layer.type == "normal":

@@ -128,8 +128,9 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 if tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0):
                     box.label(text="Coordinates: another object's or Generated")
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
-            if layer.type == "height":
+            if scene.bumps_height(layer):
                 col.prop(layer, "strength")
+            if layer.type == "height":
                 col.prop(layer, "channel")
             if layer.type == "height" or (layer.type in ("planar", "triplanar")
                                           and layer.kind == "height"):

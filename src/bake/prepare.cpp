@@ -401,6 +401,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.scheme = layer.gradient;
       source.gradient = layer.heightGradient;
       source.step = layer.step ? *layer.step : defaultStep(objectSize);
+      source.strength = layer.strength;
       result.source = source;
       break;
     }
@@ -416,6 +417,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.scale = layer.scale;
       source.normal = projected;
       source.gradient = layer.heightGradient;
+      source.strength = layer.strength;
       result.source = source;
       break;
     }
@@ -430,6 +432,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.normals = vector;
       source.options = triplanarOptions(layer);
       source.gradient = layer.heightGradient;
+      source.strength = layer.strength;
       result.source = source;
       break;
     }

@@ -385,14 +385,14 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       break;
     case SceneLayerType::kVolume:
       add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
-           "gradient", "step", "base"});
+           "gradient", "step", "base", "strength"});
       break;
     case SceneLayerType::kPlanar:
-      add({"kind", "axis", "scale", "mapping", "green", "base", "gradient"});
+      add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength"});
       break;
     case SceneLayerType::kTriplanar:
       add({"kind", "scale", "mapping", "projection", "sharpness", "min_weight", "box_blend",
-           "green", "base", "gradient", "tangent_uv"});
+           "green", "base", "gradient", "tangent_uv", "strength"});
       break;
   }
   return keys;
@@ -745,15 +745,19 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     layer.mask = parseMask(reader.at("mask"), appendPath(where, "mask"), paths, layer.uvSet);
   }
   if (reader.has("scale")) layer.scale = reader.number("scale");
-  if (reader.has("strength")) {
-    // A normal map's Strength is its only factor (held as its scale); a height layer's is the
-    // Bump node's, beside its scale (the Bump node's Distance).
-    (layer.type == SceneLayerType::kHeight ? layer.strength : layer.scale) =
-        reader.number("strength");
-  }
   reader.optionalName("green", kGreens, layer.green);
   reader.optionalName("space", kSpaces, layer.space);
   reader.optionalName("kind", kKinds, layer.kind);
+  if (reader.has("strength")) {
+    // A normal map's Strength is its only factor (held as its scale); a height's is the Bump
+    // node's, beside its scale (the Bump node's Distance).
+    if (layer.projected() && !layer.hasHeight()) {
+      fail(where,
+           "key 'strength' applies to heights (a projected normal map's strength is its "
+           "'scale')");
+    }
+    (layer.hasHeight() ? layer.strength : layer.scale) = reader.number("strength");
+  }
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
   reader.optionalName("channel", kChannels, layer.channel);
@@ -1435,10 +1439,12 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   if (tangentNormals) j["green"] = nameIn(kGreens, layer.green);
   if (layer.tangentUvSet) j["tangent_uv"] = *layer.tangentUvSet;
   if (layer.decodesInUvTangentFrames() && layer.projected()) j["uv"] = layer.uvSet;
+  // A height's Bump Strength (written always for UV heights, as before; else when not 1).
+  if (layer.type == SceneLayerType::kHeight || (layer.hasHeight() && layer.strength != 1))
+    j["strength"] = layer.strength;
   switch (layer.type) {
     case SceneLayerType::kHeight:
       j["uv"] = layer.uvSet;
-      j["strength"] = layer.strength;
       if (layer.channel != ImageChannels::kLuminance)
         j["channel"] = nameIn(kChannels, layer.channel);
       if (layer.heightGradient != HeightGradient::kAnalytic)

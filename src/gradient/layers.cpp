@@ -35,8 +35,10 @@ Vec3d unblendedGradient(const UvHeightSource& s, const SurfacePoint& point) {
                                    uvDerivativesFromTexture(h, s.tiling, s.scale), s.minFrameSine);
 }
 
+/// The evaluate(source, point) functions give the Γ of a source before its Bump Strength
+/// (gradient_detail::unblendedLayerGradient).
 Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
-  return withNormalMapStrength(unblendedGradient(s, point), point.normal, s.strength);
+  return unblendedGradient(s, point);
 }
 
 Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point,
@@ -241,10 +243,25 @@ std::vector<std::vector<Layer>> layersByMaterial(std::span<const Layer> layers) 
 }
 
 Vec3d layerGradient(const LayerSource& source, const SurfacePoint& point) {
-  return std::visit([&](const auto& s) { return evaluate(s, point); }, source);
+  return withNormalMapStrength(gradient_detail::unblendedLayerGradient(source, point), point.normal,
+                               gradient_detail::bumpStrength(source));
 }
 
 namespace gradient_detail {
+
+double bumpStrength(const LayerSource& source) {
+  if (const auto* uv = std::get_if<UvHeightSource>(&source)) return uv->strength;
+  if (const auto* volume = std::get_if<VolumeSource>(&source)) return volume->strength;
+  if (const auto* planar = std::get_if<PlanarSource>(&source))
+    return planar->kind == ProjectedKind::kHeight ? planar->strength : 1.0;
+  if (const auto* triplanar = std::get_if<TriplanarSource>(&source))
+    return triplanar->kind == ProjectedKind::kHeight ? triplanar->strength : 1.0;
+  return 1;
+}
+
+Vec3d unblendedLayerGradient(const LayerSource& source, const SurfacePoint& point) {
+  return std::visit([&](const auto& s) { return evaluate(s, point); }, source);
+}
 
 Vec3d layerGradientNoting(const TangentNormalSource& source, const SurfacePoint& point,
                           NormalBelowSurface* below) {
@@ -277,14 +294,12 @@ Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const 
     noteHandedOn(below, aboveNormal);
     return gammaAbove;
   }
-  const auto* uvHeight = std::get_if<UvHeightSource>(&layer.source);
-  const double strength = uvHeight != nullptr ? uvHeight->strength : 1.0;
+  const double strength = bumpStrength(layer.source);
   if (!(strength > 0)) {  // Blender clamps Strength at 0 (and NaN is no bump)
     noteHandedOn(below, aboveNormal);
     return gammaAbove;
   }
-  const Vec3d gamma = factor * (uvHeight != nullptr ? unblendedGradient(*uvHeight, point)
-                                                    : layerGradient(layer.source, point));
+  const Vec3d gamma = factor * unblendedLayerGradient(layer.source, point);
   return stackGradientNoting(gamma, strength, point.normal, point.planeNormal(), gammaAbove,
                              incoming, aboveNormal, below);
 }

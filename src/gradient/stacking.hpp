@@ -117,6 +117,14 @@ Vec3d stackLayerGradientOn(const Layer& layer, const SurfacePoint& point, const 
                            const Vec3d& incoming, const Vec3d* aboveNormal,
                            NormalBelowSurface* below);
 
+/// @brief Blender's Bump node Strength of a height source (UvHeightSource::strength, and that
+/// of volumes and projected heights), 1 for normal maps (whose Strength is in their Γ).
+double bumpStrength(const LayerSource& source);
+
+/// @brief The Γ of a source before its bumpStrength: layerGradient is
+/// withNormalMapStrength(unblendedLayerGradient, N, bumpStrength).
+Vec3d unblendedLayerGradient(const LayerSource& source, const SurfacePoint& point);
+
 /// @brief layerGradient, and @p below (non-null) set when the source is a normal map that
 /// decodes below the surface here (a tangent-space texel with z below its minNormalZ, an
 /// object-space normal within kMinObjectNormalCosine of the tangent plane or behind it).

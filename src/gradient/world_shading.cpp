@@ -72,10 +72,11 @@ class WorldLayerEvaluator {
     unblended.strength = 1;
     return decodedNormal(objectNormal(unblended), s.strength);
   }
+  /// Heights read at positions: their Strength blends in world space too.
   WorldGradient operator()(const VolumeSource& s) const {
     if (s.volume != nullptr && gradient_detail::usesBumpNode(s.gradient, world_))
-      return {bumpNodeInWorld(s, object_)};
-    return {heightGradient(layerGradient(s, object_))};
+      return {bumpNodeInWorld(s, object_), s.strength};
+    return {heightGradient(gradient_detail::unblendedLayerGradient(s, object_)), s.strength};
   }
   WorldGradient operator()(const PlanarSource& s) const { return projected(s, object_); }
   /// Cycles picks a triplanar's planes (weights, Box mirrors) by the world normal it shades
@@ -135,10 +136,10 @@ class WorldLayerEvaluator {
   WorldGradient projected(const Source& s, const SurfacePoint& object) const {
     if (s.kind == ProjectedKind::kHeight && s.height != nullptr &&
         gradient_detail::usesBumpNode(s.gradient, world_)) {
-      return {bumpNodeInWorld(s, object)};
+      return {bumpNodeInWorld(s, object), s.strength};
     }
-    const Vec3d gamma = layerGradient(s, object);
-    return s.kind == ProjectedKind::kHeight ? WorldGradient{heightGradient(gamma)}
+    const Vec3d gamma = gradient_detail::unblendedLayerGradient(s, object);
+    return s.kind == ProjectedKind::kHeight ? WorldGradient{heightGradient(gamma), s.strength}
                                             : decodedNormal(object.normal - gamma);
   }
   static Vec3d finiteOrZero(const Vec3d& v) { return sgbake::isFinite(v) ? v : Vec3d{}; }

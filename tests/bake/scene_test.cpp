@@ -639,6 +639,31 @@ TEST(Scene, HeightGradientIsParsedAndInTheParametersOnlyWhenNotAnalytic) {
       "height, volume, planar or triplanar layers)");
 }
 
+// A Bump node's Strength on heights read at positions: volumes and projected heights take
+// "strength" as height layers do (written only when not 1, so that older scenes keep their
+// hashes); a projected normal map's strength is its "scale".
+TEST(Scene, HeightsReadAtPositionsTakeAStrength) {
+  for (const char* layer :
+       {R"({"type": "volume", "function": "sine", "strength": 0.25})",
+        R"({"type": "planar", "image": "h.png", "strength": 0.25})",
+        R"({"type": "triplanar", "image": "h.png", "projection": "box", "strength": 0.25})"}) {
+    Result<Scene> scene = parseScene(withLayer(layer), options());
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->layers[0].strength, 0.25) << layer;
+    EXPECT_EQ(scene->layers[0].scale, 1) << layer;
+    EXPECT_NE(layerParametersJson(scene->layers[0]).find(R"("strength":0.25)"), std::string::npos)
+        << layer;
+  }
+  Result<Scene> plain =
+      parseScene(withLayer(R"({"type": "volume", "function": "sine"})"), options());
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_EQ(layerParametersJson(plain->layers[0]).find("strength"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(R"({"type": "triplanar", "image": "n.png",
+                                     "kind": "object-normal", "strength": 0.5})")),
+            "scene.json: layers[0]: key 'strength' applies to heights (a projected normal map's "
+            "strength is its 'scale')");
+}
+
 TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
   Result<Scene> box = parseScene(
       withLayer(

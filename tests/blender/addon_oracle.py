@@ -300,8 +300,11 @@ def layers_from_material(settings, distance):
     planar, _, planar_ignored = operators.material_layers(tree)
     # Box projection there: sgbake's triplanar with "projection": "box" and the node's Blend
     # (BlenderBakeOracle's box cases check it against Cycles).
+    # Its Bump Strength goes along (BlenderBakeOracle's box_strength_sphere checks the bake).
     tex.projection, tex.projection_blend = "BOX", 0.25
+    bump.inputs["Strength"].default_value = 0.5
     box, _, box_ignored = operators.material_layers(tree)
+    bump.inputs["Strength"].default_value = 1.0
     # A Mapping node (Point) between them: its Location, Rotation and Scale, nothing named.
     mapping = tree.nodes.new("ShaderNodeMapping")
     moved = {"Location": (0.5, -0.25, 1.0), "Rotation": (0.1, 0.2, 0.3), "Scale": (2.0, 1.0, 0.5)}
@@ -356,13 +359,13 @@ def layers_from_material(settings, distance):
                           f"scale {distance}, nothing named: {planar}, {planar_ignored}; "
                           f"another object's named: {other_ignored}")
     expected_box = {"type": "triplanar", "kind": "height", "projection": "box",
-                    "slopes": "bump-node"}
+                    "slopes": "bump-node", "strength": 0.5}
     if (len(box) != 1 or any(box[0].get(k) != v for k, v in expected_box.items())
             or abs(box[0].get("box_blend", -1) - 0.25) > 1e-7 or "uv_map" in box[0]
             or box_ignored):
-        entry["error"] = (f"a Box projection on object coordinates should make one "
-                          f"{expected_box} layer with box_blend 0.25, nothing named: {box}, "
-                          f"{box_ignored}")
+        entry["error"] = (f"a Box projection on object coordinates (Bump Strength 0.5) should "
+                          f"make one {expected_box} layer with box_blend 0.25, nothing named: "
+                          f"{box}, {box_ignored}")
     got = mapped[0] if len(mapped) == 1 else {}
     if (got.get("type") != "triplanar" or mapped_ignored
             or any(max((abs(a - b) for a, b in zip(got.get(f"mapping_{name.lower()}", ()),
@@ -970,9 +973,10 @@ def options_case(settings, height, work):
                           f"{wrong}"}]
     # Projection Box sends Blender's Blend instead of the blended projection's keys.
     tri.projection, tri.box_blend, tri.mapping_rotation = "box", 0.4, (0.0, 0.5, 0.0)
-    tri.mapping_type = "TEXTURE"
+    tri.mapping_type, tri.strength = "TEXTURE", 0.5
     sent_box = operators.BakeJob(bpy.context).scene["layers"][2]
-    want_box = {"projection": "box", "box_blend": f(tri.box_blend),
+    tri.strength = 1.0
+    want_box = {"projection": "box", "box_blend": f(tri.box_blend), "strength": 0.5,
                 "mapping": {"location": [0.0] * 3, "rotation": [0.0, f(tri.mapping_rotation[1]), 0.0],
                             "scale": [1.0] * 3, "type": "texture"}}
     # A Box-projected tangent-space map sends the UV set whose frames decode it: the render

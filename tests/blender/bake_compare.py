@@ -16,6 +16,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                      as Cycles' Bump node does)
   ours_bake_blended.exr  a Box-projection case's bump-node bake with sgbake's own triplanar
                      (projection "blended") instead (a negative control)
+  ours_bake_full_strength.exr  a case with a Bump Strength: its bump-node bake at Strength 1
+                       (a negative control)
   ours_bake_unmapped.exr  a mapped case's bump-node bake without its "mapping" (a negative
                      control)
   ours_mask.exr      `sgbake bake --map mask`
@@ -116,6 +118,7 @@ def compare_case(entry):
                       ("bake_bump_node", "ours_bake_bump_node.exr"),
                       ("bake_blended", "ours_bake_blended.exr"),
                       ("bake_unmapped", "ours_bake_unmapped.exr"),
+                      ("bake_full_strength", "ours_bake_full_strength.exr"),
                       ("bake_object_space", "ours_bake_object_space.exr")):
         img = load_if(os.path.join(d, name))
         if img is None:

@@ -61,7 +61,9 @@ Texture Box projection with Blend 0.3 on object coordinates) bake a "triplanar" 
 "projection": "box" the same way; their control ours_bake_blended.exr, sgbake's own triplanar
 blend (seed 003), must fail both (b) and (e). box_mapped_sphere puts a Mapping node (Point: moved,
 turned, unevenly scaled) between the coordinates and the texture, the layer's "mapping"; its
-control ours_bake_unmapped.exr, the layer without it, must fail them too.
+control ours_bake_unmapped.exr, the layer without it, must fail them too. box_strength_sphere
+gives the Bump node a Strength of 0.4 (the layer's "strength"); its control
+ours_bake_full_strength.exr, at Strength 1, must fail them too.
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -215,7 +217,7 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
                  "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
                  "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
-                 "box_empty_sphere", "box_generated_sphere", "box_nmap_sphere",
+                 "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
                  "box_nmap_sphere_object")
 
 
@@ -285,11 +287,16 @@ def sgbake_case(cli, entry, sabotage, threads):
             bakes.append(("ours_bake_blended", bake_scale, "bump-node"))
         if "mapping" in entry["planar"]:
             bakes.append(("ours_bake_unmapped", bake_scale, "bump-node"))
+        strength = entry["planar"].get("strength", 1.0)
+        if strength != 1.0:
+            bakes.append(("ours_bake_full_strength", bake_scale, "bump-node"))
         for name, layer_scale, gradient in bakes:
             layer = {"type": "planar", "image": p("height.exr"), "kind": "height", "axis": "z",
                      "scale": layer_scale, "filter": entry["filter"], "gradient": gradient}
             if "mapping" in entry["planar"] and name != "ours_bake_unmapped":
                 layer["mapping"] = entry["planar"]["mapping"]
+            if strength != 1.0 and name != "ours_bake_full_strength":
+                layer["strength"] = strength
             if box:  # Blender's Box projection; the control: sgbake's own triplanar blend
                 del layer["axis"]
                 layer["type"] = "triplanar"
@@ -623,7 +630,9 @@ def evaluate(name, r, planar=False):
                          f"bars ({fmt(r['bake'])})")
     for key, label, what in (("bake_blended", "sgbake's blend:   ",
                               "sgbake's own triplanar blend instead of Blender's Box"),
-                             ("bake_unmapped", "without Mapping:  ", "its Mapping node left out")):
+                             ("bake_unmapped", "without Mapping:  ", "its Mapping node left out"),
+                             ("bake_full_strength", "Strength 1:       ",
+                              "the Bump's Strength left out")):
         if key not in r:
             continue
         s = r[key]

@@ -151,17 +151,20 @@ PLANAR = {}
 
 
 def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapping=None,
-                coordinates=None):
+                coordinates=None, strength=1.0):
     """Registers case `name`: the mesh (and transform) of case `mesh_case`, its Bump (Distance
     `scale`) fed by the height image projected onto object coordinates (`projection`), moved
     first by a Mapping node (Point) when `mapping` = (location, rotation, scale). `coordinates`:
     ("EMPTY", (location, rotation, scale)), the Object coordinates of an Empty placed so, or
-    ("GENERATED",), the Generated ones, instead of the object's own."""
+    ("GENERATED",), the Generated ones, instead of the object's own. `strength`: the Bump
+    node's Strength."""
     CASES[name] = (CASES[mesh_case][0], size, scale)
     SUBDIVISION[name] = SUBDIVISION[mesh_case]
     if mesh_case in TRANSFORMS:
         TRANSFORMS[name] = TRANSFORMS[mesh_case]
     PLANAR[name] = {"projection": projection, "blend": blend}
+    if strength != 1.0:
+        PLANAR[name]["strength"] = strength
     if mapping is not None:
         PLANAR[name]["mapping"] = {"location": list(mapping[0]), "rotation": list(mapping[1]),
                                    "scale": list(mapping[2])}
@@ -368,6 +371,8 @@ planar_case("box_generated_sphere", "sphere", 256, 0.01, "BOX", 0.3,
 # Normal maps read by the Box projection (Blend 0.3) into a Normal Map node: decoded in the UV
 # map's tangent frames, and in object space (Strength 0.3, so that normals leaning from +z stay
 # above the sphere's lower half).
+# A Bump Strength of 0.4 on the Box-projected height (the bumped normal blended with N).
+planar_case("box_strength_sphere", "sphere", 256, 0.02, "BOX", 0.3, strength=0.4)
 box_normal_map_case("box_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, 0.3)
 box_normal_map_case("box_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, 0.3)
 
@@ -589,6 +594,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             tex = next(n for n in mat.node_tree.nodes
                        if n.bl_idname == "ShaderNodeTexImage" and n != target)
             project_texture(name, mat, tex, ob)
+            bump = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBump")
+            bump.inputs["Strength"].default_value = PLANAR[name].get("strength", 1.0)
     else:
         if nmap["space"] == "TANGENT" or name in PLANAR:
             field = normal_field(height_size, nmap["tilt_deg"])
@@ -629,7 +636,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
              "transform": [list(row) for row in ob.matrix_world]}
     if name in PLANAR:
         entry["planar"] = {"projection": PLANAR[name]["projection"].lower(),
-                           "blend": PLANAR[name]["blend"]}
+                           "blend": PLANAR[name]["blend"],
+                           "strength": PLANAR[name].get("strength", 1.0)}
         if "mapping" in PLANAR[name] or "matrix" in PLANAR[name]:
             entry["planar"]["mapping"] = dict(PLANAR[name].get("mapping", {}))
             if "matrix" in PLANAR[name]:

@@ -302,6 +302,55 @@ TEST(Layers, VolumeSourceProjectsTheVolumeGradient) {
   }
 }
 
+// Heights read at positions take Blender's Bump Strength as UV heights do: the bumped normal
+// blended with N (withNormalMapStrength), on the surface and on the layers above alike; a normal
+// kind's is its scale, and the field is not read.
+TEST(Layers, HeightsReadAtPositionsTakeTheBumpStrength) {
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  const AnalyticHeight heights(0.3, -0.2, 0.05);
+  WavyNormalTexture wavy;
+  TriplanarSource box;
+  box.height = &heights;
+  box.options.projection = TriplanarProjection::kBox;
+  box.options.boxBlend = 0.3;
+  box.options.scale = 0.2;
+  PlanarSource planar;
+  planar.height = &heights;
+  planar.scale = 0.3;
+  const std::vector<LayerSource> sources{VolumeSource{&*sine, GradientScheme::kAnalytic, 0, 0.5},
+                                         planar, box};
+  std::mt19937_64 rng(71);
+  for (int i = 0; i < 30; ++i) {
+    SurfacePoint p = samplePoint(rng);
+    p.geometricNormal = p.normal;
+    for (const LayerSource& full : sources) {
+      LayerSource half = full;
+      std::visit(
+          [](auto& s) {
+            if constexpr (requires { s.strength; }) s.strength = 0.5;
+          },
+          half);
+      EXPECT_EQ(gradient_detail::bumpStrength(half), 0.5);
+      const Vec3d gamma = layerGradient(full, p);
+      EXPECT_GT(length(gamma), 0);
+      EXPECT_LT(maxAbsDiff(layerGradient(half, p), withNormalMapStrength(gamma, p.normal, 0.5)),
+                1e-15);
+      // On the layers above (here: none), the same blend of normals.
+      Layer above{half, 1.0, {}};
+      above.base = LayerBase::kLayersAbove;
+      EXPECT_LT(maxAbsDiff(resolveNormal(p.normal, compositeGradient(std::vector{above}, p)),
+                           resolveNormal(p.normal, layerGradient(half, p))),
+                1e-12);
+    }
+  }
+  TriplanarSource normals;
+  normals.kind = ProjectedKind::kObjectNormal;
+  normals.normals = &wavy;
+  normals.strength = 0.5;  // not a normal kind's: its scale is
+  EXPECT_EQ(gradient_detail::bumpStrength(normals), 1);
+}
+
 // On a triangle whose shading normal N leans from its geometric normal Ng, a height defined in
 // space takes its slopes along the triangle's plane, as Cycles' Bump node does (and as eq. 31
 // does for UV heights): Γ ⊥ N with ⟨Γ, a⟩ = ⟨∇h, a⟩ for every a ⊥ Ng. Where N = Ng it is the

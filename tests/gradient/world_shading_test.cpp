@@ -10,6 +10,7 @@
 
 #include "gradient/valid_reflection.hpp"
 #include "sgbake/core/math.hpp"
+#include "sgbake/gradient/volume.hpp"
 #include "sgbake/gradient/world_shading.hpp"
 #include "support/analytic_textures.hpp"
 #include "support/surface_points.hpp"
@@ -139,6 +140,17 @@ TEST(WorldShading, StrengthBlendsTheWorldNormals) {
   const Vec3d blended =
       shadeLayersInWorld(std::vector<Layer>{{half, 1.0, {}}}, object, world, space).normal;
   EXPECT_LT(maxAbsDiff(blended, normalizeOr(0.5 * bumped + 0.5 * n, {})), 1e-15);
+  // A height read at positions (a volume) blends in world space too.
+  auto sine = DirectionalSine::create({0.2, 1.5, {1, 2, 3}, 0.3});
+  ASSERT_TRUE(sine.ok());
+  VolumeSource volume{&*sine, GradientScheme::kAnalytic, 0, 0.5};
+  const Vec3d volumeBumped =
+      shadeLayersInWorld(std::vector<Layer>{{volume, 1.0, {}}}, object, world, space).normal;
+  volume.strength = 0.5;
+  const Vec3d volumeBlended =
+      shadeLayersInWorld(std::vector<Layer>{{volume, 1.0, {}}}, object, world, space).normal;
+  ASSERT_GT(length(volumeBumped - n), 1e-3);
+  EXPECT_LT(maxAbsDiff(volumeBlended, normalizeOr(0.5 * volumeBumped + 0.5 * n, {})), 1e-15);
 }
 
 // A shear can carry an object normal 60° from N below the world's tangent plane. No Γ stands

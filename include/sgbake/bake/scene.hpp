@@ -156,7 +156,9 @@ struct SceneLayer {
   /// "scale" (height, planar, triplanar: object units per unit of value; strength for projected
   /// normal maps) or "strength" (normal).
   double scale = 1;
-  double strength = 1;  ///< "strength" of a height layer: the Bump node's (a blend of normals)
+  /// "strength" of a height (height layers, volumes, projected heights): the Bump node's (a
+  /// blend of normals)
+  double strength = 1;
   /// "channel" of a height layer: luminance (Rec. 709 of RGB, as a colour into the Bump node's
   /// Height), or one channel: r, g, b, a (a height packed into another map, or the Image
   /// Texture's Alpha output)

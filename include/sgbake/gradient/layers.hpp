@@ -98,6 +98,7 @@ struct VolumeSource {
   /// kBumpNode: the volume read again at the point's BumpOffsets, as the Bump node reads a
   /// height at positions (Texture Coordinate Object); `scheme` where the point has none.
   HeightGradient gradient = HeightGradient::kAnalytic;
+  double strength = 1;  ///< Blender's Bump node Strength, as UvHeightSource::strength
 };
 
 /// @brief What a projected texture holds.
@@ -117,6 +118,8 @@ struct PlanarSource {
   double scale = 1;  ///< height scale (kHeight) or strength (normal maps)
   ProjectedNormalOptions normal{};
   HeightGradient gradient = HeightGradient::kAnalytic;  ///< of kHeight, as VolumeSource's
+  /// kHeight: Blender's Bump node Strength, as UvHeightSource::strength (normal kinds: scale)
+  double strength = 1;
 };
 
 /// @brief A texture projected on the three axis planes and blended (seed 003, eq. 45-50); see
@@ -127,6 +130,8 @@ struct TriplanarSource {
   const VectorTexture* normals = nullptr;  ///< for the normal kinds; not owned
   TriplanarOptions options{};              ///< scale, tiling, offset, sharpness, minWeight, decode
   HeightGradient gradient = HeightGradient::kAnalytic;  ///< of kHeight, as VolumeSource's
+  /// kHeight: Blender's Bump node Strength, as UvHeightSource::strength (normal kinds: scale)
+  double strength = 1;
 };
 
 /// @brief One of the source kinds.
