@@ -123,6 +123,18 @@ Vec3d evaluate(const TriplanarSource& s, const SurfacePoint& point) {
   return {};
 }
 
+/// A source's Bump Strength (gradient_detail::bumpStrength): heights' own, 1 for normal maps.
+double strengthOf(const UvHeightSource& s) { return s.strength; }
+double strengthOf(const VolumeSource& s) { return s.strength; }
+double strengthOf(const PlanarSource& s) {
+  return s.kind == ProjectedKind::kHeight ? s.strength : 1.0;
+}
+double strengthOf(const TriplanarSource& s) {
+  return s.kind == ProjectedKind::kHeight ? s.strength : 1.0;
+}
+double strengthOf(const TangentNormalSource&) { return 1; }
+double strengthOf(const ObjectNormalSource&) { return 1; }
+
 // --- validation ------------------------------------------------------------------------------
 
 /// What is wrong with one layer, or an empty string.
@@ -243,20 +255,17 @@ std::vector<std::vector<Layer>> layersByMaterial(std::span<const Layer> layers) 
 }
 
 Vec3d layerGradient(const LayerSource& source, const SurfacePoint& point) {
-  return withNormalMapStrength(gradient_detail::unblendedLayerGradient(source, point), point.normal,
-                               gradient_detail::bumpStrength(source));
+  return std::visit(
+      [&](const auto& s) {
+        return withNormalMapStrength(evaluate(s, point), point.normal, strengthOf(s));
+      },
+      source);
 }
 
 namespace gradient_detail {
 
 double bumpStrength(const LayerSource& source) {
-  if (const auto* uv = std::get_if<UvHeightSource>(&source)) return uv->strength;
-  if (const auto* volume = std::get_if<VolumeSource>(&source)) return volume->strength;
-  if (const auto* planar = std::get_if<PlanarSource>(&source))
-    return planar->kind == ProjectedKind::kHeight ? planar->strength : 1.0;
-  if (const auto* triplanar = std::get_if<TriplanarSource>(&source))
-    return triplanar->kind == ProjectedKind::kHeight ? triplanar->strength : 1.0;
-  return 1;
+  return std::visit([](const auto& s) { return strengthOf(s); }, source);
 }
 
 Vec3d unblendedLayerGradient(const LayerSource& source, const SurfacePoint& point) {
