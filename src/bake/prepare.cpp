@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/udim.hpp"
@@ -24,6 +25,28 @@ void padImage(FloatImage& image, const OutputPadding& padding, const BakeInput& 
   sgbake::padImage(image, padding.mode, padding.margin, *input.mesh, settings.uvSet,
                    settings.udimTile, settings.samples, settings.threads);
 }
+
+namespace {
+
+/// Above this many faces at one vertex, subdividing is slow enough to say so beforehand.
+constexpr std::uint32_t kSlowSubdivisionValence = 100;
+
+struct VertexValence {
+  std::uint32_t vertex = 0;
+  std::uint32_t corners = 0;  ///< how many face corners lie on it
+};
+
+/// The vertex that is a corner of the most faces (the first such).
+VertexValence largestValence(const Mesh& mesh) {
+  std::vector<std::uint32_t> corners(mesh.positions.size());
+  for (const std::uint32_t v : mesh.cornerVertex) ++corners[v];
+  VertexValence busiest;
+  for (std::uint32_t v = 0; v < corners.size(); ++v)
+    if (corners[v] > busiest.corners) busiest = {v, corners[v]};
+  return busiest;
+}
+
+}  // namespace
 
 Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
   if (scene.transform && !scene.transform->shadesAsObjectSpace()) {
@@ -58,6 +81,16 @@ Status setSurface(const Scene& scene, Mesh coarse, Loaded& loaded) {
              : std::string("the subdivided mesh is shaded smooth: give \"auto_smooth\" "
                            "(--auto-smooth DEG) with the object's Auto Smooth angle to split its "
                            "normals as Blender does")));
+  }
+  // Subdividing around a vertex of many faces takes time growing as the cube of their number
+  // (OpenSubdiv's end caps, in Blender too: docs/subdivision.md): say so before it starts.
+  if (const VertexValence busiest = largestValence(coarse);
+      busiest.corners > kSlowSubdivisionValence) {
+    loaded.warnings.push_back(scene.mesh.string() + ": vertex " +
+                              std::to_string(busiest.vertex + 1) + " is a corner of " +
+                              std::to_string(busiest.corners) +
+                              " faces: subdividing around it is slow (about 2 s at 128 faces, "
+                              "2 minutes at 400; Blender's modifier too)");
   }
   if (!subdivision.limitSurface()) {
     Result<Mesh> subdivided = subdivideMesh(coarse, subdivision.options());

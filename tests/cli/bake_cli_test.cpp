@@ -1101,6 +1101,36 @@ TEST_F(BakeCliTest, AutoSmoothWithoutSubdivisionFromSceneAndFlag) {
   EXPECT_EQ(readPixels(dir_ / "split_flag.exr"), split);
 }
 
+// A vertex shared by over 100 faces makes subdividing slow (about n³: OpenSubdiv's end caps, in
+// Blender too): a warning names it, so that a long run is explained; 100 faces do not.
+TEST_F(BakeCliTest, SubdividingAroundAVertexOfManyFacesWarns) {
+  const auto fan = [&](int n) {
+    std::string obj = "v 0 0 0.2\nvt 0.5 0.5\n";
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * 3.141592653589793 * i / n;
+      obj += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+      obj += "vt " + std::to_string(0.5 + 0.4 * std::cos(a)) + " " +
+             std::to_string(0.5 + 0.4 * std::sin(a)) + "\n";
+    }
+    for (int i = 0; i < n; ++i) {
+      const std::string b = std::to_string(i + 2), c = std::to_string((i + 1) % n + 2);
+      obj += "f 1/1 " + b + "/" + b + " " + c + "/" + c + "\n";
+    }
+    const fs::path path = dir_ / ("fan" + std::to_string(n) + ".obj");
+    writeFile(path, obj);
+    return run({"bake", "--mesh", path.string(), "--map", "mask", "--size", "16", "--subdivide",
+                "1", "--no-manifest", "-o", (dir_ / "m.png").string()});
+  };
+  const ProcessResult many = fan(101);
+  ASSERT_EQ(many.exitCode, 0) << many.err;
+  EXPECT_EQ(many.err, "sgbake: warning: " + (dir_ / "fan101.obj").string() +
+                          ": vertex 1 is a corner of 101 faces: subdividing around it is slow "
+                          "(about 2 s at 128 faces, 2 minutes at 400; Blender's modifier too)\n");
+  const ProcessResult fewer = fan(100);
+  ASSERT_EQ(fewer.exitCode, 0) << fewer.err;
+  EXPECT_EQ(fewer.err, "");
+}
+
 // An OBJ whose normals only Auto Smooth makes (split at vertex 3) says Auto Smooth was on, not
 // its angle: subdivided without "auto_smooth", it is shaded smooth, which a warning says.
 TEST_F(BakeCliTest, SubdividingSplitNormalsWithoutAnAngleWarns) {
