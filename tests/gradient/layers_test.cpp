@@ -483,6 +483,19 @@ TEST(Layers, ABoxReadNormalMapDecodesTheBlendedColourAsAUvTexel) {
     EXPECT_EQ(layerGradient(tangentBox, bare), Vec3d{}) << i;
   }
   EXPECT_GT(blended, 10);  // points where the Box blends planes were among them
+  // A blend that cancels (the colour (0.5, 0.5, 0.5) decodes to the zero vector) bumps nothing.
+  Colour grey;
+  grey.colour = {0.5, 0.5, 0.5};
+  SurfacePoint p = samplePoint(rng);
+  TangentNormalSource greyTangent{&grey, 0, {}};
+  greyTangent.box = box;
+  ObjectNormalSource greyObject{&grey};
+  greyObject.box = box;
+  for (const LayerSource& source : std::vector<LayerSource>{greyTangent, greyObject}) {
+    const Vec3d gamma = layerGradient(source, p);
+    EXPECT_TRUE(isFinite(gamma));
+    EXPECT_LT(length(gamma), 1e-12);
+  }
   // Only Blender's Box projection reads a normal map's texels.
   TangentNormalSource blendedRead{&wavy, 0, {}};
   blendedRead.box = box;
@@ -510,6 +523,18 @@ TEST(Layers, NoNanForExtremeParameters) {
         tri.normals = &ts;
         tri.options.scale = s;
         tri.options.tiling = {t, t};
+        // Normal maps read by Blender's Box projection (Blend 1: the planes blended widely).
+        TriplanarOptions box;
+        box.projection = TriplanarProjection::kBox;
+        box.boxBlend = 1;
+        box.tiling = {t, t};
+        TangentNormalSource tangentBox{
+            &ts, 1, {NormalMapGreen::kOpenGL, TangentFrameChoice::kAuto, s, {t, t}}};
+        tangentBox.box = box;
+        ObjectNormalSource objectBox{&ts, 0, {t, t}, {0, 0}, s};
+        objectBox.box = box;
+        VolumeSource weak{&*sine, GradientScheme::kAnalytic, 0, s};
+        weak.strength = 1 / s;  // a Bump Strength far out of range either way
         const std::vector<Layer> layers{
             {UvHeightSource{&h, 0, s, {t, t}}, s, {}},
             {TangentNormalSource{
@@ -518,7 +543,10 @@ TEST(Layers, NoNanForExtremeParameters) {
              {}},
             {ObjectNormalSource{&ts, 0, {t, t}, {0, 0}, s}, 1, {}},
             {VolumeSource{&*sine, GradientScheme::kTetrahedral, 1e-3 * t, s}, 1, {}},
-            {tri, 1 / s, {}}};
+            {tri, 1 / s, {}},
+            {tangentBox, 1, {}},
+            {objectBox, 1, {}},
+            {weak, 1, {}}};
         for (int i = 0; i < 50; ++i) {
           SurfacePoint p = samplePoint(rng);
           if (i % 5 == 0) p.uv[0].dPdv = p.uv[0].dPdu;  // degenerate UV frame
