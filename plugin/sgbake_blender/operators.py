@@ -481,13 +481,10 @@ def _object_projected(tex, ob=None):
 
 def _projection_taken(node, tex, ob=None):
     """Whether a layer takes over how Image Texture node `tex` feeding Bump or Normal Map node
-    `node` reads object coordinates: a Bump's Flat (a planar layer) or Box (a triplanar one)
-    projection; a Normal Map's Box projection (a triplanar layer of a normal kind, decoded as the
-    node decodes the colour the projection reads). A Normal Map's Flat projection is not: a
-    planar layer decodes tangent-space normals in its plane's frame, not in the UV map's."""
-    if not _object_projected(tex, ob):
-        return False
-    return node.type == "BUMP" or tex.projection == "BOX"
+    `node` reads object coordinates: its Flat projection (a planar layer) or Box projection (a
+    triplanar one); a Normal Map's as Blender's projections of a normal kind, decoded as the
+    node decodes the colour the projection reads."""
+    return _object_projected(tex, ob)
 
 
 def _ignored(node, tex, inputs, socket, ob=None):
@@ -579,7 +576,8 @@ def material_layers(node_tree, render_uv=None, ob=None):
                     values.update(type="triplanar", kind="height", projection="box",
                                   box_blend=tex.projection_blend)
                 else:
-                    values.update(type="planar", kind="height", axis="z")
+                    values.update(type="planar", kind="height", axis="z",
+                                  planar_projection="flat")
                 kind = values["type"]
                 if alpha:
                     ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {kind} "
@@ -598,12 +596,17 @@ def material_layers(node_tree, render_uv=None, ob=None):
             values = _texture_settings(tex, render_uv)
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
             if _projection_taken(node, tex, ob):
-                # Box projection on object coordinates: the colour it reads, decoded by the node
-                # (tangent space: in the frames of the node's UV map, else the render UV map's).
+                # Box or Flat projection on object coordinates: the colour it reads, decoded by
+                # the node (tangent space: in the frames of the node's UV map, else the render
+                # UV map's).
                 values.pop("uv_map", None)
                 values.update(_object_coordinates(tex, ob))
-                values.update(type="triplanar", kind=f"{space}-normal", projection="box",
-                              box_blend=tex.projection_blend)
+                if tex.projection == "BOX":
+                    values.update(type="triplanar", kind=f"{space}-normal", projection="box",
+                                  box_blend=tex.projection_blend)
+                else:
+                    values.update(type="planar", kind=f"{space}-normal", axis="z",
+                                  planar_projection="flat")
                 if space == "tangent" and node.uv_map:
                     values["tangent_uv_map"] = node.uv_map
             elif space == "tangent":

@@ -58,6 +58,13 @@ KINDS = (
     ("tangent-normal", "Tangent Normal", "The image holds tangent-space normals"),
     ("object-normal", "Object Normal", "The image holds object-space normals"),
 )
+PLANAR_PROJECTIONS = (
+    ("axis", "Along Axis", "sgbake's planar projection along Axis (normal kinds in the plane's "
+                           "own frame)"),
+    ("flat", "Flat", "Blender's Image Texture Flat projection, the (x, y) plane: what Cycles "
+                     "bakes (normal kinds decode the colour as a Normal Map node does)"),
+)
+
 MAPPING_TYPES = (
     ("POINT", "Point", "Scale, rotate, then move the coordinates (the Mapping node's Point)"),
     ("TEXTURE", "Texture", "The inverse of Point: move back, rotate back, divide by the scale"),
@@ -161,6 +168,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
         description="Projections: the coordinates read, as an affine map of the object's own "
                     "(3 rows of 4; set by Layers from Material from another object's or the "
                     "Generated coordinates), before the Mapping")
+    planar_projection: EnumProperty(name="Projection", items=PLANAR_PROJECTIONS, default="axis",
+                                    description="How a planar layer projects its image")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",

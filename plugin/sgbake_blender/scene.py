@@ -118,9 +118,16 @@ def tangent_frames_uv(layer, default_uv=None):
     the render UV map Cycles' Normal Map node takes when its own is empty."""
     if layer.type == "normal" and layer.space == "tangent":
         return layer.tangent_uv_map or None
-    if layer.type == "triplanar" and layer.projection == "box" and layer.kind == "tangent-normal":
+    if projected_by_blender(layer) and layer.kind == "tangent-normal":
         return layer.tangent_uv_map or default_uv or None
     return None
+
+
+def projected_by_blender(layer):
+    """Whether the layer projects its image as Blender's Image Texture does: a triplanar
+    layer's Box projection, a planar layer's Flat one."""
+    return ((layer.type == "triplanar" and layer.projection == "box")
+            or (layer.type == "planar" and layer.planar_projection == "flat"))
 
 
 def layer_json(layer, uv_index, default_uv=None):
@@ -162,6 +169,8 @@ def layer_json(layer, uv_index, default_uv=None):
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
+        if layer.planar_projection == "flat":  # Blender's Flat projection: the (x, y) plane
+            entry.update(projection="flat", axis="z")
     elif layer.type == "triplanar":
         entry.update(kind=layer.kind, scale=_number(layer.scale))
         if layer.projection == "box":

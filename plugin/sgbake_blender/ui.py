@@ -118,7 +118,9 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             if layer.type in ("planar", "triplanar"):
                 col.prop(layer, "kind")
             if layer.type == "planar":
-                col.prop(layer, "axis")
+                col.prop(layer, "planar_projection")
+                if layer.planar_projection == "axis":
+                    col.prop(layer, "axis")
             if layer.type in ("planar", "triplanar"):
                 box = col.box()
                 box.label(text="Mapping")
@@ -149,8 +151,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
         if layer.type == "normal":
             col.prop(layer, "space")
         if (layer.type == "normal" and layer.space == "tangent") or (
-                layer.type == "triplanar" and layer.projection == "box"
-                and layer.kind == "tangent-normal"):
+                scene.projected_by_blender(layer) and layer.kind == "tangent-normal"):
             ob = context.active_object
             if ob is not None and ob.type == "MESH":
                 col.prop_search(layer, "tangent_uv_map", ob.data, "uv_layers")

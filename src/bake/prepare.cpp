@@ -332,7 +332,7 @@ CoordinateMapping coordinateMapping(const SceneLayer& layer) {
   return node.after(CoordinateMapping::affine(*m.matrix, m.matrixTranslation));
 }
 
-/// A triplanar layer's options (the Box projection's too).
+/// A projected layer's options (the Box and Flat projections' too).
 TriplanarOptions triplanarOptions(const SceneLayer& layer) {
   TriplanarOptions options;
   options.tiling = layer.tiling;
@@ -347,24 +347,25 @@ TriplanarOptions triplanarOptions(const SceneLayer& layer) {
   return options;
 }
 
-/// A triplanar normal-map layer with Blender's Box projection: what Cycles bakes, a Normal Map
-/// node (Strength = the layer's scale) decoding the colour an Image Texture's Box projection
-/// reads. The normal-map source with its texels read by that projection (TangentNormalSource::
-/// box): Strength, guards and normals below the surface as a UV normal map's.
-LayerSource boxNormalSource(const SceneLayer& layer, const VectorTexture* texture) {
+/// A normal-map layer projected by one of Blender's projections (Box, Flat): what Cycles bakes,
+/// a Normal Map node (Strength = the layer's scale) decoding the colour an Image Texture's
+/// projection reads. The normal-map source with its texels read by that projection
+/// (TangentNormalSource::projection): Strength, guards and normals below the surface as a UV
+/// normal map's.
+LayerSource projectedNormalSource(const SceneLayer& layer, const VectorTexture* texture) {
   if (layer.kind == ProjectedKind::kTangentNormal) {
     TangentNormalSource source;
     source.texture = texture;
     source.uvSet = layer.frameUvSet();
     source.options.green = layer.green;
     source.options.strength = layer.scale;
-    source.box = triplanarOptions(layer);
+    source.projection = triplanarOptions(layer);
     return source;
   }
   ObjectNormalSource source;
   source.texture = texture;
   source.strength = layer.scale;
-  source.box = triplanarOptions(layer);
+  source.projection = triplanarOptions(layer);
   return source;
 }
 
@@ -439,6 +440,10 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       break;
     }
     case SceneLayerType::kPlanar: {
+      if (layer.projectedByBlender() && layer.readsNormals()) {
+        result.source = projectedNormalSource(layer, vector);
+        break;
+      }
       PlanarSource source;
       source.kind = layer.kind;
       source.height = scalar;
@@ -455,8 +460,8 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       break;
     }
     case SceneLayerType::kTriplanar: {
-      if (layer.projection == TriplanarProjection::kBox && layer.readsNormals()) {
-        result.source = boxNormalSource(layer, vector);
+      if (layer.projectedByBlender() && layer.readsNormals()) {
+        result.source = projectedNormalSource(layer, vector);
         break;
       }
       TriplanarSource source;

@@ -102,6 +102,8 @@ constexpr Named<TriplanarProjection> kProjections[] = {{"blended", TriplanarProj
 constexpr Named<MappingType> kMappingTypes[] = {{"point", MappingType::kPoint},
                                                 {"texture", MappingType::kTexture},
                                                 {"vector", MappingType::kVector}};
+constexpr Named<TriplanarProjection> kPlanarProjections[] = {
+    {"axis", TriplanarProjection::kBlended}, {"flat", TriplanarProjection::kFlat}};
 constexpr Named<ProjectionAxis> kAxes[] = {
     {"x", ProjectionAxis::kX}, {"y", ProjectionAxis::kY}, {"z", ProjectionAxis::kZ}};
 constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
@@ -388,7 +390,8 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "gradient", "step", "base", "strength"});
       break;
     case SceneLayerType::kPlanar:
-      add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength"});
+      add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
+           "projection", "tangent_uv"});
       break;
     case SceneLayerType::kTriplanar:
       add({"kind", "scale", "mapping", "projection", "sharpness", "min_weight", "box_blend",
@@ -768,7 +771,11 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     layer.tangentUvSet = reader.smallInteger("tangent_uv", 0, kMaxUvSets - 1);
   if (reader.has("sharpness")) layer.sharpness = reader.numberAtLeast("sharpness", 0, false);
   if (reader.has("min_weight")) layer.minWeight = reader.numberAtLeast("min_weight", 0, false);
-  reader.optionalName("projection", kProjections, layer.projection);
+  if (layer.type == SceneLayerType::kPlanar) {
+    reader.optionalName("projection", kPlanarProjections, layer.projection);
+  } else {
+    reader.optionalName("projection", kProjections, layer.projection);
+  }
   if (reader.has("mapping"))
     layer.mapping = parseMapping(reader.at("mapping"), appendPath(where, "mapping"));
   if (reader.has("box_blend")) layer.boxBlend = reader.numberAtLeast("box_blend", 0, false);
@@ -1086,9 +1093,14 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   if (!(layer.boxBlend >= 0 && layer.boxBlend <= 1)) {
     return "box_blend must be a number from 0 to 1 (Blender's Blend)";
   }
+  if (layer.type == SceneLayerType::kPlanar && layer.projection == TriplanarProjection::kFlat &&
+      layer.axis != ProjectionAxis::kZ) {
+    return "'projection': 'flat' reads the (x, y) plane, as Blender's Flat projection does: "
+           "'axis' must be z";
+  }
   if (layer.tangentUvSet && !layer.decodesInUvTangentFrames()) {
     return "key 'tangent_uv' applies only to tangent-space normal maps (normal layers, and "
-           "triplanar ones with 'projection': 'box')";
+           "projected ones with 'projection': 'box' or 'flat')";
   }
   if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
     return "step must be a finite number > 0";
@@ -1262,8 +1274,12 @@ bool SceneLayer::readsNormals() const {
 
 bool SceneLayer::decodesInUvTangentFrames() const {
   if (type == SceneLayerType::kNormal) return space == NormalSpace::kTangent;
-  return type == SceneLayerType::kTriplanar && projection == TriplanarProjection::kBox &&
-         kind == ProjectedKind::kTangentNormal;
+  return projectedByBlender() && kind == ProjectedKind::kTangentNormal;
+}
+
+bool SceneLayer::projectedByBlender() const {
+  return (type == SceneLayerType::kTriplanar && projection == TriplanarProjection::kBox) ||
+         (type == SceneLayerType::kPlanar && projection == TriplanarProjection::kFlat);
 }
 
 bool SceneLayer::hasHeight() const {
@@ -1473,6 +1489,7 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     case SceneLayerType::kPlanar:
       j["kind"] = nameIn(kKinds, layer.kind);
       j["axis"] = nameIn(kAxes, layer.axis);
+      if (layer.projection == TriplanarProjection::kFlat) j["projection"] = "flat";
       break;
     case SceneLayerType::kTriplanar:
       j["kind"] = nameIn(kKinds, layer.kind);

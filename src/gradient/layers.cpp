@@ -43,10 +43,11 @@ Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
 
 Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point,
                gradient_detail::NormalBelowSurface* below = nullptr) {
-  if (s.texture == nullptr || !hasUvSet(point, s.box ? s.frameUvSet() : s.uvSet)) return {};
-  const Vec3d texel = s.box ? boxTexel(*s.texture, *s.box, point)
-                            : s.texture->sample(textureCoordinates(
-                                  uvFrame(point, s.uvSet).uv, s.options.tiling, s.options.offset));
+  if (s.texture == nullptr || !hasUvSet(point, s.projection ? s.frameUvSet() : s.uvSet)) return {};
+  const Vec3d texel = s.projection
+                          ? projectedTexel(*s.texture, *s.projection, point)
+                          : s.texture->sample(textureCoordinates(
+                                uvFrame(point, s.uvSet).uv, s.options.tiling, s.options.offset));
   const Vec3d n = decodeNormalTexel(texel, s.options.green);
   if (below != nullptr && isFinite(n) &&
       !(n.z >= std::min(gradient_detail::guardedTolerance(s.options.minNormalZ), 1.0) *
@@ -61,10 +62,11 @@ Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point,
 
 Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
                gradient_detail::NormalBelowSurface* below = nullptr) {
-  if (s.texture == nullptr || (!s.box && !hasUvSet(point, s.uvSet))) return {};
-  const Vec3d n = decodeNormalTexel(s.box ? boxTexel(*s.texture, *s.box, point)
-                                          : s.texture->sample(textureCoordinates(
-                                                uvFrame(point, s.uvSet).uv, s.tiling, s.offset)));
+  if (s.texture == nullptr || (!s.projection && !hasUvSet(point, s.uvSet))) return {};
+  const Vec3d n = decodeNormalTexel(
+      s.projection
+          ? projectedTexel(*s.texture, *s.projection, point)
+          : s.texture->sample(textureCoordinates(uvFrame(point, s.uvSet).uv, s.tiling, s.offset)));
   if (below != nullptr) {
     const Vec3d unit = normalizeOr(n, Vec3d{});
     if (gradient_detail::belowSurface(unit, point.normal, s.minCosine))
@@ -147,15 +149,15 @@ class LayerChecker {
                   finite(s.tiling, "tiling"), finite(s.offset, "offset")});
   }
   std::string operator()(const TangentNormalSource& s) const {
-    return first({present(s.texture, "texture"), s.box ? std::string() : uvSet(s.uvSet),
+    return first({present(s.texture, "texture"), s.projection ? std::string() : uvSet(s.uvSet),
                   uvSet(s.frameUvSet()), finite(s.options.strength, "strength"),
                   finite(s.options.tiling, "tiling"), finite(s.options.offset, "offset"),
-                  box(s.box)});
+                  projectedRead(s.projection)});
   }
   std::string operator()(const ObjectNormalSource& s) const {
-    return first({present(s.texture, "texture"), s.box ? std::string() : uvSet(s.uvSet),
+    return first({present(s.texture, "texture"), s.projection ? std::string() : uvSet(s.uvSet),
                   finite(s.strength, "strength"), finite(s.tiling, "tiling"),
-                  finite(s.offset, "offset"), box(s.box)});
+                  finite(s.offset, "offset"), projectedRead(s.projection)});
   }
   std::string operator()(const VolumeSource& s) const {
     return first({present(s.volume, "volume"), finite(s.scale, "scale"),
@@ -194,11 +196,11 @@ class LayerChecker {
   static std::string finite(Vec2d x, const char* what) {
     return isFinite(x) ? std::string() : std::string(what) + " is not finite";
   }
-  /// A normal map's Box read.
-  static std::string box(const std::optional<TriplanarOptions>& options) {
+  /// A normal map's projected read.
+  static std::string projectedRead(const std::optional<TriplanarOptions>& options) {
     if (!options) return {};
-    if (options->projection != TriplanarProjection::kBox)
-      return "its projected read must be a Box projection";
+    if (options->projection == TriplanarProjection::kBlended)
+      return "its projected read must be Blender's Box or Flat projection";
     return first({finite(options->tiling, "tiling"), finite(options->offset, "offset"),
                   finite(options->boxBlend, "Box blend")});
   }

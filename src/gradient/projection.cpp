@@ -239,11 +239,16 @@ TriplanarWeights boxProjectionWeights(Vec3d normal, double blend) {
 }
 
 TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNormal) {
+  TriplanarPlanes planes;
+  if (options.projection == TriplanarProjection::kFlat) {
+    planes.plane[0] = {{ProjectionAxis::kZ, options.tiling, options.offset}, 1.0};
+    planes.count = 1;
+    return planes;
+  }
   const bool box = options.projection == TriplanarProjection::kBox;
   const TriplanarWeights weights =
       box ? boxProjectionWeights(seenNormal, options.boxBlend)
           : triplanarWeights(seenNormal, options.sharpness, options.minWeight);
-  TriplanarPlanes planes;
   for (const ProjectionAxis axis : kAxes) {
     const double w = weights.w[index(axis)];
     if (w == 0) continue;
@@ -296,8 +301,8 @@ Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const Triplan
       projectOntoTangentPlane(options.coordinates.pullBack(volumeGradient), point.normal));
 }
 
-Vec3d boxTexel(const VectorTexture& texture, const TriplanarOptions& options,
-               const SurfacePoint& point) {
+Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options,
+                     const SurfacePoint& point) {
   const Vec3d position = options.coordinates.apply(point.position);
   Vec3d blend{};
   for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal()))
@@ -309,7 +314,7 @@ Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const Triplana
                                     const SurfacePoint& point) {
   if (options.projection == TriplanarProjection::kBox) {
     // Cycles blends the texels' colours and a Normal Map node decodes the blend: one normal.
-    const Vec3d blend = decodeNormalTexel(boxTexel(texture, options, point));
+    const Vec3d blend = decodeNormalTexel(projectedTexel(texture, options, point));
     return finiteOrZero(options.scale *
                         gradientFromObjectNormal(blend, point.normal, options.normal.minCosine));
   }

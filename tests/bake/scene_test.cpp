@@ -542,7 +542,7 @@ TEST(Scene, InvalidCombinations) {
   EXPECT_EQ(parseError(withLayer(
                 R"({"type": "normal", "image": "n.png", "space": "object", "tangent_uv": 1})")),
             "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps "
-            "(normal layers, and triplanar ones with 'projection': 'box')");
+            "(normal layers, and projected ones with 'projection': 'box' or 'flat')");
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "base": "above"})")),
             "scene.json: layers[0]: key 'base' does not apply to a normal layer (it is for "
             "height, volume, planar or triplanar layers)");
@@ -703,7 +703,7 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
     EXPECT_EQ(parseError(withLayer(std::string(R"({"type": "triplanar", "image": "n.png", )") +
                                    kind + R"(, "tangent_uv": 1})")),
               "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps "
-              "(normal layers, and triplanar ones with 'projection': 'box')")
+              "(normal layers, and projected ones with 'projection': 'box' or 'flat')")
         << kind;
   }
   EXPECT_EQ(
@@ -713,9 +713,27 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
   EXPECT_EQ(
       parseError(withLayer(R"({"type": "triplanar", "image": "h.png", "projection": "flat"})")),
       "scene.json: layers[0]: unknown projection 'flat' (expected blended or box)");
+  // A planar layer's projections: along its axis (sgbake's), or Blender's Flat, whose normal
+  // kinds decode as a Normal Map node does (a tangent-space one in a UV set's frames).
   EXPECT_EQ(parseError(withLayer(R"({"type": "planar", "image": "h.png", "projection": "box"})")),
-            "scene.json: layers[0]: key 'projection' does not apply to a planar layer (it is for "
-            "triplanar layers)");
+            "scene.json: layers[0]: unknown projection 'box' (expected axis or flat)");
+  Result<Scene> flat = parseScene(withLayer(R"({"type": "planar", "image": "n.png",
+                    "projection": "flat", "kind": "tangent-normal", "tangent_uv": 1})"),
+                                  options());
+  ASSERT_TRUE(flat) << flat.error().message;
+  EXPECT_EQ(flat->layers[0].projection, TriplanarProjection::kFlat);
+  EXPECT_TRUE(flat->layers[0].projectedByBlender());
+  EXPECT_TRUE(flat->layers[0].decodesInUvTangentFrames());
+  EXPECT_NE(layerParametersJson(flat->layers[0]).find(R"("projection":"flat")"), std::string::npos);
+  Result<Scene> axis = parseScene(
+      withLayer(R"({"type": "planar", "image": "n.png", "kind": "tangent-normal"})"), options());
+  ASSERT_TRUE(axis) << axis.error().message;
+  EXPECT_FALSE(axis->layers[0].decodesInUvTangentFrames());
+  EXPECT_EQ(layerParametersJson(axis->layers[0]).find("projection"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "planar", "image": "h.png", "projection": "flat", "axis": "x"})")),
+            "scene.json: layers[0]: 'projection': 'flat' reads the (x, y) plane, as Blender's "
+            "Flat projection does: 'axis' must be z");
 }
 
 TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
@@ -1091,7 +1109,7 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message,
             "layers[0]: key 'tangent_uv' applies only to tangent-space normal maps (normal "
-            "layers, and triplanar ones with 'projection': 'box')");
+            "layers, and projected ones with 'projection': 'box' or 'flat')");
   scene.layers[0].kind = ProjectedKind::kTangentNormal;
   EXPECT_TRUE(validateScene(scene));
 }

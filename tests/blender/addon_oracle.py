@@ -515,25 +515,30 @@ def material_checks(settings, ob, distance):
     tree.nodes.remove(uvmap)
     # Its image read with Box projection on object coordinates: a triplanar Box layer of the
     # node's space, decoded in the frames of the node's UV map (BlenderBakeOracle's
-    # box_nmap_sphere checks such a layer against Cycles); Flat projection is named instead.
+    # box_nmap_sphere checks such a layer against Cycles); with Flat projection, a planar Flat
+    # layer (flat_nmap_sphere).
     coordinates = tree.nodes.new("ShaderNodeTexCoord")
     tree.links.new(coordinates.outputs["Object"], tex.inputs["Vector"])
     tex.projection, tex.projection_blend, nmap.uv_map = "BOX", 0.2, "UV2"
     boxed, _, boxed_ignored = operators.material_layers(tree, "UVMap")
     boxed_normal = next((v for v in boxed if v["type"] != "height"), {})
     tex.projection = "FLAT"
-    _, _, flat_ignored = operators.material_layers(tree, "UVMap")
+    flat, _, flat_ignored = operators.material_layers(tree, "UVMap")
+    flat_normal = next((v for v in flat if v["type"] != "height"), {})
     tex.projection, nmap.uv_map = "FLAT", ""
     tree.nodes.remove(coordinates)
     want = {"type": "triplanar", "kind": "tangent-normal", "projection": "box",
             "tangent_uv_map": "UV2"}
-    check("Layers from Material: a Normal Map of a Box-projected image",
+    want_flat = {"type": "planar", "kind": "tangent-normal", "planar_projection": "flat",
+                 "axis": "z", "tangent_uv_map": "UV2"}
+    check("Layers from Material: a Normal Map of a Box- or Flat-projected image",
           all(boxed_normal.get(k) == v for k, v in want.items())
           and abs(boxed_normal.get("box_blend", -1) - 0.2) < 1e-6 and "uv_map" not in boxed_normal
           and not any(tex.name in note for note in boxed_ignored)
-          and any(f"'{tex.name}' Vector from" in note for note in flat_ignored),
-          f"{want}, box_blend 0.2, nothing named; the Flat projection named",
-          f"{boxed_normal}; named {boxed_ignored}; Flat: named {flat_ignored}")
+          and all(flat_normal.get(k) == v for k, v in want_flat.items())
+          and not any(tex.name in note for note in flat_ignored),
+          f"{want}, box_blend 0.2; Flat: {want_flat}; nothing named",
+          f"{boxed_normal}; named {boxed_ignored}; Flat: {flat_normal}, named {flat_ignored}")
     tree.nodes.remove(nmap)
     # A Bump node linked to nothing makes no layer.
     stray = tree.nodes.new("ShaderNodeBump")

@@ -218,7 +218,7 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
                  "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
                  "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
-                 "box_nmap_sphere_object")
+                 "box_nmap_sphere_object", "flat_nmap_sphere")
 
 
 def run_blender_script(blender, script, args):
@@ -367,17 +367,20 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     map_green = "directx" if sabotage == "normal-green" else "opengl"
     green = "directx" if sabotage == "green" else "opengl"
 
-    box = "planar" in entry  # read by Blender's Box projection, not through the UV map
+    projected = "planar" in entry  # read by Blender's Box or Flat projection, not the UV map
 
     def scene_file(name, layer_strength, outputs, base="above", transform=True,
                    gradient="analytic", through_uvs=False):
         layer = {"type": "normal", "image": p("normal.exr"), "space": nmap["space"],
                  "strength": layer_strength, "filter": "bilinear", "uv": 0, "weight": 1.0}
-        if box and not through_uvs:
+        if projected and not through_uvs:
             layer = {"type": "triplanar", "image": p("normal.exr"),
                      "kind": f"{nmap['space']}-normal", "scale": layer_strength,
                      "projection": "box", "box_blend": entry["planar"]["blend"],
                      "filter": "bilinear", "weight": 1.0}
+            if entry["planar"]["projection"] == "flat":
+                del layer["box_blend"]
+                layer.update(type="planar", projection="flat")
         if nmap["space"] == "tangent":
             layer["green"] = map_green
         layers = [layer]
@@ -404,7 +407,7 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
                             [("tangent-normal", "ours_nmap_weak.exr")])):
         if not run_sgbake(cli, args, log):
             failed.append(log[-1])
-    if box and not run_sgbake(  # the control: the same map read through the UV map
+    if projected and not run_sgbake(  # the control: the same map read through the UV map
             cli, scene_file("scene_uv.json", strength, [("tangent-normal", "ours_nmap_uv.exr")],
                             through_uvs=True), log):
         failed.append(log[-1])
@@ -422,7 +425,7 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
                             [("tangent-normal", "ours_nmap_bump_node.exr")],
                             gradient="bump-node"), log):
         failed.append(log[-1])
-    if nmap["strength"] == 1.0 and "bump" not in nmap and not box:
+    if nmap["strength"] == 1.0 and "bump" not in nmap and not projected:
         # (the flags have no Strength, chain or projection)
         flags = ["bake", "--mesh", p("mesh.obj"), "--normal", p("normal.exr"), "--normal-space",
                  nmap["space"], "--map", "tangent-normal", "--size", size, "--green", green,
@@ -481,7 +484,9 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
     stretched = stretched_case
     print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {nmap['space']}-space normal map "
           f"(tilts up to {nmap['tilt_deg']:g} deg), Strength {nmap['strength']:g}"
-          + (f", read by the Box projection with Blend {nmap['box']:g}" if "box" in nmap else "")
+          + ((f", read by the Box projection with Blend {nmap['box']:g}"
+              if nmap["projection"] == "box" else ", read by the Flat projection")
+             if "projection" in nmap else "")
           + (f", then a Bump node of Distance {nmap['bump']:g} on its output" if chain else "")
           + f", {r['covered']} covered texels, {r['compared']} compared; Blender's tangent bake "
           f"tilt from +Z: {fmt_nmap(r['tilt'])}")
@@ -528,7 +533,7 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
         negative_control(name, r, "nmap_sum", "bump added, not stacked:  ",
                          "the bake with the bump added to the normal map's gradient", chain,
                          fails, stretched)
-    if "box" in nmap:
+    if "projection" in nmap:
         negative_control(name, r, "nmap_uv", "read through the UV map:  ",
                          "the bake of the map read through the UV map", chain, fails, stretched)
     elif nmap["strength"] == 1.0 and not chain:
@@ -704,6 +709,7 @@ def main():
             if "normal_map" in entry:
                 nmap = dict(entry["normal_map"])
                 if "planar" in entry:
+                    nmap["projection"] = entry["planar"]["projection"]
                     nmap["box"] = entry["planar"]["blend"]
                 failures += evaluate_nmap(entry["name"], results[entry["name"]], nmap,
                                           transformed(entry))

@@ -172,13 +172,15 @@ def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapp
         PLANAR[name]["coordinates"] = coordinates
 
 
-def box_normal_map_case(name, mesh_case, size, space, strength, tilt_deg, blend):
-    """Registers case `name`: normal_map_case's, its Image Texture read with Box projection
-    (Blend `blend`) on the object's coordinates instead of its UV map (sgbake's triplanar
-    layer with "projection": "box" of kind tangent-normal or object-normal). Its image is
-    normal_field in either space: as object-space normals they lean up to `tilt_deg` from +z."""
+def projected_normal_map_case(name, mesh_case, size, space, strength, tilt_deg,
+                              projection="BOX", blend=0.0):
+    """Registers case `name`: normal_map_case's, its Image Texture read with `projection`
+    (Box with Blend `blend`: sgbake's triplanar layer with "projection": "box"; Flat: its planar
+    layer with "projection": "flat") on the object's coordinates instead of its UV map, of kind
+    tangent-normal or object-normal. Its image is normal_field in either space: as object-space
+    normals they lean up to `tilt_deg` from +z."""
     normal_map_case(name, mesh_case, size, space, strength, tilt_deg)
-    PLANAR[name] = {"projection": "BOX", "blend": blend}
+    PLANAR[name] = {"projection": projection, "blend": blend}
 
 
 def apply_subdivision(ob, levels):
@@ -373,8 +375,11 @@ planar_case("box_generated_sphere", "sphere", 256, 0.01, "BOX", 0.3,
 # above the sphere's lower half).
 # A Bump Strength of 0.4 on the Box-projected height (the bumped normal blended with N).
 planar_case("box_strength_sphere", "sphere", 256, 0.02, "BOX", 0.3, strength=0.4)
-box_normal_map_case("box_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, 0.3)
-box_normal_map_case("box_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, 0.3)
+projected_normal_map_case("box_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "BOX", 0.3)
+projected_normal_map_case("box_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "BOX",
+                          0.3)
+# The same tangent-space map read with Flat projection (the image at the object's (x, y)).
+projected_normal_map_case("flat_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "FLAT")
 
 
 def tilt_field(size, tilt_deg):

@@ -429,12 +429,12 @@ TEST(Layers, PlanarAndObjectSpaceSourcesDispatchToTheirKernels) {
 
 // No NaN from any layer kind at random points with extreme parameters (1e±8 scales, tilings and
 // weights, grazing normals, degenerate frames).
-// A normal map whose texels Blender's Box projection reads (TangentNormalSource::box,
-// ObjectNormalSource::box: an Image Texture with Projection Box before a Normal Map node)
+// A normal map whose texels Blender's Box projection reads (TangentNormalSource::projection,
+// ObjectNormalSource::projection: an Image Texture with Projection Box before a Normal Map node)
 // decodes the blended colour exactly as the same map read through a UV set decodes a texel of
 // that colour: Strength, frames and guards are the normal map's, and the colour is blended
 // before it is decoded.
-TEST(Layers, ABoxReadNormalMapDecodesTheBlendedColourAsAUvTexel) {
+TEST(Layers, AProjectedNormalMapDecodesTheColourReadAsAUvTexel) {
   class Colour final : public VectorTexture {
    public:
     Vec3d colour;
@@ -461,17 +461,17 @@ TEST(Layers, ABoxReadNormalMapDecodesTheBlendedColourAsAUvTexel) {
       frame.dPdv = r * frame.dPdv;
     }
     Colour same;
-    same.colour = boxTexel(wavy, box, p);
+    same.colour = projectedTexel(wavy, box, p);
     blended += triplanarPlanes(box, p.normal).count > 1;
     TangentNormalSource tangentBox{&wavy, 1, {}};
     tangentBox.options.strength = 0.7;
-    tangentBox.box = box;
+    tangentBox.projection = box;
     TangentNormalSource tangentUv{&same, 1, {}};
     tangentUv.options.strength = 0.7;
     EXPECT_EQ(layerGradient(tangentBox, p), layerGradient(tangentUv, p)) << i;
     ObjectNormalSource objectBox{&wavy};
     objectBox.strength = 1.3;
-    objectBox.box = box;
+    objectBox.projection = box;
     ObjectNormalSource objectUv{&same};
     objectUv.strength = 1.3;
     EXPECT_EQ(layerGradient(objectBox, p), layerGradient(objectUv, p)) << i;
@@ -488,22 +488,32 @@ TEST(Layers, ABoxReadNormalMapDecodesTheBlendedColourAsAUvTexel) {
   grey.colour = {0.5, 0.5, 0.5};
   SurfacePoint p = samplePoint(rng);
   TangentNormalSource greyTangent{&grey, 0, {}};
-  greyTangent.box = box;
+  greyTangent.projection = box;
   ObjectNormalSource greyObject{&grey};
-  greyObject.box = box;
+  greyObject.projection = box;
   for (const LayerSource& source : std::vector<LayerSource>{greyTangent, greyObject}) {
     const Vec3d gamma = layerGradient(source, p);
     EXPECT_TRUE(isFinite(gamma));
     EXPECT_LT(length(gamma), 1e-12);
   }
-  // Only Blender's Box projection reads a normal map's texels.
+  // Blender's Flat projection reads the (x, y) plane of the mapped coordinates, whatever the
+  // normal; sgbake's own blend is no read of Blender's.
+  TriplanarOptions flat = box;
+  flat.projection = TriplanarProjection::kFlat;
+  for (int i = 0; i < 10; ++i) {
+    const SurfacePoint q = samplePoint(rng);
+    const Vec3d at = flat.coordinates.apply(q.position);
+    EXPECT_EQ(projectedTexel(wavy, flat, q),
+              wavy.sample(Vec2d{flat.tiling.x * at.x, flat.tiling.y * at.y} + flat.offset));
+  }
   TangentNormalSource blendedRead{&wavy, 0, {}};
-  blendedRead.box = box;
-  blendedRead.box->projection = TriplanarProjection::kBlended;
+  blendedRead.projection = box;
+  blendedRead.projection->projection = TriplanarProjection::kBlended;
   const Status status = validateLayers(std::vector<Layer>{{blendedRead, 1.0, {}}}, 2);
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message,
-            "layer 0 (tangent-space normal map): its projected read must be a Box projection");
+            "layer 0 (tangent-space normal map): its projected read must be Blender's Box or Flat "
+            "projection");
 }
 
 TEST(Layers, NoNanForExtremeParameters) {
@@ -530,9 +540,9 @@ TEST(Layers, NoNanForExtremeParameters) {
         box.tiling = {t, t};
         TangentNormalSource tangentBox{
             &ts, 1, {NormalMapGreen::kOpenGL, TangentFrameChoice::kAuto, s, {t, t}}};
-        tangentBox.box = box;
+        tangentBox.projection = box;
         ObjectNormalSource objectBox{&ts, 0, {t, t}, {0, 0}, s};
-        objectBox.box = box;
+        objectBox.projection = box;
         VolumeSource weak{&*sine, GradientScheme::kAnalytic, 0, s};
         weak.strength = 1 / s;  // a Bump Strength far out of range either way
         const std::vector<Layer> layers{

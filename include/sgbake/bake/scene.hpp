@@ -175,8 +175,11 @@ struct SceneLayer {
   ProjectionAxis axis = ProjectionAxis::kZ;        ///< "axis" (planar)
   double sharpness = kDefaultTriplanarSharpness;   ///< "sharpness" (triplanar)
   double minWeight = kDefaultMinTriplanarWeight;   ///< "min_weight" (triplanar)
-  /// "projection" (triplanar): "blended" (seed 003's planes and weights, the default) or "box"
-  /// (Blender's Image Texture Box projection, kinds height and object-normal)
+  /// "projection": sgbake's own (kBlended: a triplanar layer's "blended", seed 003's planes and
+  /// weights; a planar layer's "axis", along its axis, normal kinds in the plane's frame), the
+  /// default, or Blender's Image Texture projections: a triplanar layer's "box" (kBox), a planar
+  /// layer's "flat" (kFlat, the (x, y) plane). Blender's decode normal kinds as a Normal Map node
+  /// decodes the colour they read.
   TriplanarProjection projection = TriplanarProjection::kBlended;
   double boxBlend = kDefaultBoxBlend;  ///< "box_blend" (triplanar box): Blender's Blend, 0 … 1
   std::optional<SceneMapping> mapping;  ///< "mapping" (planar, triplanar)
@@ -209,10 +212,13 @@ struct SceneLayer {
   bool hasHeight() const;
   /// @brief Whether the layer projects its image at positions: planar or triplanar.
   bool projected() const;
+  /// @brief Whether the layer projects its image as one of Blender's Image Texture projections:
+  /// a triplanar layer's "box", a planar layer's "flat".
+  bool projectedByBlender() const;
   /// @brief Whether the layer decodes a tangent-space normal map in the MikkTSpace frames of a
-  /// UV set (frameUvSet): a tangent-space normal layer, or a triplanar one with Blender's Box
-  /// projection (a Normal Map node decoding what an Image Texture's Box projection reads).
-  /// sgbake's blended triplanar decodes in each plane's own frame instead.
+  /// UV set (frameUvSet): a tangent-space normal layer, or a projected one of Blender's
+  /// projections (projectedByBlender: a Normal Map node decoding what an Image Texture's Box or
+  /// Flat projection reads). sgbake's own projections decode in each plane's own frame instead.
   bool decodesInUvTangentFrames() const;
   /// @brief The UV set whose frames decode its tangent-space normals: "tangent_uv", else "uv".
   int frameUvSet() const { return tangentUvSet.value_or(uvSet); }

@@ -226,6 +226,10 @@ enum class TriplanarProjection {
   kBlended,
   /// Blender's Box projection: PlaneLayout::kBox, weights boxProjectionWeights (boxBlend).
   kBox,
+  /// Blender's Flat projection: the one plane (x, y) of P' (the Z plane, cyclic layout), weight
+  /// 1 whatever the normal. A height so projected is a planar one on z; it serves a normal
+  /// map's projected read (TangentNormalSource::projection).
+  kFlat,
 };
 
 /// Default Blend of a Box projection, Blender's.
@@ -264,12 +268,13 @@ struct TriplanarPlanes {
 };
 TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNormal);
 
-/// @brief The colour an Image Texture with Projection Box gives at @p point: the texels of the
-/// planes triplanarPlanes picks for the normal Cycles shades with there (point.seenNormal()),
-/// read at @p options' coordinates of P, blended by their weights, not decoded (what a Normal
-/// Map node receives). Reads @p options' projection, boxBlend, tiling, offset and coordinates.
-Vec3d boxTexel(const VectorTexture& texture, const TriplanarOptions& options,
-               const SurfacePoint& point);
+/// @brief The colour an Image Texture with Projection Box or Flat gives at @p point: the texels
+/// of the planes triplanarPlanes picks for the normal Cycles shades with there
+/// (point.seenNormal()), read at @p options' coordinates of P, blended by their weights, not
+/// decoded (what a Normal Map node receives). Reads @p options' projection, boxBlend, tiling,
+/// offset and coordinates.
+Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options,
+                     const SurfacePoint& point);
 
 /// @brief Γ of a height map by triplanar projection (seed 003; eq. 46-49 then eq. 30):
 /// ∇h = Σ_i w_i · planeVolumeGradient_i, Γ = ∇h − ⟨∇h, N⟩N.
