@@ -21,6 +21,44 @@ class BakeInputError(Exception):
     """The object, its UV maps or the layers' images cannot be baked as they are."""
 
 
+def coordinates_matrix(ob, other=None, generated=False):
+    """The coordinates a Texture Coordinate node gives on object `ob`, as an affine map of
+    `ob`'s own (12 numbers, row by row), as they are now: with `other`, its Object output naming
+    that object, inverse(other.matrix_world) @ ob.matrix_world; with `generated`, its Generated
+    output, the texture space of ob's mesh (the bounding box, by default) to [0, 1]. None when
+    neither is given, or the texture space is flat."""
+    if other is not None:
+        m = other.matrix_world.inverted_safe() @ ob.matrix_world
+        return tuple(m[r][c] for r in range(3) for c in range(4))
+    if generated and ob.type == "MESH":
+        loc, size = ob.data.texspace_location, ob.data.texspace_size
+        if any(s == 0 for s in size):
+            return None
+        rows = [[0.0] * 4 for _ in range(3)]
+        for i in range(3):
+            rows[i][i] = 0.5 / size[i]
+            rows[i][3] = 0.5 - 0.5 * loc[i] / size[i]
+        return tuple(v for row in rows for v in row)
+    return None
+
+
+def follow_coordinates(layers, ob):
+    """Sets the Coordinates (mapping_matrix) of every projected layer that reads another
+    object's or the Generated coordinates to what they are now on `ob`, so that a moved
+    projector or an edited mesh bakes as Cycles renders it without Layers from Material again."""
+    for layer in layers:
+        if layer.type not in ("planar", "triplanar"):
+            continue
+        if layer.coordinates_object is None and not layer.coordinates_generated:
+            continue
+        matrix = coordinates_matrix(ob, layer.coordinates_object, layer.coordinates_generated)
+        if matrix is None:
+            raise BakeInputError(f"layer '{layer.name}': the Generated coordinates of object "
+                                 f"'{ob.name}' have a flat texture space")
+        if tuple(layer.mapping_matrix) != matrix:
+            layer.mapping_matrix = matrix
+
+
 def render_uv_name(mesh):
     """The name of the mesh's UV map active for rendering (the camera icon of the UV Maps
     list), which Cycles reads an Image Texture without a UV Map node on; the active UV map

@@ -32,6 +32,7 @@ class BakeJob:
             raise gather.BakeInputError("sgbake bakes the active object, which must be a mesh")
         layers = scene.baked_layers(settings)
         self.images = gather.layer_images(layers)
+        gather.follow_coordinates(layers, ob)
 
         if ob.mode == "EDIT":
             ob.update_from_editmode()
@@ -418,26 +419,15 @@ def _not_image(socket):
 MAPPING_INPUTS = ("Location", "Rotation", "Scale")
 
 
-def _coordinates_matrix(link, ob):
-    """The coordinates a Texture Coordinate node's output `link` gives on object `ob`, as an
-    affine map of `ob`'s own (12 numbers, row by row); None when they are not one (or `ob` is
-    not known), the identity (None too) for its Object output without another object. Object
-    with another object named: inverse(its matrix_world) @ ob.matrix_world. Generated: the
-    texture space of ob's mesh (the bounding box, by default) to [0, 1]. Both as they are now:
-    moving the other object or the mesh later needs Layers from Material again."""
+def _coordinates_source(link):
+    """What a Texture Coordinate node's output `link` reads other than the object's own
+    coordinates: {"coordinates_object": the object its Object output names} or
+    {"coordinates_generated": True}; None for the object's own, and for other outputs."""
     node, output = link.from_node, link.from_socket.name
-    if output == "Object" and node.object is not None and ob is not None:
-        m = node.object.matrix_world.inverted_safe() @ ob.matrix_world
-        return tuple(m[r][c] for r in range(3) for c in range(4))
-    if output == "Generated" and ob is not None and ob.type == "MESH":
-        loc, size = ob.data.texspace_location, ob.data.texspace_size
-        if any(s == 0 for s in size):
-            return None
-        rows = [[0.0] * 4 for _ in range(3)]
-        for i in range(3):
-            rows[i][i] = 0.5 / size[i]
-            rows[i][3] = 0.5 - 0.5 * loc[i] / size[i]
-        return tuple(v for row in rows for v in row)
+    if output == "Object" and node.object is not None:
+        return {"coordinates_object": node.object}
+    if output == "Generated":
+        return {"coordinates_generated": True}
     return None
 
 
@@ -466,11 +456,16 @@ def _object_coordinates(tex, ob=None):
     if link is None or link.from_node.type != "TEX_COORD":
         return None
     own = link.from_socket.name == "Object" and link.from_node.object is None
-    matrix = None if own else _coordinates_matrix(link, ob)
-    if not own and matrix is None:
+    if own:
+        return settings
+    source = _coordinates_source(link)
+    # Another object's or the Generated coordinates: the layer keeps which, and their map now
+    # (gather.follow_coordinates brings it up to date at every bake).
+    matrix = None if source is None or ob is None else gather.coordinates_matrix(
+        ob, source.get("coordinates_object"), source.get("coordinates_generated", False))
+    if matrix is None:
         return None
-    if matrix is not None:
-        settings["mapping_matrix"] = matrix
+    settings.update(source, mapping_matrix=matrix)
     return settings
 
 

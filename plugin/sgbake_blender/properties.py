@@ -166,10 +166,18 @@ class SgbakeLayer(bpy.types.PropertyGroup):
         name="Coordinates", size=12, default=(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
                                               0.0, 0.0, 1.0, 0.0),
         description="Projections: the coordinates read, as an affine map of the object's own "
-                    "(3 rows of 4; set by Layers from Material from another object's or the "
-                    "Generated coordinates), before the Mapping")
+                    "(3 rows of 4, before the Mapping; set at every bake from Coordinates "
+                    "Object or Generated Coordinates when one is given)")
     planar_projection: EnumProperty(name="Projection", items=PLANAR_PROJECTIONS, default="axis",
                                     description="How a planar layer projects its image")
+    coordinates_object: PointerProperty(
+        name="Coordinates Object", type=bpy.types.Object,
+        description="Projections: the object whose coordinates are read (a Texture Coordinate "
+                    "node's Object output naming it); Coordinates follow it at every bake")
+    coordinates_generated: BoolProperty(
+        name="Generated Coordinates", default=False,
+        description="Projections: the baked object's Generated coordinates (its texture space "
+                    "to [0, 1]); Coordinates follow them at every bake")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",

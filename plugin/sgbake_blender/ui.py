@@ -127,8 +127,11 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 for name in ("mapping_type", "mapping_location", "mapping_rotation",
                              "mapping_scale"):
                     box.prop(layer, name)
-                if tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0):
-                    box.label(text="Coordinates: another object's or Generated")
+                box.prop(layer, "coordinates_object")
+                box.prop(layer, "coordinates_generated")
+                if (tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0)
+                        and layer.coordinates_object is None and not layer.coordinates_generated):
+                    box.label(text="Coordinates: an affine map of the object's own")
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
             if scene.bumps_height(layer):
                 col.prop(layer, "strength")

@@ -1419,6 +1419,20 @@ def projector_case(settings, ob, work):
             bpy.data.images.remove(cycles)
         target.image = None
         scene.render.engine = engine
+        # The Empty moved after Layers from Material: the next bake reads it where it is now.
+        empty.location = (empty.location[0] + 0.5, empty.location[1], empty.location[2] - 0.25)
+        bpy.context.view_layer.update()
+        sent = operators.BakeJob(bpy.context).scene["layers"][0].get("mapping", {})
+        want = empty.matrix_world.inverted() @ ob.matrix_world
+        got = [v for row in sent.get("matrix", []) for v in row]
+        worst = (max(abs(got[4 * r + c] - want[r][c]) for r in range(3) for c in range(4))
+                 if len(got) == 12 else None)
+        entry["checks"].append({
+            "name": "projector: the Empty moved, the next bake's coordinates follow it",
+            "ok": layer.coordinates_object == empty and worst is not None and worst < 1e-6,
+            "expected": f"coordinates_object 'projector', matrix {[list(r) for r in want[:3]]}",
+            "message": f"coordinates_object {layer.coordinates_object}, sent {sent}, "
+                       f"max difference {worst}"})
     finally:
         tree.nodes.remove(mapping)
         tree.nodes.remove(coordinates)
