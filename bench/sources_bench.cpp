@@ -21,6 +21,9 @@
 ///   - `TriplanarBoxHeight/planes:N`: the same with Blender's Box projection (Blend 0.3), normals
 ///     in its one-, two- and three-plane zones; `TriplanarBoxHeight/mapped` three planes after a
 ///     Mapping node (CoordinateMapping)
+///   - `ProjectedTangentNormal/box:N`, `ProjectedTangentNormal/flat`: the tangent-space map read
+///     by Blender's Box projection (normals in its N-plane zone) or Flat projection and decoded
+///     in the MikkTSpace frame (TangentNormalSource::projection), against `TangentNormal/mikk`
 ///   - `Composite3`: UV height + tangent-space map + triplanar height (all 3 planes) together,
 ///     resolved to the perturbed normal (perturbedNormal)
 
@@ -168,6 +171,33 @@ void runBox(benchmark::State& state, int planes, const CoordinateMapping& coordi
   if (active != planes * static_cast<int>(points.size())) state.SkipWithError("wrong plane count");
   runLayers(state, {{tri, 1, {}}}, points);
 }
+
+/// The tangent-space map read by a projection of Blender's (kBox: Blend 0.3, normals in the
+/// zone of `planes` planes; kFlat).
+void runProjectedTangentNormal(benchmark::State& state, TriplanarProjection projection,
+                               int planes) {
+  TangentNormalSource source{&kTangentMap, 0, {}};
+  source.projection = TriplanarOptions{};
+  source.projection->projection = projection;
+  source.projection->boxBlend = 0.3;
+  source.projection->tiling = {2, 2};
+  runLayers(state, {{source, 1, {}}}, boxPoints(planes));
+}
+
+void ProjectedTangentNormalBox(benchmark::State& state) {
+  runProjectedTangentNormal(state, TriplanarProjection::kBox, static_cast<int>(state.range(0)));
+}
+BENCHMARK(ProjectedTangentNormalBox)
+    ->Name("ProjectedTangentNormal")
+    ->ArgName("box")
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(3);
+
+void ProjectedTangentNormalFlat(benchmark::State& state) {
+  runProjectedTangentNormal(state, TriplanarProjection::kFlat, 3);
+}
+BENCHMARK(ProjectedTangentNormalFlat)->Name("ProjectedTangentNormal/flat");
 
 void TriplanarBoxHeight(benchmark::State& state) {
   runBox(state, static_cast<int>(state.range(0)), {});
