@@ -41,14 +41,23 @@ Vec3d evaluate(const UvHeightSource& s, const SurfacePoint& point) {
   return unblendedGradient(s, point);
 }
 
+/// A normal map's texels: through its UV set, or by its projection, whose planes are picked by
+/// @p planesNormal when given (else point.seenNormal()).
+template <class Source>
+Vec3d normalTexel(const Source& s, const SurfacePoint& point, Vec2d tiling, Vec2d offset,
+                  const Vec3d* planesNormal) {
+  if (!s.projection)
+    return s.texture->sample(textureCoordinates(uvFrame(point, s.uvSet).uv, tiling, offset));
+  return projectedTexel(*s.texture, *s.projection, point.position,
+                        planesNormal != nullptr ? *planesNormal : point.seenNormal());
+}
+
 Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point,
-               gradient_detail::NormalBelowSurface* below = nullptr) {
+               gradient_detail::NormalBelowSurface* below = nullptr,
+               const Vec3d* planesNormal = nullptr) {
   if (s.texture == nullptr || !hasUvSet(point, s.projection ? s.frameUvSet() : s.uvSet)) return {};
-  const Vec3d texel = s.projection
-                          ? projectedTexel(*s.texture, *s.projection, point)
-                          : s.texture->sample(textureCoordinates(
-                                uvFrame(point, s.uvSet).uv, s.options.tiling, s.options.offset));
-  const Vec3d n = decodeNormalTexel(texel, s.options.green);
+  const Vec3d n = decodeNormalTexel(
+      normalTexel(s, point, s.options.tiling, s.options.offset, planesNormal), s.options.green);
   if (below != nullptr && isFinite(n) &&
       !(n.z >= std::min(gradient_detail::guardedTolerance(s.options.minNormalZ), 1.0) *
                    std::sqrt(lengthSquared(n)))) {
@@ -61,12 +70,10 @@ Vec3d evaluate(const TangentNormalSource& s, const SurfacePoint& point,
 }
 
 Vec3d evaluate(const ObjectNormalSource& s, const SurfacePoint& point,
-               gradient_detail::NormalBelowSurface* below = nullptr) {
+               gradient_detail::NormalBelowSurface* below = nullptr,
+               const Vec3d* planesNormal = nullptr) {
   if (s.texture == nullptr || (!s.projection && !hasUvSet(point, s.uvSet))) return {};
-  const Vec3d n = decodeNormalTexel(
-      s.projection
-          ? projectedTexel(*s.texture, *s.projection, point)
-          : s.texture->sample(textureCoordinates(uvFrame(point, s.uvSet).uv, s.tiling, s.offset)));
+  const Vec3d n = decodeNormalTexel(normalTexel(s, point, s.tiling, s.offset, planesNormal));
   if (below != nullptr) {
     const Vec3d unit = normalizeOr(n, Vec3d{});
     if (gradient_detail::belowSurface(unit, point.normal, s.minCosine))
@@ -275,15 +282,15 @@ Vec3d unblendedLayerGradient(const LayerSource& source, const SurfacePoint& poin
 }
 
 Vec3d layerGradientNoting(const TangentNormalSource& source, const SurfacePoint& point,
-                          NormalBelowSurface* below) {
+                          NormalBelowSurface* below, const Vec3d* planesNormal) {
   if (below != nullptr) *below = {};
-  return evaluate(source, point, below);
+  return evaluate(source, point, below, planesNormal);
 }
 
 Vec3d layerGradientNoting(const ObjectNormalSource& source, const SurfacePoint& point,
-                          NormalBelowSurface* below) {
+                          NormalBelowSurface* below, const Vec3d* planesNormal) {
   if (below != nullptr) *below = {};
-  return evaluate(source, point, below);
+  return evaluate(source, point, below, planesNormal);
 }
 
 Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,

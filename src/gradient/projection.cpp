@@ -303,10 +303,15 @@ Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const Triplan
 
 Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options,
                      const SurfacePoint& point) {
-  const Vec3d position = options.coordinates.apply(point.position);
+  return projectedTexel(texture, options, point.position, point.seenNormal());
+}
+
+Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options, Vec3d position,
+                     Vec3d seenNormal) {
+  const Vec3d at = options.coordinates.apply(position);
   Vec3d blend{};
-  for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal()))
-    blend += p.weight * texture.sample(planarTextureCoordinates(position, p.mapping));
+  for (const WeightedPlane& p : triplanarPlanes(options, seenNormal))
+    blend += p.weight * texture.sample(planarTextureCoordinates(at, p.mapping));
   return blend;
 }
 

@@ -130,12 +130,14 @@ Vec3d unblendedLayerGradient(const LayerSource& source, const SurfacePoint& poin
 /// object-space normal within kMinObjectNormalCosine of the tangent plane or behind it).
 Vec3d layerGradientNoting(const LayerSource& source, const SurfacePoint& point,
                           NormalBelowSurface* below);
-/// @brief layerGradientNoting of a tangent-space normal map, without a LayerSource to hold it.
+/// @brief layerGradientNoting of a tangent-space normal map, without a LayerSource to hold it;
+/// a projected one's planes picked by @p planesNormal when given (else point.seenNormal()).
 Vec3d layerGradientNoting(const TangentNormalSource& source, const SurfacePoint& point,
-                          NormalBelowSurface* below);
-/// @brief layerGradientNoting of an object-space normal map, without a LayerSource to hold it.
+                          NormalBelowSurface* below, const Vec3d* planesNormal = nullptr);
+/// @brief layerGradientNoting of an object-space normal map, without a LayerSource to hold it
+/// (@p planesNormal as above).
 Vec3d layerGradientNoting(const ObjectNormalSource& source, const SurfacePoint& point,
-                          NormalBelowSurface* below);
+                          NormalBelowSurface* below, const Vec3d* planesNormal = nullptr);
 
 /// @brief Whether Cycles shades @p n as back-facing: a unit shading normal that points behind
 /// its triangle's unit geometric normal @p ng (custom normals, smooth normals of a folded mesh,

@@ -88,7 +88,7 @@ class WorldLayerEvaluator {
   /// taken relative to it.
   WorldGradient operator()(const TriplanarSource& s) const {
     SurfacePoint planes = object_;
-    planes.normal = normalizeOr(space_.normalToObject * world_.normal, object_.normal);
+    planes.normal = planesNormal();
     return projected(s, planes);
   }
 
@@ -103,11 +103,18 @@ class WorldLayerEvaluator {
   }
   /// A normal map's decoded object-space normal (Strength 1): N − Γ_o, or the decoded normal
   /// itself where it lies below the object's surface and Γ_o cannot stand for it.
+  /// A projected map's planes are picked by the world normal taken back to object space, as a
+  /// triplanar's (above); it decodes with the object's own normal and frames.
   template <class Source>
   Vec3d objectNormal(const Source& s) const {
     gradient_detail::NormalBelowSurface below;
-    const Vec3d gamma = gradient_detail::layerGradientNoting(s, object_, &below);
+    const Vec3d seen = object_.bump.behind ? -planesNormal() : planesNormal();
+    const Vec3d gamma = gradient_detail::layerGradientNoting(s, object_, &below, &seen);
     return below.found ? below.decoded : object_.normal - gamma;
+  }
+  /// The world normal Cycles shades with, taken back to object space (M^T n), unit.
+  Vec3d planesNormal() const {
+    return normalizeOr(space_.normalToObject * world_.normal, object_.normal);
   }
   /// The Γ of a normal map's object-space normal @p objectNormal, carried to world space as a
   /// normal (and that normal when the Γ cannot stand for it).

@@ -218,7 +218,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
                  "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
                  "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
-                 "box_nmap_sphere_object", "flat_nmap_sphere")
+                 "box_nmap_sphere_object", "flat_nmap_sphere",
+                 "box_nmap_stretch_sphere")
 
 
 def run_blender_script(blender, script, args):

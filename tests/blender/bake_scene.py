@@ -180,6 +180,8 @@ def projected_normal_map_case(name, mesh_case, size, space, strength, tilt_deg,
     tangent-normal or object-normal. Its image is normal_field in either space: as object-space
     normals they lean up to `tilt_deg` from +z."""
     normal_map_case(name, mesh_case, size, space, strength, tilt_deg)
+    if mesh_case in TRANSFORMS:
+        TRANSFORMS[name] = TRANSFORMS[mesh_case]
     PLANAR[name] = {"projection": projection, "blend": blend}
 
 
@@ -380,6 +382,9 @@ projected_normal_map_case("box_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3
                           0.3)
 # The same tangent-space map read with Flat projection (the image at the object's (x, y)).
 projected_normal_map_case("flat_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "FLAT")
+# On the sphere stretched (2, 1, 0.5) and turned, in world space.
+projected_normal_map_case("box_nmap_stretch_sphere", "stretch_sphere", 256, "TANGENT", 1.0, 40.0,
+                          "BOX", 0.3)
 
 
 def tilt_field(size, tilt_deg):

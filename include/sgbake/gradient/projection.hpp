@@ -275,6 +275,11 @@ TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNorma
 /// offset and coordinates.
 Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options,
                      const SurfacePoint& point);
+/// @brief projectedTexel at object position @p position (before @p options' coordinates),
+/// the planes picked by @p seenNormal (in world space Cycles picks them by the world normal
+/// taken back to object space, not by the object's interpolated one).
+Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options, Vec3d position,
+                     Vec3d seenNormal);
 
 /// @brief Γ of a height map by triplanar projection (seed 003; eq. 46-49 then eq. 30):
 /// ∇h = Σ_i w_i · planeVolumeGradient_i, Γ = ∇h − ⟨∇h, N⟩N.
