@@ -470,23 +470,17 @@ def _object_coordinates(tex, ob=None):
 
 
 def _object_projected(tex, ob=None):
-    """Whether Image Texture node `tex` reads object coordinates (_object_coordinates)."""
+    """Whether Image Texture node `tex` reads object coordinates (_object_coordinates): then a
+    layer takes its projection over, for a Bump or a Normal Map alike (Flat: a planar layer, Box:
+    a triplanar one; a normal map's colour decoded as the Normal Map node decodes it)."""
     return _object_coordinates(tex, ob) is not None
-
-
-def _projection_taken(node, tex, ob=None):
-    """Whether a layer takes over how Image Texture node `tex` feeding Bump or Normal Map node
-    `node` reads object coordinates: its Flat projection (a planar layer) or Box projection (a
-    triplanar one); a Normal Map's as Blender's projections of a normal kind, decoded as the
-    node decodes the colour the projection reads."""
-    return _object_projected(tex, ob)
 
 
 def _ignored(node, tex, inputs, socket, ob=None):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
     input other than a UV map (a Mapping node, object or generated coordinates; those of a
-    projection a layer takes, _projection_taken, are not named), a projection other than Flat
+    projection a layer takes, _object_projected, are not named), a projection other than Flat
     (but a Box one a layer takes), Closest interpolation (read bilinear), and node-driven `inputs` (of which
     the layer takes the unconnected value)."""
     notes = []
@@ -499,9 +493,9 @@ def _ignored(node, tex, inputs, socket, ob=None):
     if link is not None:
         uv = link.from_node.type == "UVMAP" or (link.from_node.type == "TEX_COORD"
                                                  and link.from_socket.name == "UV")
-        if not uv and not _projection_taken(node, tex, ob):
+        if not uv and not _object_projected(tex, ob):
             notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
-    if tex.projection != "FLAT" and not _projection_taken(node, tex, ob):
+    if tex.projection != "FLAT" and not _object_projected(tex, ob):
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
     for name in inputs:
         if node.inputs[name].is_linked:
@@ -590,7 +584,7 @@ def material_layers(node_tree, render_uv=None, ob=None):
             ignored += _ignored(node, tex, ("Strength",), "Color", ob)
             values = _texture_settings(tex, render_uv)
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
-            if _projection_taken(node, tex, ob):
+            if _object_projected(tex, ob):
                 # Box or Flat projection on object coordinates: the colour it reads, decoded by
                 # the node (tangent space: in the frames of the node's UV map, else the render
                 # UV map's).
