@@ -16,6 +16,7 @@
 
 #include <cmath>
 
+#include "gradient/triplanar_sum.hpp"
 #include "sgbake/core/math.hpp"
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/projection.hpp"
@@ -117,11 +118,10 @@ inline double unscaledHeightAt(const PlanarSource& s, const Vec3d& position, con
 }
 inline double unscaledHeightAt(const TriplanarSource& s, const Vec3d& position,
                                const Vec3d& seenNormal) {
-  const Vec3d mapped = s.options.coordinates.apply(position);
-  double h = 0;
-  for (const WeightedPlane& plane : triplanarPlanes(s.options, seenNormal))
-    h += plane.weight * s.height->sample(planarTextureCoordinates(mapped, plane.mapping)).value;
-  return h;
+  return sumOverPlanes<double>(s.options, position, seenNormal,
+                               [&](const PlanarMapping&, Vec2d st, double weight) {
+                                 return weight * s.height->sample(st).value;
+                               });
 }
 inline double heightScale(const VolumeSource& s) { return s.scale; }
 inline double heightScale(const PlanarSource& s) { return s.scale; }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gradient/triplanar_sum.hpp"
 #include "sgbake/core/math.hpp"
 
 namespace sgbake {
@@ -264,19 +265,16 @@ TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNorma
 
 namespace {
 
-/// Σ over the planes of triplanarPlanes at the point of plane(mapping, st, w · scale), st being
-/// the point's texture coordinates in that plane: the loop the three triplanar kinds share.
-/// Planes of weight 0 are not sampled at all.
+/// gradient_detail::sumOverPlanes at @p point of plane(mapping, st, w · scale): the loop the
+/// three triplanar kinds share.
 template <class PlaneTerm>
 Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
                     const PlaneTerm& plane) {
-  const Vec3d position = options.coordinates.apply(point.position);  // P', once for the planes
-  Vec3d sum{};
-  for (const WeightedPlane& p : triplanarPlanes(options, point.seenNormal())) {
-    sum +=
-        plane(p.mapping, planarTextureCoordinates(position, p.mapping), p.weight * options.scale);
-  }
-  return sum;
+  return gradient_detail::sumOverPlanes<Vec3d>(
+      options, point.position, point.seenNormal(),
+      [&](const PlanarMapping& mapping, Vec2d st, double weight) {
+        return plane(mapping, st, weight * options.scale);
+      });
 }
 
 }  // namespace
@@ -308,11 +306,9 @@ Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& optio
 
 Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options, Vec3d position,
                      Vec3d seenNormal) {
-  const Vec3d at = options.coordinates.apply(position);
-  Vec3d blend{};
-  for (const WeightedPlane& p : triplanarPlanes(options, seenNormal))
-    blend += p.weight * texture.sample(planarTextureCoordinates(at, p.mapping));
-  return blend;
+  return gradient_detail::sumOverPlanes<Vec3d>(
+      options, position, seenNormal,
+      [&](const PlanarMapping&, Vec2d st, double weight) { return weight * texture.sample(st); });
 }
 
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
