@@ -332,7 +332,7 @@ CoordinateMapping coordinateMapping(const SceneLayer& layer) {
   return node.after(CoordinateMapping::affine(*m.matrix, m.matrixTranslation));
 }
 
-/// A projected layer's options (the Box and Flat projections' too).
+/// A projected layer's options (those of Blender's projections too).
 TriplanarOptions triplanarOptions(const SceneLayer& layer) {
   TriplanarOptions options;
   options.tiling = layer.tiling;
@@ -347,7 +347,8 @@ TriplanarOptions triplanarOptions(const SceneLayer& layer) {
   return options;
 }
 
-/// A normal-map layer projected by one of Blender's projections (Box, Flat): what Cycles bakes,
+/// A normal-map layer projected by one of Blender's projections (Box, Flat, Sphere, Tube): what
+/// Cycles bakes,
 /// a Normal Map node (Strength = the layer's scale) decoding the colour an Image Texture's
 /// projection reads. The normal-map source with its texels read by that projection
 /// (TangentNormalSource::projection): Strength, guards and normals below the surface as a UV
@@ -448,9 +449,9 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       source.kind = layer.kind;
       source.height = scalar;
       source.normals = vector;
-      source.mapping.axis = layer.axis;
-      source.mapping.tiling = layer.tiling;
-      source.mapping.offset = layer.offset;
+      source.mapping = isSingleLookup(layer.projection)
+                           ? singleLookupMapping(layer.projection, layer.tiling, layer.offset)
+                           : PlanarMapping{layer.axis, layer.tiling, layer.offset};
       source.coordinates = coordinateMapping(layer);
       source.scale = layer.scale;
       source.normal = projected;

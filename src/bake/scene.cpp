@@ -103,7 +103,10 @@ constexpr Named<MappingType> kMappingTypes[] = {{"point", MappingType::kPoint},
                                                 {"texture", MappingType::kTexture},
                                                 {"vector", MappingType::kVector}};
 constexpr Named<TriplanarProjection> kPlanarProjections[] = {
-    {"axis", TriplanarProjection::kBlended}, {"flat", TriplanarProjection::kFlat}};
+    {"axis", TriplanarProjection::kBlended},
+    {"flat", TriplanarProjection::kFlat},
+    {"sphere", TriplanarProjection::kSphere},
+    {"tube", TriplanarProjection::kTube}};
 constexpr Named<ProjectionAxis> kAxes[] = {
     {"x", ProjectionAxis::kX}, {"y", ProjectionAxis::kY}, {"z", ProjectionAxis::kZ}};
 constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
@@ -1093,14 +1096,23 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   if (!(layer.boxBlend >= 0 && layer.boxBlend <= 1)) {
     return "box_blend must be a number from 0 to 1 (Blender's Blend)";
   }
-  if (layer.type == SceneLayerType::kPlanar && layer.projection == TriplanarProjection::kFlat &&
+  if (layer.type == SceneLayerType::kPlanar && isSingleLookup(layer.projection) &&
       layer.axis != ProjectionAxis::kZ) {
-    return "'projection': 'flat' reads the (x, y) plane, as Blender's Flat projection does: "
-           "'axis' must be z";
+    switch (layer.projection) {
+      case TriplanarProjection::kSphere:
+        return "'projection': 'sphere' wraps the image around the z axis, as Blender's Sphere "
+               "projection does: 'axis' must be z";
+      case TriplanarProjection::kTube:
+        return "'projection': 'tube' wraps the image around the z axis, as Blender's Tube "
+               "projection does: 'axis' must be z";
+      default:
+        return "'projection': 'flat' reads the (x, y) plane, as Blender's Flat projection does: "
+               "'axis' must be z";
+    }
   }
   if (layer.tangentUvSet && !layer.decodesInUvTangentFrames()) {
     return "key 'tangent_uv' applies only to tangent-space normal maps (normal layers, and "
-           "projected ones with 'projection': 'box' or 'flat')";
+           "projected ones with 'projection': 'box', 'flat', 'sphere' or 'tube')";
   }
   if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
     return "step must be a finite number > 0";
@@ -1279,7 +1291,7 @@ bool SceneLayer::decodesInUvTangentFrames() const {
 
 bool SceneLayer::projectedByBlender() const {
   return (type == SceneLayerType::kTriplanar && projection == TriplanarProjection::kBox) ||
-         (type == SceneLayerType::kPlanar && projection == TriplanarProjection::kFlat);
+         (type == SceneLayerType::kPlanar && isSingleLookup(projection));
 }
 
 bool SceneLayer::hasHeight() const {
@@ -1489,7 +1501,8 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     case SceneLayerType::kPlanar:
       j["kind"] = nameIn(kKinds, layer.kind);
       j["axis"] = nameIn(kAxes, layer.axis);
-      if (layer.projection == TriplanarProjection::kFlat) j["projection"] = "flat";
+      if (layer.projection != TriplanarProjection::kBlended)
+        j["projection"] = nameIn(kPlanarProjections, layer.projection);
       break;
     case SceneLayerType::kTriplanar:
       j["kind"] = nameIn(kKinds, layer.kind);

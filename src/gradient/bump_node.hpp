@@ -119,7 +119,7 @@ inline double unscaledHeightAt(const PlanarSource& s, const Vec3d& position, con
 inline double unscaledHeightAt(const TriplanarSource& s, const Vec3d& position,
                                const Vec3d& seenNormal) {
   return sumOverPlanes<double>(s.options, position, seenNormal,
-                               [&](const PlanarMapping&, Vec2d st, double weight) {
+                               [&](const PlanarMapping&, Vec3d, Vec2d st, double weight) {
                                  return weight * s.height->sample(st).value;
                                });
 }

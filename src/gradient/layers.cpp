@@ -207,7 +207,7 @@ class LayerChecker {
   static std::string projectedRead(const std::optional<TriplanarOptions>& options) {
     if (!options) return {};
     if (options->projection == TriplanarProjection::kBlended)
-      return "its projected read must be Blender's Box or Flat projection";
+      return "its projected read must be one of Blender's projections (Box, Flat, Sphere, Tube)";
     return first({finite(options->tiling, "tiling"), finite(options->offset, "offset"),
                   finite(options->boxBlend, "Box blend")});
   }

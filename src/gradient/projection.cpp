@@ -90,9 +90,53 @@ PlaneIndices planeIndices(const PlanarMapping& mapping) {
   return (mapping.layout == PlaneLayout::kBox ? kBox : kCyclic)[index(mapping.axis)];
 }
 
+/// Cycles' remap of the [0, 1] box to [−1, 1] before its Sphere and Tube projections.
+Vec3d remapSquare(Vec3d mapped) { return 2.0 * (mapped - Vec3d{0.5, 0.5, 0.5}); }
+
+/// u of the Sphere and Tube projections: the angle about z from −y, as a fraction of a turn.
+double wrappedU(Vec3d c) { return 0.5 - std::atan2(c.x, c.y) / (2 * kPi); }
+
 }  // namespace
 
+Vec2d sphereCoordinates(Vec3d mapped) {
+  const Vec3d c = remapSquare(mapped);
+  const double r = length(c);
+  if (!(r > 0)) return {0, 0};
+  const double u = c.x == 0 && c.y == 0 ? 0.0 : wrappedU(c);
+  return {u, 1 - std::acos(std::clamp(c.z / r, -1.0, 1.0)) / kPi};
+}
+
+Vec2d tubeCoordinates(Vec3d mapped) {
+  const Vec3d c = remapSquare(mapped);
+  if (c.x == 0 && c.y == 0) return {0, 0};
+  return {wrappedU(c), 0.5 * (c.z + 1)};
+}
+
+CoordinateGradients wrappedCoordinateGradients(Vec3d mapped, PlaneLayout layout) {
+  // d/dP' = 2 d/dc. u = ½ − atan2(x, y)/2π: ∇_c u = (−y, x, 0) / (2π ρ²), ρ² = x² + y².
+  const Vec3d c = remapSquare(mapped);
+  const double rho2 = c.x * c.x + c.y * c.y;
+  CoordinateGradients g;
+  if (layout == PlaneLayout::kTube) g.t = {0, 0, 1};  // v = (z + 1)/2
+  if (!(rho2 > 0) || !std::isfinite(rho2)) return g;
+  g.s = (1 / (kPi * rho2)) * Vec3d{-c.y, c.x, 0};
+  if (layout == PlaneLayout::kSphere) {
+    // v = 1 − acos(z / r)/π: ∇_c v = (−x z / ρ, −y z / ρ, ρ) / (π r²).
+    const double rho = std::sqrt(rho2), r2 = rho2 + c.z * c.z;
+    g.t = (2 / (kPi * r2)) * Vec3d{-c.x * c.z / rho, -c.y * c.z / rho, rho};
+  }
+  return g;
+}
+
+PlanarMapping singleLookupMapping(TriplanarProjection projection, Vec2d tiling, Vec2d offset) {
+  PlanarMapping mapping{ProjectionAxis::kZ, tiling, offset};
+  if (projection == TriplanarProjection::kSphere) mapping.layout = PlaneLayout::kSphere;
+  if (projection == TriplanarProjection::kTube) mapping.layout = PlaneLayout::kTube;
+  return mapping;
+}
+
 PlaneAxes planeAxes(const PlanarMapping& mapping) {
+  if (isWrapped(mapping.layout)) return {};
   const PlaneIndices i = planeIndices(mapping);
   PlaneAxes a;
   a.s[i.s] = mapping.mirrored ? -1 : 1;
@@ -106,6 +150,8 @@ Vec2d planeCoordinates(Vec3d position, ProjectionAxis axis) {
 }
 
 Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping) {
+  if (mapping.layout == PlaneLayout::kSphere) return sphereCoordinates(position);
+  if (mapping.layout == PlaneLayout::kTube) return tubeCoordinates(position);
   // A mirrored plane's first coordinate is 1 − s (Cycles' Box), not −s.
   const PlaneIndices i = planeIndices(mapping);
   const double s = position[i.s];
@@ -116,7 +162,15 @@ Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping) {
   return textureCoordinates(planeCoordinates(position, mapping), mapping.tiling, mapping.offset);
 }
 
+Vec3d projectedVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, Vec3d mapped,
+                              double scale) {
+  if (!isWrapped(mapping.layout)) return planeVolumeGradient(dhdst, mapping, scale);
+  const CoordinateGradients g = wrappedCoordinateGradients(mapped, mapping.layout);
+  return scale * (mapping.tiling.x * dhdst.x * g.s + mapping.tiling.y * dhdst.y * g.t);
+}
+
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale) {
+  if (isWrapped(mapping.layout)) return {};  // no fixed axes: projectedVolumeGradient
   const PlaneIndices i = planeIndices(mapping);
   Vec3d g{};
   const double alongS = scale * mapping.tiling.x * dhdst.x;
@@ -127,21 +181,22 @@ Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scal
 
 Vec3d planarHeightGradient(const ScalarTexture& texture, const PlanarMapping& mapping, double scale,
                            const SurfacePoint& point, const CoordinateMapping& coordinates) {
-  const ScalarSample h =
-      texture.sample(planarTextureCoordinates(coordinates.apply(point.position), mapping));
+  const Vec3d mapped = coordinates.apply(point.position);
+  const ScalarSample h = texture.sample(planarTextureCoordinates(mapped, mapping));
   return finiteOrZero(projectOntoTangentPlaneAlong(
-      coordinates.pullBack(planeVolumeGradient(h.gradient, mapping, scale)), point.normal,
-      point.geometricNormal));
+      coordinates.pullBack(projectedVolumeGradient(h.gradient, mapping, mapped, scale)),
+      point.normal, point.geometricNormal));
 }
 
 Vec3d planarTangentNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
                                   double strength, const SurfacePoint& point,
                                   const ProjectedNormalOptions& options,
                                   const CoordinateMapping& coordinates) {
-  const Vec2d slopes = planeSlopes(
-      texture, planarTextureCoordinates(coordinates.apply(point.position), mapping), options);
+  const Vec3d mapped = coordinates.apply(point.position);
+  const Vec2d slopes = planeSlopes(texture, planarTextureCoordinates(mapped, mapping), options);
   return finiteOrZero(projectOntoTangentPlane(
-      coordinates.pullBack(planeVolumeGradient(slopes, mapping, strength)), point.normal));
+      coordinates.pullBack(projectedVolumeGradient(slopes, mapping, mapped, strength)),
+      point.normal));
 }
 
 Vec3d planarObjectNormalGradient(const VectorTexture& texture, const PlanarMapping& mapping,
@@ -241,8 +296,9 @@ TriplanarWeights boxProjectionWeights(Vec3d normal, double blend) {
 
 TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNormal) {
   TriplanarPlanes planes;
-  if (options.projection == TriplanarProjection::kFlat) {
-    planes.plane[0] = {{ProjectionAxis::kZ, options.tiling, options.offset}, 1.0};
+  if (isSingleLookup(options.projection)) {
+    planes.plane[0] = {singleLookupMapping(options.projection, options.tiling, options.offset),
+                       1.0};
     planes.count = 1;
     return planes;
   }
@@ -265,15 +321,15 @@ TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNorma
 
 namespace {
 
-/// gradient_detail::sumOverPlanes at @p point of plane(mapping, st, w · scale): the loop the
-/// three triplanar kinds share.
+/// gradient_detail::sumOverPlanes at @p point of plane(mapping, P', st, w · scale): the loop
+/// the three triplanar kinds share.
 template <class PlaneTerm>
 Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
                     const PlaneTerm& plane) {
   return gradient_detail::sumOverPlanes<Vec3d>(
       options, point.position, point.seenNormal(),
-      [&](const PlanarMapping& mapping, Vec2d st, double weight) {
-        return plane(mapping, st, weight * options.scale);
+      [&](const PlanarMapping& mapping, Vec3d mapped, Vec2d st, double weight) {
+        return plane(mapping, mapped, st, weight * options.scale);
       });
 }
 
@@ -282,8 +338,9 @@ Vec3d sumOverPlanes(const TriplanarOptions& options, const SurfacePoint& point,
 Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptions& options,
                               const SurfacePoint& point) {
   const Vec3d volumeGradient = sumOverPlanes(
-      options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
-        return planeVolumeGradient(texture.sample(st).gradient, mapping, weightedScale);
+      options, point,
+      [&](const PlanarMapping& mapping, Vec3d mapped, Vec2d st, double weightedScale) {
+        return projectedVolumeGradient(texture.sample(st).gradient, mapping, mapped, weightedScale);
       });
   return finiteOrZero(projectOntoTangentPlaneAlong(options.coordinates.pullBack(volumeGradient),
                                                    point.normal, point.geometricNormal));
@@ -292,8 +349,10 @@ Vec3d triplanarHeightGradient(const ScalarTexture& texture, const TriplanarOptio
 Vec3d triplanarTangentNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
                                      const SurfacePoint& point) {
   const Vec3d volumeGradient = sumOverPlanes(
-      options, point, [&](const PlanarMapping& mapping, Vec2d st, double weightedScale) {
-        return planeVolumeGradient(planeSlopes(texture, st, options.normal), mapping, weightedScale);
+      options, point,
+      [&](const PlanarMapping& mapping, Vec3d mapped, Vec2d st, double weightedScale) {
+        return projectedVolumeGradient(planeSlopes(texture, st, options.normal), mapping, mapped,
+                                       weightedScale);
       });
   return finiteOrZero(
       projectOntoTangentPlane(options.coordinates.pullBack(volumeGradient), point.normal));
@@ -307,8 +366,9 @@ Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& optio
 Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options, Vec3d position,
                      Vec3d seenNormal) {
   return gradient_detail::sumOverPlanes<Vec3d>(
-      options, position, seenNormal,
-      [&](const PlanarMapping&, Vec2d st, double weight) { return weight * texture.sample(st); });
+      options, position, seenNormal, [&](const PlanarMapping&, Vec3d, Vec2d st, double weight) {
+        return weight * texture.sample(st);
+      });
 }
 
 Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const TriplanarOptions& options,
@@ -320,7 +380,7 @@ Vec3d triplanarObjectNormalGradient(const VectorTexture& texture, const Triplana
                         gradientFromObjectNormal(blend, point.normal, options.normal.minCosine));
   }
   return finiteOrZero(sumOverPlanes(
-      options, point, [&](const PlanarMapping&, Vec2d st, double weightedScale) {
+      options, point, [&](const PlanarMapping&, Vec3d, Vec2d st, double weightedScale) {
         const Vec3d n = decodeNormalTexel(texture.sample(st));
         return weightedScale * gradientFromObjectNormal(n, point.normal, options.normal.minCosine);
       }));

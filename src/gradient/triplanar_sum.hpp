@@ -7,16 +7,16 @@
 
 namespace sgbake::gradient_detail {
 
-/// @brief Σ over triplanarPlanes(options, seenNormal) of term(mapping, st, weight), st being the
-/// texture coordinates in that plane of object position @p position (options.coordinates
-/// applied once for all planes). Planes of weight 0 are not sampled at all.
+/// @brief Σ over triplanarPlanes(options, seenNormal) of term(mapping, P', st, weight), st being
+/// the texture coordinates in that plane of P', object position @p position moved by
+/// options.coordinates (once for all planes). Planes of weight 0 are not sampled at all.
 template <class T, class Term>
 T sumOverPlanes(const TriplanarOptions& options, Vec3d position, Vec3d seenNormal,
                 const Term& term) {
   const Vec3d mapped = options.coordinates.apply(position);
   T sum{};
   for (const WeightedPlane& p : triplanarPlanes(options, seenNormal))
-    sum += term(p.mapping, planarTextureCoordinates(mapped, p.mapping), p.weight);
+    sum += term(p.mapping, mapped, planarTextureCoordinates(mapped, p.mapping), p.weight);
   return sum;
 }
 

@@ -542,7 +542,8 @@ TEST(Scene, InvalidCombinations) {
   EXPECT_EQ(parseError(withLayer(
                 R"({"type": "normal", "image": "n.png", "space": "object", "tangent_uv": 1})")),
             "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps "
-            "(normal layers, and projected ones with 'projection': 'box' or 'flat')");
+            "(normal layers, and projected ones with 'projection': 'box', 'flat', 'sphere' or "
+            "'tube')");
   EXPECT_EQ(parseError(withLayer(R"({"type": "normal", "image": "n.png", "base": "above"})")),
             "scene.json: layers[0]: key 'base' does not apply to a normal layer (it is for "
             "height, volume, planar or triplanar layers)");
@@ -703,7 +704,8 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
     EXPECT_EQ(parseError(withLayer(std::string(R"({"type": "triplanar", "image": "n.png", )") +
                                    kind + R"(, "tangent_uv": 1})")),
               "scene.json: layers[0]: key 'tangent_uv' applies only to tangent-space normal maps "
-              "(normal layers, and projected ones with 'projection': 'box' or 'flat')")
+              "(normal layers, and projected ones with 'projection': 'box', 'flat', 'sphere' or "
+              "'tube')")
         << kind;
   }
   EXPECT_EQ(
@@ -716,7 +718,8 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
   // A planar layer's projections: along its axis (sgbake's), or Blender's Flat, whose normal
   // kinds decode as a Normal Map node does (a tangent-space one in a UV set's frames).
   EXPECT_EQ(parseError(withLayer(R"({"type": "planar", "image": "h.png", "projection": "box"})")),
-            "scene.json: layers[0]: unknown projection 'box' (expected axis or flat)");
+            "scene.json: layers[0]: unknown projection 'box' (expected axis, flat, sphere or "
+            "tube)");
   Result<Scene> flat = parseScene(withLayer(R"({"type": "planar", "image": "n.png",
                     "projection": "flat", "kind": "tangent-normal", "tangent_uv": 1})"),
                                   options());
@@ -734,6 +737,24 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
                 R"({"type": "planar", "image": "h.png", "projection": "flat", "axis": "x"})")),
             "scene.json: layers[0]: 'projection': 'flat' reads the (x, y) plane, as Blender's "
             "Flat projection does: 'axis' must be z");
+  // Blender's Sphere and Tube: a planar layer's single lookups wrapped around z.
+  for (const auto& [name, projection] : {std::pair{"sphere", TriplanarProjection::kSphere},
+                                         std::pair{"tube", TriplanarProjection::kTube}}) {
+    Result<Scene> wrapped = parseScene(
+        withLayer(std::string(R"({"type": "planar", "image": "h.png", "projection": ")") + name +
+                  R"("})"),
+        options());
+    ASSERT_TRUE(wrapped) << wrapped.error().message;
+    EXPECT_EQ(wrapped->layers[0].projection, projection);
+    EXPECT_TRUE(wrapped->layers[0].projectedByBlender());
+    EXPECT_NE(layerParametersJson(wrapped->layers[0])
+                  .find(std::string(R"("projection":")") + name + "\""),
+              std::string::npos);
+  }
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "planar", "image": "h.png", "projection": "tube", "axis": "y"})")),
+            "scene.json: layers[0]: 'projection': 'tube' wraps the image around the z axis, as "
+            "Blender's Tube projection does: 'axis' must be z");
 }
 
 TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
@@ -1109,7 +1130,7 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message,
             "layers[0]: key 'tangent_uv' applies only to tangent-space normal maps (normal "
-            "layers, and projected ones with 'projection': 'box' or 'flat')");
+            "layers, and projected ones with 'projection': 'box', 'flat', 'sphere' or 'tube')");
   scene.layers[0].kind = ProjectedKind::kTangentNormal;
   EXPECT_TRUE(validateScene(scene));
 }

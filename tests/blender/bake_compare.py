@@ -20,6 +20,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                        (a negative control)
   ours_bake_unmapped.exr  a mapped case's bump-node bake without its "mapping" (a negative
                      control)
+  ours_bake_swapped.exr, ours_nmap_swapped.exr  a Sphere- or Tube-projection case's bake
+                     with the other wrap (a negative control)
   ours_mask.exr      `sgbake bake --map mask`
   ours_nmap_tangent.exr, ours_nmap_object.exr   a normal-map case's scene (normal layer,
                      tangent- and object-normal outputs), against Blender's tangent and
@@ -118,6 +120,7 @@ def compare_case(entry):
                       ("bake_bump_node", "ours_bake_bump_node.exr"),
                       ("bake_blended", "ours_bake_blended.exr"),
                       ("bake_unmapped", "ours_bake_unmapped.exr"),
+                      ("bake_swapped", "ours_bake_swapped.exr"),
                       ("bake_full_strength", "ours_bake_full_strength.exr"),
                       ("bake_object_space", "ours_bake_object_space.exr")):
         img = load_if(os.path.join(d, name))
@@ -141,6 +144,7 @@ def compare_case(entry):
                              ("nmap_flags", "ours_nmap_flags.exr", "tangent"),
                              ("nmap_weak", "ours_nmap_weak.exr", "tangent"),
                              ("nmap_uv", "ours_nmap_uv.exr", "tangent"),
+                             ("nmap_swapped", "ours_nmap_swapped.exr", "tangent"),
                              ("nmap_sum", "ours_nmap_sum.exr", "tangent"),
                              ("nmap_bump_node", "ours_nmap_bump_node.exr", "tangent"),
                              ("nmap_object_space", "ours_nmap_object_space.exr", "tangent")):

@@ -63,7 +63,11 @@ blend (seed 003), must fail both (b) and (e). box_mapped_sphere puts a Mapping n
 turned, unevenly scaled) between the coordinates and the texture, the layer's "mapping"; its
 control ours_bake_unmapped.exr, the layer without it, must fail them too. box_strength_sphere
 gives the Bump node a Strength of 0.4 (the layer's "strength"); its control
-ours_bake_full_strength.exr, at Strength 1, must fail them too.
+ours_bake_full_strength.exr, at Strength 1, must fail them too. sphere_wrap_sphere and
+tube_wrap_sphere read the height by Blender's Sphere and Tube projections (after a Mapping node
+that centres and turns them), a "planar" layer with "projection": "sphere" or "tube"; their
+control ours_bake_swapped.exr, the other wrap, must fail them too, as must ours_nmap_swapped.exr
+for the normal maps those projections read (sphere_nmap_sphere, tube_nmap_sphere_object).
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -219,7 +223,14 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
                  "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
                  "box_nmap_sphere_object", "flat_nmap_sphere",
-                 "box_nmap_stretch_sphere")
+                 "box_nmap_stretch_sphere", "sphere_wrap_sphere", "tube_wrap_sphere",
+                 "sphere_nmap_sphere", "tube_nmap_sphere_object")
+# Blender's Sphere and Tube projections: their own wrap is the control of each other's
+# (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
+# Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
+# and 0.12 deg); normal maps median 0.0014-0.0017, p99 <= 0.0020 deg; the other wrap 3.3 deg
+# (heights), 6.6-19.9 deg (normal maps).
+SWAPPED_WRAP = {"sphere": "tube", "tube": "sphere"}
 
 
 def run_blender_script(blender, script, args):
@@ -281,11 +292,14 @@ def sgbake_case(cli, entry, sabotage, threads):
     bake_scale = scale * (1.5 if sabotage == "scale" else 1.0)
     green = "directx" if sabotage == "green" else "opengl"
     if "planar" in entry:  # the height projected at positions: no flags for it, scenes only
-        box = entry["planar"]["projection"] == "box"
+        projection = entry["planar"]["projection"]
+        box = projection == "box"
         bakes = [("ours_bake", bake_scale, "analytic"), ("ours_bake_x2", 2 * scale, "analytic"),
                  ("ours_bake_bump_node", bake_scale, "bump-node")]
         if box:
             bakes.append(("ours_bake_blended", bake_scale, "bump-node"))
+        if projection in SWAPPED_WRAP:
+            bakes.append(("ours_bake_swapped", bake_scale, "bump-node"))
         if "mapping" in entry["planar"]:
             bakes.append(("ours_bake_unmapped", bake_scale, "bump-node"))
         strength = entry["planar"].get("strength", 1.0)
@@ -298,6 +312,9 @@ def sgbake_case(cli, entry, sabotage, threads):
                 layer["mapping"] = entry["planar"]["mapping"]
             if strength != 1.0 and name != "ours_bake_full_strength":
                 layer["strength"] = strength
+            if projection in SWAPPED_WRAP:  # Blender's Sphere and Tube; the control: swapped
+                layer["projection"] = (SWAPPED_WRAP[projection] if name == "ours_bake_swapped"
+                                       else projection)
             if box:  # Blender's Box projection; the control: sgbake's own triplanar blend
                 del layer["axis"]
                 layer["type"] = "triplanar"
@@ -368,10 +385,11 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     map_green = "directx" if sabotage == "normal-green" else "opengl"
     green = "directx" if sabotage == "green" else "opengl"
 
-    projected = "planar" in entry  # read by Blender's Box or Flat projection, not the UV map
+    projected = "planar" in entry  # read by one of Blender's projections, not the UV map
 
     def scene_file(name, layer_strength, outputs, base="above", transform=True,
-                   gradient="analytic", through_uvs=False):
+                   gradient="analytic", through_uvs=False, projection=None):
+        projection = projection or (entry["planar"]["projection"] if projected else None)
         layer = {"type": "normal", "image": p("normal.exr"), "space": nmap["space"],
                  "strength": layer_strength, "filter": "bilinear", "uv": 0, "weight": 1.0}
         if projected and not through_uvs:
@@ -379,9 +397,11 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
                      "kind": f"{nmap['space']}-normal", "scale": layer_strength,
                      "projection": "box", "box_blend": entry["planar"]["blend"],
                      "filter": "bilinear", "weight": 1.0}
-            if entry["planar"]["projection"] == "flat":
+            if entry["planar"]["projection"] != "box":  # Flat, Sphere, Tube: single lookups
                 del layer["box_blend"]
-                layer.update(type="planar", projection="flat")
+                layer.update(type="planar", projection=projection)
+            if "mapping" in entry["planar"]:
+                layer["mapping"] = entry["planar"]["mapping"]
         if nmap["space"] == "tangent":
             layer["green"] = map_green
         layers = [layer]
@@ -411,6 +431,11 @@ def sgbake_nmap_case(cli, entry, sabotage, threads):
     if projected and not run_sgbake(  # the control: the same map read through the UV map
             cli, scene_file("scene_uv.json", strength, [("tangent-normal", "ours_nmap_uv.exr")],
                             through_uvs=True), log):
+        failed.append(log[-1])
+    if projected and entry["planar"]["projection"] in SWAPPED_WRAP and not run_sgbake(
+            cli, scene_file("scene_swapped.json", strength,  # the control: the other wrap
+                            [("tangent-normal", "ours_nmap_swapped.exr")],
+                            projection=SWAPPED_WRAP[entry["planar"]["projection"]]), log):
         failed.append(log[-1])
     if transformed(entry) and not run_sgbake(
             cli, scene_file("scene_object_space.json", strength,
@@ -486,7 +511,8 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
     print(f"case {name}: {r['size'][1]}x{r['size'][0]}, {nmap['space']}-space normal map "
           f"(tilts up to {nmap['tilt_deg']:g} deg), Strength {nmap['strength']:g}"
           + ((f", read by the Box projection with Blend {nmap['box']:g}"
-              if nmap["projection"] == "box" else ", read by the Flat projection")
+              if nmap["projection"] == "box"
+              else f", read by the {nmap['projection'].title()} projection")
              if "projection" in nmap else "")
           + (f", then a Bump node of Distance {nmap['bump']:g} on its output" if chain else "")
           + f", {r['covered']} covered texels, {r['compared']} compared; Blender's tangent bake "
@@ -537,6 +563,9 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
     if "projection" in nmap:
         negative_control(name, r, "nmap_uv", "read through the UV map:  ",
                          "the bake of the map read through the UV map", chain, fails, stretched)
+    if nmap.get("projection") in SWAPPED_WRAP:
+        negative_control(name, r, "nmap_swapped", "the other wrap:           ",
+                         "the bake of the map read by the other wrap", chain, fails, stretched)
     elif nmap["strength"] == 1.0 and not chain:
         s = r.get("nmap_flags")
         same = s.get("json_vs_flags_max_abs") if s else None
@@ -637,6 +666,8 @@ def evaluate(name, r, planar=False):
     for key, label, what in (("bake_blended", "sgbake's blend:   ",
                               "sgbake's own triplanar blend instead of Blender's Box"),
                              ("bake_unmapped", "without Mapping:  ", "its Mapping node left out"),
+                             ("bake_swapped", "the other wrap:   ",
+                              "the Sphere and Tube projections swapped"),
                              ("bake_full_strength", "Strength 1:       ",
                               "the Bump's Strength left out")):
         if key not in r:

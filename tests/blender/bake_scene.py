@@ -146,7 +146,8 @@ def transformed_case(name, of_case, location, rotation, scale, size=None):
 # height through Texture Coordinate Object into an Image Texture, not through a UV map (a height
 # read at a position). {"projection": "FLAT"}: the image at the object's (x, y), sgbake's
 # "planar" height layer on axis z. {"projection": "BOX", "blend": b}: Blender's Box projection
-# with Blend b, sgbake's "triplanar" layer with "projection": "box".
+# with Blend b, sgbake's "triplanar" layer with "projection": "box". "SPHERE", "TUBE": the image
+# wrapped around z, sgbake's "planar" layer with "projection": "sphere" or "tube".
 PLANAR = {}
 
 
@@ -173,16 +174,20 @@ def planar_case(name, mesh_case, size, scale, projection="FLAT", blend=0.0, mapp
 
 
 def projected_normal_map_case(name, mesh_case, size, space, strength, tilt_deg,
-                              projection="BOX", blend=0.0):
+                              projection="BOX", blend=0.0, mapping=None):
     """Registers case `name`: normal_map_case's, its Image Texture read with `projection`
-    (Box with Blend `blend`: sgbake's triplanar layer with "projection": "box"; Flat: its planar
-    layer with "projection": "flat") on the object's coordinates instead of its UV map, of kind
-    tangent-normal or object-normal. Its image is normal_field in either space: as object-space
-    normals they lean up to `tilt_deg` from +z."""
+    (Box with Blend `blend`: sgbake's triplanar layer with "projection": "box"; Flat, Sphere,
+    Tube: its planar layer with that "projection") on the object's coordinates instead of its UV
+    map, moved first by a Mapping node (Point) when `mapping` = (location, rotation, scale), of
+    kind tangent-normal or object-normal. Its image is normal_field in either space: as
+    object-space normals they lean up to `tilt_deg` from +z."""
     normal_map_case(name, mesh_case, size, space, strength, tilt_deg)
     if mesh_case in TRANSFORMS:
         TRANSFORMS[name] = TRANSFORMS[mesh_case]
     PLANAR[name] = {"projection": projection, "blend": blend}
+    if mapping is not None:
+        PLANAR[name]["mapping"] = {"location": list(mapping[0]), "rotation": list(mapping[1]),
+                                   "scale": list(mapping[2])}
 
 
 def apply_subdivision(ob, levels):
@@ -385,6 +390,16 @@ projected_normal_map_case("flat_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.
 # On the sphere stretched (2, 1, 0.5) and turned, in world space.
 projected_normal_map_case("box_nmap_stretch_sphere", "stretch_sphere", 256, "TANGENT", 1.0, 40.0,
                           "BOX", 0.3)
+# Blender's Sphere and Tube projections, which wrap the image around z of 2 (P' - 0.5): a Mapping
+# node (scale 0.5, location 0.5) centres them on the sphere, turned so that their axis, where u
+# has no derivative, crosses the mesh away from its own poles. Heights and normal maps.
+WRAP_MAPPING = ((0.5, 0.5, 0.5), (0.5, 0.3, 0.0), (0.5, 0.5, 0.5))
+planar_case("sphere_wrap_sphere", "sphere", 256, 0.02, "SPHERE", mapping=WRAP_MAPPING)
+planar_case("tube_wrap_sphere", "sphere", 256, 0.02, "TUBE", mapping=WRAP_MAPPING)
+projected_normal_map_case("sphere_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "SPHERE",
+                          mapping=WRAP_MAPPING)
+projected_normal_map_case("tube_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "TUBE",
+                          mapping=WRAP_MAPPING)
 
 
 def tilt_field(size, tilt_deg):

@@ -505,6 +505,15 @@ TEST(Layers, AProjectedNormalMapDecodesTheColourReadAsAUvTexel) {
     const Vec3d at = flat.coordinates.apply(q.position);
     EXPECT_EQ(projectedTexel(wavy, flat, q),
               wavy.sample(Vec2d{flat.tiling.x * at.x, flat.tiling.y * at.y} + flat.offset));
+    // Its Sphere and Tube projections wrap the image around z, whatever the normal too.
+    TriplanarOptions sphere = flat, tube = flat;
+    sphere.projection = TriplanarProjection::kSphere;
+    tube.projection = TriplanarProjection::kTube;
+    const Vec2d su = sphereCoordinates(at), tu = tubeCoordinates(at);
+    EXPECT_EQ(projectedTexel(wavy, sphere, q),
+              wavy.sample(Vec2d{flat.tiling.x * su.x, flat.tiling.y * su.y} + flat.offset));
+    EXPECT_EQ(projectedTexel(wavy, tube, q),
+              wavy.sample(Vec2d{flat.tiling.x * tu.x, flat.tiling.y * tu.y} + flat.offset));
   }
   TangentNormalSource blendedRead{&wavy, 0, {}};
   blendedRead.projection = box;
@@ -512,8 +521,8 @@ TEST(Layers, AProjectedNormalMapDecodesTheColourReadAsAUvTexel) {
   const Status status = validateLayers(std::vector<Layer>{{blendedRead, 1.0, {}}}, 2);
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().message,
-            "layer 0 (tangent-space normal map): its projected read must be Blender's Box or Flat "
-            "projection");
+            "layer 0 (tangent-space normal map): its projected read must be one of Blender's "
+            "projections (Box, Flat, Sphere, Tube)");
 }
 
 TEST(Layers, NoNanForExtremeParameters) {

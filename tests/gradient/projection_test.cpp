@@ -656,5 +656,134 @@ TEST(CoordinateMapping, SlopesAreThoseOfTheMappedCoordinates) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Blender's Sphere and Tube projections
+
+/// P' whose Cycles remap 2 · (P' − ½) is @p c.
+Vec3d mappedOf(Vec3d c) { return 0.5 * c + Vec3d{0.5, 0.5, 0.5}; }
+
+// u turns about z from the seam at −y (0) through +x (¼), +y (½), −x (¾); the Sphere's v is the
+// latitude from the south pole (0) to the north (1), the Tube's the height from c_z = −1 to 1.
+// On the z axis and at the centre they are what Cycles returns there.
+TEST(WrappedProjection, CoordinatesAtHandComputedPoints) {
+  struct Case {
+    Vec3d c;
+    Vec2d sphere, tube;
+  };
+  const Case cases[] = {
+      {{1, 0, 0}, {0.25, 0.5}, {0.25, 0.5}},
+      {{0, 2, 0}, {0.5, 0.5}, {0.5, 0.5}},
+      {{-1, 0, 0}, {0.75, 0.5}, {0.75, 0.5}},
+      {{0, -1, 0}, {0.0, 0.5}, {0.0, 0.5}},  // atan2(+0, −1) = π: the seam's u = 0 side
+      {{1, 0, 1}, {0.25, 0.75}, {0.25, 1.0}},
+      {{0, 1, -std::sqrt(3.0)}, {0.5, 1.0 / 6.0}, {0.5, 0.5 * (1 - std::sqrt(3.0))}},
+      {{0, 0, 1}, {0.0, 1.0}, {0.0, 0.0}},  // the axis: u = 0; the Tube gives (0, 0)
+      {{0, 0, -0.5}, {0.0, 0.0}, {0.0, 0.0}},
+      {{0, 0, 0}, {0.0, 0.0}, {0.0, 0.0}},  // the centre
+  };
+  for (const Case& k : cases) {
+    EXPECT_LT(maxAbsDiff(sphereCoordinates(mappedOf(k.c)), k.sphere), 1e-15) << k.c.x << k.c.y;
+    EXPECT_LT(maxAbsDiff(tubeCoordinates(mappedOf(k.c)), k.tube), 1e-15) << k.c.x << k.c.y;
+  }
+  // Just past the seam, on the −x side, u is just below 1.
+  EXPECT_NEAR(sphereCoordinates(mappedOf({-1e-9, -1, 0})).x, 1.0, 1e-9);
+  // The single lookups: Flat is the Z plane, Sphere and Tube these.
+  const Vec3d p{0.3, 0.9, -0.2};
+  EXPECT_EQ(planarTextureCoordinates(p, singleLookupMapping(TriplanarProjection::kFlat)),
+            (Vec2d{0.3, 0.9}));
+  EXPECT_EQ(planarTextureCoordinates(p, singleLookupMapping(TriplanarProjection::kSphere)),
+            sphereCoordinates(p));
+  EXPECT_EQ(planarTextureCoordinates(
+                p, singleLookupMapping(TriplanarProjection::kTube, {2, 3}, {0.5, 0.25})),
+            (Vec2d{2 * tubeCoordinates(p).x + 0.5, 3 * tubeCoordinates(p).y + 0.25}));
+}
+
+TEST(WrappedProjection, CoordinateGradientsAreTheDerivatives) {
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  int tested = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Vec3d x{u(rng), u(rng), u(rng)};
+    const Vec3d c = 2.0 * (x - Vec3d{0.5, 0.5, 0.5});
+    const double su = sphereCoordinates(x).x;
+    // Away from the axis, where u is not differentiable, and from the seam, where it jumps.
+    if (c.x * c.x + c.y * c.y < 0.01 || su < 0.01 || su > 0.99) continue;
+    ++tested;
+    for (const PlaneLayout layout : {PlaneLayout::kSphere, PlaneLayout::kTube}) {
+      const auto uv = [&](Vec3d y) {
+        return layout == PlaneLayout::kSphere ? sphereCoordinates(y) : tubeCoordinates(y);
+      };
+      const CoordinateGradients g = wrappedCoordinateGradients(x, layout);
+      const double e = 1e-6;
+      for (std::size_t k = 0; k < 3; ++k) {
+        Vec3d d{};
+        d[k] = e;
+        const Vec2d central = (1 / (2 * e)) * (uv(x + d) - uv(x - d));
+        EXPECT_NEAR(g.s[k], central.x, 1e-7 * (1 + std::abs(central.x)));
+        EXPECT_NEAR(g.t[k], central.y, 1e-7 * (1 + std::abs(central.y)));
+      }
+    }
+  }
+  EXPECT_GT(tested, 300);
+}
+
+// A height read through the Sphere or Tube projection (after a Mapping node): Γ is the
+// tangential gradient of the height it reads, as planar and triplanar layers' is; the
+// triplanar kernel with a single-lookup projection gives the same; projectedTexel reads there.
+TEST(WrappedProjection, HeightIsTheProjectedGradientOfTheWrappedHeight) {
+  SineTexture tex;
+  const CoordinateMapping m =
+      CoordinateMapping::fromMappingNode({0.5, 0.45, 0.55}, {0.3, -0.2, 0.4}, {0.6, 0.4, 0.5});
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int tested = 0;
+  for (int i = 0; i < 400; ++i) {
+    const SurfacePoint p = pointAt({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+    const Vec3d c = 2.0 * (m.apply(p.position) - Vec3d{0.5, 0.5, 0.5});
+    const double su = sphereCoordinates(m.apply(p.position)).x;
+    if (c.x * c.x + c.y * c.y < 0.01 || su < 0.01 || su > 0.99) continue;
+    ++tested;
+    for (const TriplanarProjection projection :
+         {TriplanarProjection::kSphere, TriplanarProjection::kTube}) {
+      const PlanarMapping lookup = singleLookupMapping(projection, {1.3, 0.7}, {0.2, -0.1});
+      const auto height = [&](Vec3d x) {
+        return 0.5 * tex.sample(planarTextureCoordinates(m.apply(x), lookup)).value;
+      };
+      const Vec3d reference = projectedCentralGradient(height, p);
+      EXPECT_LT(maxAbsDiff(planarHeightGradient(tex, lookup, 0.5, p, m), reference),
+                1e-7 * (1 + length(reference)));
+      TriplanarOptions o;
+      o.projection = projection;
+      o.tiling = lookup.tiling;
+      o.offset = lookup.offset;
+      o.scale = 0.5;
+      o.coordinates = m;
+      EXPECT_EQ(triplanarHeightGradient(tex, o, p), planarHeightGradient(tex, lookup, 0.5, p, m));
+      HeightNormalTexture normals(tex);
+      EXPECT_EQ(projectedTexel(normals, o, p),
+                normals.sample(planarTextureCoordinates(m.apply(p.position), lookup)));
+    }
+  }
+  EXPECT_GT(tested, 300);
+}
+
+// On the z axis u has no derivative: the slopes along v alone, finite; at the centre, none.
+TEST(WrappedProjection, OnTheAxisTheSlopesAreFinite) {
+  SineTexture tex;
+  for (const Vec3d c : {Vec3d{0, 0, 0.7}, Vec3d{0, 0, -0.3}, Vec3d{0, 0, 0}}) {
+    for (const TriplanarProjection projection :
+         {TriplanarProjection::kSphere, TriplanarProjection::kTube}) {
+      const SurfacePoint p = pointAt(mappedOf(c), {0.3, 0.4, 0.8});
+      const Vec3d gamma = planarHeightGradient(tex, singleLookupMapping(projection), 1, p);
+      EXPECT_TRUE(isFinite(gamma));
+      const CoordinateGradients g = wrappedCoordinateGradients(mappedOf(c), PlaneLayout::kSphere);
+      EXPECT_EQ(g.s, Vec3d{});
+      EXPECT_EQ(g.t, Vec3d{});
+      // The Tube's v grows along z everywhere: 2 · ½ per unit of P'.
+      EXPECT_EQ(wrappedCoordinateGradients(mappedOf(c), PlaneLayout::kTube).t, (Vec3d{0, 0, 1}));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sgbake

@@ -14,6 +14,9 @@ namespace sgbake::test {
 inline double maxAbsDiff(Vec3d a, Vec3d b) {
   return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
 }
+inline double maxAbsDiff(Vec2d a, Vec2d b) {
+  return std::max(std::abs(a.x - b.x), std::abs(a.y - b.y));
+}
 
 /// One normal everywhere, encoded n/2 + 0.5 as a normal map's texel.
 class ConstantNormalTexture final : public VectorTexture {

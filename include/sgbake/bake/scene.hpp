@@ -167,7 +167,8 @@ struct SceneLayer {
   /// half a texel apart that Blender's Bump node takes when Cycles bakes (HeightGradient)
   HeightGradient heightGradient = HeightGradient::kAnalytic;
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
-  /// "tangent_uv" (tangent-space normal layers, and Box-projected ones): the UV set whose
+  /// "tangent_uv" (tangent-space normal layers, and those Blender's projections read): the UV
+  /// set whose
   /// tangent frames decode the map, when not its "uv" (TangentNormalSource::tangentUvSet)
   std::optional<int> tangentUvSet;
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps, all projections)
@@ -178,8 +179,9 @@ struct SceneLayer {
   /// "projection": sgbake's own (kBlended: a triplanar layer's "blended", seed 003's planes and
   /// weights; a planar layer's "axis", along its axis, normal kinds in the plane's frame), the
   /// default, or Blender's Image Texture projections: a triplanar layer's "box" (kBox), a planar
-  /// layer's "flat" (kFlat, the (x, y) plane). Blender's decode normal kinds as a Normal Map node
-  /// decodes the colour they read.
+  /// layer's "flat" (kFlat, the (x, y) plane), "sphere" (kSphere) or "tube" (kTube), the last
+  /// two wrapped around the z axis of 2 · (P' − ½). Blender's decode normal kinds as a Normal
+  /// Map node decodes the colour they read.
   TriplanarProjection projection = TriplanarProjection::kBlended;
   double boxBlend = kDefaultBoxBlend;  ///< "box_blend" (triplanar box): Blender's Blend, 0 … 1
   std::optional<SceneMapping> mapping;  ///< "mapping" (planar, triplanar)
@@ -213,12 +215,12 @@ struct SceneLayer {
   /// @brief Whether the layer projects its image at positions: planar or triplanar.
   bool projected() const;
   /// @brief Whether the layer projects its image as one of Blender's Image Texture projections:
-  /// a triplanar layer's "box", a planar layer's "flat".
+  /// a triplanar layer's "box", a planar layer's "flat", "sphere" or "tube".
   bool projectedByBlender() const;
   /// @brief Whether the layer decodes a tangent-space normal map in the MikkTSpace frames of a
   /// UV set (frameUvSet): a tangent-space normal layer, or a projected one of Blender's
-  /// projections (projectedByBlender: a Normal Map node decoding what an Image Texture's Box or
-  /// Flat projection reads). sgbake's own projections decode in each plane's own frame instead.
+  /// projections (projectedByBlender: a Normal Map node decoding the colour an Image Texture's
+  /// projection reads). sgbake's own projections decode in each plane's own frame instead.
   bool decodesInUvTangentFrames() const;
   /// @brief The UV set whose frames decode its tangent-space normals: "tangent_uv", else "uv".
   int frameUvSet() const { return tangentUvSet.value_or(uvSet); }

@@ -66,10 +66,11 @@ struct TangentNormalSource {
   /// takes them from its own UV Map, or the render UV map when that is empty, whatever UV map
   /// its image is read on.)
   int tangentUvSet = -1;
-  /// When set, the texels are read by Blender's Box or Flat projection of the object
-  /// coordinates instead of through uvSet (projectedTexel; the options' projection must be kBox
-  /// or kFlat, their tiling and offset replace those above): an Image Texture with Projection
-  /// Box or Flat on Texture Coordinate Object feeding a Normal Map node. The frame still comes
+  /// When set, the texels are read by one of Blender's projections of the object coordinates
+  /// instead of through uvSet (projectedTexel; the options' projection must be kBox, kFlat,
+  /// kSphere or kTube, their tiling and offset replace those above): an Image Texture with
+  /// Projection Box, Flat, Sphere or Tube on Texture Coordinate Object feeding a Normal Map
+  /// node. The frame still comes
   /// from frameUvSet().
   std::optional<TriplanarOptions> projection{};
   int frameUvSet() const { return tangentUvSet >= 0 ? tangentUvSet : uvSet; }
@@ -84,7 +85,7 @@ struct ObjectNormalSource {
   Vec2d offset{0, 0};
   double strength = 1;  ///< Blender's Normal Map Strength (withNormalMapStrength)
   double minCosine = kMinObjectNormalCosine;
-  /// When set, the texels are read by Blender's Box or Flat projection instead of through uvSet
+  /// When set, the texels are read by one of Blender's projections instead of through uvSet
   /// (see TangentNormalSource::projection; no UV set is read then).
   std::optional<TriplanarOptions> projection{};
 };

@@ -32,6 +32,13 @@
 /// coordinate mirrored (s ↦ 1 − s) on the −X, +Y and +Z sides of the normal Cycles shades with,
 /// so no side sees its image mirrored; its weights are boxProjectionWeights. Its slopes are
 /// taken as the blended ones (frozen weights; a mirrored plane's s axis is −e_s).
+///
+/// **Blender's Sphere and Tube projections** (TriplanarProjection::kSphere, kTube;
+/// PlaneLayout::kSphere, kTube) are single lookups that wrap the image around the z axis of
+/// c = 2 · (P' − ½) (Cycles remaps the [0, 1] box to [−1, 1] first): both take
+/// u = ½ − atan2(c_x, c_y) / 2π (the seam at −y), the Sphere v = 1 − acos(c_z / |c|) / π, the
+/// Tube v = (c_z + 1) / 2. Their slopes are exact: the volume gradient is the chain rule
+/// through (u, v) (projectedVolumeGradient), which does not depend on any plane.
 #pragma once
 
 #include <array>
@@ -98,12 +105,41 @@ struct CoordinateMapping {
   }
 };
 
-/// @brief Which object coordinates texture a plane (before tiling).
+/// @brief Which object coordinates texture a plane (before tiling), or how a wrapped lookup
+/// reads them.
 enum class PlaneLayout {
   kCyclic,  ///< the cyclic pairs of the table above: (y, z), (z, x), (x, y)
   /// Blender's Box projection: (y, z) on X, (x, z) on Y, (y, x) on Z; see PlanarMapping::mirrored
   kBox,
+  /// Not a plane: Blender's Sphere projection, (u, v) = sphereCoordinates(P') (the file
+  /// comment); the axis is not read.
+  kSphere,
+  /// Not a plane: Blender's Tube projection, (u, v) = tubeCoordinates(P').
+  kTube,
 };
+
+/// @brief Whether @p layout wraps the image around an axis (kSphere, kTube) rather than laying
+/// it on a plane.
+constexpr bool isWrapped(PlaneLayout layout) {
+  return layout == PlaneLayout::kSphere || layout == PlaneLayout::kTube;
+}
+
+/// @brief Cycles' Sphere projection of P' (its map_to_sphere of c = 2 · (P' − ½)):
+/// u = ½ − atan2(c_x, c_y) / 2π, v = 1 − acos(c_z / |c|) / π; u = 0 on the z axis and
+/// (0, 0) at c = 0, as Cycles gives them.
+Vec2d sphereCoordinates(Vec3d mapped);
+/// @brief Cycles' Tube projection of P' (its map_to_tube of c = 2 · (P' − ½)): u as the
+/// Sphere's, v = (c_z + 1) / 2; (0, 0) on the z axis, as Cycles gives them.
+Vec2d tubeCoordinates(Vec3d mapped);
+
+/// @brief The gradients w.r.t. P' of a lookup's two texture coordinates before tiling.
+struct CoordinateGradients {
+  Vec3d s, t;
+};
+
+/// @brief ∇u and ∇v of sphereCoordinates or tubeCoordinates (@p layout) at @p mapped; zero
+/// where they are not differentiable (the z axis, for u and the Sphere's v).
+CoordinateGradients wrappedCoordinateGradients(Vec3d mapped, PlaneLayout layout);
 
 /// @brief How a plane is textured: (s, t) = tiling ∘ planeCoordinates(P, mapping) + offset.
 struct PlanarMapping {
@@ -121,10 +157,11 @@ inline const CoordinateMapping kObjectCoordinates{};
 
 /// @brief The axes of a plane as @p mapping lays it out: s and t the object-space directions
 /// its two texture coordinates grow along (before tiling), n = s × t (±the plane's axis).
+/// Planar layouts only: a wrapped one (isWrapped) has no fixed axes and gets zero ones.
 PlaneAxes planeAxes(const PlanarMapping& mapping);
 
 /// @brief Plane coordinates of @p position (P', after any CoordinateMapping) under @p mapping's
-/// layout and mirror, before tiling.
+/// layout and mirror, before tiling (a wrapped layout's (u, v)).
 Vec2d planeCoordinates(Vec3d position, const PlanarMapping& mapping);
 
 /// @brief Texture coordinates of @p position (P', after any CoordinateMapping) under
@@ -137,6 +174,12 @@ Vec2d planarTextureCoordinates(Vec3d position, const PlanarMapping& mapping);
 ///
 /// @param[in] dhdst (∂h/∂s, ∂h/∂t) at the point, per texture unit
 Vec3d planeVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, double scale);
+
+/// @brief Volume gradient w.r.t. P' of `scale · h(planarTextureCoordinates(P', mapping))` at
+/// @p mapped (P'), for any layout: planeVolumeGradient on a plane; on a wrapped layout
+/// scale · (tiling.x · dhdst.x · ∇u + tiling.y · dhdst.y · ∇v) (wrappedCoordinateGradients).
+Vec3d projectedVolumeGradient(Vec2d dhdst, const PlanarMapping& mapping, Vec3d mapped,
+                              double scale);
 
 /// @brief Options shared by planar and triplanar normal-map lookups.
 struct ProjectedNormalOptions {
@@ -230,7 +273,23 @@ enum class TriplanarProjection {
   /// 1 whatever the normal. A height so projected is a planar one on z; it serves a normal
   /// map's projected read (TangentNormalSource::projection).
   kFlat,
+  /// Blender's Sphere projection: one lookup of PlaneLayout::kSphere, weight 1. A height so
+  /// projected is a planar one of that layout.
+  kSphere,
+  /// Blender's Tube projection: one lookup of PlaneLayout::kTube, weight 1.
+  kTube,
 };
+
+/// @brief Whether @p projection is one lookup whatever the normal (kFlat, kSphere, kTube).
+constexpr bool isSingleLookup(TriplanarProjection projection) {
+  return projection == TriplanarProjection::kFlat || projection == TriplanarProjection::kSphere ||
+         projection == TriplanarProjection::kTube;
+}
+
+/// @brief The one lookup of a single-lookup projection (isSingleLookup) with @p tiling and
+/// @p offset: the Z plane (kFlat), or the Sphere's or Tube's wrap.
+PlanarMapping singleLookupMapping(TriplanarProjection projection, Vec2d tiling = {1, 1},
+                                  Vec2d offset = {0, 0});
 
 /// Default Blend of a Box projection, Blender's.
 inline constexpr double kDefaultBoxBlend = 0;
@@ -268,11 +327,11 @@ struct TriplanarPlanes {
 };
 TriplanarPlanes triplanarPlanes(const TriplanarOptions& options, Vec3d seenNormal);
 
-/// @brief The colour an Image Texture with Projection Box or Flat gives at @p point: the texels
-/// of the planes triplanarPlanes picks for the normal Cycles shades with there
-/// (point.seenNormal()), read at @p options' coordinates of P, blended by their weights, not
-/// decoded (what a Normal Map node receives). Reads @p options' projection, boxBlend, tiling,
-/// offset and coordinates.
+/// @brief The colour an Image Texture with Projection Box, Flat, Sphere or Tube gives at
+/// @p point: the texels of the planes triplanarPlanes picks for the normal Cycles shades with
+/// there (point.seenNormal(); the single lookups' one whatever the normal), read at @p options'
+/// coordinates of P, blended by their weights, not decoded (what a Normal Map node receives). Reads
+/// @p options' projection, boxBlend, tiling, offset and coordinates.
 Vec3d projectedTexel(const VectorTexture& texture, const TriplanarOptions& options,
                      const SurfacePoint& point);
 /// @brief projectedTexel at object position @p position (before @p options' coordinates),
