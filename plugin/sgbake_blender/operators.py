@@ -434,14 +434,15 @@ def _coordinates_source(link):
 def _object_coordinates(tex, ob=None):
     """How Image Texture node `tex` reads object coordinates: None when it does not; else the
     layer settings of what lies between (empty for the object's own). It does when its
-    projection is Flat or Box and its Vector comes from a Texture Coordinate node's Object
+    projection is Flat, Box, Sphere or Tube and its Vector comes from a Texture Coordinate
+    node's Object
     output (the baked object's own coordinates; another object's, or its Generated output, when
     the baked object `ob` is known: mapping_matrix), straight or through one Mapping node of
     type Point, Texture or Vector whose Location, Rotation and Scale are its own values (not
     Normal, which normalizes the coordinates). Its height is then
-    sgbake's planar layer on axis z (Flat) or its triplanar layer with Blender's Box projection
-    (Box)."""
-    if tex.projection not in ("FLAT", "BOX"):
+    sgbake's planar layer on axis z (Flat), with its Sphere or Tube projection (Sphere, Tube),
+    or its triplanar layer with Blender's Box projection (Box)."""
+    if tex.projection not in ("FLAT", "BOX", "SPHERE", "TUBE"):
         return None
     link = _source_link(tex.inputs["Vector"])
     settings = {}
@@ -471,9 +472,21 @@ def _object_coordinates(tex, ob=None):
 
 def _object_projected(tex, ob=None):
     """Whether Image Texture node `tex` reads object coordinates (_object_coordinates): then a
-    layer takes its projection over, for a Bump or a Normal Map alike (Flat: a planar layer, Box:
-    a triplanar one; a normal map's colour decoded as the Normal Map node decodes it)."""
+    layer takes its projection over, for a Bump or a Normal Map alike (Flat, Sphere, Tube: a
+    planar layer, Box: a triplanar one; a normal map's colour decoded as the Normal Map node
+    decodes it)."""
     return _object_coordinates(tex, ob) is not None
+
+
+def _projection_settings(tex, kind):
+    """The layer settings of Image Texture node `tex`'s projection read at object coordinates
+    (_object_projected), for an image of `kind`: Box, a triplanar layer with Blender's Box and
+    the node's Blend; Flat, Sphere and Tube, a planar layer with that projection."""
+    if tex.projection == "BOX":
+        return {"type": "triplanar", "kind": kind, "projection": "box",
+                "box_blend": tex.projection_blend}
+    return {"type": "planar", "kind": kind, "axis": "z",
+            "planar_projection": tex.projection.lower()}
 
 
 def _ignored(node, tex, inputs, socket, ob=None):
@@ -481,7 +494,7 @@ def _ignored(node, tex, inputs, socket, ob=None):
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
     input other than a UV map (a Mapping node, object or generated coordinates; those of a
     projection a layer takes, _object_projected, are not named), a projection other than Flat
-    (but a Box one a layer takes), Closest interpolation (read bilinear), and node-driven `inputs` (of which
+    (but one a layer takes), Closest interpolation (read bilinear), and node-driven `inputs` (of which
     the layer takes the unconnected value)."""
     notes = []
     if node.type != "BUMP" and _source_link(node.inputs[socket]).from_socket.name == "Alpha":
@@ -557,16 +570,12 @@ def material_layers(node_tree, render_uv=None, ob=None):
                           slopes="bump-node")
             alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
             if _object_projected(tex, ob):
-                # Object coordinates: the height projected along z onto the object (Flat), or
-                # on the three axis planes as Blender's Box projection blends them (Box).
+                # Object coordinates: the height projected along z onto the object (Flat),
+                # wrapped around z (Sphere, Tube), or on the three axis planes as Blender's Box
+                # projection blends them (Box).
                 values.pop("uv_map", None)
                 values.update(_object_coordinates(tex, ob))
-                if tex.projection == "BOX":
-                    values.update(type="triplanar", kind="height", projection="box",
-                                  box_blend=tex.projection_blend)
-                else:
-                    values.update(type="planar", kind="height", axis="z",
-                                  planar_projection="flat")
+                values.update(_projection_settings(tex, "height"))
                 kind = values["type"]
                 if alpha:
                     ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {kind} "
@@ -585,17 +594,12 @@ def material_layers(node_tree, render_uv=None, ob=None):
             values = _texture_settings(tex, render_uv)
             values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
             if _object_projected(tex, ob):
-                # Box or Flat projection on object coordinates: the colour it reads, decoded by
-                # the node (tangent space: in the frames of the node's UV map, else the render
-                # UV map's).
+                # A projection on object coordinates: the colour it reads, decoded by the node
+                # (tangent space: in the frames of the node's UV map, else the render UV
+                # map's).
                 values.pop("uv_map", None)
                 values.update(_object_coordinates(tex, ob))
-                if tex.projection == "BOX":
-                    values.update(type="triplanar", kind=f"{space}-normal", projection="box",
-                                  box_blend=tex.projection_blend)
-                else:
-                    values.update(type="planar", kind=f"{space}-normal", axis="z",
-                                  planar_projection="flat")
+                values.update(_projection_settings(tex, f"{space}-normal"))
                 if space == "tangent" and node.uv_map:
                     values["tangent_uv_map"] = node.uv_map
             elif space == "tangent":

@@ -63,6 +63,10 @@ PLANAR_PROJECTIONS = (
                            "own frame)"),
     ("flat", "Flat", "Blender's Image Texture Flat projection, the (x, y) plane: what Cycles "
                      "bakes (normal kinds decode the colour as a Normal Map node does)"),
+    ("sphere", "Sphere", "Blender's Image Texture Sphere projection, wrapped around z of "
+                         "2 (coordinates - 0.5): what Cycles bakes"),
+    ("tube", "Tube", "Blender's Image Texture Tube projection, wrapped around z of "
+                     "2 (coordinates - 0.5): what Cycles bakes"),
 )
 
 MAPPING_TYPES = (

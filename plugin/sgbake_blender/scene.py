@@ -125,9 +125,9 @@ def tangent_frames_uv(layer, default_uv=None):
 
 def projected_by_blender(layer):
     """Whether the layer projects its image as Blender's Image Texture does: a triplanar
-    layer's Box projection, a planar layer's Flat one."""
+    layer's Box projection, a planar layer's Flat, Sphere or Tube one."""
     return ((layer.type == "triplanar" and layer.projection == "box")
-            or (layer.type == "planar" and layer.planar_projection == "flat"))
+            or (layer.type == "planar" and layer.planar_projection != "axis"))
 
 
 def layer_json(layer, uv_index, default_uv=None):
@@ -169,8 +169,8 @@ def layer_json(layer, uv_index, default_uv=None):
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
-        if layer.planar_projection == "flat":  # Blender's Flat projection: the (x, y) plane
-            entry.update(projection="flat", axis="z")
+        if layer.planar_projection != "axis":  # Blender's Flat, Sphere and Tube: about z
+            entry.update(projection=layer.planar_projection, axis="z")
     elif layer.type == "triplanar":
         entry.update(kind=layer.kind, scale=_number(layer.scale))
         if layer.projection == "box":

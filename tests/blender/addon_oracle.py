@@ -525,8 +525,22 @@ def material_checks(settings, ob, distance):
     tex.projection = "FLAT"
     flat, _, flat_ignored = operators.material_layers(tree, "UVMap")
     flat_normal = next((v for v in flat if v["type"] != "height"), {})
+    # Sphere and Tube: planar layers with those projections (sphere_nmap_sphere and
+    # tube_nmap_sphere_object check such layers against Cycles).
+    wrapped = {}
+    for projection in ("SPHERE", "TUBE"):
+        tex.projection = projection
+        layers, _, named = operators.material_layers(tree, "UVMap")
+        wrapped[projection] = (next((v for v in layers if v["type"] != "height"), {}), named)
     tex.projection, nmap.uv_map = "FLAT", ""
     tree.nodes.remove(coordinates)
+    check("Layers from Material: a Normal Map of a Sphere- or Tube-projected image",
+          all(layer.get("type") == "planar" and layer.get("planar_projection") == proj.lower()
+              and layer.get("tangent_uv_map") == "UV2" and "uv_map" not in layer
+              and not any(tex.name in note for note in named)
+              for proj, (layer, named) in wrapped.items()),
+          "planar layers, planar_projection sphere and tube, tangent_uv_map 'UV2', nothing "
+          "named", str(wrapped))
     want = {"type": "triplanar", "kind": "tangent-normal", "projection": "box",
             "tangent_uv_map": "UV2"}
     want_flat = {"type": "planar", "kind": "tangent-normal", "planar_projection": "flat",
