@@ -374,6 +374,65 @@ def _source_link(socket):
     return None
 
 
+# Math and Vector Math operations _constant folds, as Cycles folds them (its safe division:
+# 0 where the divisor is 0).
+def _divide(a, b):
+    return a / b if b != 0.0 else 0.0
+
+
+MATH_OPERATIONS = {
+    "ADD": lambda a, b, c: a + b, "SUBTRACT": lambda a, b, c: a - b,
+    "MULTIPLY": lambda a, b, c: a * b, "DIVIDE": lambda a, b, c: _divide(a, b),
+    "MULTIPLY_ADD": lambda a, b, c: a * b + c, "MINIMUM": lambda a, b, c: min(a, b),
+    "MAXIMUM": lambda a, b, c: max(a, b), "ABSOLUTE": lambda a, b, c: abs(a),
+}
+VECTOR_MATH_OPERATIONS = {
+    "ADD": lambda a, b, s: tuple(x + y for x, y in zip(a, b)),
+    "SUBTRACT": lambda a, b, s: tuple(x - y for x, y in zip(a, b)),
+    "MULTIPLY": lambda a, b, s: tuple(x * y for x, y in zip(a, b)),
+    "DIVIDE": lambda a, b, s: tuple(_divide(x, y) for x, y in zip(a, b)),
+    "SCALE": lambda a, b, s: tuple(x * s for x in a),
+}
+
+
+def _constant(socket):
+    """The value input `socket` takes when every node feeding it is a constant: its own value
+    when nothing (or a muted link) feeds it, a Value node's, a Combine XYZ of constants, a Math
+    or Vector Math node of the operations above on constants (clamped when the node clamps),
+    through Reroutes; a float fed into a vector is (f, f, f), as Blender converts it. A float,
+    a 3-tuple, or None when something else feeds it (a texture, an attribute, a muted node)."""
+    link = _source_link(socket)
+    if link is None:
+        value = socket.default_value
+        return float(value) if socket.type == "VALUE" else tuple(float(v) for v in value)
+    node, output = link.from_node, link.from_socket
+    value = None
+    if node.mute:
+        return None
+    if node.type == "VALUE":
+        value = float(output.default_value)
+    elif node.type == "COMBXYZ":
+        parts = [_constant(node.inputs[name]) for name in ("X", "Y", "Z")]
+        value = None if any(p is None for p in parts) else tuple(parts)
+    elif node.type == "MATH" and node.operation in MATH_OPERATIONS:
+        args = [_constant(node.inputs[i]) for i in range(3)]
+        if all(isinstance(a, float) for a in args):
+            value = MATH_OPERATIONS[node.operation](*args)
+            if node.use_clamp:
+                value = min(max(value, 0.0), 1.0)
+    elif (node.type == "VECT_MATH" and node.operation in VECTOR_MATH_OPERATIONS
+          and output.name == "Vector"):
+        a, b = _constant(node.inputs[0]), _constant(node.inputs[1])
+        scale = _constant(node.inputs["Scale"])
+        if isinstance(a, tuple) and isinstance(b, tuple) and isinstance(scale, float):
+            value = VECTOR_MATH_OPERATIONS[node.operation](a, b, scale)
+    if value is None:
+        return None
+    if socket.type == "VALUE":
+        return value if isinstance(value, float) else None
+    return (value,) * 3 if isinstance(value, float) else value
+
+
 def _linked_image_node(socket):
     """The Image Texture node (with an image) that feeds `socket` (_source_link), or None."""
     link = _source_link(socket)
@@ -438,8 +497,9 @@ def _object_coordinates(tex, ob=None):
     node's Object
     output (the baked object's own coordinates; another object's, or its Generated output, when
     the baked object `ob` is known: mapping_matrix), straight or through one Mapping node of
-    type Point, Texture or Vector whose Location, Rotation and Scale are its own values (not
-    Normal, which normalizes the coordinates). Its height is then
+    type Point, Texture or Vector whose Location, Rotation and Scale are constants (_constant:
+    their own values, or Value, Combine XYZ and Math nodes of constants; not type Normal, which
+    normalizes the coordinates). Its height is then
     sgbake's planar layer on axis z (Flat), with its Sphere or Tube projection (Sphere, Tube),
     or its triplanar layer with Blender's Box projection (Box)."""
     if tex.projection not in ("FLAT", "BOX", "SPHERE", "TUBE"):
@@ -448,11 +508,12 @@ def _object_coordinates(tex, ob=None):
     settings = {}
     if link is not None and link.from_node.type == "MAPPING":
         node = link.from_node
-        if node.vector_type == "NORMAL" or any(node.inputs[n].is_linked for n in MAPPING_INPUTS):
+        values = {name: _constant(node.inputs[name]) for name in MAPPING_INPUTS}
+        if node.vector_type == "NORMAL" or any(v is None for v in values.values()):
             return None
         settings["mapping_type"] = node.vector_type
-        for name in MAPPING_INPUTS:
-            settings[f"mapping_{name.lower()}"] = tuple(node.inputs[name].default_value)
+        for name, value in values.items():
+            settings[f"mapping_{name.lower()}"] = value
         link = _source_link(node.inputs["Vector"])
     if link is None or link.from_node.type != "TEX_COORD":
         return None
@@ -489,13 +550,20 @@ def _projection_settings(tex, kind):
             "planar_projection": tex.projection.lower()}
 
 
+def _input_value(node, name):
+    """The float `node`'s input `name` takes: _constant's, else (fed by something else, which
+    _ignored names) its own value."""
+    value = _constant(node.inputs[name])
+    return value if value is not None else node.inputs[name].default_value
+
+
 def _ignored(node, tex, inputs, socket, ob=None):
     """What of a Bump or Normal Map `node` fed by the Image Texture node `tex` into its input
     `socket` a layer cannot take over: a normal map from the texture's Alpha output, a Vector
     input other than a UV map (a Mapping node, object or generated coordinates; those of a
     projection a layer takes, _object_projected, are not named), a projection other than Flat
-    (but one a layer takes), Closest interpolation (read bilinear), and node-driven `inputs` (of which
-    the layer takes the unconnected value)."""
+    (but one a layer takes), Closest interpolation (read bilinear), and `inputs` fed by
+    anything but constants (_constant; of which the layer takes the unconnected value)."""
     notes = []
     if node.type != "BUMP" and _source_link(node.inputs[socket]).from_socket.name == "Alpha":
         notes.append(f"'{node.name}' {socket} from '{tex.name}' Alpha (the layer reads its "
@@ -511,7 +579,7 @@ def _ignored(node, tex, inputs, socket, ob=None):
     if tex.projection != "FLAT" and not _object_projected(tex, ob):
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
     for name in inputs:
-        if node.inputs[name].is_linked:
+        if _constant(node.inputs[name]) is None:
             notes.append(f"'{node.name}' {name} from a node (its own value "
                          f"{node.inputs[name].default_value:.4g} is used)")
     return notes
@@ -561,12 +629,12 @@ def material_layers(node_tree, render_uv=None, ob=None):
                 skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
                 continue
             ignored += _ignored(node, tex, ("Strength", "Distance"), "Height", ob)
-            scale = node.inputs["Distance"].default_value
+            scale = _input_value(node, "Distance")
             values = _texture_settings(tex, render_uv)
             # The node's slopes as Cycles takes them when it bakes (forward differences half
             # a texel apart): the layer then bakes what Cycles bakes from it.
             values.update(type="height", scale=-scale if node.invert else scale,
-                          strength=max(node.inputs["Strength"].default_value, 0.0),
+                          strength=max(_input_value(node, "Strength"), 0.0),
                           slopes="bump-node")
             alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
             if _object_projected(tex, ob):
@@ -592,7 +660,7 @@ def material_layers(node_tree, render_uv=None, ob=None):
                 continue
             ignored += _ignored(node, tex, ("Strength",), "Color", ob)
             values = _texture_settings(tex, render_uv)
-            values.update(type="normal", space=space, scale=node.inputs["Strength"].default_value)
+            values.update(type="normal", space=space, scale=_input_value(node, "Strength"))
             if _object_projected(tex, ob):
                 # A projection on object coordinates: the colour it reads, decoded by the node
                 # (tangent space: in the frames of the node's UV map, else the render UV

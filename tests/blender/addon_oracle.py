@@ -287,6 +287,23 @@ def layers_from_material(settings, distance):
     if len(weak) != 1 or abs(weak[0].get("strength", 1.0) - 0.5) > 1e-7 \
             or abs(weak[0]["scale"] - distance) > 1e-7:
         entry["error"] = f"a Bump Strength 0.5 should give strength 0.5, scale {distance}: {weak}"
+    # A Strength fed by a texture is not a constant: named, the node's own value taken; fed by a
+    # Math node of constants (clamped), folded as Cycles folds it, nothing named.
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Fac"], bump.inputs["Strength"])
+    _, _, textured = operators.material_layers(tree)
+    tree.nodes.remove(noise)
+    math = tree.nodes.new("ShaderNodeMath")
+    math.operation, math.use_clamp = "SUBTRACT", True
+    math.inputs[0].default_value, math.inputs[1].default_value = 0.25, 0.5
+    tree.links.new(math.outputs[0], bump.inputs["Strength"])
+    clamped, _, clamped_ignored = operators.material_layers(tree)
+    tree.nodes.remove(math)
+    if (not any("Strength from a node" in note for note in textured) or clamped_ignored
+            or len(clamped) != 1 or clamped[0].get("strength", 1.0) != 0.0):
+        entry["error"] = (f"a Strength from a Noise Texture should be named ({textured}); one "
+                          f"from a clamped Math node of 0.25 - 0.5 should be 0 and nothing named "
+                          f"({clamped}, {clamped_ignored})")
     _, _, none_ignored = operators.material_layers(tree)
     if len(found) != 1 or not any("Vector from 'Mapping'" in note for note in ignored) \
             or none_ignored:
@@ -1392,21 +1409,48 @@ def projector_case(settings, ob, work):
     tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
     tex.projection, tex.projection_blend = "BOX", PROJECTOR_BLEND
-    bump.inputs["Distance"].default_value = PROJECTOR_DISTANCE
+    # The Mapping's Scale and the Bump's Distance fed by constant nodes, their own values wrong:
+    # a Combine XYZ of (Value x 3, its own Y, Value + Value), and a Value node. Cycles folds
+    # them; so must Layers from Material.
+    value = tree.nodes.new("ShaderNodeValue")
+    value.outputs[0].default_value = PROJECTOR_MAPPING[2][2] / 2
+    times = tree.nodes.new("ShaderNodeMath")
+    times.operation, times.inputs[1].default_value = "MULTIPLY", 3.0
+    twice = tree.nodes.new("ShaderNodeMath")
+    twice.operation = "ADD"
+    combine = tree.nodes.new("ShaderNodeCombineXYZ")
+    combine.inputs["Y"].default_value = PROJECTOR_MAPPING[2][1]
+    tree.links.new(value.outputs[0], times.inputs[0])
+    tree.links.new(value.outputs[0], twice.inputs[0])
+    tree.links.new(value.outputs[0], twice.inputs[1])
+    tree.links.new(times.outputs[0], combine.inputs["X"])
+    tree.links.new(twice.outputs[0], combine.inputs["Z"])
+    tree.links.new(combine.outputs[0], mapping.inputs["Scale"])
+    mapping.inputs["Scale"].default_value = (1.0, 1.0, 1.0)
+    distance_node = tree.nodes.new("ShaderNodeValue")
+    distance_node.outputs[0].default_value = PROJECTOR_DISTANCE
+    tree.links.new(distance_node.outputs[0], bump.inputs["Distance"])
+    bump.inputs["Distance"].default_value = 5 * PROJECTOR_DISTANCE
+    constants = (value, times, twice, combine, distance_node)
     entry = {"result": None, "checks": []}
     try:
         bpy.ops.object.sgbake_layers_from_material()
         layer = settings.layers[0]
         entry["layer"] = {"type": layer.type, "projection": layer.projection,
                           "box_blend": layer.box_blend, "slopes": layer.slopes,
-                          "mapping_type": layer.mapping_type}
+                          "mapping_type": layer.mapping_type,
+                          "mapping_scale": tuple(layer.mapping_scale), "scale": layer.scale}
         entry["checks"].append({
             "name": "projector: Layers from Material makes one triplanar Box layer",
             "ok": (len(settings.layers) == 1 and layer.type == "triplanar"
                    and layer.projection == "box" and layer.slopes == "bump-node"
-                   and layer.mapping_type == PROJECTOR_MAPPING_TYPE),
+                   and layer.mapping_type == PROJECTOR_MAPPING_TYPE
+                   and max(abs(a - b) for a, b in zip(layer.mapping_scale,
+                                                      PROJECTOR_MAPPING[2])) < 1e-6
+                   and abs(layer.scale - PROJECTOR_DISTANCE) < 1e-9),
             "expected": f"one triplanar layer, projection box, slopes bump-node, mapping type "
-                        f"{PROJECTOR_MAPPING_TYPE}",
+                        f"{PROJECTOR_MAPPING_TYPE}, mapping scale {PROJECTOR_MAPPING[2]} and "
+                        f"scale {PROJECTOR_DISTANCE} from the constant nodes",
             "message": str(entry["layer"])})
         settings.target_image = None
         settings.width = settings.height = SIZE
@@ -1450,6 +1494,8 @@ def projector_case(settings, ob, work):
     finally:
         tree.nodes.remove(mapping)
         tree.nodes.remove(coordinates)
+        for node in constants:
+            tree.nodes.remove(node)
         tex.projection = "FLAT"
         bump.inputs["Distance"].default_value = distance
         bpy.data.objects.remove(empty)
