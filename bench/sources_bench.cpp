@@ -21,9 +21,12 @@
 ///   - `TriplanarBoxHeight/planes:N`: the same with Blender's Box projection (Blend 0.3), normals
 ///     in its one-, two- and three-plane zones; `TriplanarBoxHeight/mapped` three planes after a
 ///     Mapping node (CoordinateMapping)
-///   - `ProjectedTangentNormal/box:N`, `ProjectedTangentNormal/flat`: the tangent-space map read
-///     by Blender's Box projection (normals in its N-plane zone) or Flat projection and decoded
-///     in the MikkTSpace frame (TangentNormalSource::projection), against `TangentNormal/mikk`
+///   - `ProjectedTangentNormal/box:N`, `ProjectedTangentNormal/flat`, `/sphere`, `/tube`: the
+///     tangent-space map read by Blender's Box projection (normals in its N-plane zone) or its
+///     Flat, Sphere or Tube projection and decoded in the MikkTSpace frame
+///     (TangentNormalSource::projection), against `TangentNormal/mikk`
+///   - `PlanarHeight/flat`, `/sphere`, `/tube`: a height read by those single lookups (a planar
+///     layer; the wrapped ones with their exact slopes, wrappedCoordinateGradients)
 ///   - `Composite3`: UV height + tangent-space map + triplanar height (all 3 planes) together,
 ///     resolved to the perturbed normal (perturbedNormal)
 
@@ -198,6 +201,39 @@ void ProjectedTangentNormalFlat(benchmark::State& state) {
   runProjectedTangentNormal(state, TriplanarProjection::kFlat, 3);
 }
 BENCHMARK(ProjectedTangentNormalFlat)->Name("ProjectedTangentNormal/flat");
+
+void ProjectedTangentNormalSphere(benchmark::State& state) {
+  runProjectedTangentNormal(state, TriplanarProjection::kSphere, 3);
+}
+BENCHMARK(ProjectedTangentNormalSphere)->Name("ProjectedTangentNormal/sphere");
+
+void ProjectedTangentNormalTube(benchmark::State& state) {
+  runProjectedTangentNormal(state, TriplanarProjection::kTube, 3);
+}
+BENCHMARK(ProjectedTangentNormalTube)->Name("ProjectedTangentNormal/tube");
+
+/// A height read by one of Blender's single lookups (kFlat, kSphere, kTube): a planar layer.
+void runSingleLookupHeight(benchmark::State& state, TriplanarProjection projection) {
+  PlanarSource planar;
+  planar.height = &kHeight;
+  planar.mapping = singleLookupMapping(projection, {2, 2});
+  runLayers(state, {{planar, 1, {}}}, defaultPoints());
+}
+
+void PlanarHeightFlat(benchmark::State& state) {
+  runSingleLookupHeight(state, TriplanarProjection::kFlat);
+}
+BENCHMARK(PlanarHeightFlat)->Name("PlanarHeight/flat");
+
+void PlanarHeightSphere(benchmark::State& state) {
+  runSingleLookupHeight(state, TriplanarProjection::kSphere);
+}
+BENCHMARK(PlanarHeightSphere)->Name("PlanarHeight/sphere");
+
+void PlanarHeightTube(benchmark::State& state) {
+  runSingleLookupHeight(state, TriplanarProjection::kTube);
+}
+BENCHMARK(PlanarHeightTube)->Name("PlanarHeight/tube");
 
 void TriplanarBoxHeight(benchmark::State& state) {
   runBox(state, static_cast<int>(state.range(0)), {});
