@@ -323,12 +323,17 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
                                                        : NormalMapGreen::kOpenGL);
   // The object's transform (not for height maps, whose heights it does not change): a rotation
   // (or mirror) with a uniform scale s shades as object space with heights divided by s
-  // (ObjectTransform::uniformScale); any other is shaded in world space (world_shading.hpp).
+  // (ObjectTransform::uniformScale) unless the Bump node's offsets are read, which Cycles
+  // spreads along its orthonormals of the world Ng (a rotation turns them otherwise than the
+  // object); any other is shaded in world space (world_shading.hpp).
   std::vector<Layer> scaledLayers;
   WorldSpace world;
   if (input.transform != nullptr && !input.transform->shadesAsObjectSpace() &&
       settings.map != MapKind::kHeight) {
-    if (const std::optional<double> s = input.transform->uniformScale()) {
+    if (const std::optional<double> s = input.transform->uniformScale();
+        s && !std::ranges::any_of(input.layers, [](const Layer& layer) {
+          return gradient_detail::readsBumpOffsets(layer.source);
+        })) {
       for (const Layer& layer : input.layers)
         scaledLayers.push_back(withHeightsScaled(layer, 1 / *s));
       base.layers = scaledLayers;

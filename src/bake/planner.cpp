@@ -758,8 +758,13 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       if (!output.upToDate && shadedThroughTransform(o)) shaded.push_back(o.file.string());
     }
     if (!shaded.empty()) {
-      // A rotation (or mirror) with a uniform scale shades as object space (runBake).
-      const std::optional<double> uniform = scene.transform->uniformScale();
+      // A rotation (or mirror) with a uniform scale shades as object space (runBake), unless
+      // a height is differenced as the Bump node does (its offsets turn with the world).
+      const bool bumpNode = std::ranges::any_of(scene.layers, [](const SceneLayer& layer) {
+        return layer.hasHeight() && layer.heightGradient == HeightGradient::kBumpNode;
+      });
+      const std::optional<double> uniform =
+          bumpNode ? std::nullopt : scene.transform->uniformScale();
       plan.steps.push_back(
           {uniform ? "shade in object space with heights divided by the object's uniform scale " +
                          formatNumber(*uniform) + " (as Cycles shades it in world space)"

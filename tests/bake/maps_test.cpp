@@ -15,6 +15,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/corners.hpp"
 #include "sgbake/gradient/volume.hpp"
+#include "support/analytic_textures.hpp"
 #include "support/parametric_mesh.hpp"
 
 namespace sgbake {
@@ -295,6 +296,38 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
   }
   EXPECT_EQ(bakeWith(&similar, MapKind::kHeight).pixels,
             bakeWith(nullptr, MapKind::kHeight).pixels);
+  // Heights differenced as the Bump node does, on that rotation: Cycles lays the offsets along
+  // its orthonormals of the world Ng, which do not turn with the object, so the rotation shades
+  // as the world path does (which a stretch by 1e-4 takes, changing the bump by as little), not
+  // as object space: on a curved height the two sets of differences part by 4e-3 here.
+  {
+    const test::AnalyticHeight wavy(0.1, -0.2, 0.05);
+    Layer differenced{UvHeightSource{&wavy, 0, scale}, 1.0, {}};
+    std::get<UvHeightSource>(differenced.source).gradient = HeightGradient::kBumpNode;
+    const std::vector<Layer> bumpNode{differenced};
+    const ObjectTransform stretched{similar.linear * Mat3::diagonal({1, 1, 1 + 1e-4}), {}};
+    ASSERT_FALSE(stretched.uniformScale().has_value());
+    const auto bakeBumpNode = [&](const ObjectTransform* t) {
+      BakeInput input{&mesh, &*tangents, bumpNode};
+      input.transform = t;
+      BakeSettings settings;
+      settings.map = MapKind::kTangentNormal;
+      settings.width = settings.height = 32;
+      Result<FloatImage> image = bakeMap(input, settings);
+      EXPECT_TRUE(image.ok()) << image.error().message;
+      return image.ok() ? std::move(*image) : FloatImage{};
+    };
+    const FloatImage turned = bakeBumpNode(&similar), world = bakeBumpNode(&stretched);
+    const FloatImage still = bakeBumpNode(nullptr);
+    ASSERT_EQ(turned.pixels.size(), world.pixels.size());
+    float worst = 0, fromStill = 0;
+    for (std::size_t i = 0; i < turned.pixels.size(); ++i) {
+      worst = std::max(worst, std::abs(turned.pixels[i] - world.pixels[i]));
+      fromStill = std::max(fromStill, std::abs(turned.pixels[i] - still.pixels[i]));
+    }
+    EXPECT_LT(worst, 1e-4f);
+    EXPECT_GT(fromStill, 1e-3f);  // (the bump is the halved one: not the unturned bake)
+  }
   const ObjectTransform singular{Mat3::diagonal({1, 1, 0}), {}};
   BakeInput bad{&mesh, &*tangents, layers};
   bad.transform = &singular;

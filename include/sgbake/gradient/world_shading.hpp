@@ -51,7 +51,9 @@ struct ObjectTransform {
   /// within @p tolerance (relative; Blender's float matrices are orthogonal to ~1e-7), else
   /// nothing. Such an object shades in world space exactly as in object space with every
   /// height divided by s (the normals carried there and back are the object's own, and the
-  /// guard does not change under a rotation or a mirror): withHeightsScaled.
+  /// guard does not change under a rotation or a mirror): withHeightsScaled. Not heights
+  /// differenced as the Bump node does: Cycles lays its offsets along its orthonormals of the
+  /// world Ng, which do not turn with the object.
   std::optional<double> uniformScale(double tolerance = 1e-6) const;
 };
 
