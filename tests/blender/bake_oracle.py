@@ -67,7 +67,12 @@ ours_bake_full_strength.exr, at Strength 1, must fail them too. sphere_wrap_sphe
 tube_wrap_sphere read the height by Blender's Sphere and Tube projections (after a Mapping node
 that centres and turns them), a "planar" layer with "projection": "sphere" or "tube"; their
 control ours_bake_swapped.exr, the other wrap, must fail them too, as must ours_nmap_swapped.exr
-for the normal maps those projections read (sphere_nmap_sphere, tube_nmap_sphere_object).
+for the normal maps those projections read (sphere_nmap_sphere, tube_nmap_sphere_object). The
+displacement cases (displacement_sphere, displacement_stretch_sphere, displacement_object_sphere:
+a Displacement node into the Material Output's Displacement, Bump Only, instead of a Bump node)
+are judged as the plain ones, the height layer's scale the node's Scale times the object's scale
+in object space; the object-space case's control ours_bake_unscaled.exr (its Scale alone) must
+fail (b) and (e).
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -224,7 +229,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
                  "box_nmap_sphere_object", "flat_nmap_sphere",
                  "box_nmap_stretch_sphere", "sphere_wrap_sphere", "tube_wrap_sphere",
-                 "sphere_nmap_sphere", "tube_nmap_sphere_object")
+                 "sphere_nmap_sphere", "tube_nmap_sphere_object", "displacement_sphere",
+                 "displacement_stretch_sphere", "displacement_object_sphere")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
@@ -269,7 +275,10 @@ def sgbake_case(cli, entry, sabotage, threads):
     """Runs every sgbake command of one case; returns a list of failed command lines."""
     d = entry["dir"]
     p = lambda name: os.path.join(d, name)  # noqa: E731
-    scale, size = entry["scale"], entry["size"]
+    # A displacement case's height layer: the Displacement node's Scale, times the object's
+    # scale when the node is in object space (bake_scene.DISPLACEMENT).
+    scale = entry["scale"] * entry.get("displacement", {}).get("factor", 1.0)
+    size = entry["size"]
     # 32-bit float EXRs (sgbake's default 16 = half floats moves convert's median from 0.0025 to
     # 0.016 deg on Suzanne, a third of the 0.05 deg budget), and
     # no .sgbake-manifest.json (it would let a re-run in a kept directory skip the bake).
@@ -348,6 +357,10 @@ def sgbake_case(cli, entry, sabotage, threads):
     if not run_sgbake(cli, bake + ["--height-scale", repr(bake_scale), "--height-gradient",
                                    "bump-node", "-o", p("ours_bake_bump_node.exr")], log):
         failed.append(log[-1])
+    if entry.get("displacement", {}).get("factor", 1.0) != 1.0 and not run_sgbake(
+            cli, bake + ["--height-scale", repr(entry["scale"]), "--height-gradient",
+                         "bump-node", "-o", p("ours_bake_unscaled.exr")], log):
+        failed.append(log[-1])  # the control: the object-space Scale not grown with the object
 
     scene = {
         "mesh": p("mesh.obj"),
@@ -668,6 +681,8 @@ def evaluate(name, r, planar=False):
                              ("bake_unmapped", "without Mapping:  ", "its Mapping node left out"),
                              ("bake_swapped", "the other wrap:   ",
                               "the Sphere and Tube projections swapped"),
+                             ("bake_unscaled", "Scale unscaled:   ",
+                              "the object-space Displacement's Scale not scaled with the object"),
                              ("bake_full_strength", "Strength 1:       ",
                               "the Bump's Strength left out")):
         if key not in r:

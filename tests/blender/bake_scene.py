@@ -124,6 +124,48 @@ def normal_map_case(name, mesh_case, size, space, strength, tilt_deg, bump=None)
         NORMAL_MAPS[name]["bump"] = bump
 
 
+# name -> how a displacement case feeds its height: {"space": "WORLD" | "OBJECT"}, the space of
+# a Displacement node (Scale = the case's Distance) into the Material Output's Displacement, the
+# material's Displacement method Bump Only, instead of a Bump node: Cycles then bumps the
+# surface as a Bump node of Distance 1 fed by the displacement along the normal, (h - 0.5) x
+# Scale in world space; in object space the displacement is carried to world space first, so a
+# uniformly scaled object's Scale grows with it. The case's manifest entry has
+# "displacement": {"space", "factor"}, factor the object's uniform scale in object space (1 in
+# world space): sgbake's height layer of scale Distance x factor bakes what Cycles bakes.
+DISPLACEMENT = {}
+
+
+def displacement_case(name, of_case, space, transform=None):
+    """Registers case `name`: case `of_case` (mesh, transform, size, Distance) with its Bump node
+    replaced by a Displacement node in `space` (DISPLACEMENT), and the object moved, turned and
+    scaled by `transform` = (location, rotation, scale) when given."""
+    CASES[name] = CASES[of_case]
+    SUBDIVISION[name] = SUBDIVISION[of_case]
+    if transform is not None:
+        TRANSFORMS[name] = transform
+    elif of_case in TRANSFORMS:
+        TRANSFORMS[name] = TRANSFORMS[of_case]
+    DISPLACEMENT[name] = {"space": space}
+
+
+def bump_by_displacement(mat, space):
+    """Replaces `mat`'s Bump node (make_material) by a Displacement node in `space` of the same
+    Scale, fed by the same texture, into the Material Output's Displacement; the material's
+    Displacement method Bump Only."""
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bump = next(n for n in nodes if n.bl_idname == "ShaderNodeBump")
+    tex = bump.inputs["Height"].links[0].from_node
+    node = nodes.new("ShaderNodeDisplacement")
+    node.space = space
+    node.inputs["Scale"].default_value = bump.inputs["Distance"].default_value
+    node.inputs["Midlevel"].default_value = 0.5
+    links.new(tex.outputs["Color"], node.inputs["Height"])
+    out = next(n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    links.new(node.outputs["Displacement"], out.inputs["Displacement"])
+    nodes.remove(bump)
+    mat.cycles.displacement_method = "BUMP"
+
+
 # name -> the object transform of a case (location, XYZ Euler rotation in radians, scale):
 # mesh.obj stays in object space, Cycles shades the object in world space, and sgbake is given
 # the object's matrix_world ("transform" in the JSON scene). Cases not listed sit at the origin
@@ -396,6 +438,13 @@ projected_normal_map_case("box_nmap_stretch_sphere", "stretch_sphere", 256, "TAN
 WRAP_MAPPING = ((0.5, 0.5, 0.5), (0.5, 0.3, 0.0), (0.5, 0.5, 0.5))
 planar_case("sphere_wrap_sphere", "sphere", 256, 0.02, "SPHERE", mapping=WRAP_MAPPING)
 planar_case("tube_wrap_sphere", "sphere", 256, 0.02, "TUBE", mapping=WRAP_MAPPING)
+# Heights through the Material Output's Displacement (Bump Only) instead of a Bump node: in world
+# space on the sphere and on the stretched one (its Scale stays world units), in object space on
+# the sphere scaled 3 (and turned and moved: its Scale x 3).
+displacement_case("displacement_sphere", "sphere", "WORLD")
+displacement_case("displacement_stretch_sphere", "stretch_sphere", "WORLD")
+displacement_case("displacement_object_sphere", "sphere", "OBJECT",
+                  ((0.3, -0.5, 1.0), (0.5, 0.1, -0.4), (3.0, 3.0, 3.0)))
 projected_normal_map_case("sphere_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "SPHERE",
                           mapping=WRAP_MAPPING)
 projected_normal_map_case("tube_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "TUBE",
@@ -621,6 +670,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             project_texture(name, mat, tex, ob)
             bump = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBump")
             bump.inputs["Strength"].default_value = PLANAR[name].get("strength", 1.0)
+        if name in DISPLACEMENT:
+            bump_by_displacement(mat, DISPLACEMENT[name]["space"])
     else:
         if nmap["space"] == "TANGENT" or name in PLANAR:
             field = normal_field(height_size, nmap["tilt_deg"])
@@ -667,6 +718,13 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             entry["planar"]["mapping"] = dict(PLANAR[name].get("mapping", {}))
             if "matrix" in PLANAR[name]:
                 entry["planar"]["mapping"]["matrix"] = PLANAR[name]["matrix"]
+    if name in DISPLACEMENT:
+        space = DISPLACEMENT[name]["space"]
+        scales = ob.matrix_world.to_scale()
+        if space == "OBJECT" and max(scales) - min(scales) > 1e-6 * max(scales):
+            raise RuntimeError(f"case {name}: object-space displacement needs a uniform scale")
+        entry["displacement"] = {"space": space.lower(),
+                                 "factor": float(scales[0]) if space == "OBJECT" else 1.0}
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}
