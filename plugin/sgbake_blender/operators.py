@@ -341,13 +341,16 @@ def object_layers(sources, render_uv=None, ob=None):
     material only."""
     found, skipped, ignored = [], [], []
     for slot, material in sources:
-        values, slot_skipped, slot_ignored = material_layers(material.node_tree, render_uv, ob)
+        cycles = getattr(material, "cycles", None)  # (Cycles' add-on holds the method)
+        values, slot_skipped, slot_ignored = material_layers(
+            material.node_tree, render_uv, ob,
+            getattr(cycles, "displacement_method", "BUMP"))
         if slot is not None:
             where = f"material '{material.name}' (slot {slot})"
             for entry in values:
                 entry["material_index"] = slot
             if not values and not slot_skipped:
-                slot_skipped.append("no Bump or Normal Map node fed by an Image Texture node")
+                slot_skipped.append("no Bump, Normal Map or Displacement node fed by an Image Texture node")
             slot_skipped = [f"{where}: {note}" for note in slot_skipped]
             slot_ignored = [f"{where}: {note}" for note in slot_ignored]
         found += values
@@ -539,6 +542,82 @@ def _object_projected(tex, ob=None):
     return _object_coordinates(tex, ob) is not None
 
 
+def _height_settings(node, tex, render_uv, ob, ignored):
+    """The settings of a height layer read from Image Texture node `tex` into the Height input of
+    `node` (a Bump or a Displacement node), before its scale: the texture's, with the slopes as
+    Cycles takes them when it bakes (forward differences half a texel apart: the layer then
+    bakes what Cycles bakes from it); on object coordinates the projection's; from the Alpha
+    output, channel a (a projection reads the luminance: named in `ignored`)."""
+    values = _texture_settings(tex, render_uv)
+    values.update(type="height", slopes="bump-node")
+    alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
+    if _object_projected(tex, ob):
+        # Object coordinates: the height projected along z onto the object (Flat), wrapped
+        # around z (Sphere, Tube), or on the three axis planes as Blender's Box projection
+        # blends them (Box).
+        values.pop("uv_map", None)
+        values.update(_object_coordinates(tex, ob))
+        values.update(_projection_settings(tex, "height"))
+        if alpha:
+            ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {values['type']} "
+                           "layer reads the luminance)")
+    elif alpha:
+        values["channel"] = "a"
+    return values
+
+
+def _object_space_factor(ob, where, ignored):
+    """What a length along the normal in object space measures in the world on object `ob`:
+    its uniform scale (1 without `ob`); on a non-uniformly scaled object it varies with the
+    normal, and the cube root of its volume scale is taken (named in `ignored` after
+    `where`)."""
+    if ob is None:
+        return 1.0
+    scales = [abs(v) for v in ob.matrix_world.to_scale()]
+    if max(scales) - min(scales) > 1e-6 * max(scales):
+        ignored.append(f"{where} in object space on an object scaled unevenly (its Scale is "
+                       "taken at the object's mean scale; Cycles grows it with the normal)")
+        return (scales[0] * scales[1] * scales[2]) ** (1.0 / 3.0)
+    return scales[0]
+
+
+def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
+    """The height layer of the Material Output's Displacement (None when there is none to
+    bake): a Displacement node fed by an Image Texture, with the material's Displacement method
+    Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the displacement along the
+    normal, (height - Midlevel) x Scale in world units (in object space, x the object's scale):
+    a height layer of scale Scale (x the object's), its slopes as Cycles takes them. Other
+    methods displace the mesh, which sgbake does not; other nodes are not read (notes in
+    `skipped`)."""
+    output = node_tree.get_output_node("CYCLES")
+    link = _source_link(output.inputs["Displacement"]) if output is not None else None
+    if link is None:
+        return None
+    where = f"'{output.name}' Displacement"
+    if method != "BUMP":
+        skipped.append(f"{where}: method {method.replace('_', ' ').title()} displaces the mesh "
+                       "(only Bump Only is baked)")
+        return None
+    node = link.from_node
+    if node.type != "DISPLACEMENT":
+        skipped.append(f"{where} from '{node.name}' (a Displacement node is read)")
+        return None
+    tex = _linked_image_node(node.inputs["Height"])
+    if tex is None:
+        skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
+        return None
+    ignored += _ignored(node, tex, ("Scale",), "Height", ob)
+    if _source_link(node.inputs["Normal"]) is not None:
+        ignored.append(f"'{node.name}' Normal from a node (the layer displaces along the "
+                       "surface's normal)")
+    values = _height_settings(node, tex, render_uv, ob, ignored)
+    scale = _input_value(node, "Scale")
+    if node.space == "OBJECT":
+        scale *= _object_space_factor(ob, f"'{node.name}'", ignored)
+    values.update(scale=scale, strength=1.0)
+    return values
+
+
 def _projection_settings(tex, kind):
     """The layer settings of Image Texture node `tex`'s projection read at object coordinates
     (_object_projected), for an image of `kind`: Box, a triplanar layer with Blender's Box and
@@ -600,22 +679,31 @@ def _texture_settings(node, render_uv=None):
     return values
 
 
-def material_layers(node_tree, render_uv=None, ob=None):
+def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
     and each Normal Map node whose Color input is an Image Texture node, among the nodes that
-    reach the Surface of the material's output; and notes on the Bump and Normal Map nodes that
-    were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV map
-    active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
-    object baked (for textures on another object's or Generated coordinates).
+    reach the Surface of the material's output, and for the output's Displacement
+    (_displacement_layer, with the material's `displacement_method`); and notes on the nodes
+    that were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV
+    map active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
+    object baked (for textures on another object's or Generated coordinates, and the scale of
+    an object-space displacement).
 
     Bump: scale = Distance, negated when Invert is on, and its Strength (the blend of the bumped
     normal with the original one, as Cycles' Bump node does it); when its Normal input comes
     from a Bump or Normal Map node that made a layer, base "above" (it bumps that node's
     normal), the layers ordered so that such a node's comes first. Normal Map: its space
-    (Tangent or Object) and its Strength. Then notes on what the layers cannot take over
-    (_ignored): the layers are made, and the report says what differs."""
+    (Tangent or Object) and its Strength. Displacement: Cycles bumps the surface's normal with
+    it before the surface's nodes run, so it comes first, and a Bump node whose Normal input is
+    unlinked bumps the normal it makes (base "above"); a shader whose Normal input is unlinked
+    takes that normal. A tangent- or object-space Normal Map does not start from it: where
+    every shader's normal comes from one, the displacement is not baked, as in Cycles. Then
+    notes on what the layers cannot take over (_ignored): the layers are made, and the report
+    says what differs."""
     found, skipped, ignored = [], [], []
     reaching = _surface_nodes(node_tree)
+    displaced = _displacement_layer(node_tree, render_uv, ob, displacement_method, skipped,
+                                    ignored)
     made = {}  # node name -> its entry of found
     for node in node_tree.nodes:
         if node.type not in ("BUMP", "NORMAL_MAP"):
@@ -630,26 +718,9 @@ def material_layers(node_tree, render_uv=None, ob=None):
                 continue
             ignored += _ignored(node, tex, ("Strength", "Distance"), "Height", ob)
             scale = _input_value(node, "Distance")
-            values = _texture_settings(tex, render_uv)
-            # The node's slopes as Cycles takes them when it bakes (forward differences half
-            # a texel apart): the layer then bakes what Cycles bakes from it.
-            values.update(type="height", scale=-scale if node.invert else scale,
-                          strength=max(_input_value(node, "Strength"), 0.0),
-                          slopes="bump-node")
-            alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
-            if _object_projected(tex, ob):
-                # Object coordinates: the height projected along z onto the object (Flat),
-                # wrapped around z (Sphere, Tube), or on the three axis planes as Blender's Box
-                # projection blends them (Box).
-                values.pop("uv_map", None)
-                values.update(_object_coordinates(tex, ob))
-                values.update(_projection_settings(tex, "height"))
-                kind = values["type"]
-                if alpha:
-                    ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {kind} "
-                                   "layer reads the luminance)")
-            elif alpha:
-                values["channel"] = "a"
+            values = _height_settings(node, tex, render_uv, ob, ignored)
+            values.update(scale=-scale if node.invert else scale,
+                          strength=max(_input_value(node, "Strength"), 0.0))
         else:
             tex = _linked_image_node(node.inputs["Color"])
             space = NORMAL_MAP_SPACES.get(node.space)
@@ -693,6 +764,9 @@ def material_layers(node_tree, render_uv=None, ob=None):
             if source is not None and source.name in made and source.name not in seen:
                 made[name]["base"] = "above"
                 below = chain_depth(source.name, seen + (name,)) + 1
+            elif source is None and displaced is not None:
+                made[name]["base"] = "above"  # the displaced normal, Cycles' N
+                below = 1
             elif source is not None:
                 ignored.append(f"'{node.name}' Normal from '{source.name}' (the layer bumps the "
                                "surface's normal)")
@@ -701,22 +775,48 @@ def material_layers(node_tree, render_uv=None, ob=None):
 
     order = {id(values): chain_depth(name) for name, values in made.items()}
     found.sort(key=lambda values: order[id(values)])
+    shaders = [node_tree.nodes[name] for name in sorted(reaching or ())
+               if any(output.type == "SHADER" for output in node_tree.nodes[name].outputs)
+               and node_tree.nodes[name].inputs.get("Normal") is not None]
+    if displaced is not None:
+        # The displaced normal reaches the bake through the shaders that take Cycles' N and the
+        # Bump nodes that bump it.
+        takes_n = [node for node in shaders if _source_node(node.inputs["Normal"]) is None]
+        bumps_n = [name for name, values in made.items()
+                   if node_tree.nodes[name].type == "BUMP" and values.get("base") == "above"
+                   and _source_node(node_tree.nodes[name].inputs["Normal"]) is None]
+        if not takes_n and not bumps_n:
+            skipped.append("the output's Displacement: no shader takes the displaced normal "
+                           "(a Normal Map does not start from it; Cycles bakes none of it)")
+            displaced = None
+        else:
+            found.insert(0, displaced)
+            for node in shaders:
+                source = _source_node(node.inputs["Normal"])
+                if takes_n and source is not None and source.type == "NORMAL_MAP":
+                    ignored.append(f"'{node.name}' Normal from '{source.name}' is mixed with "
+                                   "the displaced normal (Cycles averages them)")
+            for name in made:
+                node = node_tree.nodes[name]
+                if node.type == "NORMAL_MAP" and _input_value(node, "Strength") != 1.0:
+                    ignored.append(f"'{node.name}' Strength blends with the displaced normal "
+                                   "(the layer blends with the surface's)")
     # Cycles' normal bake averages the normals of every shader the surface mixes: one without
     # a bump flattens the result, which layers (bumping the whole surface) cannot follow.
     if found and reaching is not None:
-        for name in sorted(reaching):
-            node = node_tree.nodes[name]
-            normal = node.inputs.get("Normal")
-            shader = any(output.type == "SHADER" for output in node.outputs)
-            if shader and normal is not None and _source_node(normal) is None:
+        for node in shaders:
+            if displaced is None and _source_node(node.inputs["Normal"]) is None:
                 ignored.append(f"'{node.name}' has no bump and is mixed in (Cycles averages "
                                "its normal with the bumped ones)")
+        for name in sorted(reaching):
+            node = node_tree.nodes[name]
             # A Principled BSDF's clearcoat is a closure of its own, on Clearcoat Normal.
             coat = node.inputs.get("Clearcoat")
             coat_normal = node.inputs.get("Clearcoat Normal")
             if (node.type == "BSDF_PRINCIPLED" and coat is not None and coat_normal is not None
                     and (coat.is_linked or coat.default_value > 0)
-                    and _source_node(coat_normal) is None):
+                    and _source_node(coat_normal) is None
+                    and (displaced is None or _source_node(node.inputs["Normal"]) is not None)):
                 ignored.append(f"'{node.name}' has a clearcoat without a bump (Clearcoat Normal "
                                "unlinked: Cycles averages its normal with the bumped ones)")
     return found, skipped, ignored

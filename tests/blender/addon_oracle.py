@@ -66,6 +66,10 @@
    Empty's coordinates through a Mapping node of type Texture (PROJECTOR_*). Layers from
    Material must make one triplanar Box layer (bump-node slopes, the node's type); its tangent-normal bake must be Cycles' (median <=
    PROJECTOR_MEDIAN_DEG), and the same job with sgbake's own triplanar blend must not.
+   Displacement (displacement_case): the texture also into a world-space Displacement node
+   into the Material Output's Displacement (Bump Only), the Bump node's Normal unlinked; Layers
+   from Material must make the displacement's layer and the Bump's above it, baked as Cycles
+   bakes them (DISPLACEMENT_*), the Bump added instead of stacked must not be.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -185,6 +189,16 @@ PROJECTOR_BLEND = 0.3
 PROJECTOR_DISTANCE = 0.01
 PROJECTOR_MEDIAN_DEG = 0.01
 PROJECTOR_CONTROL_FACTOR = 3.0
+# The displacement case (displacement_case): the bump material's texture also fed into a
+# Displacement node (world space, Scale DISPLACEMENT_SCALE) into the Material Output's
+# Displacement (Bump Only), its Bump node left with its Normal input unlinked: Cycles bumps the
+# surface with the displacement first and the Bump node bumps that normal. Layers from Material
+# must make the displacement's height layer first and the Bump's above it; the bake must be
+# Cycles' (median <= DISPLACEMENT_MEDIAN_DEG) and the same job with the Bump added to the
+# displacement instead (no "base") at least DISPLACEMENT_CONTROL_FACTOR times worse.
+DISPLACEMENT_SCALE = 0.05
+DISPLACEMENT_MEDIAN_DEG = 0.01
+DISPLACEMENT_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -596,6 +610,48 @@ def material_checks(settings, ob, distance):
     _, _, plain_notes = operators.material_layers(tree)
     check("Layers from Material: no note for the plain material", not plain_notes,
           "no note", str(plain_notes))
+    # The Material Output's Displacement: with Displacement only (true displacement) it is
+    # skipped and named; in object space on this unevenly scaled Suzanne it is taken at the
+    # object's mean scale, named; where every shader's normal comes from a Normal Map (which
+    # does not start from the displaced normal) it is not baked, as in Cycles.
+    material = ob.active_material
+    output = tree.get_output_node("CYCLES")
+    displace = tree.nodes.new("ShaderNodeDisplacement")
+    displace.inputs["Scale"].default_value = 0.2
+    tree.links.new(tex.outputs["Color"], displace.inputs["Height"])
+    tree.links.new(displace.outputs["Displacement"], output.inputs["Displacement"])
+    material.cycles.displacement_method = "DISPLACEMENT"
+    true_found, true_skipped, _ = operators.object_layers([(None, material)], None, ob)
+    material.cycles.displacement_method = "BUMP"
+    displace.space = "OBJECT"
+    scale = tuple(ob.scale)
+    ob.scale = (2.0, 1.0, 0.8)
+    bpy.context.view_layer.update()
+    object_found, _, object_notes = operators.object_layers([(None, material)], None, ob)
+    ob.scale = scale
+    bpy.context.view_layer.update()
+    mean = 0.2 * 1.6 ** (1 / 3)
+    mapped = tree.nodes.new("ShaderNodeNormalMap")
+    tree.links.new(tex.outputs["Color"], mapped.inputs["Color"])
+    tree.links.new(mapped.outputs["Normal"], diffuse.inputs["Normal"])
+    tree.links.new(tex.outputs["Color"], mapped.inputs["Color"])
+    mapped_found, mapped_skipped, _ = operators.material_layers(tree, None, ob)
+    tree.links.new(bump.outputs["Normal"], diffuse.inputs["Normal"])
+    tree.nodes.remove(mapped)
+    tree.nodes.remove(displace)
+    check("Layers from Material: the output's Displacement, true, in object space, under a "
+          "Normal Map",
+          len(true_found) == 1 and any("displaces the mesh" in n for n in true_skipped)
+          and len(object_found) == 2 and abs(object_found[0]["scale"] - mean) < 1e-6
+          and object_found[1].get("base") == "above"
+          and any("scaled unevenly" in n for n in object_notes)
+          and not any(v["type"] == "height" and v.get("base") != "above"
+                      for v in mapped_found if v is not mapped_found[-1])
+          and any("no shader takes the displaced normal" in n for n in mapped_skipped),
+          f"skipped as true displacement; scale {mean:.4g} then the Bump above it, the uneven "
+          "scale named; not baked under a Normal Map",
+          f"{true_found}, {true_skipped}; {object_found}, {object_notes}; {mapped_found}, "
+          f"{mapped_skipped}")
     # A Principled BSDF bumped through Normal: its clearcoat (a closure on Clearcoat Normal) is
     # named while it is on and unbumped.
     principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
@@ -1502,6 +1558,73 @@ def projector_case(settings, ob, work):
     return entry
 
 
+def displacement_case(settings, ob, work):
+    """The bump material's texture also into a Displacement node (world space, Scale
+    DISPLACEMENT_SCALE) into the Material Output's Displacement, Bump Only, the Bump node's
+    Normal input unlinked: Layers from Material, then the add-on's tangent-normal bake
+    (addon_displacement.npy), the same job without the layers' "base" (the Bump added to the
+    displacement: addon_displacement_control.npy) and Cycles' (cycles_displacement.npy, its
+    mask cycles_displacement_mask.npy). The material is put back afterwards. Returns the
+    manifest entry (result, the layers made, checks)."""
+    import bpy
+    import numpy as np
+    import bake_scene
+    from sgbake_blender import operators
+    mat = ob.active_material
+    tree = mat.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    output = tree.get_output_node("CYCLES")
+    node = tree.nodes.new("ShaderNodeDisplacement")
+    node.space = "WORLD"
+    node.inputs["Scale"].default_value = DISPLACEMENT_SCALE
+    tree.links.new(tex.outputs["Color"], node.inputs["Height"])
+    tree.links.new(node.outputs["Displacement"], output.inputs["Displacement"])
+    mat.cycles.displacement_method = "BUMP"
+    entry = {"result": None, "checks": []}
+    try:
+        bpy.ops.object.sgbake_layers_from_material()
+        layers = [{"type": layer.type, "scale": layer.scale, "base": layer.base,
+                   "slopes": layer.slopes} for layer in settings.layers]
+        entry["layers"] = layers
+        entry["checks"].append({
+            "name": "displacement: Layers from Material makes its layer, then the Bump's above it",
+            "ok": (len(layers) == 2 and all(l["type"] == "height" and l["slopes"] == "bump-node"
+                                            for l in layers)
+                   and abs(layers[0]["scale"] - DISPLACEMENT_SCALE) < 1e-7
+                   and layers[0]["base"] == "surface" and layers[1]["base"] == "above"),
+            "expected": f"two height layers: scale {DISPLACEMENT_SCALE} (surface), then the "
+                        "Bump's (above), slopes bump-node",
+            "message": str(layers)})
+        settings.target_image = None
+        settings.width = settings.height = SIZE
+        settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+        settings.padding, settings.surface, settings.green = "extend", "mesh", "opengl"
+        settings.map = "tangent-normal"
+        job = operators.BakeJob(bpy.context)
+        try:
+            entry["result"] = sorted(bpy.ops.object.sgbake_bake())
+        except RuntimeError as exc:
+            entry["result"] = ["ERROR", str(exc).strip()]
+        if entry["result"] == ["FINISHED"]:
+            save_with_control(job, bpy.data.images[f"{ob.name}_tangent-normal"], work,
+                              "displacement", ("base",))
+        scene = bpy.context.scene
+        engine = scene.render.engine
+        bc.setup_cycles(scene)
+        target = tree.nodes["bake_target"]
+        for space in ("tangent", "mask"):
+            cycles = bc.new_float_image(f"cycles_displacement_{space}", SIZE, SIZE)
+            bake_scene.bake_pass(ob, mat, target, cycles, space, 0)
+            name = "cycles_displacement" + ("" if space == "tangent" else "_mask")
+            np.save(os.path.join(work, f"{name}.npy"), bc.image_array(cycles))
+            bpy.data.images.remove(cycles)
+        target.image = None
+        scene.render.engine = engine
+    finally:
+        tree.nodes.remove(node)
+    return entry
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -1524,6 +1647,7 @@ def blender_make(work, library_path, sabotage):
     manifest["world"] = world_case(settings, ob, work, sabotage)
     manifest["materials"] = materials_case(settings, ob, height, work, sabotage)
     manifest["projector"] = projector_case(settings, ob, work)
+    manifest["displacement"] = displacement_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance)
                           + worker_thread_checks(settings, ob)
@@ -1570,6 +1694,7 @@ def blender_compare(work):
     results["world"] = world_comparisons(work, manifest)
     results["materials"] = materials_comparisons(work)
     results["projector"] = against_cycles(work, "projector")
+    results["displacement"] = against_cycles(work, "displacement")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -1780,10 +1905,11 @@ def evaluate(manifest, results):
     failures += evaluate_world(manifest["world"], results["world"])
     failures += evaluate_materials(manifest["materials"], results["materials"])
     failures += evaluate_projector(manifest["projector"], results["projector"])
+    failures += evaluate_displacement(manifest["displacement"], results["displacement"])
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
-                  + manifest["errors"]):
+                  + manifest["displacement"]["checks"] + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
@@ -1875,6 +2001,23 @@ def evaluate_projector(entry, r):
     return failures + judge_against_cycles("projector", "", r["addon"], r["control"],
                                            "with sgbake's own triplanar blend",
                                            PROJECTOR_MEDIAN_DEG, PROJECTOR_CONTROL_FACTOR)
+
+
+def evaluate_displacement(entry, r):
+    """Prints the displacement case's angles to Cycles; returns failures: a median over
+    DISPLACEMENT_MEDIAN_DEG, or a control (the Bump added, not stacked) less than
+    DISPLACEMENT_CONTROL_FACTOR times worse."""
+    print("  Displacement (Bump Only, world space) with a Bump node on the displaced normal "
+          f"({entry.get('layers')}) vs Cycles:")
+    failures = []
+    if entry["result"] != ["FINISHED"]:
+        failures.append(f"displacement: the add-on's bake returned {entry['result']}")
+    if "error" in r:
+        print(f"    {r['error']}")
+        return failures + [f"displacement: {r['error']}"]
+    return failures + judge_against_cycles("displacement", "", r["addon"], r["control"],
+                                           "with the Bump added to the displacement",
+                                           DISPLACEMENT_MEDIAN_DEG, DISPLACEMENT_CONTROL_FACTOR)
 
 
 def main():
