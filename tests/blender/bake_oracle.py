@@ -573,12 +573,12 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
         negative_control(name, r, "nmap_sum", "bump added, not stacked:  ",
                          "the bake with the bump added to the normal map's gradient", chain,
                          fails, stretched)
-    if "projection" in nmap:
-        negative_control(name, r, "nmap_uv", "read through the UV map:  ",
-                         "the bake of the map read through the UV map", chain, fails, stretched)
     if nmap.get("projection") in SWAPPED_WRAP:
         negative_control(name, r, "nmap_swapped", "the other wrap:           ",
                          "the bake of the map read by the other wrap", chain, fails, stretched)
+    if "projection" in nmap:
+        negative_control(name, r, "nmap_uv", "read through the UV map:  ",
+                         "the bake of the map read through the UV map", chain, fails, stretched)
     elif nmap["strength"] == 1.0 and not chain:
         s = r.get("nmap_flags")
         same = s.get("json_vs_flags_max_abs") if s else None
