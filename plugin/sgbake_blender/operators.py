@@ -436,6 +436,78 @@ def _constant(socket):
     return (value,) * 3 if isinstance(value, float) else value
 
 
+SEPARATED_CHANNELS = {"R": "r", "G": "g", "B": "b", "Red": "r", "Green": "g", "Blue": "b"}
+
+
+def _affine_step(node, link):
+    """How Math node or Map Range node `node` changes the height fed into its input the chain
+    comes through (the one input linked to something other than constants): (that input,
+    factor) when its output is factor x height + a constant, which no slope sees; None for any
+    other operation, a clamp, or more than one varying input."""
+    if node.type == "MATH" and not node.use_clamp:
+        operands = {"ADD": 2, "SUBTRACT": 2, "MULTIPLY": 2, "DIVIDE": 2, "MULTIPLY_ADD": 3}
+        count = operands.get(node.operation)
+        if count is None:
+            return None
+        values = [_constant(node.inputs[i]) for i in range(count)]
+        varying = [i for i, v in enumerate(values) if v is None]
+        if len(varying) != 1:
+            return None
+        i = varying[0]
+        factor = {"ADD": lambda: 1.0, "SUBTRACT": lambda: 1.0 if i == 0 else -1.0,
+                  "MULTIPLY": lambda: values[1 - i],
+                  "DIVIDE": lambda: _divide(1.0, values[1]) if i == 0 else None,
+                  "MULTIPLY_ADD": lambda: (values[1] if i == 0 else values[0] if i == 1
+                                           else 1.0)}[node.operation]()
+        return None if factor is None else (node.inputs[i], factor)
+    if (node.type == "MAP_RANGE" and node.data_type == "FLOAT" and not node.clamp
+            and node.interpolation_type == "LINEAR"):
+        ends = [_constant(node.inputs[name]) for name in ("From Min", "From Max", "To Min",
+                                                          "To Max")]
+        if any(v is None for v in ends):
+            return None
+        return node.inputs["Value"], _divide(ends[3] - ends[2], ends[1] - ends[0])
+    return None
+
+
+def _height_source(socket):
+    """The Image Texture node (with an image) that feeds height input `socket`, the channel it
+    is read on and the factor the nodes between scale it by: (node, channel, factor), or None.
+    Followed back through Reroutes and nodes that change the height affinely (_affine_step:
+    Math and Map Range nodes with constants; the offset moves no slope), RGB to BW (the
+    luminance, as the input's own conversion) and Separate RGB or Color (RGB mode: channel r,
+    g or b); the texture's Alpha output is channel a, its Color the luminance."""
+    factor, channel = 1.0, None
+    while True:
+        link = _source_link(socket)
+        if link is None or link.from_node.mute:
+            return None
+        node = link.from_node
+        if node.type == "TEX_IMAGE":
+            if node.image is None:
+                return None
+            if link.from_socket.name == "Alpha":
+                if channel is not None:
+                    return None
+                channel = "a"
+            return node, channel or "luminance", factor
+        if node.type in ("SEPRGB", "SEPARATE_COLOR"):
+            if channel is not None or getattr(node, "mode", "RGB") != "RGB":
+                return None
+            channel = SEPARATED_CHANNELS.get(link.from_socket.name)
+            if channel is None:
+                return None
+            socket = node.inputs[0]
+        elif node.type == "RGBTOBW" and channel is None:
+            socket = node.inputs[0]
+        else:
+            step = _affine_step(node, link)
+            if step is None:
+                return None
+            socket, by = step
+            factor *= by
+
+
 def _linked_image_node(socket):
     """The Image Texture node (with an image) that feeds `socket` (_source_link), or None."""
     link = _source_link(socket)
@@ -542,15 +614,15 @@ def _object_projected(tex, ob=None):
     return _object_coordinates(tex, ob) is not None
 
 
-def _height_settings(node, tex, render_uv, ob, ignored):
-    """The settings of a height layer read from Image Texture node `tex` into the Height input of
-    `node` (a Bump or a Displacement node), before its scale: the texture's, with the slopes as
-    Cycles takes them when it bakes (forward differences half a texel apart: the layer then
-    bakes what Cycles bakes from it); on object coordinates the projection's; from the Alpha
-    output, channel a (a projection reads the luminance: named in `ignored`)."""
+def _height_settings(node, tex, channel, render_uv, ob, ignored):
+    """The settings of a height layer read from Image Texture node `tex` on `channel`
+    (_height_source) into the Height input of `node` (a Bump or a Displacement node), before
+    its scale: the texture's, with the slopes as Cycles takes them when it bakes (forward
+    differences half a texel apart: the layer then bakes what Cycles bakes from it); on object
+    coordinates the projection's (which reads the luminance: another channel is named in
+    `ignored`)."""
     values = _texture_settings(tex, render_uv)
     values.update(type="height", slopes="bump-node")
-    alpha = _source_link(node.inputs["Height"]).from_socket.name == "Alpha"
     if _object_projected(tex, ob):
         # Object coordinates: the height projected along z onto the object (Flat), wrapped
         # around z (Sphere, Tube), or on the three axis planes as Blender's Box projection
@@ -558,11 +630,11 @@ def _height_settings(node, tex, render_uv, ob, ignored):
         values.pop("uv_map", None)
         values.update(_object_coordinates(tex, ob))
         values.update(_projection_settings(tex, "height"))
-        if alpha:
-            ignored.append(f"'{node.name}' Height from '{tex.name}' Alpha (a {values['type']} "
-                           "layer reads the luminance)")
-    elif alpha:
-        values["channel"] = "a"
+        if channel != "luminance":
+            ignored.append(f"'{node.name}' Height from '{tex.name}' channel {channel.upper()} "
+                           f"(a {values['type']} layer reads the luminance)")
+    elif channel != "luminance":
+        values["channel"] = channel
     return values
 
 
@@ -602,16 +674,17 @@ def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     if node.type != "DISPLACEMENT":
         skipped.append(f"{where} from '{node.name}' (a Displacement node is read)")
         return None
-    tex = _linked_image_node(node.inputs["Height"])
-    if tex is None:
+    source = _height_source(node.inputs["Height"])
+    if source is None:
         skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
         return None
+    tex, channel, factor = source
     ignored += _ignored(node, tex, ("Scale",), "Height", ob)
     if _source_link(node.inputs["Normal"]) is not None:
         ignored.append(f"'{node.name}' Normal from a node (the layer displaces along the "
                        "surface's normal)")
-    values = _height_settings(node, tex, render_uv, ob, ignored)
-    scale = _input_value(node, "Scale")
+    values = _height_settings(node, tex, channel, render_uv, ob, ignored)
+    scale = factor * _input_value(node, "Scale")
     if node.space == "OBJECT":
         scale *= _object_space_factor(ob, f"'{node.name}'", ignored)
     values.update(scale=scale, strength=1.0)
@@ -644,7 +717,8 @@ def _ignored(node, tex, inputs, socket, ob=None):
     (but one a layer takes), Closest interpolation (read bilinear), and `inputs` fed by
     anything but constants (_constant; of which the layer takes the unconnected value)."""
     notes = []
-    if node.type != "BUMP" and _source_link(node.inputs[socket]).from_socket.name == "Alpha":
+    if (node.type == "NORMAL_MAP"
+            and _source_link(node.inputs[socket]).from_socket.name == "Alpha"):
         notes.append(f"'{node.name}' {socket} from '{tex.name}' Alpha (the layer reads its "
                      "colour)")
     if tex.interpolation == "Closest":
@@ -712,13 +786,14 @@ def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUM
             skipped.append(f"'{node.name}': not linked to the material output's Surface")
             continue
         if node.type == "BUMP":
-            tex = _linked_image_node(node.inputs["Height"])
-            if tex is None:
+            source = _height_source(node.inputs["Height"])
+            if source is None:
                 skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
                 continue
+            tex, channel, factor = source
             ignored += _ignored(node, tex, ("Strength", "Distance"), "Height", ob)
-            scale = _input_value(node, "Distance")
-            values = _height_settings(node, tex, render_uv, ob, ignored)
+            scale = factor * _input_value(node, "Distance")
+            values = _height_settings(node, tex, channel, render_uv, ob, ignored)
             values.update(scale=-scale if node.invert else scale,
                           strength=max(_input_value(node, "Strength"), 0.0))
         else:

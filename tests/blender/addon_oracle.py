@@ -189,8 +189,9 @@ PROJECTOR_BLEND = 0.3
 PROJECTOR_DISTANCE = 0.01
 PROJECTOR_MEDIAN_DEG = 0.01
 PROJECTOR_CONTROL_FACTOR = 3.0
-# The displacement case (displacement_case): the bump material's texture also fed into a
-# Displacement node (world space, Scale DISPLACEMENT_SCALE) into the Material Output's
+# The displacement case (displacement_case): the bump material's texture also fed, through a
+# Math node doubling it, into a Displacement node (world space, Scale DISPLACEMENT_SCALE / 2)
+# into the Material Output's
 # Displacement (Bump Only), its Bump node left with its Normal input unlinked: Cycles bumps the
 # surface with the displacement first and the Bump node bumps that normal. Layers from Material
 # must make the displacement's height layer first and the Bump's above it; the bake must be
@@ -610,6 +611,35 @@ def material_checks(settings, ob, distance):
     _, _, plain_notes = operators.material_layers(tree)
     check("Layers from Material: no note for the plain material", not plain_notes,
           "no note", str(plain_notes))
+    # A height through nodes that change it affinely (Math x 0.5, then Map Range 0..1 to
+    # 0.2..0.8: x 0.3 in all) scales the layer; through Separate Color's Green, channel g; a
+    # clamped Math node is not affine: no layer.
+    half = tree.nodes.new("ShaderNodeMath")
+    half.operation, half.inputs[1].default_value = "MULTIPLY", 0.5
+    ranged = tree.nodes.new("ShaderNodeMapRange")
+    ranged.clamp = False
+    ranged.inputs["To Min"].default_value, ranged.inputs["To Max"].default_value = 0.2, 0.8
+    tree.links.new(tex.outputs["Color"], half.inputs[0])
+    tree.links.new(half.outputs[0], ranged.inputs["Value"])
+    tree.links.new(ranged.outputs["Result"], bump.inputs["Height"])
+    affine, _, affine_notes = operators.material_layers(tree)
+    half.use_clamp = True
+    clamped, clamped_skipped, _ = operators.material_layers(tree)
+    separate = tree.nodes.new("ShaderNodeSeparateColor")
+    tree.links.new(tex.outputs["Color"], separate.inputs[0])
+    tree.links.new(separate.outputs["Green"], bump.inputs["Height"])
+    green, _, _ = operators.material_layers(tree)
+    tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    for extra in (half, ranged, separate):
+        tree.nodes.remove(extra)
+    check("Layers from Material: a height through Math, Map Range and Separate Color nodes",
+          len(affine) == 1 and abs(affine[0]["scale"] - 0.3 * distance) < 1e-7
+          and not affine_notes and not clamped
+          and any("not an Image Texture" in n for n in clamped_skipped)
+          and len(green) == 1 and green[0].get("channel") == "g"
+          and abs(green[0]["scale"] - distance) < 1e-7,
+          f"scale {0.3 * distance:.4g}, nothing named; clamped: skipped; Green: channel g",
+          f"{affine}, {affine_notes}; {clamped}, {clamped_skipped}; {green}")
     # The Material Output's Displacement: with Displacement only (true displacement) it is
     # skipped and named; in object space on this unevenly scaled Suzanne it is taken at the
     # object's mean scale, named; where every shader's normal comes from a Normal Map (which
@@ -1576,8 +1606,12 @@ def displacement_case(settings, ob, work):
     output = tree.get_output_node("CYCLES")
     node = tree.nodes.new("ShaderNodeDisplacement")
     node.space = "WORLD"
-    node.inputs["Scale"].default_value = DISPLACEMENT_SCALE
-    tree.links.new(tex.outputs["Color"], node.inputs["Height"])
+    # Its height through a Math node (x 2), its Scale halved: the layer's scale is the product.
+    node.inputs["Scale"].default_value = DISPLACEMENT_SCALE / 2
+    double = tree.nodes.new("ShaderNodeMath")
+    double.operation, double.inputs[1].default_value = "MULTIPLY", 2.0
+    tree.links.new(tex.outputs["Color"], double.inputs[0])
+    tree.links.new(double.outputs[0], node.inputs["Height"])
     tree.links.new(node.outputs["Displacement"], output.inputs["Displacement"])
     mat.cycles.displacement_method = "BUMP"
     entry = {"result": None, "checks": []}
@@ -1622,6 +1656,7 @@ def displacement_case(settings, ob, work):
         scene.render.engine = engine
     finally:
         tree.nodes.remove(node)
+        tree.nodes.remove(double)
     return entry
 
 
