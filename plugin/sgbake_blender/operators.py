@@ -753,7 +753,118 @@ def _texture_settings(node, render_uv=None):
     return values
 
 
+# Node properties a flattened copy does not take over (placement and looks, not shading).
+UNCOPIED_PROPERTIES = {"name", "label", "location", "width", "height", "width_hidden", "parent",
+                       "select", "hide", "mute", "show_options", "show_preview", "show_texture",
+                       "use_custom_color", "color", "node_tree"}
+
+
+def _copy_node(tree, node, name):
+    """A copy of `node` in `tree` named `name`: its writable properties, its sockets' values."""
+    new = tree.nodes.new(node.bl_idname)
+    new.name = name
+    for prop in node.bl_rna.properties:
+        if prop.is_readonly or prop.identifier in UNCOPIED_PROPERTIES:
+            continue
+        try:
+            setattr(new, prop.identifier, getattr(node, prop.identifier))
+        except (AttributeError, TypeError, ValueError, RuntimeError):
+            pass  # (properties a node type makes read-only on its own)
+    for sockets, copies in ((node.inputs, new.inputs), (node.outputs, new.outputs)):
+        for socket, copy in zip(sockets, copies):
+            if hasattr(socket, "default_value") and hasattr(copy, "default_value"):
+                try:
+                    copy.default_value = socket.default_value
+                except (AttributeError, TypeError, ValueError):
+                    pass
+    new.mute = node.mute
+    return new
+
+
+def _flattened(node_tree):
+    """A temporary material whose node tree is `node_tree` with its Group nodes expanded, as
+    Cycles expands them before it shades: every node inside a group (and inside groups in
+    groups) copied once per group node, named by its path ("Group/Bump"), and every link that
+    crosses a group's Group Input or Group Output linked straight through (a group input fed
+    by nothing gives its socket's value). None when `node_tree` has no Group node. The caller
+    removes the material."""
+    if not any(node.type == "GROUP" for node in node_tree.nodes):
+        return None
+    material = bpy.data.materials.new("sgbake flattened")
+    material.use_nodes = True
+    flat = material.node_tree
+    flat.nodes.clear()
+    trees, groups, copies = {(): node_tree}, {}, {}
+
+    def copy(tree, path):
+        for node in tree.nodes:
+            if node.type == "GROUP" and node.node_tree is not None:
+                inner = path + (node.name,)
+                trees[inner], groups[inner] = node.node_tree, (path, node)
+                copy(node.node_tree, inner)
+            elif node.type not in ("GROUP", "GROUP_INPUT", "GROUP_OUTPUT", "FRAME"):
+                copies[(path, node.name)] = _copy_node(flat, node, "/".join(path + (node.name,)))
+
+    def index(sockets, socket):
+        return next(i for i, s in enumerate(sockets) if s == socket)
+
+    def feed(socket, path):
+        """What feeds input `socket` of a node at `path`: ("socket", flat output socket),
+        ("value", value) or None (nothing; the input's own value)."""
+        links = [link for link in socket.links if not link.is_muted]
+        if not links:
+            return None
+        link = links[0]
+        node = link.from_node
+        if node.type == "GROUP":
+            inner = path + (node.name,)
+            output = next((n for n in node.node_tree.nodes if n.type == "GROUP_OUTPUT"
+                           and n.is_active_output), None) if node.node_tree else None
+            if output is None:
+                return None
+            inside = output.inputs[index(node.outputs, link.from_socket)]
+            return feed(inside, inner) or (
+                ("value", inside.default_value) if hasattr(inside, "default_value") else None)
+        if node.type == "GROUP_INPUT":
+            parent, group = groups[path]
+            outside = group.inputs[index(node.outputs, link.from_socket)]
+            return feed(outside, parent) or (
+                ("value", outside.default_value) if hasattr(outside, "default_value") else None)
+        made = copies.get((path, node.name))
+        if made is None:
+            return None
+        return "socket", made.outputs[index(node.outputs, link.from_socket)]
+
+    copy(node_tree, ())
+    for (path, name), made in copies.items():
+        node = trees[path].nodes[name]
+        for socket, target in zip(node.inputs, made.inputs):
+            source = feed(socket, path)
+            if source is None:
+                continue
+            if source[0] == "socket":
+                flat.links.new(source[1], target)
+            else:
+                try:
+                    target.default_value = source[1]
+                except (AttributeError, TypeError, ValueError):
+                    pass
+    return material
+
+
 def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
+    """_tree_layers of `node_tree`, its Group nodes expanded first as Cycles expands them
+    (_flattened: the nodes inside a group are named by their path, "Group/Bump")."""
+    material = _flattened(node_tree)
+    try:
+        return _tree_layers(material.node_tree if material else node_tree, render_uv, ob,
+                            displacement_method)
+    finally:
+        if material is not None:
+            bpy.data.materials.remove(material)
+
+
+def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
     and each Normal Map node whose Color input is an Image Texture node, among the nodes that
     reach the Surface of the material's output, and for the output's Displacement

@@ -190,7 +190,7 @@ PROJECTOR_DISTANCE = 0.01
 PROJECTOR_MEDIAN_DEG = 0.01
 PROJECTOR_CONTROL_FACTOR = 3.0
 # The displacement case (displacement_case): the bump material's texture also fed, through a
-# Math node doubling it, into a Displacement node (world space, Scale DISPLACEMENT_SCALE / 2)
+# node group whose Math node doubles it, into a Displacement node (world space, Scale DISPLACEMENT_SCALE / 2)
 # into the Material Output's
 # Displacement (Bump Only), its Bump node left with its Normal input unlinked: Cycles bumps the
 # surface with the displacement first and the Bump node bumps that normal. Layers from Material
@@ -611,6 +611,52 @@ def material_checks(settings, ob, distance):
     _, _, plain_notes = operators.material_layers(tree)
     check("Layers from Material: no note for the plain material", not plain_notes,
           "no note", str(plain_notes))
+    # The texture and the Bump inside a node group (its Distance a group input, fed from
+    # outside by a Value node; its Normal the group's output into the shader), in a group in a
+    # group: the same layer as the Bump made outside, the nodes named by their path.
+    direct, _, _ = operators.material_layers(tree)
+    inner = bpy.data.node_groups.new("sgbake inner", "ShaderNodeTree")
+    inner.inputs.new("NodeSocketFloat", "Distance")
+    inner.outputs.new("NodeSocketVector", "Normal")
+    inner_in, inner_out = inner.nodes.new("NodeGroupInput"), inner.nodes.new("NodeGroupOutput")
+    inner_tex = inner.nodes.new("ShaderNodeTexImage")
+    inner_tex.image, inner_tex.interpolation = tex.image, "Closest"  # (named, by its path)
+    inner_bump = inner.nodes.new("ShaderNodeBump")
+    inner_bump.inputs["Distance"].default_value = 5.0  # (its own value: not the one used)
+    inner.links.new(inner_tex.outputs["Color"], inner_bump.inputs["Height"])
+    inner.links.new(inner_in.outputs["Distance"], inner_bump.inputs["Distance"])
+    inner.links.new(inner_bump.outputs["Normal"], inner_out.inputs["Normal"])
+    outer = bpy.data.node_groups.new("sgbake outer", "ShaderNodeTree")
+    outer.inputs.new("NodeSocketFloat", "Distance")
+    outer.outputs.new("NodeSocketVector", "Normal")
+    outer_in, outer_out = outer.nodes.new("NodeGroupInput"), outer.nodes.new("NodeGroupOutput")
+    nested = outer.nodes.new("ShaderNodeGroup")
+    nested.node_tree = inner
+    outer.links.new(outer_in.outputs["Distance"], nested.inputs["Distance"])
+    outer.links.new(nested.outputs["Normal"], outer_out.inputs["Normal"])
+    grouped = tree.nodes.new("ShaderNodeGroup")
+    grouped.node_tree = outer
+    value = tree.nodes.new("ShaderNodeValue")
+    value.outputs[0].default_value = distance
+    tree.links.new(value.outputs[0], grouped.inputs["Distance"])
+    tree.links.new(grouped.outputs["Normal"], diffuse.inputs["Normal"])
+    in_groups, skipped_groups, named_groups = operators.material_layers(tree)
+    path = f"{grouped.name}/{nested.name}/{inner_tex.name}"
+    tree.links.new(bump.outputs["Normal"], diffuse.inputs["Normal"])
+    tree.nodes.remove(grouped)
+    tree.nodes.remove(value)
+    bpy.data.node_groups.remove(outer)
+    bpy.data.node_groups.remove(inner)
+    keys = ("type", "image", "filter", "wrap", "slopes", "strength", "scale")
+    check("Layers from Material: a Bump inside a group inside a group",
+          len(in_groups) == 1 and len(direct) == 1
+          and all(in_groups[0].get(k) == direct[0].get(k) for k in keys)
+          and named_groups == [f"'{path}' Closest interpolation (read bilinear)"]
+          and any(f"'{bump.name}': not linked" in n for n in skipped_groups)
+          and not bpy.data.materials.get("sgbake flattened"),
+          f"the direct layer {[{k: direct[0].get(k) for k in keys}] if direct else direct}, "
+          f"'{path}' named, the Bump outside skipped, no flattened material left",
+          f"{in_groups}, {skipped_groups}, {named_groups}")
     # A height through nodes that change it affinely (Math x 0.5, then Map Range 0..1 to
     # 0.2..0.8: x 0.3 in all) scales the layer; through Separate Color's Green, channel g; a
     # clamped Math node is not affine: no layer.
@@ -1606,12 +1652,20 @@ def displacement_case(settings, ob, work):
     output = tree.get_output_node("CYCLES")
     node = tree.nodes.new("ShaderNodeDisplacement")
     node.space = "WORLD"
-    # Its height through a Math node (x 2), its Scale halved: the layer's scale is the product.
+    # Its height through a Math node (x 2) inside a node group, its Scale halved: the layer's
+    # scale is the product.
     node.inputs["Scale"].default_value = DISPLACEMENT_SCALE / 2
-    double = tree.nodes.new("ShaderNodeMath")
-    double.operation, double.inputs[1].default_value = "MULTIPLY", 2.0
-    tree.links.new(tex.outputs["Color"], double.inputs[0])
-    tree.links.new(double.outputs[0], node.inputs["Height"])
+    doubling = bpy.data.node_groups.new("sgbake doubling", "ShaderNodeTree")
+    doubling.inputs.new("NodeSocketFloat", "Height")
+    doubling.outputs.new("NodeSocketFloat", "Height")
+    math = doubling.nodes.new("ShaderNodeMath")
+    math.operation, math.inputs[1].default_value = "MULTIPLY", 2.0
+    doubling.links.new(doubling.nodes.new("NodeGroupInput").outputs["Height"], math.inputs[0])
+    doubling.links.new(math.outputs[0], doubling.nodes.new("NodeGroupOutput").inputs["Height"])
+    double = tree.nodes.new("ShaderNodeGroup")
+    double.node_tree = doubling
+    tree.links.new(tex.outputs["Color"], double.inputs["Height"])
+    tree.links.new(double.outputs["Height"], node.inputs["Height"])
     tree.links.new(node.outputs["Displacement"], output.inputs["Displacement"])
     mat.cycles.displacement_method = "BUMP"
     entry = {"result": None, "checks": []}
@@ -1657,6 +1711,7 @@ def displacement_case(settings, ob, work):
     finally:
         tree.nodes.remove(node)
         tree.nodes.remove(double)
+        bpy.data.node_groups.remove(doubling)
     return entry
 
 
