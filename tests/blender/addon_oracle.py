@@ -1512,6 +1512,44 @@ def save_with_control(job, image, work, case, keys):
         np.save(os.path.join(work, f"addon_{case}_control.npy"), bc.image_array(control))
 
 
+def bake_against_cycles(settings, ob, work, case, control_keys):
+    """The add-on's 256^2 tangent-normal bake of `ob` with its layers (addon_CASE.npy), the same
+    job with `control_keys` taken out of every layer (addon_CASE_control.npy, save_with_control)
+    and Cycles' bake of its active material with its mask (cycles_CASE.npy,
+    cycles_CASE_mask.npy); returns the add-on bake's result."""
+    import bpy
+    import numpy as np
+    import bake_scene
+    from sgbake_blender import operators
+    settings.target_image = None
+    settings.width = settings.height = SIZE
+    settings.margin, settings.samples, settings.use_alpha = 0, 1, False
+    settings.padding, settings.surface, settings.green = "extend", "mesh", "opengl"
+    settings.map = "tangent-normal"
+    job = operators.BakeJob(bpy.context)
+    try:
+        result = sorted(bpy.ops.object.sgbake_bake())
+    except RuntimeError as exc:
+        result = ["ERROR", str(exc).strip()]
+    if result == ["FINISHED"]:
+        save_with_control(job, bpy.data.images[f"{ob.name}_tangent-normal"], work, case,
+                          control_keys)
+    scene = bpy.context.scene
+    engine = scene.render.engine
+    bc.setup_cycles(scene)
+    mat = ob.active_material
+    target = mat.node_tree.nodes["bake_target"]
+    for space in ("tangent", "mask"):
+        cycles = bc.new_float_image(f"cycles_{case}_{space}", SIZE, SIZE)
+        bake_scene.bake_pass(ob, mat, target, cycles, space, 0)
+        name = f"cycles_{case}" + ("" if space == "tangent" else "_mask")
+        np.save(os.path.join(work, f"{name}.npy"), bc.image_array(cycles))
+        bpy.data.images.remove(cycles)
+    target.image = None
+    scene.render.engine = engine
+    return result
+
+
 def projector_case(settings, ob, work):
     """The bump material's Image Texture switched to Box projection on an Empty's coordinates
     through a Mapping node (PROJECTOR_*), Distance PROJECTOR_DISTANCE: Layers from Material,
@@ -1520,8 +1558,6 @@ def projector_case(settings, ob, work):
     mask cycles_projector_mask.npy). The material is put back afterwards. Returns the manifest
     entry (result, the layer made, checks)."""
     import bpy
-    import numpy as np
-    import bake_scene
     from sgbake_blender import operators
     mat = ob.active_material
     tree = mat.node_tree
@@ -1584,31 +1620,7 @@ def projector_case(settings, ob, work):
                         f"{PROJECTOR_MAPPING_TYPE}, mapping scale {PROJECTOR_MAPPING[2]} and "
                         f"scale {PROJECTOR_DISTANCE} from the constant nodes",
             "message": str(entry["layer"])})
-        settings.target_image = None
-        settings.width = settings.height = SIZE
-        settings.margin, settings.samples, settings.use_alpha = 0, 1, False
-        settings.padding, settings.surface, settings.green = "extend", "mesh", "opengl"
-        settings.map = "tangent-normal"
-        job = operators.BakeJob(bpy.context)
-        try:
-            entry["result"] = sorted(bpy.ops.object.sgbake_bake())
-        except RuntimeError as exc:
-            entry["result"] = ["ERROR", str(exc).strip()]
-        if entry["result"] == ["FINISHED"]:
-            save_with_control(job, bpy.data.images[f"{ob.name}_tangent-normal"], work,
-                              "projector", ("projection", "box_blend"))
-        scene = bpy.context.scene
-        engine = scene.render.engine
-        bc.setup_cycles(scene)
-        target = tree.nodes["bake_target"]
-        for space in ("tangent", "mask"):
-            cycles = bc.new_float_image(f"cycles_projector_{space}", SIZE, SIZE)
-            bake_scene.bake_pass(ob, mat, target, cycles, space, 0)
-            name = "cycles_projector" + ("" if space == "tangent" else "_mask")
-            np.save(os.path.join(work, f"{name}.npy"), bc.image_array(cycles))
-            bpy.data.images.remove(cycles)
-        target.image = None
-        scene.render.engine = engine
+        entry["result"] = bake_against_cycles(settings, ob, work, "projector", ("projection", "box_blend"))
         # The Empty moved after Layers from Material: the next bake reads it where it is now.
         empty.location = (empty.location[0] + 0.5, empty.location[1], empty.location[2] - 0.25)
         bpy.context.view_layer.update()
@@ -1643,9 +1655,6 @@ def displacement_case(settings, ob, work):
     mask cycles_displacement_mask.npy). The material is put back afterwards. Returns the
     manifest entry (result, the layers made, checks)."""
     import bpy
-    import numpy as np
-    import bake_scene
-    from sgbake_blender import operators
     mat = ob.active_material
     tree = mat.node_tree
     tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
@@ -1683,31 +1692,7 @@ def displacement_case(settings, ob, work):
             "expected": f"two height layers: scale {DISPLACEMENT_SCALE} (surface), then the "
                         "Bump's (above), slopes bump-node",
             "message": str(layers)})
-        settings.target_image = None
-        settings.width = settings.height = SIZE
-        settings.margin, settings.samples, settings.use_alpha = 0, 1, False
-        settings.padding, settings.surface, settings.green = "extend", "mesh", "opengl"
-        settings.map = "tangent-normal"
-        job = operators.BakeJob(bpy.context)
-        try:
-            entry["result"] = sorted(bpy.ops.object.sgbake_bake())
-        except RuntimeError as exc:
-            entry["result"] = ["ERROR", str(exc).strip()]
-        if entry["result"] == ["FINISHED"]:
-            save_with_control(job, bpy.data.images[f"{ob.name}_tangent-normal"], work,
-                              "displacement", ("base",))
-        scene = bpy.context.scene
-        engine = scene.render.engine
-        bc.setup_cycles(scene)
-        target = tree.nodes["bake_target"]
-        for space in ("tangent", "mask"):
-            cycles = bc.new_float_image(f"cycles_displacement_{space}", SIZE, SIZE)
-            bake_scene.bake_pass(ob, mat, target, cycles, space, 0)
-            name = "cycles_displacement" + ("" if space == "tangent" else "_mask")
-            np.save(os.path.join(work, f"{name}.npy"), bc.image_array(cycles))
-            bpy.data.images.remove(cycles)
-        target.image = None
-        scene.render.engine = engine
+        entry["result"] = bake_against_cycles(settings, ob, work, "displacement", ("base",))
     finally:
         tree.nodes.remove(node)
         tree.nodes.remove(double)
@@ -1994,8 +1979,16 @@ def evaluate(manifest, results):
                             f"{'be within' if equal else 'exceed'} {tolerance:g}")
     failures += evaluate_world(manifest["world"], results["world"])
     failures += evaluate_materials(manifest["materials"], results["materials"])
-    failures += evaluate_projector(manifest["projector"], results["projector"])
-    failures += evaluate_displacement(manifest["displacement"], results["displacement"])
+    failures += evaluate_case_against_cycles(
+        "projector", "Box projection on an Empty's coordinates through a Mapping node "
+        f"({manifest['projector'].get('layer')})", manifest["projector"], results["projector"],
+        "with sgbake's own triplanar blend", PROJECTOR_MEDIAN_DEG, PROJECTOR_CONTROL_FACTOR)
+    failures += evaluate_case_against_cycles(
+        "displacement", "Displacement (Bump Only, world space) with a Bump node on the "
+        f"displaced normal ({manifest['displacement'].get('layers')})",
+        manifest["displacement"], results["displacement"],
+        "with the Bump added to the displacement", DISPLACEMENT_MEDIAN_DEG,
+        DISPLACEMENT_CONTROL_FACTOR)
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
@@ -2076,38 +2069,19 @@ def evaluate_materials(entry, r):
     return failures
 
 
-def evaluate_projector(entry, r):
-    """Prints the projector case's angles to Cycles; returns failures: a median over
-    PROJECTOR_MEDIAN_DEG, or a control (sgbake's own blend) less than PROJECTOR_CONTROL_FACTOR
-    times worse."""
-    print(f"  Box projection on an Empty's coordinates through a Mapping node ({entry.get('layer')})"
-          " vs Cycles:")
+def evaluate_case_against_cycles(name, title, entry, r, control_what, bar, factor):
+    """Prints case `name`'s angles to Cycles under `title`; returns failures: its add-on bake
+    not finished, a median over `bar`, or a control (`control_what`) less than `factor` times
+    worse."""
+    print(f"  {title} vs Cycles:")
     failures = []
     if entry["result"] != ["FINISHED"]:
-        failures.append(f"projector: the add-on's bake returned {entry['result']}")
+        failures.append(f"{name}: the add-on's bake returned {entry['result']}")
     if "error" in r:
         print(f"    {r['error']}")
-        return failures + [f"projector: {r['error']}"]
-    return failures + judge_against_cycles("projector", "", r["addon"], r["control"],
-                                           "with sgbake's own triplanar blend",
-                                           PROJECTOR_MEDIAN_DEG, PROJECTOR_CONTROL_FACTOR)
-
-
-def evaluate_displacement(entry, r):
-    """Prints the displacement case's angles to Cycles; returns failures: a median over
-    DISPLACEMENT_MEDIAN_DEG, or a control (the Bump added, not stacked) less than
-    DISPLACEMENT_CONTROL_FACTOR times worse."""
-    print("  Displacement (Bump Only, world space) with a Bump node on the displaced normal "
-          f"({entry.get('layers')}) vs Cycles:")
-    failures = []
-    if entry["result"] != ["FINISHED"]:
-        failures.append(f"displacement: the add-on's bake returned {entry['result']}")
-    if "error" in r:
-        print(f"    {r['error']}")
-        return failures + [f"displacement: {r['error']}"]
-    return failures + judge_against_cycles("displacement", "", r["addon"], r["control"],
-                                           "with the Bump added to the displacement",
-                                           DISPLACEMENT_MEDIAN_DEG, DISPLACEMENT_CONTROL_FACTOR)
+        return failures + [f"{name}: {r['error']}"]
+    return failures + judge_against_cycles(name, "", r["addon"], r["control"], control_what,
+                                           bar, factor)
 
 
 def main():
