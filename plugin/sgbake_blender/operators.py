@@ -638,27 +638,13 @@ def _height_settings(node, tex, channel, render_uv, ob, ignored):
     return values
 
 
-def _object_space_factor(ob, where, ignored):
-    """What a length along the normal in object space measures in the world on object `ob`:
-    its uniform scale (1 without `ob`); on a non-uniformly scaled object it varies with the
-    normal, and the cube root of its volume scale is taken (named in `ignored` after
-    `where`)."""
-    if ob is None:
-        return 1.0
-    scales = [abs(v) for v in ob.matrix_world.to_scale()]
-    if max(scales) - min(scales) > 1e-6 * max(scales):
-        ignored.append(f"{where} in object space on an object scaled unevenly (its Scale is "
-                       "taken at the object's mean scale; Cycles grows it with the normal)")
-        return (scales[0] * scales[1] * scales[2]) ** (1.0 / 3.0)
-    return scales[0]
-
-
 def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     """The height layer of the Material Output's Displacement (None when there is none to
     bake): a Displacement node fed by an Image Texture, with the material's Displacement method
     Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the displacement along the
-    normal, (height - Midlevel) x Scale in world units (in object space, x the object's scale):
-    a height layer of scale Scale (x the object's), its slopes as Cycles takes them. Other
+    normal, (height - Midlevel) x Scale in world units (in object space, grown with the
+    object's scale along the normal): a height layer of scale Scale in the node's space
+    (height_space), its slopes as Cycles takes them. Other
     methods displace the mesh, which sgbake does not; other nodes are not read (notes in
     `skipped`)."""
     output = node_tree.get_output_node("CYCLES")
@@ -684,10 +670,8 @@ def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
         ignored.append(f"'{node.name}' Normal from a node (the layer displaces along the "
                        "surface's normal)")
     values = _height_settings(node, tex, channel, render_uv, ob, ignored)
-    scale = factor * _input_value(node, "Scale")
-    if node.space == "OBJECT":
-        scale *= _object_space_factor(ob, f"'{node.name}'", ignored)
-    values.update(scale=scale, strength=1.0)
+    values.update(scale=factor * _input_value(node, "Scale"), strength=1.0,
+                  height_space="object" if node.space == "OBJECT" else "world")
     return values
 
 

@@ -46,6 +46,12 @@ BASES = (
     ("above", "Layers Above", "Bump the normal the layers above make, as a Bump node whose "
                               "Normal input is linked to the node before it"),
 )
+HEIGHT_SPACES = (
+    ("world", "World", "Scale in world units, as a Bump node's Distance or a Displacement node's "
+                       "Scale in World space"),
+    ("object", "Object", "Scale in object units along the normal, as a Displacement node's Scale "
+                         "in Object space: grown with the object's scale along the normal"),
+)
 SLOPES = (
     ("analytic", "Exact", "The exact slopes of the filtered height"),
     ("bump-node", "As Cycles' Bump", "The slopes Cycles' Bump node takes when it bakes: the "
@@ -126,6 +132,9 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                           description="What of a height layer's image is the height")
     base: EnumProperty(name="Bumps", items=BASES, default="surface",
                        description="Which normal a height layer bumps")
+    height_space: EnumProperty(name="Height Space", items=HEIGHT_SPACES, default="world",
+                               description="Heights: the units of Scale (the scene's "
+                                           "\"height_space\")")
     slopes: EnumProperty(name="Slopes", items=SLOPES, default="analytic",
                          description="How a height layer's slopes are taken (Layers from "
                                      "Material takes a Bump node's as Cycles does)")

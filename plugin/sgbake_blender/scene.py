@@ -151,6 +151,8 @@ def layer_json(layer, uv_index, default_uv=None):
         entry["tangent_uv"] = uv_index(tangent_frames_uv(layer, default_uv))
     if bumps_height(layer) and layer.strength != 1.0:  # the Bump's blend of normals (1: none)
         entry["strength"] = _number(layer.strength)
+    if bumps_height(layer) and layer.height_space != "world":  # (a Displacement in Object space)
+        entry["height_space"] = layer.height_space
     if layer.type == "height":
         entry["scale"] = _number(layer.scale)
         if layer.channel != "luminance":

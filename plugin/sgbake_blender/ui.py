@@ -135,6 +135,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
             if scene.bumps_height(layer):
                 col.prop(layer, "strength")
+                col.prop(layer, "height_space")
             if layer.type == "height":
                 col.prop(layer, "channel")
             if layer.type == "height" or (layer.type in ("planar", "triplanar")

@@ -334,8 +334,9 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
         s && !std::ranges::any_of(input.layers, [](const Layer& layer) {
           return gradient_detail::readsBumpOffsets(layer.source);
         })) {
+      // (Heights in object units are s times as high in the world: unchanged.)
       for (const Layer& layer : input.layers)
-        scaledLayers.push_back(withHeightsScaled(layer, 1 / *s));
+        scaledLayers.push_back(layer.objectSpaceHeight ? layer : withHeightsScaled(layer, 1 / *s));
       base.layers = scaledLayers;
     } else {
       world = WorldSpace::of(*input.transform).value();  // validateSettings checked it

@@ -385,6 +385,7 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
     result.mask.offset = layer.mask->offset;
   }
   result.base = layer.base;
+  result.objectSpaceHeight = layer.objectSpaceHeight;
   Result<int> material = layerMaterial(plan.scene, planned.sceneLayer, loaded);
   if (!material) return material.error();
   result.material = *material;

@@ -92,6 +92,7 @@ constexpr Named<ImageChannels> kChannels[] = {{"luminance", ImageChannels::kLumi
                                               {"a", ImageChannels::kAlpha}};
 constexpr Named<LayerBase> kBases[] = {{"surface", LayerBase::kSurface},
                                        {"above", LayerBase::kLayersAbove}};
+constexpr Named<bool> kHeightSpaces[] = {{"world", false}, {"object", true}};
 constexpr Named<NormalMapGreen> kGreens[] = {{"opengl", NormalMapGreen::kOpenGL},
                                              {"directx", NormalMapGreen::kDirectX}};
 constexpr Named<ProjectedKind> kKinds[] = {{"height", ProjectedKind::kHeight},
@@ -383,22 +384,22 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
     keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
   switch (type) {
     case SceneLayerType::kHeight:
-      add({"uv", "scale", "strength", "base", "channel", "gradient"});
+      add({"uv", "scale", "strength", "base", "channel", "gradient", "height_space"});
       break;
     case SceneLayerType::kNormal:
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
       add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
-           "gradient", "step", "base", "strength"});
+           "gradient", "step", "base", "strength", "height_space"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
-           "projection", "tangent_uv"});
+           "projection", "tangent_uv", "height_space"});
       break;
     case SceneLayerType::kTriplanar:
       add({"kind", "scale", "mapping", "projection", "sharpness", "min_weight", "box_blend",
-           "green", "base", "gradient", "tangent_uv", "strength"});
+           "green", "base", "gradient", "tangent_uv", "strength", "height_space"});
       break;
   }
   return keys;
@@ -766,6 +767,7 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   }
   reader.optionalName("axis", kAxes, layer.axis);
   reader.optionalName("base", kBases, layer.base);
+  reader.optionalName("height_space", kHeightSpaces, layer.objectSpaceHeight);
   reader.optionalName("channel", kChannels, layer.channel);
   if (layer.type == SceneLayerType::kHeight || layer.projected()) {
     reader.optionalName("gradient", kHeightGradients, layer.heightGradient);
@@ -845,6 +847,9 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (layer.base == LayerBase::kLayersAbove && layer.readsNormals()) {
     fail(where,
          "'base': 'above' applies only to heights (a normal map has no normal to start from)");
+  }
+  if (layer.readsNormals() && reader.has("height_space")) {
+    fail(where, "key 'height_space' applies only to heights (a normal map has no height)");
   }
   return layer;
 }
@@ -1444,6 +1449,7 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   j["type"] = sceneLayerTypeName(layer.type);
   j["weight"] = layer.weight;
   if (layer.base != LayerBase::kSurface) j["base"] = nameIn(kBases, layer.base);
+  if (layer.objectSpaceHeight) j["height_space"] = "object";
   if (layer.material) j["material"] = *layer.material;
   if (layer.materialName) j["material"] = *layer.materialName;
   if (layer.mask) {

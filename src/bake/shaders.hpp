@@ -633,7 +633,8 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
 /// batchTexelFrames' fallbacks on the world triangle, an N̂ − Γ that does not normalize the
 /// common way, a back-facing N̂, a normal the guard turns and a normal map decoded below the
 /// surface (NormalBelowSurface). Layers the batch does not take
-/// whole (batchesWhole) are added sample by sample (addWorldLayerGradient), in layer order.
+/// whole (batchesWhole, and heights in object units) are added sample by sample
+/// (addWorldLayerGradient), in layer order.
 /// Out of line: the object-space paths stay as the compiler laid them out.
 [[gnu::noinline]] inline void batchShadeInWorld(BakeShaderBase& shader, const SampleBatch& s,
                                                 Lanes3& normal, Lanes3& unguarded,
@@ -653,7 +654,8 @@ inline void batchTransform(const Mat3& m, std::size_t n, const Lanes3& v, Lanes3
   for (std::size_t i = 0; i < n; ++i) gamma.x[i] = gamma.y[i] = gamma.z[i] = 0.0;
   for (const Layer& layer : shader.layers) {
     if (layer.weight == 0 || !std::isfinite(layer.weight)) continue;
-    if (!batchesWhole(layer)) {  // sample by sample, shadeLayersInWorld's step
+    // (A height in object units scales with the world normal: sample by sample too.)
+    if (!batchesWhole(layer) || layer.objectSpaceHeight) {  // shadeLayersInWorld's step
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
         const SurfacePoint& objectPoint = shader.pointAt(b, texelFrame(shader.tri, b));

@@ -53,6 +53,7 @@ struct BakeArguments {
   double heightScale = 1;
   std::string filter = "bilinear";
   std::string heightGradient = "analytic";
+  std::string heightSpace = "world";
   std::string normalImage;
   std::string normalSpace = "tangent";
   std::string normalGreen = "opengl";
@@ -116,7 +117,8 @@ constexpr const char* kFooter =
     "               maps them first (another object's coordinates, Generated)\n"
     "  Heights (height, volume, planar and triplanar of kind height) take strength = 1 (the\n"
     "  Bump node's), gradient = bump-node (slopes as Cycles' Bump node takes them when it\n"
-    "  bakes) and base =\n"
+    "  bakes), height_space = world|object (object: the scale in object units along the\n"
+    "  normal, as a Displacement node's in Object space) and base =\n"
     "  surface|above: 'above' bumps the normal the layers before it make, as a Bump node whose\n"
     "  Normal input is linked to the node before it (a Normal Map, another Bump); 'surface'\n"
     "  (the default) adds the layer's surface gradient to the others'.\n"
@@ -172,6 +174,7 @@ const char* const kOneMapOptions[] = {"--mesh",
                                       "--height-scale",
                                       "--filter",
                                       "--height-gradient",
+                                      "--height-space",
                                       "--normal",
                                       "--normal-space",
                                       "--normal-green",
@@ -342,8 +345,12 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
         !ok) {
       return ok.error();
     }
+    if (Status ok = parseName("--height-space", args.heightSpace, {"world", "object"}); !ok) {
+      return ok.error();
+    }
     SceneLayer height;
     height.type = SceneLayerType::kHeight;
+    height.objectSpaceHeight = args.heightSpace == "object";
     height.heightGradient =
         args.heightGradient == "bump-node" ? HeightGradient::kBumpNode : HeightGradient::kAnalytic;
     height.image = args.heightImage;
@@ -486,6 +493,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
   for (const auto& [option, applies, needs] :
        {std::tuple{"--height-scale", height, "--height"},
         {"--height-gradient", height, "--height"},
+        {"--height-space", height, "--height"},
         {"--filter", height || normal, "--height or --normal"},
         {"--normal-space", normal, "--normal"},
         {"--normal-green", normal, "--normal"},
@@ -680,6 +688,13 @@ CommandAction defineBakeCommand(CLI::App& app) {
                  "Slopes of --height: analytic (exact), or bump-node (Blender's Bump node as "
                  "Cycles bakes it: differences half a texel apart)")
       ->type_name("MODE")
+      ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--height-space", args->heightSpace,
+                 "Units of --height-scale: world (as a Bump node's Distance), or object (as a "
+                 "Displacement node's Scale in Object space: grown along the normal by "
+                 "--transform)")
+      ->type_name("SPACE")
       ->capture_default_str()
       ->group(oneMap);
   app.add_option("--normal", args->normalImage, "Normal-map layer")

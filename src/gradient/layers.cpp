@@ -452,6 +452,8 @@ Status validateLayers(std::span<const Layer> layers, int numUvSets) {
           "only a height can bump the normal of the layers above (a normal map has no "
           "normal to start from)";
     }
+    if (problem.empty() && layer.objectSpaceHeight && !bumpsHeights(layer.source))
+      problem = "only a height is measured in object units (a normal map has no height)";
     if (problem.empty()) problem = checker.mask(layer.mask);
     if (!problem.empty()) {
       return Error::badInput("layer " + std::to_string(i) + " (" + kindName(layer.source) +

@@ -306,7 +306,10 @@ void addWorldLayerGradient(const Layer& layer, const SurfacePoint& objectPoint,
                            const PreparedUvFrame* preparedWorldUv, const Vec3d& incoming,
                            Vec3d& gamma, NormalBelowSurface* below, const Vec3d* aboveNormal) {
   if (below != nullptr) *below = {};
-  const double factor = layer.weight * layerMask(layer.mask, objectPoint);
+  double factor = layer.weight * layerMask(layer.mask, objectPoint);
+  // A height in object units along the normal (a Displacement node in Object space): |Mᵀn|
+  // times it in the world.
+  if (layer.objectSpaceHeight) factor *= length(space.normalToObject * worldPoint.normal);
   if (factor == 0) {  // masked out: the source is not sampled
     if (layer.base == LayerBase::kLayersAbove) noteHandedOn(below, aboveNormal);
     return;

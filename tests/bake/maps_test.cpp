@@ -296,6 +296,36 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
   }
   EXPECT_EQ(bakeWith(&similar, MapKind::kHeight).pixels,
             bakeWith(nullptr, MapKind::kHeight).pixels);
+  // Heights in object units along the normal (a Displacement node in Object space): sz times
+  // as high in the world on the stretched plane (|Mᵀn| = sz), s = 2 times on the similar one,
+  // where they bake as without the transform.
+  {
+    Layer objectUnits = layers[0];
+    objectUnits.objectSpaceHeight = true;
+    Layer worldUnits = withHeightsScaled(layers[0], sz);
+    const auto bakeLayer = [&](const Layer& layer, const ObjectTransform* t) {
+      const std::vector<Layer> one{layer};
+      BakeInput input{&mesh, &*tangents, one};
+      input.transform = t;
+      BakeSettings settings;
+      settings.map = MapKind::kTangentNormal;
+      settings.width = settings.height = 32;
+      Result<FloatImage> image = bakeMap(input, settings);
+      EXPECT_TRUE(image.ok()) << image.error().message;
+      return image.ok() ? std::move(*image) : FloatImage{};
+    };
+    const FloatImage object = bakeLayer(objectUnits, &transform);
+    const FloatImage world = bakeLayer(worldUnits, &transform);
+    const FloatImage asWorld = bakeLayer(layers[0], &transform);
+    float worst = 0, fromWorldUnits = 0;
+    for (std::size_t i = 0; i < object.pixels.size(); ++i) {
+      worst = std::max(worst, std::abs(object.pixels[i] - world.pixels[i]));
+      fromWorldUnits = std::max(fromWorldUnits, std::abs(object.pixels[i] - asWorld.pixels[i]));
+    }
+    EXPECT_LT(worst, 1e-6f);
+    EXPECT_GT(fromWorldUnits, 1e-2f);
+    EXPECT_EQ(bakeLayer(objectUnits, &similar).pixels, bakeLayer(layers[0], nullptr).pixels);
+  }
   // Heights differenced as the Bump node does, on that rotation: Cycles lays the offsets along
   // its orthonormals of the world Ng, which do not turn with the object, so the rotation shades
   // as the world path does (which a stretch by 1e-4 takes, changing the bump by as little), not

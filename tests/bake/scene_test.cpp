@@ -757,6 +757,33 @@ TEST(Scene, BoxProjectionIsParsedAndInTheParametersOnlyWhenChosen) {
             "Blender's Tube projection does: 'axis' must be z");
 }
 
+// "height_space": a height's scale in world units (the default, in no manifest) or in object
+// units along the normal (a Displacement node in Object space); a normal map has no height.
+TEST(Scene, HeightSpaceIsParsedForHeightsOnly) {
+  for (const char* layer : {R"({"type": "height", "image": "h.png", "height_space": "object"})",
+                            R"({"type": "volume", "height_space": "object"})",
+                            R"({"type": "planar", "image": "h.png", "height_space": "object"})"}) {
+    Result<Scene> scene = parseScene(withLayer(layer), options());
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_TRUE(scene->layers[0].objectSpaceHeight) << layer;
+    EXPECT_NE(layerParametersJson(scene->layers[0]).find(R"("height_space":"object")"),
+              std::string::npos);
+  }
+  Result<Scene> world = parseScene(
+      withLayer(R"({"type": "height", "image": "h.png", "height_space": "world"})"), options());
+  ASSERT_TRUE(world) << world.error().message;
+  EXPECT_FALSE(world->layers[0].objectSpaceHeight);
+  EXPECT_EQ(layerParametersJson(world->layers[0]).find("height_space"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "planar", "image": "n.png", "kind": "object-normal",
+                    "height_space": "object"})")),
+            "scene.json: layers[0]: key 'height_space' applies only to heights (a normal map "
+            "has no height)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "height", "image": "h.png", "height_space": "local"})")),
+      "scene.json: layers[0]: unknown height_space 'local' (expected world or object)");
+}
+
 TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
   Result<Scene> mapped = parseScene(withLayer(R"({"type": "planar", "image": "h.png",
                     "mapping": {"location": [1, 2, 3], "rotation": [0, 0.5, 0]}})"),

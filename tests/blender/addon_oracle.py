@@ -66,10 +66,11 @@
    Empty's coordinates through a Mapping node of type Texture (PROJECTOR_*). Layers from
    Material must make one triplanar Box layer (bump-node slopes, the node's type); its tangent-normal bake must be Cycles' (median <=
    PROJECTOR_MEDIAN_DEG), and the same job with sgbake's own triplanar blend must not.
-   Displacement (displacement_case): the texture also into a world-space Displacement node
-   into the Material Output's Displacement (Bump Only), the Bump node's Normal unlinked; Layers
-   from Material must make the displacement's layer and the Bump's above it, baked as Cycles
-   bakes them (DISPLACEMENT_*), the Bump added instead of stacked must not be.
+   Displacement (displacement_case): the texture also, doubled by a Math node in a node
+   group, into an object-space Displacement node into the Material Output's Displacement (Bump
+   Only) on Suzanne stretched and turned, the Bump node's Normal unlinked; Layers from Material
+   must make the displacement's layer (height space object) and the Bump's above it, baked as
+   Cycles bakes them (DISPLACEMENT_*), the Bump added instead of stacked must not be.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -190,14 +191,15 @@ PROJECTOR_DISTANCE = 0.01
 PROJECTOR_MEDIAN_DEG = 0.01
 PROJECTOR_CONTROL_FACTOR = 3.0
 # The displacement case (displacement_case): the bump material's texture also fed, through a
-# node group whose Math node doubles it, into a Displacement node (world space, Scale DISPLACEMENT_SCALE / 2)
-# into the Material Output's
+# node group whose Math node doubles it, into a Displacement node (object space, on Suzanne
+# placed as DISPLACEMENT_PLACEMENT, Scale DISPLACEMENT_SCALE / 2) into the Material Output's
 # Displacement (Bump Only), its Bump node left with its Normal input unlinked: Cycles bumps the
 # surface with the displacement first and the Bump node bumps that normal. Layers from Material
 # must make the displacement's height layer first and the Bump's above it; the bake must be
 # Cycles' (median <= DISPLACEMENT_MEDIAN_DEG) and the same job with the Bump added to the
 # displacement instead (no "base") at least DISPLACEMENT_CONTROL_FACTOR times worse.
 DISPLACEMENT_SCALE = 0.05
+DISPLACEMENT_PLACEMENT = ((0.3, -0.2, 0.1), (0.3, -0.2, 0.5), (1.6, 1.0, 0.7))
 DISPLACEMENT_MEDIAN_DEG = 0.01
 DISPLACEMENT_CONTROL_FACTOR = 3.0
 
@@ -687,9 +689,9 @@ def material_checks(settings, ob, distance):
           f"scale {0.3 * distance:.4g}, nothing named; clamped: skipped; Green: channel g",
           f"{affine}, {affine_notes}; {clamped}, {clamped_skipped}; {green}")
     # The Material Output's Displacement: with Displacement only (true displacement) it is
-    # skipped and named; in object space on this unevenly scaled Suzanne it is taken at the
-    # object's mean scale, named; where every shader's normal comes from a Normal Map (which
-    # does not start from the displaced normal) it is not baked, as in Cycles.
+    # skipped and named; in object space on Suzanne scaled unevenly, a layer of height space
+    # object; where every shader's normal comes from a Normal Map (which does not start from
+    # the displaced normal) it is not baked, as in Cycles.
     material = ob.active_material
     output = tree.get_output_node("CYCLES")
     displace = tree.nodes.new("ShaderNodeDisplacement")
@@ -706,7 +708,6 @@ def material_checks(settings, ob, distance):
     object_found, _, object_notes = operators.object_layers([(None, material)], None, ob)
     ob.scale = scale
     bpy.context.view_layer.update()
-    mean = 0.2 * 1.6 ** (1 / 3)
     mapped = tree.nodes.new("ShaderNodeNormalMap")
     tree.links.new(tex.outputs["Color"], mapped.inputs["Color"])
     tree.links.new(mapped.outputs["Normal"], diffuse.inputs["Normal"])
@@ -718,14 +719,14 @@ def material_checks(settings, ob, distance):
     check("Layers from Material: the output's Displacement, true, in object space, under a "
           "Normal Map",
           len(true_found) == 1 and any("displaces the mesh" in n for n in true_skipped)
-          and len(object_found) == 2 and abs(object_found[0]["scale"] - mean) < 1e-6
-          and object_found[1].get("base") == "above"
-          and any("scaled unevenly" in n for n in object_notes)
+          and len(object_found) == 2 and abs(object_found[0]["scale"] - 0.2) < 1e-6
+          and object_found[0].get("height_space") == "object"
+          and object_found[1].get("base") == "above" and not object_notes
           and not any(v["type"] == "height" and v.get("base") != "above"
                       for v in mapped_found if v is not mapped_found[-1])
           and any("no shader takes the displaced normal" in n for n in mapped_skipped),
-          f"skipped as true displacement; scale {mean:.4g} then the Bump above it, the uneven "
-          "scale named; not baked under a Normal Map",
+          "skipped as true displacement; scale 0.2 in object space then the Bump above it, "
+          "nothing named; not baked under a Normal Map",
           f"{true_found}, {true_skipped}; {object_found}, {object_notes}; {mapped_found}, "
           f"{mapped_skipped}")
     # A Principled BSDF bumped through Normal: its clearcoat (a closure on Clearcoat Normal) is
@@ -1660,7 +1661,10 @@ def displacement_case(settings, ob, work):
     tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
     output = tree.get_output_node("CYCLES")
     node = tree.nodes.new("ShaderNodeDisplacement")
-    node.space = "WORLD"
+    node.space = "OBJECT"  # on Suzanne stretched and turned: grown along the normal
+    placement = (tuple(ob.location), tuple(ob.rotation_euler), tuple(ob.scale))
+    ob.location, ob.rotation_euler, ob.scale = DISPLACEMENT_PLACEMENT
+    bpy.context.view_layer.update()
     # Its height through a Math node (x 2) inside a node group, its Scale halved: the layer's
     # scale is the product.
     node.inputs["Scale"].default_value = DISPLACEMENT_SCALE / 2
@@ -1681,22 +1685,26 @@ def displacement_case(settings, ob, work):
     try:
         bpy.ops.object.sgbake_layers_from_material()
         layers = [{"type": layer.type, "scale": layer.scale, "base": layer.base,
-                   "slopes": layer.slopes} for layer in settings.layers]
+                   "slopes": layer.slopes, "height_space": layer.height_space}
+                  for layer in settings.layers]
         entry["layers"] = layers
         entry["checks"].append({
             "name": "displacement: Layers from Material makes its layer, then the Bump's above it",
             "ok": (len(layers) == 2 and all(l["type"] == "height" and l["slopes"] == "bump-node"
                                             for l in layers)
                    and abs(layers[0]["scale"] - DISPLACEMENT_SCALE) < 1e-7
+                   and layers[0]["height_space"] == "object"
                    and layers[0]["base"] == "surface" and layers[1]["base"] == "above"),
-            "expected": f"two height layers: scale {DISPLACEMENT_SCALE} (surface), then the "
-                        "Bump's (above), slopes bump-node",
+            "expected": f"two height layers: scale {DISPLACEMENT_SCALE} in object space "
+                        "(surface), then the Bump's (above), slopes bump-node",
             "message": str(layers)})
         entry["result"] = bake_against_cycles(settings, ob, work, "displacement", ("base",))
     finally:
         tree.nodes.remove(node)
         tree.nodes.remove(double)
         bpy.data.node_groups.remove(doubling)
+        ob.location, ob.rotation_euler, ob.scale = placement
+        bpy.context.view_layer.update()
     return entry
 
 
@@ -1984,7 +1992,7 @@ def evaluate(manifest, results):
         f"({manifest['projector'].get('layer')})", manifest["projector"], results["projector"],
         "with sgbake's own triplanar blend", PROJECTOR_MEDIAN_DEG, PROJECTOR_CONTROL_FACTOR)
     failures += evaluate_case_against_cycles(
-        "displacement", "Displacement (Bump Only, world space) with a Bump node on the "
+        "displacement", "Displacement (Bump Only, object space, Suzanne stretched) with a Bump node on the "
         f"displaced normal ({manifest['displacement'].get('layers')})",
         manifest["displacement"], results["displacement"],
         "with the Bump added to the displacement", DISPLACEMENT_MEDIAN_DEG,

@@ -23,7 +23,7 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
   ours_bake_swapped.exr, ours_nmap_swapped.exr  a Sphere- or Tube-projection case's bake
                      with the other wrap (a negative control)
   ours_bake_unscaled.exr  an object-space displacement case's bump-node bake with the
-                     node's Scale not grown with the object (a negative control)
+                     node's Scale in world units (a negative control)
   ours_mask.exr      `sgbake bake --map mask`
   ours_nmap_tangent.exr, ours_nmap_object.exr   a normal-map case's scene (normal layer,
                      tangent- and object-normal outputs), against Blender's tangent and

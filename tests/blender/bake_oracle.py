@@ -70,9 +70,9 @@ control ours_bake_swapped.exr, the other wrap, must fail them too, as must ours_
 for the normal maps those projections read (sphere_nmap_sphere, tube_nmap_sphere_object). The
 displacement cases (displacement_sphere, displacement_stretch_sphere, displacement_object_sphere:
 a Displacement node into the Material Output's Displacement, Bump Only, instead of a Bump node)
-are judged as the plain ones, the height layer's scale the node's Scale times the object's scale
-in object space; the object-space case's control ours_bake_unscaled.exr (its Scale alone) must
-fail (b) and (e).
+are judged as the plain ones, the height layer's scale the node's Scale in its space
+(--height-space, "height_space"); the object-space cases' control ours_bake_unscaled.exr (the
+Scale in world units) must fail (b) and (e).
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -230,7 +230,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "box_nmap_sphere_object", "flat_nmap_sphere",
                  "box_nmap_stretch_sphere", "sphere_wrap_sphere", "tube_wrap_sphere",
                  "sphere_nmap_sphere", "tube_nmap_sphere_object", "displacement_sphere",
-                 "displacement_stretch_sphere", "displacement_object_sphere")
+                 "displacement_stretch_sphere", "displacement_object_sphere",
+                 "displacement_object_stretch_sphere")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
@@ -275,10 +276,10 @@ def sgbake_case(cli, entry, sabotage, threads):
     """Runs every sgbake command of one case; returns a list of failed command lines."""
     d = entry["dir"]
     p = lambda name: os.path.join(d, name)  # noqa: E731
-    # A displacement case's height layer: the Displacement node's Scale, times the object's
-    # scale when the node is in object space (bake_scene.DISPLACEMENT).
-    scale = entry["scale"] * entry.get("displacement", {}).get("factor", 1.0)
-    size = entry["size"]
+    scale, size = entry["scale"], entry["size"]
+    # A displacement case's height layer: the Displacement node's Scale, in its space
+    # (bake_scene.DISPLACEMENT: object space grows along the normal with the object's scale).
+    height_space = entry.get("displacement", {}).get("space", "world")
     # 32-bit float EXRs (sgbake's default 16 = half floats moves convert's median from 0.0025 to
     # 0.016 deg on Suzanne, a third of the 0.05 deg budget), and
     # no .sgbake-manifest.json (it would let a re-run in a kept directory skip the bake).
@@ -343,7 +344,12 @@ def sgbake_case(cli, entry, sabotage, threads):
         return failed
     bake = ["bake", "--mesh", p("mesh.obj"), "--height", p("height.exr"), "--filter",
             entry["filter"], "--map", "tangent-normal", "--size", size, "--green", green] + common
-    if transformed(entry) and not run_sgbake(
+    world_units = list(bake)  # (the control of an object-space displacement)
+    if height_space == "object":
+        bake += ["--height-space", "object"]
+    # The control without the transform (not for heights in object units: on a uniformly
+    # scaled object they bake the same without it, the control ours_bake_unscaled tells).
+    if transformed(entry) and height_space == "world" and not run_sgbake(
             cli, bake + ["--height-scale", repr(bake_scale), "-o",
                          p("ours_bake_object_space.exr")], log):
         failed.append(log[-1])
@@ -357,16 +363,18 @@ def sgbake_case(cli, entry, sabotage, threads):
     if not run_sgbake(cli, bake + ["--height-scale", repr(bake_scale), "--height-gradient",
                                    "bump-node", "-o", p("ours_bake_bump_node.exr")], log):
         failed.append(log[-1])
-    if entry.get("displacement", {}).get("factor", 1.0) != 1.0 and not run_sgbake(
-            cli, bake + ["--height-scale", repr(entry["scale"]), "--height-gradient",
-                         "bump-node", "-o", p("ours_bake_unscaled.exr")], log):
-        failed.append(log[-1])  # the control: the object-space Scale not grown with the object
+    if height_space == "object" and not run_sgbake(
+            cli, world_units + transform_flags(entry)
+            + ["--height-scale", repr(bake_scale), "--height-gradient", "bump-node", "-o",
+               p("ours_bake_unscaled.exr")], log):
+        failed.append(log[-1])  # the control: the object-space Scale taken in world units
 
     scene = {
         "mesh": p("mesh.obj"),
         "subdivision": {"level": entry.get("subdivision", 0)},
         "layers": [{"type": "height", "image": p("height.exr"), "scale": bake_scale,
-                    "filter": entry["filter"], "uv": 0, "weight": 1.0}],
+                    "filter": entry["filter"], "uv": 0, "weight": 1.0,
+                    "height_space": height_space}],
         "outputs": [{"map": "tangent-normal", "file": p("ours_bake_json.exr"), "size": size,
                      "margin": 0, "samples": 1, "green": green, "bit_depth": 32}],
     }
@@ -681,8 +689,8 @@ def evaluate(name, r, planar=False):
                              ("bake_unmapped", "without Mapping:  ", "its Mapping node left out"),
                              ("bake_swapped", "the other wrap:   ",
                               "the Sphere and Tube projections swapped"),
-                             ("bake_unscaled", "Scale unscaled:   ",
-                              "the object-space Displacement's Scale not scaled with the object"),
+                             ("bake_unscaled", "Scale in world:   ",
+                              "the object-space Displacement's Scale taken in world units"),
                              ("bake_full_strength", "Strength 1:       ",
                               "the Bump's Strength left out")):
         if key not in r:

@@ -128,10 +128,10 @@ def normal_map_case(name, mesh_case, size, space, strength, tilt_deg, bump=None)
 # a Displacement node (Scale = the case's Distance) into the Material Output's Displacement, the
 # material's Displacement method Bump Only, instead of a Bump node: Cycles then bumps the
 # surface as a Bump node of Distance 1 fed by the displacement along the normal, (h - 0.5) x
-# Scale in world space; in object space the displacement is carried to world space first, so a
-# uniformly scaled object's Scale grows with it. The case's manifest entry has
-# "displacement": {"space", "factor"}, factor the object's uniform scale in object space (1 in
-# world space): sgbake's height layer of scale Distance x factor bakes what Cycles bakes.
+# Scale in world space; in object space the displacement is carried to world space along the
+# normal first, so its Scale grows with the object's scale along the normal. The case's
+# manifest entry has "displacement": {"space": "world" | "object"}: sgbake's height layer of
+# scale Distance with "height_space" that space bakes what Cycles bakes.
 DISPLACEMENT = {}
 
 
@@ -440,11 +440,13 @@ planar_case("sphere_wrap_sphere", "sphere", 256, 0.02, "SPHERE", mapping=WRAP_MA
 planar_case("tube_wrap_sphere", "sphere", 256, 0.02, "TUBE", mapping=WRAP_MAPPING)
 # Heights through the Material Output's Displacement (Bump Only) instead of a Bump node: in world
 # space on the sphere and on the stretched one (its Scale stays world units), in object space on
-# the sphere scaled 3 (and turned and moved: its Scale x 3).
+# the sphere scaled 3 (and turned and moved) and on the stretched sphere (its Scale grown by
+# the object's scale along the normal).
 displacement_case("displacement_sphere", "sphere", "WORLD")
 displacement_case("displacement_stretch_sphere", "stretch_sphere", "WORLD")
 displacement_case("displacement_object_sphere", "sphere", "OBJECT",
                   ((0.3, -0.5, 1.0), (0.5, 0.1, -0.4), (3.0, 3.0, 3.0)))
+displacement_case("displacement_object_stretch_sphere", "stretch_sphere", "OBJECT")
 projected_normal_map_case("sphere_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "SPHERE",
                           mapping=WRAP_MAPPING)
 projected_normal_map_case("tube_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "TUBE",
@@ -719,12 +721,7 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             if "matrix" in PLANAR[name]:
                 entry["planar"]["mapping"]["matrix"] = PLANAR[name]["matrix"]
     if name in DISPLACEMENT:
-        space = DISPLACEMENT[name]["space"]
-        scales = ob.matrix_world.to_scale()
-        if space == "OBJECT" and max(scales) - min(scales) > 1e-6 * max(scales):
-            raise RuntimeError(f"case {name}: object-space displacement needs a uniform scale")
-        entry["displacement"] = {"space": space.lower(),
-                                 "factor": float(scales[0]) if space == "OBJECT" else 1.0}
+        entry["displacement"] = {"space": DISPLACEMENT[name]["space"].lower()}
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}

@@ -188,6 +188,10 @@ struct SceneLayer {
   /// "base" (heights): "surface" (N, the default) or "above" (the normal the layers above make,
   /// as a Bump node whose Normal input is linked to them; LayerBase::kLayersAbove)
   LayerBase base = LayerBase::kSurface;
+  /// "height_space" (heights): "world" (the default: the scale in world units, as a Bump
+  /// node's Distance or a Displacement node in World space) or "object" (in object units along
+  /// the normal, as a Displacement node in Object space: Layer::objectSpaceHeight)
+  bool objectSpaceHeight = false;
   /// "material": the faces the layer applies to, those of one material: an index (Blender's
   /// material slot; Mesh::faceMaterial) or an OBJ `usemtl` name (materialName). Neither: every
   /// face.

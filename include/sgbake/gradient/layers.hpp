@@ -170,6 +170,13 @@ struct Layer {
   double weight = 1;  ///< any finite value (negative inverts the bumps); 0 disables
   LayerMask mask{};
   LayerBase base = LayerBase::kSurface;
+  /// Heights only: the height is measured in object units along the normal, as Blender's
+  /// Displacement node in Object space displaces (its Scale), not in world units as a Bump
+  /// node's Distance. Under an object transform M, Cycles carries such a displacement to the
+  /// world along the normal, so its world height is |Mᵀn| times it (n the unit world normal
+  /// Cycles shades with; the object's scale along the normal): world shading multiplies the
+  /// layer's Γ by that. Without a transform it changes nothing.
+  bool objectSpaceHeight = false;
   /// The material whose faces the layer applies to (Mesh::faceMaterial: Blender's material
   /// slot), as a multi-material object's Bump and Normal Map nodes apply to their material's
   /// faces only; −1: every face. The engine's functions of a point do not read it: the baker
