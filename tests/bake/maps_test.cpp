@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "bake/texel_frame.hpp"
@@ -245,8 +246,10 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
   const Vec3d objectNormal =
       normalizeOr(Vec3d{-scale * a / (sx * sx * lx), -scale * b / (sy * sy * ly), 1 / sz}, Vec3d{});
   const Vec3d gamma{scale * a / (lx * sz), scale * b / (ly * sz), 0};
-  const auto bakeWith = [&](const ObjectTransform* t, MapKind kind) {
-    BakeInput input{&mesh, &*tangents, layers};
+  // A 32² bake of `baked` (the ramp by default) under transform t.
+  const auto bakeWith = [&](const ObjectTransform* t, MapKind kind,
+                            std::span<const Layer> baked = {}) {
+    BakeInput input{&mesh, &*tangents, baked.empty() ? std::span<const Layer>(layers) : baked};
     input.transform = t;
     BakeSettings settings;
     settings.map = kind;
@@ -254,6 +257,13 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
     Result<FloatImage> image = bakeMap(input, settings);
     EXPECT_TRUE(image.ok()) << image.error().message;
     return image.ok() ? std::move(*image) : FloatImage{};
+  };
+  const auto maxDifference = [](const FloatImage& x, const FloatImage& y) {
+    EXPECT_EQ(x.pixels.size(), y.pixels.size());
+    float worst = 0;
+    for (std::size_t i = 0; i < std::min(x.pixels.size(), y.pixels.size()); ++i)
+      worst = std::max(worst, std::abs(x.pixels[i] - y.pixels[i]));
+    return worst;
   };
   const FloatImage tn = bakeWith(&transform, MapKind::kTangentNormal);
   const FloatImage on = bakeWith(&transform, MapKind::kObjectNormal);
@@ -300,31 +310,15 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
   // as high in the world on the stretched plane (|Mᵀn| = sz), s = 2 times on the similar one,
   // where they bake as without the transform.
   {
-    Layer objectUnits = layers[0];
-    objectUnits.objectSpaceHeight = true;
-    Layer worldUnits = withHeightsScaled(layers[0], sz);
-    const auto bakeLayer = [&](const Layer& layer, const ObjectTransform* t) {
-      const std::vector<Layer> one{layer};
-      BakeInput input{&mesh, &*tangents, one};
-      input.transform = t;
-      BakeSettings settings;
-      settings.map = MapKind::kTangentNormal;
-      settings.width = settings.height = 32;
-      Result<FloatImage> image = bakeMap(input, settings);
-      EXPECT_TRUE(image.ok()) << image.error().message;
-      return image.ok() ? std::move(*image) : FloatImage{};
-    };
-    const FloatImage object = bakeLayer(objectUnits, &transform);
-    const FloatImage world = bakeLayer(worldUnits, &transform);
-    const FloatImage asWorld = bakeLayer(layers[0], &transform);
-    float worst = 0, fromWorldUnits = 0;
-    for (std::size_t i = 0; i < object.pixels.size(); ++i) {
-      worst = std::max(worst, std::abs(object.pixels[i] - world.pixels[i]));
-      fromWorldUnits = std::max(fromWorldUnits, std::abs(object.pixels[i] - asWorld.pixels[i]));
-    }
-    EXPECT_LT(worst, 1e-6f);
-    EXPECT_GT(fromWorldUnits, 1e-2f);
-    EXPECT_EQ(bakeLayer(objectUnits, &similar).pixels, bakeLayer(layers[0], nullptr).pixels);
+    std::vector<Layer> objectUnits = layers;
+    objectUnits[0].objectSpaceHeight = true;
+    const std::vector<Layer> worldUnits{withHeightsScaled(layers[0], sz)};
+    const MapKind tangentMap = MapKind::kTangentNormal;
+    const FloatImage object = bakeWith(&transform, tangentMap, objectUnits);
+    EXPECT_LT(maxDifference(object, bakeWith(&transform, tangentMap, worldUnits)), 1e-6f);
+    EXPECT_GT(maxDifference(object, bakeWith(&transform, tangentMap)), 1e-2f);
+    EXPECT_EQ(bakeWith(&similar, tangentMap, objectUnits).pixels,
+              bakeWith(nullptr, tangentMap).pixels);
   }
   // Heights differenced as the Bump node does, on that rotation: Cycles lays the offsets along
   // its orthonormals of the world Ng, which do not turn with the object, so the rotation shades
@@ -337,26 +331,11 @@ TEST(Maps, LinearHeightOnATransformedPlaneIsBumpedInWorldSpace) {
     const std::vector<Layer> bumpNode{differenced};
     const ObjectTransform stretched{similar.linear * Mat3::diagonal({1, 1, 1 + 1e-4}), {}};
     ASSERT_FALSE(stretched.uniformScale().has_value());
-    const auto bakeBumpNode = [&](const ObjectTransform* t) {
-      BakeInput input{&mesh, &*tangents, bumpNode};
-      input.transform = t;
-      BakeSettings settings;
-      settings.map = MapKind::kTangentNormal;
-      settings.width = settings.height = 32;
-      Result<FloatImage> image = bakeMap(input, settings);
-      EXPECT_TRUE(image.ok()) << image.error().message;
-      return image.ok() ? std::move(*image) : FloatImage{};
-    };
-    const FloatImage turned = bakeBumpNode(&similar), world = bakeBumpNode(&stretched);
-    const FloatImage still = bakeBumpNode(nullptr);
-    ASSERT_EQ(turned.pixels.size(), world.pixels.size());
-    float worst = 0, fromStill = 0;
-    for (std::size_t i = 0; i < turned.pixels.size(); ++i) {
-      worst = std::max(worst, std::abs(turned.pixels[i] - world.pixels[i]));
-      fromStill = std::max(fromStill, std::abs(turned.pixels[i] - still.pixels[i]));
-    }
-    EXPECT_LT(worst, 1e-4f);
-    EXPECT_GT(fromStill, 1e-3f);  // (the bump is the halved one: not the unturned bake)
+    const MapKind tangentMap = MapKind::kTangentNormal;
+    const FloatImage turned = bakeWith(&similar, tangentMap, bumpNode);
+    EXPECT_LT(maxDifference(turned, bakeWith(&stretched, tangentMap, bumpNode)), 1e-4f);
+    // (the bump is the halved one: not the unturned bake)
+    EXPECT_GT(maxDifference(turned, bakeWith(nullptr, tangentMap, bumpNode)), 1e-3f);
   }
   const ObjectTransform singular{Mat3::diagonal({1, 1, 0}), {}};
   BakeInput bad{&mesh, &*tangents, layers};
