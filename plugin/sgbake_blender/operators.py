@@ -569,14 +569,13 @@ def _object_coordinates(tex, ob=None):
     """How Image Texture node `tex` reads object coordinates: None when it does not; else the
     layer settings of what lies between (empty for the object's own). It does when its
     projection is Flat, Box, Sphere or Tube and its Vector comes from a Texture Coordinate
-    node's Object
-    output (the baked object's own coordinates; another object's, or its Generated output, when
-    the baked object `ob` is known: mapping_matrix), straight or through one Mapping node of
-    type Point, Texture or Vector whose Location, Rotation and Scale are constants (_constant:
-    their own values, or Value, Combine XYZ and Math nodes of constants; not type Normal, which
-    normalizes the coordinates). Its height is then
-    sgbake's planar layer on axis z (Flat), with its Sphere or Tube projection (Sphere, Tube),
-    or its triplanar layer with Blender's Box projection (Box)."""
+    node's Object output (the baked object's own coordinates; another object's, or its
+    Generated output, when the baked object `ob` is known: mapping_matrix), straight or through
+    one Mapping node of type Point, Texture or Vector whose Location, Rotation and Scale are
+    constants (_constant: their own values, or Value, Combine XYZ and Math nodes of constants;
+    not type Normal, which normalizes the coordinates). Its height is then sgbake's planar
+    layer on axis z (Flat), with its Sphere or Tube projection (Sphere, Tube), or its triplanar
+    layer with Blender's Box projection (Box)."""
     if tex.projection not in ("FLAT", "BOX", "SPHERE", "TUBE"):
         return None
     link = _source_link(tex.inputs["Vector"])
@@ -644,9 +643,8 @@ def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the displacement along the
     normal, (height - Midlevel) x Scale in world units (in object space, grown with the
     object's scale along the normal): a height layer of scale Scale in the node's space
-    (height_space), its slopes as Cycles takes them. Other
-    methods displace the mesh, which sgbake does not; other nodes are not read (notes in
-    `skipped`)."""
+    (height_space), its slopes as Cycles takes them. Other methods displace the mesh, which
+    sgbake does not; other nodes are not read (notes in `skipped`)."""
     output = node_tree.get_output_node("CYCLES")
     link = _source_link(output.inputs["Displacement"]) if output is not None else None
     if link is None:
