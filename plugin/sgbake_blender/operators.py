@@ -508,6 +508,41 @@ def _height_source(socket):
             factor *= by
 
 
+def _recombined_normal_map(socket):
+    """The Image Texture node whose colour reaches normal-map input `socket` split into its
+    channels and combined again, and the green convention that makes: (node, "opengl" or
+    "directx"), or None. A Combine RGB or Color node (RGB) whose R, G and B are the R, G and B
+    of one Separate RGB or Color node (RGB) of the texture's Color, G through a Math node
+    computing 1 - G (unclamped) where a DirectX map is turned into Blender's convention."""
+    link = _source_link(socket)
+    node = link.from_node if link else None
+    if (node is None or node.mute or node.type not in ("COMBRGB", "COMBINE_COLOR")
+            or getattr(node, "mode", "RGB") != "RGB"):
+        return None
+    separated, flipped = set(), []
+    for i, channel in enumerate("rgb"):
+        link = _source_link(node.inputs[i])
+        inverted = (link is not None and link.from_node.type == "MATH" and not link.from_node.mute
+                    and link.from_node.operation == "SUBTRACT" and not link.from_node.use_clamp
+                    and _constant(link.from_node.inputs[0]) == 1.0)
+        if inverted:
+            link = _source_link(link.from_node.inputs[1])
+        if (link is None or link.from_node.mute
+                or link.from_node.type not in ("SEPRGB", "SEPARATE_COLOR")
+                or getattr(link.from_node, "mode", "RGB") != "RGB"
+                or SEPARATED_CHANNELS.get(link.from_socket.name) != channel):
+            return None
+        separated.add(link.from_node.name)
+        flipped.append(inverted)
+    if len(separated) != 1 or flipped[0] or flipped[2]:
+        return None
+    split = _source_link(link.from_node.inputs[0])
+    if (split is None or split.from_node.type != "TEX_IMAGE" or split.from_node.image is None
+            or split.from_socket.name != "Color"):
+        return None
+    return split.from_node, "directx" if flipped[1] else "opengl"
+
+
 def _linked_image_node(socket):
     """The Image Texture node (with an image) that feeds `socket` (_source_link), or None."""
     link = _source_link(socket)
@@ -890,7 +925,9 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
             values.update(scale=-scale if node.invert else scale,
                           strength=max(_input_value(node, "Strength"), 0.0))
         else:
-            tex = _linked_image_node(node.inputs["Color"])
+            tex, green = _linked_image_node(node.inputs["Color"]), "opengl"
+            if tex is None and _recombined_normal_map(node.inputs["Color"]) is not None:
+                tex, green = _recombined_normal_map(node.inputs["Color"])
             space = NORMAL_MAP_SPACES.get(node.space)
             if tex is None or space is None:
                 why = (_not_image(node.inputs["Color"]) if tex is None
@@ -900,6 +937,12 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
             ignored += _ignored(node, tex, ("Strength",), "Color", ob)
             values = _texture_settings(tex, render_uv)
             values.update(type="normal", space=space, scale=_input_value(node, "Strength"))
+            if green != "opengl":
+                if space == "tangent":
+                    values["green"] = green  # (its G flipped in the tree: a DirectX map)
+                else:
+                    ignored.append(f"'{node.name}' Color with its G flipped (an object-space "
+                                   "layer reads the colour)")
             if _object_projected(tex, ob):
                 # A projection on object coordinates: the colour it reads, decoded by the node
                 # (tangent space: in the frames of the node's UV map, else the render UV

@@ -587,6 +587,34 @@ def material_checks(settings, ob, distance):
           and not any(tex.name in note for note in flat_ignored),
           f"{want}, box_blend 0.2; Flat: {want_flat}; nothing named",
           f"{boxed_normal}; named {boxed_ignored}; Flat: {flat_normal}, named {flat_ignored}")
+    # Its colour split and combined again with G flipped by a Math node (1 - G): a DirectX
+    # map turned into Blender's convention, the layer's Green DirectX; not flipped, OpenGL;
+    # the channels crossed, no layer.
+    split = tree.nodes.new("ShaderNodeSeparateColor")
+    joined = tree.nodes.new("ShaderNodeCombineColor")
+    flip = tree.nodes.new("ShaderNodeMath")
+    flip.operation, flip.inputs[0].default_value = "SUBTRACT", 1.0
+    tree.links.new(tex.outputs["Color"], split.inputs[0])
+    tree.links.new(split.outputs["Red"], joined.inputs["Red"])
+    tree.links.new(split.outputs["Green"], flip.inputs[1])
+    tree.links.new(flip.outputs[0], joined.inputs["Green"])
+    tree.links.new(split.outputs["Blue"], joined.inputs["Blue"])
+    tree.links.new(joined.outputs[0], nmap.inputs["Color"])
+    recombined = {}
+    for state in ("directx", "opengl", "crossed"):
+        if state == "opengl":
+            tree.links.new(split.outputs["Green"], joined.inputs["Green"])
+        if state == "crossed":
+            tree.links.new(split.outputs["Green"], joined.inputs["Red"])
+        layers, _, _ = operators.material_layers(tree, "UVMap")
+        recombined[state] = [v.get("green", "opengl") for v in layers if v["type"] == "normal"]
+    for node in (split, joined, flip):
+        tree.nodes.remove(node)
+    tree.links.new(tex.outputs["Color"], nmap.inputs["Color"])
+    check("Layers from Material: a Normal Map's colour split and combined again",
+          recombined == {"directx": ["directx"], "opengl": ["opengl"], "crossed": []},
+          "green directx with G flipped, opengl without, no layer with the channels crossed",
+          str(recombined))
     tree.nodes.remove(nmap)
     # A Bump node linked to nothing makes no layer.
     stray = tree.nodes.new("ShaderNodeBump")
