@@ -766,7 +766,8 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       const std::optional<double> uniform =
           bumpNode ? std::nullopt : scene.transform->uniformScale();
       plan.steps.push_back(
-          {uniform ? "shade in object space with heights divided by the object's uniform scale " +
+          {uniform ? "shade in object space with heights in world units divided by the "
+                     "object's uniform scale " +
                          formatNumber(*uniform) + " (as Cycles shades it in world space)"
                    : std::string("shade in world space through the object transform, as Cycles "
                                  "does (heights in world units)"),

@@ -621,11 +621,21 @@ TEST_F(PlannerTest, TheTransformReBakesWhatItShades) {
   std::string turned = plain;
   turned.insert(1, R"("transform": [[0, -2, 0], [2, 0, 0], [0, 0, 2]], )");
   const std::string turnedPlan = explainPlan(plan(turned));
-  EXPECT_NE(turnedPlan.find("shade in object space with heights divided by the object's uniform "
-                            "scale 2 "),
+  EXPECT_NE(turnedPlan.find("shade in object space with heights in world units divided by the "
+                            "object's uniform scale 2 "),
             std::string::npos)
       << turnedPlan;
   EXPECT_EQ(turnedPlan.find("world space through"), std::string::npos) << turnedPlan;
+  // Not with heights differenced as the Bump node does: its offsets do not turn with the
+  // object.
+  std::string bumpNode = turned;
+  const std::size_t layer = bumpNode.find(R"("type": "height")");
+  ASSERT_NE(layer, std::string::npos) << bumpNode;
+  bumpNode.insert(layer, R"("gradient": "bump-node", )");
+  const std::string bumpNodePlan = explainPlan(plan(bumpNode));
+  EXPECT_NE(bumpNodePlan.find("shade in world space through the object transform"),
+            std::string::npos)
+      << bumpNodePlan;
   const std::string before = readFile(dir_ / "o.exr");
   ASSERT_TRUE(executePlan(p));
   EXPECT_NE(readFile(dir_ / "o.exr"), before);
