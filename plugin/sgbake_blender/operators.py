@@ -474,7 +474,8 @@ def _height_source(socket):
     """The Image Texture node (with an image) that feeds height input `socket`, the channel it
     is read on and the factor the nodes between scale it by: (node, channel, factor), or None.
     Followed back through Reroutes and nodes that change the height affinely (_affine_step:
-    Math and Map Range nodes with constants; the offset moves no slope), RGB to BW (the
+    Math and Map Range nodes with constants; an Invert node of constant Fac; the offset moves no
+    slope), RGB to BW (the
     luminance, as the input's own conversion) and Separate RGB or Color (RGB mode: channel r,
     g or b); the texture's Alpha output is channel a, its Color the luminance."""
     factor, channel = 1.0, None
@@ -500,6 +501,9 @@ def _height_source(socket):
             socket = node.inputs[0]
         elif node.type == "RGBTOBW" and channel is None:
             socket = node.inputs[0]
+        elif node.type == "INVERT" and isinstance(_constant(node.inputs["Fac"]), float):
+            factor *= 1 - 2 * _constant(node.inputs["Fac"])  # (1 - Fac) c + Fac (1 - c)
+            socket = node.inputs["Color"]
         else:
             step = _affine_step(node, link)
             if step is None:

@@ -705,17 +705,23 @@ def material_checks(settings, ob, distance):
     tree.links.new(tex.outputs["Color"], separate.inputs[0])
     tree.links.new(separate.outputs["Green"], bump.inputs["Height"])
     green, _, _ = operators.material_layers(tree)
+    invert = tree.nodes.new("ShaderNodeInvert")  # Fac 1: 1 - h, the bump turned over
+    tree.links.new(tex.outputs["Color"], invert.inputs["Color"])
+    tree.links.new(invert.outputs["Color"], bump.inputs["Height"])
+    inverted, _, _ = operators.material_layers(tree)
     tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
-    for extra in (half, ranged, separate):
+    for extra in (half, ranged, separate, invert):
         tree.nodes.remove(extra)
-    check("Layers from Material: a height through Math, Map Range and Separate Color nodes",
+    check("Layers from Material: a height through Math, Map Range, Separate Color, Invert nodes",
           len(affine) == 1 and abs(affine[0]["scale"] - 0.3 * distance) < 1e-7
           and not affine_notes and not clamped
           and any("not an Image Texture" in n for n in clamped_skipped)
           and len(green) == 1 and green[0].get("channel") == "g"
-          and abs(green[0]["scale"] - distance) < 1e-7,
-          f"scale {0.3 * distance:.4g}, nothing named; clamped: skipped; Green: channel g",
-          f"{affine}, {affine_notes}; {clamped}, {clamped_skipped}; {green}")
+          and abs(green[0]["scale"] - distance) < 1e-7
+          and len(inverted) == 1 and abs(inverted[0]["scale"] + distance) < 1e-7,
+          f"scale {0.3 * distance:.4g}, nothing named; clamped: skipped; Green: channel g; "
+          f"Invert: scale {-distance:.4g}",
+          f"{affine}, {affine_notes}; {clamped}, {clamped_skipped}; {green}; {inverted}")
     # The Material Output's Displacement: with Displacement only (true displacement) it is
     # skipped and named; in object space on Suzanne scaled unevenly, a layer of height space
     # object; where every shader's normal comes from a Normal Map (which does not start from
