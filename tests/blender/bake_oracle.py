@@ -229,14 +229,16 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
                  "box_nmap_sphere_object", "flat_nmap_sphere",
                  "box_nmap_stretch_sphere", "sphere_wrap_sphere", "tube_wrap_sphere",
-                 "sphere_nmap_sphere", "tube_nmap_sphere_object", "displacement_sphere",
+                 "sphere_nmap_sphere", "tube_nmap_sphere_object", "sphere_wrap_stretch_sphere",
+                 "displacement_sphere",
                  "displacement_stretch_sphere", "displacement_object_sphere",
                  "displacement_object_stretch_sphere")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
-# and 0.12 deg); normal maps median 0.0014-0.0017, p99 <= 0.0020 deg; the other wrap 3.3 deg
-# (heights), 6.6-19.9 deg (normal maps).
+# and 0.12 deg); on the stretched sphere, in world space, 0.0016 and 0.0022 deg; normal maps
+# median 0.0014-0.0017, p99 <= 0.0020 deg; the other wrap 3.3-4.2 deg (heights), 6.6-19.9 deg
+# (normal maps).
 SWAPPED_WRAP = {"sphere": "tube", "tube": "sphere"}
 
 

@@ -438,6 +438,9 @@ projected_normal_map_case("box_nmap_stretch_sphere", "stretch_sphere", 256, "TAN
 WRAP_MAPPING = ((0.5, 0.5, 0.5), (0.5, 0.3, 0.0), (0.5, 0.5, 0.5))
 planar_case("sphere_wrap_sphere", "sphere", 256, 0.02, "SPHERE", mapping=WRAP_MAPPING)
 planar_case("tube_wrap_sphere", "sphere", 256, 0.02, "TUBE", mapping=WRAP_MAPPING)
+# The Sphere projection on the sphere stretched (2, 1, 0.5) and turned: shaded in world space.
+planar_case("sphere_wrap_stretch_sphere", "stretch_sphere", 512, 0.02, "SPHERE",
+            mapping=WRAP_MAPPING)
 # Heights through the Material Output's Displacement (Bump Only) instead of a Bump node: in world
 # space on the sphere and on the stretched one (its Scale stays world units), in object space on
 # the sphere scaled 3 (and turned and moved) and on the stretched sphere (its Scale grown by
