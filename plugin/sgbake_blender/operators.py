@@ -892,8 +892,7 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
     (_displacement_layer, with the material's `displacement_method`); and notes on the nodes
     that were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV
     map active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
-    object baked (for textures on another object's or Generated coordinates, and the scale of
-    an object-space displacement).
+    object baked (for textures on another object's or Generated coordinates).
 
     Bump: scale = Distance, negated when Invert is on, and its Strength (the blend of the bumped
     normal with the original one, as Cycles' Bump node does it); when its Normal input comes
@@ -930,8 +929,9 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
                           strength=max(_input_value(node, "Strength"), 0.0))
         else:
             tex, green = _linked_image_node(node.inputs["Color"]), "opengl"
-            if tex is None and _recombined_normal_map(node.inputs["Color"]) is not None:
-                tex, green = _recombined_normal_map(node.inputs["Color"])
+            recombined = _recombined_normal_map(node.inputs["Color"]) if tex is None else None
+            if recombined is not None:
+                tex, green = recombined
             space = NORMAL_MAP_SPACES.get(node.space)
             if tex is None or space is None:
                 why = (_not_image(node.inputs["Color"]) if tex is None

@@ -348,9 +348,8 @@ TriplanarOptions triplanarOptions(const SceneLayer& layer) {
 }
 
 /// A normal-map layer projected by one of Blender's projections (Box, Flat, Sphere, Tube): what
-/// Cycles bakes,
-/// a Normal Map node (Strength = the layer's scale) decoding the colour an Image Texture's
-/// projection reads. The normal-map source with its texels read by that projection
+/// Cycles bakes, a Normal Map node (Strength = the layer's scale) decoding the colour an Image
+/// Texture's projection reads. The normal-map source with its texels read by that projection
 /// (TangentNormalSource::projection): Strength, guards and normals below the surface as a UV
 /// normal map's.
 LayerSource projectedNormalSource(const SceneLayer& layer, const VectorTexture* texture) {

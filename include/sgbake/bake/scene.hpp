@@ -168,8 +168,8 @@ struct SceneLayer {
   HeightGradient heightGradient = HeightGradient::kAnalytic;
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
   /// "tangent_uv" (tangent-space normal layers, and those Blender's projections read): the UV
-  /// set whose
-  /// tangent frames decode the map, when not its "uv" (TangentNormalSource::tangentUvSet)
+  /// set whose tangent frames decode the map, when not its "uv"
+  /// (TangentNormalSource::tangentUvSet)
   std::optional<int> tangentUvSet;
   NormalMapGreen green = NormalMapGreen::kOpenGL;  ///< "green" (normal maps, all projections)
   ProjectedKind kind = ProjectedKind::kHeight;     ///< "kind" (planar, triplanar)

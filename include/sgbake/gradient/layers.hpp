@@ -70,8 +70,7 @@ struct TangentNormalSource {
   /// instead of through uvSet (projectedTexel; the options' projection must be kBox, kFlat,
   /// kSphere or kTube, their tiling and offset replace those above): an Image Texture with
   /// Projection Box, Flat, Sphere or Tube on Texture Coordinate Object feeding a Normal Map
-  /// node. The frame still comes
-  /// from frameUvSet().
+  /// node. The frame still comes from frameUvSet().
   std::optional<TriplanarOptions> projection{};
   int frameUvSet() const { return tangentUvSet >= 0 ? tangentUvSet : uvSet; }
 };
