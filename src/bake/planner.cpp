@@ -713,11 +713,18 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       tileOf[t] = "tile " + std::to_string(tile) + " of " + texture.udimImage.string();
     }
   }
+  // A layer that reads its height through a remap (one view of the shared texture each).
+  const auto remapNote = [&scene](std::size_t sceneLayer) {
+    const std::size_t points = scene.layers[sceneLayer].remap.size();
+    return points == 0 ? std::string()
+                       : " through a remap of " + std::to_string(points) + " points";
+  };
   for (std::size_t t = 0; t < plan.textures.size(); ++t) {
     const PlannedTexture& texture = plan.textures[t];
     std::vector<std::string> users;
     for (const PlannedLayer& layer : plan.layers) {
-      if (layer.texture == t) users.push_back(layerLabel(layer.sceneLayer));
+      if (layer.texture == t)
+        users.push_back(layerLabel(layer.sceneLayer) + remapNote(layer.sceneLayer));
       if (layer.mask == t) users.push_back(layerLabel(layer.sceneLayer) + ".mask");
     }
     const std::string kind = texture.vector ? "vector" : "scalar";
@@ -742,10 +749,11 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
   for (const PlannedLayer& layer : plan.layers) {
     if (scene.layers[layer.sceneLayer].type == SceneLayerType::kVolume) {
       const SceneLayer& volume = scene.layers[layer.sceneLayer];
-      plan.steps.push_back(
-          {"make " + describeLayer(volume) + " for " + layerLabel(layer.sceneLayer),
-           volume.step ? "gradient step " + formatNumber(*volume.step)
-                       : "gradient step: 2^-20 of the mesh's bounding-box diagonal"});
+      plan.steps.push_back({"make " + describeLayer(volume) + " for " +
+                                layerLabel(layer.sceneLayer) + remapNote(layer.sceneLayer),
+                            volume.step
+                                ? "gradient step " + formatNumber(*volume.step)
+                                : "gradient step: 2^-20 of the mesh's bounding-box diagonal"});
     }
   }
   if (plan.computeTangents) {

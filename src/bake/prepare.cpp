@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sgbake/gradient/filters.hpp"
+#include "sgbake/gradient/remap.hpp"
 #include "sgbake/gradient/udim.hpp"
 
 namespace sgbake::plan_detail {
@@ -375,6 +376,20 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
   const SceneLayer& layer = plan.scene.layers[planned.sceneLayer];
   const ScalarTexture* scalar = planned.texture ? loaded.scalar[*planned.texture].get() : nullptr;
   const VectorTexture* vector = planned.texture ? loaded.vector[*planned.texture].get() : nullptr;
+  // A remapped height reads its texture through the remap (the texture itself is shared).
+  std::optional<HeightRemap> remap;
+  if (!layer.remap.empty()) {
+    Result<HeightRemap> made = HeightRemap::create(layer.remap);
+    if (!made) {
+      return Error::badInput(scenePrefix(plan.scene) + layerLabel(planned.sceneLayer) + ": " +
+                             made.error().message);
+    }
+    remap = std::move(*made);
+    if (scalar != nullptr) {
+      loaded.remapped.push_back(std::make_unique<RemappedScalarTexture>(*scalar, *remap));
+      scalar = loaded.remapped.back().get();
+    }
+  }
   Layer result;
   result.weight = layer.weight;
   if (layer.mask && planned.mask) {
@@ -431,6 +446,10 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
                                volume.error().message);
       }
       loaded.volumes.push_back(std::move(*volume));
+      if (remap) {
+        loaded.volumes.push_back(
+            std::make_unique<RemappedHeightVolume>(*loaded.volumes.back(), std::move(*remap)));
+      }
       VolumeSource source;
       source.volume = loaded.volumes.back().get();
       source.scheme = layer.gradient;

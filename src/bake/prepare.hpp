@@ -67,7 +67,9 @@ struct Loaded {
   /// Per plan texture (or null: the other kind, or a UDIM tile's, owned by its UDIM texture)
   std::vector<std::unique_ptr<ScalarTexture>> scalar;
   std::vector<std::unique_ptr<VectorTexture>> vector;  ///< per plan texture, as scalar
-  std::vector<std::unique_ptr<HeightVolume>> volumes;
+  std::vector<std::unique_ptr<HeightVolume>> volumes;  ///< remapped ones after what they read
+  /// A remapped layer's view of its texture (RemappedScalarTexture), per such layer
+  std::vector<std::unique_ptr<ScalarTexture>> remapped;
   std::vector<Layer> layers;  ///< per plan layer
   std::optional<CornerTangents> tangents;
   /// computeLoopTriangleTangents per UV set a tangent-space layer decodes on (MikkTSpace frame)

@@ -23,6 +23,7 @@
 
 #include "sgbake/bake/planner.hpp"
 #include "sgbake/core/text.hpp"
+#include "sgbake/gradient/remap.hpp"
 
 namespace sgbake {
 namespace {
@@ -283,6 +284,21 @@ class ObjectReader {
     return {numberValue(key, value[0]), numberValue(key, value[1])};
   }
 
+  /// An array of [x, y] pairs of numbers (at least one).
+  std::vector<Vec2d> points(std::string_view key) const {
+    const json& value = at(key);
+    if (!value.is_array() || value.empty()) typeError(key, "an array of [x, y] points", value);
+    std::vector<Vec2d> out;
+    out.reserve(value.size());
+    for (const json& point : value) {
+      if (!point.is_array() || point.size() != 2) {
+        typeError(key, "an array of [x, y] points", value);
+      }
+      out.push_back({numberValue(key, point[0]), numberValue(key, point[1])});
+    }
+    return out;
+  }
+
   /// An array of three numbers.
   Vec3d vec3(std::string_view key) const {
     const json& value = at(key);
@@ -384,22 +400,22 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
     keys.insert(keys.end(), kImageLayerKeys.begin(), kImageLayerKeys.end());
   switch (type) {
     case SceneLayerType::kHeight:
-      add({"uv", "scale", "strength", "base", "channel", "gradient", "height_space"});
+      add({"uv", "scale", "strength", "base", "channel", "gradient", "height_space", "remap"});
       break;
     case SceneLayerType::kNormal:
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
       add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
-           "gradient", "step", "base", "strength", "height_space"});
+           "gradient", "step", "base", "strength", "height_space", "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
-           "projection", "tangent_uv", "height_space"});
+           "projection", "tangent_uv", "height_space", "remap"});
       break;
     case SceneLayerType::kTriplanar:
       add({"kind", "scale", "mapping", "projection", "sharpness", "min_weight", "box_blend",
-           "green", "base", "gradient", "tangent_uv", "strength", "height_space"});
+           "green", "base", "gradient", "tangent_uv", "strength", "height_space", "remap"});
       break;
   }
   return keys;
@@ -847,6 +863,14 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (layer.base == LayerBase::kLayersAbove && layer.readsNormals()) {
     fail(where,
          "'base': 'above' applies only to heights (a normal map has no normal to start from)");
+  }
+  if (reader.has("remap")) {
+    if (layer.readsNormals()) {
+      fail(where, "key 'remap' applies only to heights (a normal map's colour is not remapped)");
+    }
+    Result<HeightRemap> remap = HeightRemap::create(reader.points("remap"));
+    if (!remap) fail(where, "'remap': " + remap.error().message);
+    layer.remap.assign(remap->points().begin(), remap->points().end());
   }
   if (layer.readsNormals() && reader.has("height_space")) {
     fail(where, "key 'height_space' applies only to heights (a normal map has no height)");
@@ -1476,6 +1500,11 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
   // A height's Bump Strength (written always for UV heights, as before; else when not 1).
   if (layer.type == SceneLayerType::kHeight || (layer.hasHeight() && layer.strength != 1))
     j["strength"] = layer.strength;
+  if (!layer.remap.empty()) {
+    json points = json::array();
+    for (const Vec2d& p : layer.remap) points.push_back({p.x, p.y});
+    j["remap"] = std::move(points);
+  }
   switch (layer.type) {
     case SceneLayerType::kHeight:
       j["uv"] = layer.uvSet;

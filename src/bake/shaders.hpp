@@ -434,7 +434,7 @@ void shadeSlowLanes(Shader& shader, const SampleBatch& s, const LaneFlags& slow,
 
 /// The texture samples of UV height layer @p src (non-null texture, UV set on @p tri) at every
 /// sample of @p s: the SurfacePoint's interpolated UV (moved by @p shift when given), tiled and
-/// offset, through sampleMany for an image texture (one dispatch on the filter per batch).
+/// offset, through the texture's sampleMany (an image's: one dispatch on the filter per batch).
 inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& s,
                                  const UvHeightSource& src,
                                  std::array<ScalarSample, SampleBatch::kMax>& h,
@@ -448,11 +448,7 @@ inline void batchUvHeightSamples(const ShadingTriangle& tri, const SampleBatch& 
                    s.b0[i] * uv0.y + s.b1[i] * uv1.y + s.b2[i] * uv2.y};
     st[i] = textureCoordinates(shift != nullptr ? uv + *shift : uv, src.tiling, src.offset);
   }
-  if (const auto* image = dynamic_cast<const ImageScalarTexture*>(src.texture)) {
-    image->sampleMany({st.data(), n}, {h.data(), n});
-  } else {
-    for (std::size_t i = 0; i < n; ++i) h[i] = src.texture->sample(st[i]);
-  }
+  src.texture->sampleMany({st.data(), n}, {h.data(), n});
 }
 
 /// Whether the batch paths take @p layer whole (batchUvHeightGradient): an unmasked UV height

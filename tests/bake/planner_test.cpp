@@ -351,6 +351,47 @@ TEST_F(PlannerTest, ExplainSaysTheMeshIsSubdivided) {
       << "the normal map's tilt, decoded in the plane's frame";
 }
 
+// A remapped height bakes G(h) and G′(h)·∇h: the height and derivative maps of the same layer
+// without its remap, read through it (h.png ramps 0 … 0.5 in x; G clamps 3h − 0.3 to [0, 0.6]).
+TEST_F(PlannerTest, ARemappedHeightBakesTheRemapOfTheHeightAndItsSlopes) {
+  const auto bakeTo = [&](const std::string& remap, const std::string& prefix) {
+    bake(planeScene(R"({"type": "height", "image": "h.png", "scale": 0.1)" + remap + "}",
+                    R"({"map": "height", "file": ")" + prefix +
+                        R"(h.exr", "size": 16, "bit_depth": 32},
+                       {"map": "derivative", "file": ")" +
+                        prefix + R"(d.exr", "size": 16, "bit_depth": 32})"));
+    return std::pair{readPixels(dir_ / (prefix + "h.exr")), readPixels(dir_ / (prefix + "d.exr"))};
+  };
+  const auto [height, derivative] = bakeTo("", "plain_");
+  const auto [remappedHeight, remappedDerivative] =
+      bakeTo(R"(, "remap": [[0.1, 0], [0.3, 0.6]])", "remapped_");
+  ASSERT_EQ(height.size(), std::size_t{16 * 16});
+  ASSERT_EQ(remappedHeight.size(), height.size());
+  const std::size_t channels = derivative.size() / height.size();
+  ASSERT_GE(channels, 2u);
+  ASSERT_EQ(remappedDerivative.size(), derivative.size());
+  int onSlope = 0, flat = 0;
+  for (std::size_t i = 0; i < height.size(); ++i) {
+    const double h = height[i] / 0.1;
+    EXPECT_NEAR(remappedHeight[i], 0.1 * std::clamp(3 * h - 0.3, 0.0, 0.6), 1e-6) << i;
+    if (std::abs(h - 0.1) < 0.01 || std::abs(h - 0.3) < 0.01) continue;  // next to a kink
+    const double slope = h > 0.1 && h < 0.3 ? 3 : 0;
+    (slope != 0 ? onSlope : flat) += 1;
+    for (std::size_t c = 0; c < 2; ++c) {
+      EXPECT_NEAR(remappedDerivative[i * channels + c], slope * derivative[i * channels + c], 1e-5)
+          << i;
+    }
+  }
+  EXPECT_GT(onSlope, 40);
+  EXPECT_GT(flat, 40);
+  EXPECT_GT(std::abs(derivative[channels * 8 * 16 + channels * 8]), 1e-3) << "a bump to remap";
+  const std::string text = explainPlan(
+      plan(planeScene(R"({"type": "height", "image": "h.png", "remap": [[0.1, 0], [0.3, 0.6]]})",
+                      R"({"map": "height", "file": "h.exr"})")));
+  EXPECT_NE(text.find("(sampled by layers[0] through a remap of 2 points)"), std::string::npos)
+      << text;
+}
+
 TEST_F(PlannerTest, MissingInputsAreNamed) {
   Result<Plan> image = makePlan(scene(planeScene(R"({"type": "height", "image": "missing.png"})",
                                                  R"({"map": "height", "file": "h.exr"})")));

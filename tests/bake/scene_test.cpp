@@ -784,6 +784,41 @@ TEST(Scene, HeightSpaceIsParsedForHeightsOnly) {
       "scene.json: layers[0]: unknown height_space 'local' (expected world or object)");
 }
 
+// "remap": a height read through a piecewise-linear function (levels, clamps, a Color Ramp's
+// table); in the parameters (and so the manifest) only when given; heights only.
+TEST(Scene, RemapIsParsedForHeightsAndInTheParametersOnlyWhenGiven) {
+  for (const char* layer :
+       {R"({"type": "height", "image": "h.png", "remap": [[0, 0], [0.5, 1], [0.5, 0.2]]})",
+        R"({"type": "volume", "remap": [[0, 0], [0.5, 1], [0.5, 0.2]]})",
+        R"({"type": "triplanar", "image": "h.png", "remap": [[0, 0], [0.5, 1], [0.5, 0.2]]})"}) {
+    Result<Scene> scene = parseScene(withLayer(layer), options());
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->layers[0].remap, (std::vector<Vec2d>{{0, 0}, {0.5, 1}, {0.5, 0.2}}));
+    EXPECT_NE(layerParametersJson(scene->layers[0]).find(R"("remap":[[0.0,0.0],[0.5,1.0],)"),
+              std::string::npos)
+        << layerParametersJson(scene->layers[0]);
+  }
+  Result<Scene> plain = parseScene(withLayer(R"({"type": "height", "image": "h.png"})"), options());
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_EQ(layerParametersJson(plain->layers[0]).find("remap"), std::string::npos);
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "normal", "image": "n.png", "remap": [[0, 0], [1, 1]]})")),
+      "scene.json: layers[0]: key 'remap' does not apply to a normal layer (it is for "
+      "height, volume, planar or triplanar layers)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "planar", "image": "n.png", "kind": "object-normal",
+                                     "remap": [[0, 0], [1, 1]]})")),
+            "scene.json: layers[0]: key 'remap' applies only to heights (a normal map's colour is "
+            "not remapped)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "height", "image": "h.png", "remap": [[1, 0], [0, 1]]})")),
+      "scene.json: layers[0]: 'remap': remap point 1 has a smaller x than the point before "
+      "it");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "remap": [[1, 0]]})")),
+            "scene.json: layers[0]: 'remap': a remap needs 2 to 65536 points, not 1");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "remap": [0, 1]})")),
+            "scene.json: layers[0]: 'remap' must be an array of [x, y] points, not an array");
+}
+
 TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
   Result<Scene> mapped = parseScene(withLayer(R"({"type": "planar", "image": "h.png",
                     "mapping": {"location": [1, 2, 3], "rotation": [0, 0.5, 0]}})"),

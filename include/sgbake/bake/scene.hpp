@@ -166,6 +166,9 @@ struct SceneLayer {
   /// "gradient" of a height layer: "analytic" (exact), or "bump-node": the forward differences
   /// half a texel apart that Blender's Bump node takes when Cycles bakes (HeightGradient)
   HeightGradient heightGradient = HeightGradient::kAnalytic;
+  /// "remap" (heights): [[x, y], …], the points of a piecewise-linear function the value is read
+  /// through before the scale (HeightRemap: levels, clamps, a Color Ramp's table); empty: none
+  std::vector<Vec2d> remap;
   NormalSpace space = NormalSpace::kTangent;       ///< "space" (normal; convert.hpp)
   /// "tangent_uv" (tangent-space normal layers, and those Blender's projections read): the UV
   /// set whose tangent frames decode the map, when not its "uv"

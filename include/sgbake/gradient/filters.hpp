@@ -147,7 +147,7 @@ class ImageScalarTexture final : public ScalarTexture {
   /// @brief sample() at every point of @p st into @p out (the same size), bit for bit: one
   /// dispatch on the filter for the whole batch instead of a virtual call and a switch per point
   /// (the baker samples a batch of texels at once).
-  void sampleMany(std::span<const Vec2d> st, std::span<ScalarSample> out) const;
+  void sampleMany(std::span<const Vec2d> st, std::span<ScalarSample> out) const override;
 
   /// @brief The polynomial piece of cell (cellX, cellY) at fractional position @p fraction.
   ///

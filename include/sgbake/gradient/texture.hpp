@@ -2,6 +2,9 @@
 /// @brief Textures as the gradient sources read them: filtered values with exact derivatives.
 #pragma once
 
+#include <cstddef>
+#include <span>
+
 #include "sgbake/core/vec.hpp"
 
 namespace sgbake {
@@ -20,6 +23,11 @@ class ScalarTexture {
   virtual ~ScalarTexture() = default;
   /// Value and exact derivatives at (s, t). Thread-safe.
   virtual ScalarSample sample(Vec2d st) const = 0;
+  /// sample() at every point of @p st into @p out (the same size): what the baker reads a batch
+  /// of texels with. Textures that can read a batch faster override it, bit for bit.
+  virtual void sampleMany(std::span<const Vec2d> st, std::span<ScalarSample> out) const {
+    for (std::size_t i = 0; i < st.size(); ++i) out[i] = sample(st[i]);
+  }
 };
 
 /// @brief A three-channel texture (normal maps), filtered, in the same texture space.

@@ -1,0 +1,86 @@
+/// @file remap.hpp
+/// @brief A piecewise-linear remap of a height's value, and textures and volumes read through it.
+///
+/// A height is often reshaped before it bumps: levels and clamps (Blender's Math node with Clamp,
+/// Map Range with Clamp, the Clamp node), or a Color Ramp. Each is a piecewise-linear function G
+/// of the value; the remapped height is G(h) and its slopes, by the chain rule, G′(h) ∇h. The
+/// Bump node's differences read G at each of their heights, so wrapping the texture (or volume)
+/// serves every way a layer takes its slopes.
+///
+/// Cycles tabulates a Color Ramp at 256 evenly spaced values, ramp(i / 255), and reads the table
+/// with the value clamped to [0, 1]: linearly between entries, or the entry at or below it when
+/// the ramp's interpolation is Constant. Both are HeightRemap points: (i / 255, table[i]), and
+/// for Constant a step at every entry.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "sgbake/core/result.hpp"
+#include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/texture.hpp"
+#include "sgbake/gradient/volume.hpp"
+
+namespace sgbake {
+
+/// Most points a HeightRemap takes (a Color Ramp table with a step at each entry has 512).
+inline constexpr std::size_t kMaxRemapPoints = 65536;
+
+/// @brief G: a piecewise-linear function through points (x, y) in order of x, constant beyond the
+/// first and the last point. Two points of one x make a step, G taking the second's y there
+/// (continuous from the right).
+class HeightRemap {
+ public:
+  /// @return kBadInput for fewer than two points or more than kMaxRemapPoints, a non-finite
+  /// coordinate, an x smaller than the one before, or three points of one x.
+  static Result<HeightRemap> create(std::vector<Vec2d> points);
+
+  /// G(x). A NaN x gives NaN.
+  double value(double x) const;
+  /// G′(x): the slope of the segment x lies on (of the one to its right at a point); 0 beyond the
+  /// ends and on a step.
+  double slope(double x) const;
+  /// G(x) and G′(x) together.
+  void evaluate(double x, double& value, double& slope) const;
+
+  std::span<const Vec2d> points() const { return points_; }
+
+ private:
+  explicit HeightRemap(std::vector<Vec2d> points) : points_(std::move(points)) {}
+  std::vector<Vec2d> points_;
+};
+
+/// @brief A ScalarTexture read through a HeightRemap: value G(h), gradient G′(h) ∇h.
+///
+/// The texture is **not owned**; it must outlive this one. Thread-safe as the texture is.
+class RemappedScalarTexture final : public ScalarTexture {
+ public:
+  RemappedScalarTexture(const ScalarTexture& texture, HeightRemap remap)
+      : texture_(&texture), remap_(std::move(remap)) {}
+  ScalarSample sample(Vec2d st) const override;
+  /// The texture's sampleMany, then the remap, point by point.
+  void sampleMany(std::span<const Vec2d> st, std::span<ScalarSample> out) const override;
+  const HeightRemap& remap() const { return remap_; }
+
+ private:
+  const ScalarTexture* texture_;
+  HeightRemap remap_;
+};
+
+/// @brief A HeightVolume read through a HeightRemap: value G(h), gradient G′(h) ∇h (exact where
+/// G is differentiable; finite-difference schemes read value() and see the kinks as they are).
+///
+/// The volume is **not owned**; it must outlive this one.
+class RemappedHeightVolume final : public HeightVolume {
+ public:
+  RemappedHeightVolume(const HeightVolume& volume, HeightRemap remap)
+      : volume_(&volume), remap_(std::move(remap)) {}
+  double value(Vec3d p) const override;
+  Vec3d analyticGradient(Vec3d p) const override;
+
+ private:
+  const HeightVolume* volume_;
+  HeightRemap remap_;
+};
+
+}  // namespace sgbake
