@@ -24,6 +24,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                      with the other wrap (a negative control)
   ours_bake_unscaled.exr  an object-space displacement case's bump-node bake with the
                      node's Scale in world units (a negative control)
+  ours_bake_unremapped.exr  a remapped case's bump-node bake without its "remap" (a negative
+                     control)
   ours_mask.exr      `sgbake bake --map mask`
   ours_nmap_tangent.exr, ours_nmap_object.exr   a normal-map case's scene (normal layer,
                      tangent- and object-normal outputs), against Blender's tangent and
@@ -125,6 +127,7 @@ def compare_case(entry):
                       ("bake_swapped", "ours_bake_swapped.exr"),
                       ("bake_unscaled", "ours_bake_unscaled.exr"),
                       ("bake_full_strength", "ours_bake_full_strength.exr"),
+                      ("bake_unremapped", "ours_bake_unremapped.exr"),
                       ("bake_object_space", "ours_bake_object_space.exr")):
         img = load_if(os.path.join(d, name))
         if img is None:
