@@ -11,7 +11,7 @@ import time
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from . import capi, gather, library, scene
+from . import capi, gather, library, remap, scene
 
 # Image Texture node settings -> layer settings. Cycles' Smart interpolation is cubic; Closest
 # has no counterpart and becomes bilinear. Clip and Mirror become Repeat.
@@ -88,9 +88,12 @@ class BakeJob:
             gather.check_target(image)
         gather.check_memory(self.width, self.height, settings.padding)
         self.tiles = gather.image_tiles(image)
-        self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index, tile,
-                                              subdivision, transform, render_uv)
-                       for tile in self.tiles}
+        try:
+            self.scenes = {tile: scene.scene_json(settings, layers, bake_uv, uv_names.index,
+                                                  tile, subdivision, transform, render_uv)
+                           for tile in self.tiles}
+        except scene.LayerError as exc:
+            raise gather.BakeInputError(str(exc)) from None
         self.scene = self.scenes[self.tiles[0]]
         self.uv_tiles = gather.uv_tiles(self.arrays[4][bake_uv], self.arrays[1])
         self.progress = capi.Progress(0.0, 0)
@@ -289,9 +292,10 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
         for values in found:
             layer = settings.layers.add()
             for key, value in values.items():
-                setattr(layer, key, value)
+                setattr(layer, key, scene.remap_text(value) if key == "remap" else value)
         settings.active_layer_index = len(settings.layers) - 1
         added = ", ".join(f"{v['type']} '{v['image'].name}' x {v['scale']:.4g}"
+                          + (f" remapped ({len(v['remap'])} points)" if "remap" in v else "")
                           + (f" on slot {v['material_index']}" if "material_index" in v else "")
                           for v in found)
         origin = f"'{sources[0][1].name}'" if single else f"the materials of '{ob.name}'"
@@ -436,15 +440,21 @@ def _constant(socket):
     return (value,) * 3 if isinstance(value, float) else value
 
 
+# The luminance Cycles takes of a colour linked into a float input: its rgb_to_y, the Y row
+# of Blender's scene linear to XYZ (the default colour management: Rec. 709 primaries, D65),
+# as measured from Cycles 3.4 (an Emission bake of pure R, G and B through a Math node; float
+# values). Not quite the 0.2126, 0.7152, 0.0722 of the config's "luma" (a Color Ramp's kink
+# lands ~1e-5 elsewhere with those: 0.04 deg at p99 of a bake).
+LUMINANCE = (0.212672979, 0.715152621, 0.072175443)
 SEPARATED_CHANNELS = {"R": "r", "G": "g", "B": "b", "Red": "r", "Green": "g", "Blue": "b"}
 
 
-def _affine_step(node, link):
+def _affine_step(node):
     """How Math node or Map Range node `node` changes the height fed into its input the chain
     comes through (the one input linked to something other than constants): (that input,
-    factor) when its output is factor x height + a constant, which no slope sees; None for any
-    other operation, a clamp, or more than one varying input."""
-    if node.type == "MATH" and not node.use_clamp:
+    factor, offset) when its output is factor x height + offset; None for any other operation
+    or more than one varying input. A clamp after it is _chain_step's."""
+    if node.type == "MATH":
         operands = {"ADD": 2, "SUBTRACT": 2, "MULTIPLY": 2, "DIVIDE": 2, "MULTIPLY_ADD": 3}
         count = operands.get(node.operation)
         if count is None:
@@ -454,31 +464,98 @@ def _affine_step(node, link):
         if len(varying) != 1:
             return None
         i = varying[0]
-        factor = {"ADD": lambda: 1.0, "SUBTRACT": lambda: 1.0 if i == 0 else -1.0,
-                  "MULTIPLY": lambda: values[1 - i],
-                  "DIVIDE": lambda: _divide(1.0, values[1]) if i == 0 else None,
-                  "MULTIPLY_ADD": lambda: (values[1] if i == 0 else values[0] if i == 1
-                                           else 1.0)}[node.operation]()
-        return None if factor is None else (node.inputs[i], factor)
-    if (node.type == "MAP_RANGE" and node.data_type == "FLOAT" and not node.clamp
+        other = values[1 - i] if count == 2 else None
+        line = {"ADD": lambda: (1.0, other),
+                "SUBTRACT": lambda: (1.0, -values[1]) if i == 0 else (-1.0, values[0]),
+                "MULTIPLY": lambda: (other, 0.0),
+                "DIVIDE": lambda: (_divide(1.0, values[1]), 0.0) if i == 0 else None,
+                "MULTIPLY_ADD": lambda: ((values[1], values[2]) if i == 0
+                                         else (values[0], values[2]) if i == 1
+                                         else (1.0, values[0] * values[1]))}[node.operation]()
+        return None if line is None else (node.inputs[i],) + line
+    if (node.type == "MAP_RANGE" and node.data_type == "FLOAT"
             and node.interpolation_type == "LINEAR"):
         ends = [_constant(node.inputs[name]) for name in ("From Min", "From Max", "To Min",
                                                           "To Max")]
         if any(v is None for v in ends):
             return None
-        return node.inputs["Value"], _divide(ends[3] - ends[2], ends[1] - ends[0])
+        factor = _divide(ends[3] - ends[2], ends[1] - ends[0])
+        return node.inputs["Value"], factor, ends[2] - factor * ends[0]
     return None
+
+
+def _ramp_values(node, output, channel):
+    """Color Ramp node `node`'s table as Cycles makes it (its colour at i / 255, i = 0 .. 255)
+    as read from its `output`: the alpha, else the colour's `channel` (r, g, b; None: the
+    Rec. 709 luminance, as a colour into a float input)."""
+    values = []
+    last = remap.RAMP_TABLE_SIZE - 1
+    for i in range(remap.RAMP_TABLE_SIZE):
+        r, g, b, a = node.color_ramp.evaluate(i / last)
+        if output == "Alpha":
+            values.append(a)
+        elif channel is None:
+            values.append(LUMINANCE[0] * r + LUMINANCE[1] * g + LUMINANCE[2] * b)
+        else:
+            values.append({"r": r, "g": g, "b": b}[channel])
+    return values
+
+
+def _chain_step(node, link, channel):
+    """How `node` (fed into the chain through `link`) changes the height it is fed, the
+    `channel` of its output the chain reads (r, g, b of a colour, or None): (its input the
+    chain goes on from, the function of that input's value (remap's kinds), the channel read
+    there), or None when it is not followed. Math (the affine operations of _affine_step, then
+    clamped to [0, 1] when the node clamps) and Map Range (linear, then clamped to the To range
+    when it clamps) read a float: the channel read before them is the grey's. Clamp (Min and
+    Max constants): Min Max, min(max(v, Min), Max) (Max alone when Min > Max); Range, between
+    the lower and the higher. Color Ramp: Cycles' table of it read at its Fac (remap.table),
+    its Color's luminance (or the channel read), or its Alpha. Invert of a constant Fac:
+    (1 - Fac) c + Fac (1 - c) on each channel."""
+    if node.type == "INVERT":
+        fac = _constant(node.inputs["Fac"])
+        if not isinstance(fac, float):
+            return None
+        return node.inputs["Color"], ("affine", 1.0 - 2.0 * fac, fac), channel
+    if node.type == "CLAMP":
+        low, high = _constant(node.inputs["Min"]), _constant(node.inputs["Max"])
+        if not isinstance(low, float) or not isinstance(high, float):
+            return None
+        if node.clamp_type == "RANGE":
+            low, high = min(low, high), max(low, high)
+        elif low > high:  # min(max(v, Min), Max) is Max
+            low = high
+        return node.inputs["Value"], remap.clamp(low, high), None
+    if node.type == "VALTORGB":
+        output = link.from_socket.name
+        constant = node.color_ramp.interpolation == "CONSTANT"
+        return (node.inputs["Fac"],
+                remap.table(_ramp_values(node, output, channel), constant), None)
+    step = _affine_step(node)
+    if step is None:
+        return None
+    socket, factor, offset = step
+    line = ("affine", factor, offset)
+    if node.type == "MATH" and node.use_clamp:
+        line = remap.compose(remap.clamp(0.0, 1.0), line)
+    elif node.type == "MAP_RANGE" and node.clamp:
+        ends = (_constant(node.inputs["To Min"]), _constant(node.inputs["To Max"]))
+        line = remap.compose(remap.clamp(min(ends), max(ends)), line)
+    return socket, line, None
 
 
 def _height_source(socket):
     """The Image Texture node (with an image) that feeds height input `socket`, the channel it
-    is read on and the factor the nodes between scale it by: (node, channel, factor), or None.
-    Followed back through Reroutes and nodes that change the height affinely (_affine_step:
-    Math and Map Range nodes with constants; an Invert node of constant Fac; the offset moves no
-    slope), RGB to BW (the
-    luminance, as the input's own conversion) and Separate RGB or Color (RGB mode: channel r,
-    g or b); the texture's Alpha output is channel a, its Color the luminance."""
-    factor, channel = 1.0, None
+    is read on and the function of its value the nodes between make: (node, channel, factor,
+    points), or None when the chain is not followed, or a string saying why its height cannot
+    bump (it is constant). Followed back through Reroutes, RGB to BW (the luminance, as the
+    input's own conversion), Separate RGB or Color (RGB mode: channel r, g or b; the texture's
+    Alpha output is channel a, its Color the luminance) and the nodes of _chain_step (Math, Map
+    Range, Clamp, Color Ramp, Invert), composed into one function (remap.compose). Without a
+    clamp or Color Ramp it is factor x value + an offset no slope sees: points is None; with
+    one, points is the whole function's remap (its y as the chain makes them: the outer affine
+    steps in them, not in factor, which is then 1)."""
+    function, channel = remap.IDENTITY, None
     while True:
         link = _source_link(socket)
         if link is None or link.from_node.mute:
@@ -491,7 +568,7 @@ def _height_source(socket):
                 if channel is not None:
                     return None
                 channel = "a"
-            return node, channel or "luminance", factor
+            break
         if node.type in ("SEPRGB", "SEPARATE_COLOR"):
             if channel is not None or getattr(node, "mode", "RGB") != "RGB":
                 return None
@@ -499,17 +576,27 @@ def _height_source(socket):
             if channel is None:
                 return None
             socket = node.inputs[0]
-        elif node.type == "RGBTOBW" and channel is None:
-            socket = node.inputs[0]
-        elif node.type == "INVERT" and isinstance(_constant(node.inputs["Fac"]), float):
-            factor *= 1 - 2 * _constant(node.inputs["Fac"])  # (1 - Fac) c + Fac (1 - c)
-            socket = node.inputs["Color"]
-        else:
-            step = _affine_step(node, link)
-            if step is None:
-                return None
-            socket, by = step
-            factor *= by
+            continue
+        if node.type == "RGBTOBW":
+            socket, channel = node.inputs[0], None  # (a grey: every channel its value)
+            continue
+        step = _chain_step(node, link, channel)
+        if step is None:
+            return None
+        socket, inner, channel = step
+        function = remap.compose(function, inner)
+    channel = channel or "luminance"
+    if not remap.finite(function):
+        return "the nodes between it and its Image Texture make a height that is not finite"
+    if function[0] == "affine":
+        return node, channel, function[1], None
+    if remap.is_constant(function):
+        return ("the nodes between it and its Image Texture make a constant height (no bump, "
+                "as in Cycles)")
+    if len(function[1]) > remap.MAX_POINTS:
+        return (f"the nodes between it and its Image Texture make a remap of "
+                f"{len(function[1])} points (libsgbake takes {remap.MAX_POINTS})")
+    return node, channel, 1.0, [[x, y] for x, y in function[1]]
 
 
 def _recombined_normal_map(socket):
@@ -652,15 +739,18 @@ def _object_projected(tex, ob=None):
     return _object_coordinates(tex, ob) is not None
 
 
-def _height_settings(node, tex, channel, render_uv, ob, ignored):
+def _height_settings(node, tex, channel, render_uv, ob, ignored, points=None):
     """The settings of a height layer read from Image Texture node `tex` on `channel`
-    (_height_source) into the Height input of `node` (a Bump or a Displacement node), before
-    its scale: the texture's, with the slopes as Cycles takes them when it bakes (forward
-    differences half a texel apart: the layer then bakes what Cycles bakes from it); on object
-    coordinates the projection's (which reads the luminance: another channel is named in
-    `ignored`)."""
+    (_height_source) into the Height input of `node` (a Bump or a Displacement node), through
+    the remap `points` when the nodes between make one (_height_source), before its scale: the
+    texture's, with the slopes as Cycles takes them when it bakes (forward differences half a
+    texel apart, of the remapped height: the layer then bakes what Cycles bakes from it); on
+    object coordinates the projection's (which reads the luminance: another channel is named
+    in `ignored`)."""
     values = _texture_settings(tex, render_uv)
     values.update(type="height", slopes="bump-node")
+    if points is not None:
+        values["remap"] = points
     if _object_projected(tex, ob):
         # Object coordinates: the height projected along z onto the object (Flat), wrapped
         # around z (Sphere, Tube), or on the three axis planes as Blender's Box projection
@@ -682,7 +772,8 @@ def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the displacement along the
     normal, (height - Midlevel) x Scale in world units (in object space, grown with the
     object's scale along the normal): a height layer of scale Scale in the node's space
-    (height_space), its slopes as Cycles takes them. Other methods displace the mesh, which
+    (height_space), its slopes as Cycles takes them, its height through the nodes between as
+    _height_source composes them (a factor in the scale, or a "remap"). Other methods displace the mesh, which
     sgbake does not; other nodes are not read (notes in `skipped`)."""
     output = node_tree.get_output_node("CYCLES")
     link = _source_link(output.inputs["Displacement"]) if output is not None else None
@@ -698,15 +789,15 @@ def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
         skipped.append(f"{where} from '{node.name}' (a Displacement node is read)")
         return None
     source = _height_source(node.inputs["Height"])
-    if source is None:
-        skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
+    if not isinstance(source, tuple):
+        skipped.append(f"'{node.name}': {source or _not_image(node.inputs['Height'])}")
         return None
-    tex, channel, factor = source
+    tex, channel, factor, points = source
     ignored += _ignored(node, tex, ("Scale",), "Height", ob)
     if _source_link(node.inputs["Normal"]) is not None:
         ignored.append(f"'{node.name}' Normal from a node (the layer displaces along the "
                        "surface's normal)")
-    values = _height_settings(node, tex, channel, render_uv, ob, ignored)
+    values = _height_settings(node, tex, channel, render_uv, ob, ignored, points)
     values.update(scale=factor * _input_value(node, "Scale"), strength=1.0,
                   height_space="object" if node.space == "OBJECT" else "world")
     return values
@@ -894,7 +985,9 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
     map active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
     object baked (for textures on another object's or Generated coordinates).
 
-    Bump: scale = Distance, negated when Invert is on, and its Strength (the blend of the bumped
+    Bump: scale = Distance (times the factor of affine nodes on the height, _height_source;
+    through a clamp or a Color Ramp the layer's "remap" holds the whole function of the
+    texture's value, scale the Distance alone), negated when Invert is on, and its Strength (the blend of the bumped
     normal with the original one, as Cycles' Bump node does it); when its Normal input comes
     from a Bump or Normal Map node that made a layer, base "above" (it bumps that node's
     normal), the layers ordered so that such a node's comes first. Normal Map: its space
@@ -918,13 +1011,14 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
             continue
         if node.type == "BUMP":
             source = _height_source(node.inputs["Height"])
-            if source is None:
-                skipped.append(f"'{node.name}': {_not_image(node.inputs['Height'])}")
+            if not isinstance(source, tuple):
+                skipped.append(f"'{node.name}': "
+                               f"{source or _not_image(node.inputs['Height'])}")
                 continue
-            tex, channel, factor = source
+            tex, channel, factor, points = source
             ignored += _ignored(node, tex, ("Strength", "Distance"), "Height", ob)
             scale = factor * _input_value(node, "Distance")
-            values = _height_settings(node, tex, channel, render_uv, ob, ignored)
+            values = _height_settings(node, tex, channel, render_uv, ob, ignored, points)
             values.update(scale=-scale if node.invert else scale,
                           strength=max(_input_value(node, "Strength"), 0.0))
         else:

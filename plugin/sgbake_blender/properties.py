@@ -138,6 +138,12 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     slopes: EnumProperty(name="Slopes", items=SLOPES, default="analytic",
                          description="How a height layer's slopes are taken (Layers from "
                                      "Material takes a Bump node's as Cycles does)")
+    remap: StringProperty(
+        name="Remap",
+        description="Heights: a piecewise-linear function of the image's value, as JSON "
+                    "[[x, y], ...] in non-decreasing x (two points of one x: a step), constant "
+                    "beyond the ends; the height is Scale x remap(value). Layers from Material "
+                    "sets it from a Color Ramp or a clamp on the Bump's height; empty: none")
     filter: EnumProperty(name="Filter", items=FILTERS, default="bilinear")
     wrap: EnumProperty(name="Wrap", items=WRAPS, default="repeat")
     tiling: FloatVectorProperty(name="Tiling", size=2, default=(1.0, 1.0),

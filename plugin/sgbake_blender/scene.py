@@ -9,8 +9,12 @@ layer types, spaces and maps it applies to (scene.cpp's layerKeys and kMapOutput
 Every per-layer key of the scene format is covered: the common ones (name, weight, material,
 mask with its image, uv, tiling, offset and filter), the image ones (image, filter, wrap, tiling,
 offset), uv, scale/strength, space, green, kind, axis, sharpness, min_weight and the volume's
-function, amplitude, frequency, direction, phase, seed, octaves, gradient and step.
+function, amplitude, frequency, direction, phase, seed, octaves, gradient and step; a
+height's remap (its Remap text, parsed by remap_points: LayerError for text that is not one).
 """
+
+import json
+import math
 
 MAPS = (
     ("tangent-normal", "Tangent Normal", "Normal map in tangent space (n/2 + 0.5)"),
@@ -58,6 +62,50 @@ UV_SMOOTHS = {
     "SMOOTH_ALL": "all",
 }
 BOUNDARY_SMOOTHS = {"ALL": "all", "PRESERVE_CORNERS": "keep-corners"}
+
+
+class LayerError(ValueError):
+    """A layer's setting cannot be sent as it is (its message names the layer)."""
+
+
+# libsgbake's limits on a height's "remap" (kMaxRemapPoints).
+REMAP_MIN_POINTS, REMAP_MAX_POINTS = 2, 65536
+
+
+def remap_text(points):
+    """A remap's points [[x, y], ...] as the text a layer's Remap holds (JSON)."""
+    return json.dumps([[float(x), float(y)] for x, y in points], separators=(",", ":"))
+
+
+def remap_points(layer):
+    """The points [[x, y], ...] of a layer's Remap (JSON text; "" or blank: none, None).
+    Raises LayerError, naming the layer, for text that is not a list of 2 to 65536 pairs of
+    finite numbers in non-decreasing x with at most two of one x."""
+    text = layer.remap.strip()
+    if not text:
+        return None
+
+    def bad(why):
+        return LayerError(f"layer '{layer.name}': Remap {why} (a JSON list of [x, y] points in "
+                          "non-decreasing x, at most two of one x)")
+    try:
+        points = json.loads(text)
+    except ValueError as exc:
+        raise bad(f"is not JSON: {exc}") from None
+    if not isinstance(points, list):
+        raise bad("is not a list")
+    if not REMAP_MIN_POINTS <= len(points) <= REMAP_MAX_POINTS:
+        raise bad(f"has {len(points)} points, not {REMAP_MIN_POINTS} to {REMAP_MAX_POINTS}")
+    for i, point in enumerate(points):
+        if (not isinstance(point, list) or len(point) != 2
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                           and math.isfinite(v) for v in point)):
+            raise bad(f"point {i} {json.dumps(point)[:40]} is not two finite numbers")
+        if i > 0 and point[0] < points[i - 1][0]:
+            raise bad(f"point {i} has x {point[0]:g} below the one before ({points[i - 1][0]:g})")
+        if i > 1 and point[0] == points[i - 1][0] == points[i - 2][0]:
+            raise bad(f"has three points of x {point[0]:g}")
+    return [[float(x), float(y)] for x, y in points]
 
 
 def _number(value):
@@ -135,6 +183,7 @@ def layer_json(layer, uv_index, default_uv=None):
     normal layers: the layer's own UV map, else `default_uv`, the render UV map, else the
     scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance, and is
     sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json).
+    A height's Remap goes as "remap" (remap_points, which raises LayerError for bad text).
     A layer of one material slot (material_index >= 0) sends it as "material": libsgbake then
     applies it to the faces of that slot only (the mesh's face_material)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
@@ -153,6 +202,8 @@ def layer_json(layer, uv_index, default_uv=None):
         entry["strength"] = _number(layer.strength)
     if bumps_height(layer) and layer.height_space != "world":  # (a Displacement in Object space)
         entry["height_space"] = layer.height_space
+    if bumps_height(layer) and layer.remap.strip():  # (a Color Ramp or a clamp on the height)
+        entry["remap"] = remap_points(layer)
     if layer.type == "height":
         entry["scale"] = _number(layer.scale)
         if layer.channel != "luminance":

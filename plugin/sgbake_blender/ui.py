@@ -142,6 +142,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                                           and layer.kind == "height"):
                 col.prop(layer, "base")
                 col.prop(layer, "slopes")
+            if scene.bumps_height(layer) and layer.remap.strip():
+                col.label(text=_remap_text(layer), icon="FCURVE")
             col.prop(layer, "filter")
             col.prop(layer, "wrap")
             col.prop(layer, "tiling")
@@ -195,6 +197,19 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "mask_tiling", text="Tiling")
             col.prop(layer, "mask_offset", text="Offset")
             col.prop(layer, "mask_filter", text="Filter")
+
+
+def _remap_text(layer):
+    """One line on a height layer's Remap: how many points and the range of its values, or why
+    it cannot be sent."""
+    try:
+        points = scene.remap_points(layer)
+    except scene.LayerError as exc:
+        why = str(exc).split(": Remap ", 1)[-1].split(" (a JSON list", 1)[0]
+        return f"Remap: invalid ({why})"
+    values = [y for _, y in points]
+    return (f"Remap: {len(points)} points, x {points[0][0]:.4g} to {points[-1][0]:.4g}, "
+            f"values {min(values):.4g} to {max(values):.4g}")
 
 
 def _slot_text(ob, index):

@@ -71,6 +71,14 @@
    Only) on Suzanne stretched and turned, the Bump node's Normal unlinked; Layers from Material
    must make the displacement's layer (height space object) and the Bump's above it, baked as
    Cycles bakes them (DISPLACEMENT_*), the Bump added instead of stacked must not be.
+   Remap (remap_case): the texture through a Color Ramp (Ease, coloured stops, rising and
+   falling) and a Math node x 2 clamped into the Bump: Layers from Material must compose them
+   into the layer's "remap" (sent as the layer holds it; a malformed Remap is an error report
+   naming the layer), baked as Cycles bakes it (REMAP_*: median and p99), the same job without
+   the remap clearly worse. remap_checks compares such remaps (Color Ramp Ease and Constant,
+   its Alpha, its Green separated, Map Range clamped with negative factors, the Clamp node's
+   two types) with the chains computed here from Blender's ramp at 1000 values, and a chain
+   that makes a constant (x 0, a Clamp of Min above Max) must be skipped.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -202,6 +210,15 @@ DISPLACEMENT_SCALE = 0.05
 DISPLACEMENT_PLACEMENT = ((0.3, -0.2, 0.1), (0.3, -0.2, 0.5), (1.6, 1.0, 0.7))
 DISPLACEMENT_MEDIAN_DEG = 0.01
 DISPLACEMENT_CONTROL_FACTOR = 3.0
+# The remap case (remap_case): the bump material's texture through a Color Ramp (REMAP_STOPS,
+# Ease: its luminance rises and falls) and a Math node (x REMAP_FACTOR, clamped to [0, 1]: the
+# ramp's peak is cut flat) into the Bump. Layers from Material must compose the two into the
+# layer's "remap"; its bake must be Cycles' (median <= REMAP_MEDIAN_DEG, p99 <= REMAP_P99_DEG)
+# and the same job without the remap at least REMAP_CONTROL_FACTOR times worse.
+REMAP_FACTOR = 2.0
+REMAP_MEDIAN_DEG = 0.01
+REMAP_P99_DEG = 0.01
+REMAP_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -688,8 +705,9 @@ def material_checks(settings, ob, distance):
           f"'{path}' named, the Bump outside skipped, no flattened material left",
           f"{in_groups}, {skipped_groups}, {named_groups}")
     # A height through nodes that change it affinely (Math x 0.5, then Map Range 0..1 to
-    # 0.2..0.8: x 0.3 in all) scales the layer; through Separate Color's Green, channel g; a
-    # clamped Math node is not affine: no layer.
+    # 0.2..0.8: x 0.3 in all) scales the layer, with no remap; through Separate Color's Green,
+    # channel g; a clamped Math node is not affine: a remap, 0.2 + 0.6 clamp(0.5 h, 0, 1)
+    # (remap_checks checks such chains closely), the scale the Distance.
     half = tree.nodes.new("ShaderNodeMath")
     half.operation, half.inputs[1].default_value = "MULTIPLY", 0.5
     ranged = tree.nodes.new("ShaderNodeMapRange")
@@ -714,12 +732,16 @@ def material_checks(settings, ob, distance):
         tree.nodes.remove(extra)
     check("Layers from Material: a height through Math, Map Range, Separate Color, Invert nodes",
           len(affine) == 1 and abs(affine[0]["scale"] - 0.3 * distance) < 1e-7
-          and not affine_notes and not clamped
-          and any("not an Image Texture" in n for n in clamped_skipped)
+          and "remap" not in affine[0] and not affine_notes and len(clamped) == 1
+          and abs(clamped[0]["scale"] - distance) < 1e-7
+          and all(abs(remap_at(clamped[0].get("remap") or [[0, 0], [1, 0]], x)
+                      - (0.2 + 0.6 * min(max(0.5 * x, 0.0), 1.0))) < 1e-7
+                  for x in (-0.5, 0.3, 1.7, 2.5)) and not clamped_skipped
           and len(green) == 1 and green[0].get("channel") == "g"
           and abs(green[0]["scale"] - distance) < 1e-7
           and len(inverted) == 1 and abs(inverted[0]["scale"] + distance) < 1e-7,
-          f"scale {0.3 * distance:.4g}, nothing named; clamped: skipped; Green: channel g; "
+          f"scale {0.3 * distance:.4g}, no remap, nothing named; clamped: scale "
+          f"{distance:.4g}, remap 0.2 + 0.6 clamp(0.5 h, 0, 1); Green: channel g; "
           f"Invert: scale {-distance:.4g}",
           f"{affine}, {affine_notes}; {clamped}, {clamped_skipped}; {green}; {inverted}")
     # The Material Output's Displacement: with Displacement only (true displacement) it is
@@ -886,6 +908,193 @@ def material_checks(settings, ob, distance):
           f"{faces} faces, shown in the viewport again", f"{baked} faces")
     ob.modifiers.remove(modifier)
     bpy.context.view_layer.update()
+    return checks
+
+
+# The remap checks: Layers from Material's "remap" against the chain computed here, at
+# REMAP_SAMPLES values of x in [-0.5, 1.5] (seeded, so that none falls on a step's x), within
+# REMAP_TOLERANCE.
+REMAP_SAMPLES = 1000
+REMAP_TOLERANCE = 1e-6
+# Cycles' colour into a float input (its rgb_to_y, measured: an Emission bake of R, G and B).
+REMAP_LUMINANCE = (0.212672979, 0.715152621, 0.072175443)
+# The Color Ramp of the remap checks and of remap_case: (position, colour) of three stops whose
+# luminances rise and fall (0.27, 0.64, 0.23), Ease between them.
+REMAP_STOPS = ((0.15, (0.9, 0.1, 0.1, 1.0)), (0.5, (0.2, 0.8, 0.3, 1.0)),
+               (0.85, (0.1, 0.2, 0.9, 0.6)))
+
+
+def remap_at(points, x):
+    """The scene's "remap" through `points` at x: linear between points, constant beyond the
+    ends, at a step (two points of one x) the second's value."""
+    if x < points[0][0]:
+        return points[0][1]
+    for (x0, y0), (x1, y1) in zip(points, points[1:]):
+        if x0 <= x < x1:
+            return y0 + (x - x0) * (y1 - y0) / (x1 - x0)
+    return points[-1][1]
+
+
+def cycles_ramp(ramp, fac):
+    """Cycles' Color Ramp at `fac`, computed here: its table of 256 colours ramp(i / 255), read
+    at fac clamped to [0, 1] times 255, between entries i and i + 1 (entry i alone when the ramp
+    is Constant). RGBA."""
+    f = min(max(fac, 0.0), 1.0) * 255
+    i = int(f)
+    t = f - i
+    low = ramp.evaluate(i / 255)
+    if ramp.interpolation == "CONSTANT" or t == 0:
+        return tuple(low)
+    high = ramp.evaluate((i + 1) / 255)
+    return tuple((1 - t) * a + t * b for a, b in zip(low, high))
+
+
+def make_ramp(tree, interpolation="EASE"):
+    """A Color Ramp node of REMAP_STOPS with `interpolation`."""
+    node = tree.nodes.new("ShaderNodeValToRGB")
+    ramp = node.color_ramp
+    ramp.interpolation = interpolation
+    ramp.elements[0].position, ramp.elements[0].color = REMAP_STOPS[0]
+    ramp.elements[1].position, ramp.elements[1].color = REMAP_STOPS[2]
+    middle = ramp.elements.new(REMAP_STOPS[1][0])
+    middle.color = REMAP_STOPS[1][1]
+    return node
+
+
+def remap_checks(ob, distance):
+    """Layers from Material on heights through clamps and Color Ramps: the layer's "remap",
+    evaluated as the scene format defines it (remap_at), against the chain computed here from
+    Blender's own Color Ramp (cycles_ramp) and the nodes' settings. Returns check records like
+    expect_error's."""
+    import random
+    from sgbake_blender import operators
+    tree = ob.active_material.node_tree
+    tex = next(node for node in tree.nodes if node.type == "TEX_IMAGE" and node.image
+               and node.name != "bake_target")
+    bump = next(node for node in tree.nodes if node.type == "BUMP")
+    rng = random.Random(1234)
+    xs = [rng.uniform(-0.5, 1.5) for _ in range(REMAP_SAMPLES)]
+    checks = []
+
+    def luminance(rgba):
+        return sum(w * c for w, c in zip(REMAP_LUMINANCE, rgba))
+
+    def clamp(v, low, high):
+        return min(max(v, low), high)
+
+    def compare(name, reference, extra=None, scale=None):
+        """The one layer Layers from Material makes now against `reference` (x -> height /
+        scale); `extra(layer)` an additional condition, with its description."""
+        found, skipped, _ = operators.material_layers(tree)
+        layer = found[0] if len(found) == 1 else {}
+        points = layer.get("remap")
+        want_scale = distance if scale is None else scale
+        worst = (max(abs(remap_at(points, x) - reference(x)) for x in xs)
+                 if points else None)
+        more, more_what = extra(layer) if extra else (True, "")
+        checks.append({
+            "name": f"Layers from Material: a height through {name}",
+            "ok": worst is not None and worst <= REMAP_TOLERANCE
+            and abs(layer.get("scale", 0) - want_scale) < 1e-7 and more,
+            "expected": f"one layer with a remap within {REMAP_TOLERANCE:g} of the chain at "
+                        f"{REMAP_SAMPLES} values of x in [-0.5, 1.5], scale {want_scale:.4g}"
+                        + more_what,
+            "message": f"max difference {worst}, {len(points or ())} points, scale "
+                       f"{layer.get('scale')}, keys {sorted(layer)}, skipped {skipped}"})
+
+    # Image -> Color Ramp (Ease, coloured stops: its luminance) -> Math x 2 clamped -> Bump.
+    ramp = make_ramp(tree)
+    double = tree.nodes.new("ShaderNodeMath")
+    double.operation, double.use_clamp = "MULTIPLY", True
+    double.inputs[1].default_value = 2.0
+    tree.links.new(tex.outputs["Color"], ramp.inputs["Fac"])
+    tree.links.new(ramp.outputs["Color"], double.inputs[0])
+    tree.links.new(double.outputs[0], bump.inputs["Height"])
+    compare("a Color Ramp (Ease) and a clamped Math node (x 2)",
+            lambda x: clamp(2 * luminance(cycles_ramp(ramp.color_ramp, x)), 0, 1))
+    # Constant: a step at each entry of the table.
+    ramp.color_ramp.interpolation = "CONSTANT"
+    compare("a Color Ramp (Constant) and a clamped Math node (x 2)",
+            lambda x: clamp(2 * luminance(cycles_ramp(ramp.color_ramp, x)), 0, 1),
+            lambda layer: (any(a[0] == b[0] for a, b in zip(layer.get("remap", []),
+                                                            layer.get("remap", [])[1:])),
+                           ", with steps"))
+    ramp.color_ramp.interpolation = "EASE"
+    # Its Alpha output (straight into the Bump: x 2 clamped would make it 1); its Color's
+    # green through a Separate Color node (the ramp reads the luminance at its Fac: the layer's
+    # channel stays the luminance).
+    tree.links.new(ramp.outputs["Alpha"], bump.inputs["Height"])
+    compare("a Color Ramp's Alpha", lambda x: cycles_ramp(ramp.color_ramp, x)[3])
+    tree.links.new(double.outputs[0], bump.inputs["Height"])
+    separate = tree.nodes.new("ShaderNodeSeparateColor")
+    tree.links.new(ramp.outputs["Color"], separate.inputs[0])
+    tree.links.new(separate.outputs["Green"], double.inputs[0])
+    compare("a Color Ramp's Color, its Green separated, and a clamped Math node (x 2)",
+            lambda x: clamp(2 * cycles_ramp(ramp.color_ramp, x)[1], 0, 1),
+            lambda layer: ("channel" not in layer, ", no channel (the luminance)"))
+    tree.nodes.remove(separate)
+    # A factor of 0 before the clamp makes a constant: no bump, skipped with the reason.
+    zero = tree.nodes.new("ShaderNodeMath")
+    zero.operation, zero.inputs[1].default_value = "MULTIPLY", 0.0
+    tree.links.new(tex.outputs["Color"], zero.inputs[0])
+    tree.links.new(zero.outputs[0], ramp.inputs["Fac"])
+    tree.links.new(ramp.outputs["Color"], double.inputs[0])
+    flat, flat_skipped, _ = operators.material_layers(tree)
+    checks.append({
+        "name": "Layers from Material: a height through x 0 then a Color Ramp is skipped",
+        "ok": not flat and any("constant height" in note for note in flat_skipped),
+        "expected": "no layer, skipped as a constant height",
+        "message": f"{flat}; skipped {flat_skipped}"})
+    tree.nodes.remove(zero)
+    tree.nodes.remove(ramp)
+    tree.nodes.remove(double)
+    # Image -> Math (1 - x: a negative factor) -> Map Range clamped (0.2..0.8 to 0.9..0.1) ->
+    # Math x 0.5 + 0.1 (after the clamp: in the remap's values) -> Bump.
+    flip = tree.nodes.new("ShaderNodeMath")
+    flip.operation, flip.inputs[0].default_value = "SUBTRACT", 1.0
+    ranged = tree.nodes.new("ShaderNodeMapRange")
+    ranged.clamp = True
+    for name, value in (("From Min", 0.2), ("From Max", 0.8), ("To Min", 0.9), ("To Max", 0.1)):
+        ranged.inputs[name].default_value = value
+    after = tree.nodes.new("ShaderNodeMath")
+    after.operation = "MULTIPLY_ADD"
+    after.inputs[1].default_value, after.inputs[2].default_value = 0.5, 0.1
+    tree.links.new(tex.outputs["Color"], flip.inputs[1])
+    tree.links.new(flip.outputs[0], ranged.inputs["Value"])
+    tree.links.new(ranged.outputs["Result"], after.inputs[0])
+    tree.links.new(after.outputs[0], bump.inputs["Height"])
+    compare("1 - h, a clamped Map Range (0.2..0.8 to 0.9..0.1), then x 0.5 + 0.1",
+            lambda x: 0.5 * clamp(0.9 + ((1 - x) - 0.2) / 0.6 * (0.1 - 0.9), 0.1, 0.9) + 0.1)
+    # Without the 1 - h: the Map Range's own negative factor alone turns the points over.
+    tree.links.new(tex.outputs["Color"], ranged.inputs["Value"])
+    compare("a clamped Map Range (0.2..0.8 to 0.9..0.1), then x 0.5 + 0.1",
+            lambda x: 0.5 * clamp(0.9 + (x - 0.2) / 0.6 * (0.1 - 0.9), 0.1, 0.9) + 0.1)
+    tree.nodes.remove(flip)
+    tree.nodes.remove(ranged)
+    # A Clamp node, Min Max and Range (Min above Max), then the Bump inverted.
+    limit = tree.nodes.new("ShaderNodeClamp")
+    limit.inputs["Min"].default_value, limit.inputs["Max"].default_value = 0.35, 0.6
+    tree.links.new(tex.outputs["Color"], limit.inputs["Value"])
+    tree.links.new(limit.outputs["Result"], after.inputs[0])
+    compare("a Clamp node (Min Max, 0.35..0.6), then x 0.5 + 0.1",
+            lambda x: 0.5 * clamp(x, 0.35, 0.6) + 0.1)
+    limit.clamp_type = "RANGE"
+    limit.inputs["Min"].default_value, limit.inputs["Max"].default_value = 0.7, 0.25
+    bump.invert = True
+    compare("a Clamp node (Range, Min 0.7 above Max 0.25), then x 0.5 + 0.1, the Bump inverted",
+            lambda x: 0.5 * clamp(x, 0.25, 0.7) + 0.1, scale=-distance)
+    bump.invert = False
+    # Min Max with Min above Max is Max: a constant, skipped.
+    limit.clamp_type = "MINMAX"
+    constant, constant_skipped, _ = operators.material_layers(tree)
+    checks.append({
+        "name": "Layers from Material: a height through a Clamp node of Min above Max is skipped",
+        "ok": not constant and any("constant height" in n for n in constant_skipped),
+        "expected": "no layer, skipped as a constant height (Cycles gives Max)",
+        "message": f"{constant}; skipped {constant_skipped}"})
+    tree.nodes.remove(limit)
+    tree.nodes.remove(after)
+    tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     return checks
 
 
@@ -1742,6 +1951,59 @@ def displacement_case(settings, ob, work):
     return entry
 
 
+def remap_case(settings, ob, work):
+    """The bump material's texture through a Color Ramp (REMAP_STOPS, Ease) and a Math node
+    (x REMAP_FACTOR, clamped) into the Bump: Layers from Material, then the add-on's
+    tangent-normal bake (addon_remap.npy), the same job without the layer's "remap"
+    (addon_remap_control.npy: the texture's height as it is) and Cycles' (cycles_remap.npy, its
+    mask cycles_remap_mask.npy). Also: the scene sends the layer's Remap as it holds it, and a
+    Remap that is not JSON points is an error report naming the layer. The material is put
+    back afterwards. Returns the manifest entry (result, the layer made, checks)."""
+    import bpy
+    from sgbake_blender import operators, scene
+    tree = ob.active_material.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    ramp = make_ramp(tree)
+    times = tree.nodes.new("ShaderNodeMath")
+    times.operation, times.use_clamp = "MULTIPLY", True
+    times.inputs[1].default_value = REMAP_FACTOR
+    tree.links.new(tex.outputs["Color"], ramp.inputs["Fac"])
+    tree.links.new(ramp.outputs["Color"], times.inputs[0])
+    tree.links.new(times.outputs[0], bump.inputs["Height"])
+    distance = bump.inputs["Distance"].default_value
+    entry = {"result": None, "checks": []}
+    try:
+        bpy.ops.object.sgbake_layers_from_material()
+        layer = settings.layers[0]
+        points = scene.remap_points(layer) or []
+        entry["layer"] = {"type": layer.type, "scale": layer.scale, "slopes": layer.slopes,
+                          "remap points": len(points)}
+        sent = operators.BakeJob(bpy.context).scene["layers"][0].get("remap")
+        entry["checks"].append({
+            "name": "remap: Layers from Material makes one height layer with a remap, sent as "
+                    "it is",
+            "ok": (len(settings.layers) == 1 and layer.type == "height"
+                   and layer.slopes == "bump-node" and abs(layer.scale - distance) < 1e-9
+                   and len(points) >= 2 and sent == points),
+            "expected": f"one height layer, slopes bump-node, scale {distance:.4g}, a remap, "
+                        "the scene's \"remap\" its points",
+            "message": f"{entry['layer']}; sent {len(sent or ())} points"
+                       f"{'' if sent == points else ' (not the layer points)'}"})
+        entry["result"] = bake_against_cycles(settings, ob, work, "remap", ("remap",))
+        text = layer.remap
+        layer.remap = "[[0, 0], [1]]"
+        entry["checks"].append(expect_error("remap: a Remap that is not points is an error "
+                                            "naming the layer", f"layer '{layer.name}': Remap",
+                                            bpy.ops.object.sgbake_bake))
+        layer.remap = text
+    finally:
+        tree.nodes.remove(ramp)
+        tree.nodes.remove(times)
+        tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    return entry
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -1765,8 +2027,9 @@ def blender_make(work, library_path, sabotage):
     manifest["materials"] = materials_case(settings, ob, height, work, sabotage)
     manifest["projector"] = projector_case(settings, ob, work)
     manifest["displacement"] = displacement_case(settings, ob, work)
+    manifest["remap"] = remap_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
-    manifest["errors"] = (material_checks(settings, ob, distance)
+    manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
@@ -1812,6 +2075,7 @@ def blender_compare(work):
     results["materials"] = materials_comparisons(work)
     results["projector"] = against_cycles(work, "projector")
     results["displacement"] = against_cycles(work, "displacement")
+    results["remap"] = against_cycles(work, "remap")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -2031,10 +2295,16 @@ def evaluate(manifest, results):
         manifest["displacement"], results["displacement"],
         "with the Bump added to the displacement", DISPLACEMENT_MEDIAN_DEG,
         DISPLACEMENT_CONTROL_FACTOR)
+    failures += evaluate_case_against_cycles(
+        "remap", "a Color Ramp (Ease, three coloured stops) and a clamped Math node (x "
+        f"{REMAP_FACTOR:g}) on the height ({manifest['remap'].get('layer')})",
+        manifest["remap"], results["remap"], "without the remap", REMAP_MEDIAN_DEG,
+        REMAP_CONTROL_FACTOR, REMAP_P99_DEG)
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
-                  + manifest["displacement"]["checks"] + manifest["errors"]):
+                  + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
+                  + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
@@ -2111,10 +2381,11 @@ def evaluate_materials(entry, r):
     return failures
 
 
-def evaluate_case_against_cycles(name, title, entry, r, control_what, bar, factor):
+def evaluate_case_against_cycles(name, title, entry, r, control_what, bar, factor,
+                                p99_bar=None):
     """Prints case `name`'s angles to Cycles under `title`; returns failures: its add-on bake
-    not finished, a median over `bar`, or a control (`control_what`) less than `factor` times
-    worse."""
+    not finished, a median over `bar` (a p99 over `p99_bar`, when given), or a control
+    (`control_what`) less than `factor` times worse."""
     print(f"  {title} vs Cycles:")
     failures = []
     if entry["result"] != ["FINISHED"]:
@@ -2122,8 +2393,14 @@ def evaluate_case_against_cycles(name, title, entry, r, control_what, bar, facto
     if "error" in r:
         print(f"    {r['error']}")
         return failures + [f"{name}: {r['error']}"]
-    return failures + judge_against_cycles(name, "", r["addon"], r["control"], control_what,
-                                           bar, factor)
+    failures += judge_against_cycles(name, "", r["addon"], r["control"], control_what,
+                                     bar, factor)
+    if p99_bar is not None:
+        p99 = r["addon"]["p99_deg"]
+        print(f"    p99 {p99:.4f} deg -> {'ok' if p99 <= p99_bar else 'FAIL'} (<= {p99_bar})")
+        if p99 > p99_bar:
+            failures.append(f"{name}: p99 {p99:.4f} deg from Cycles (bar {p99_bar})")
+    return failures
 
 
 def main():
