@@ -43,10 +43,13 @@ inline std::uint32_t exponentBits(float v) {
   return std::bit_cast<std::uint32_t>(v) & kExponentBits;
 }
 
-// Rec. 709 luma weights (Blender's default OCIO config, `rgb_to_y` in Cycles).
-constexpr double kLumaR = 0.2126;
-constexpr double kLumaG = 0.7152;
-constexpr double kLumaB = 0.0722;
+// The luminance Cycles takes of a colour in a float socket (`rgb_to_y`): the Y row of Blender's
+// scene-linear to XYZ matrix (Rec. 709 primaries, D65), as Cycles 3.4 computes it, measured by
+// an Emission bake of pure R, G and B through a Math node. (The config's rounded 0.2126, 0.7152,
+// 0.0722 move a height by up to 7e-5 of its value.)
+constexpr double kLumaR = 0.212672979;
+constexpr double kLumaG = 0.715152621;
+constexpr double kLumaB = 0.072175443;
 
 std::string channelsText(int n) { return std::to_string(n) + (n == 1 ? " channel" : " channels"); }
 

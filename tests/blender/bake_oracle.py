@@ -77,7 +77,7 @@ before the Bump (a Color Ramp, Ease, coloured stops rising and falling; a Math n
 2.5 h - 0.6 with Clamp): the height layer's "remap" holds the function's points (the ramp as
 Cycles tabulates it, 256 entries, luminance of the colour), baked from scenes as the planar
 cases are; their control ours_bake_unremapped.exr, the layer without it, must fail (b) and (e).
-Measured with Cycles' slopes: median 0.0016-0.0017 deg, p99 0.0029-0.0051 deg (one Suzanne
+Measured with Cycles' slopes: median 0.0016-0.0017 deg, p99 0.0026-0.0029 deg (one Suzanne
 texel 6.4 deg, its height on the clamp's corner); exact slopes median 0.40 and 0.70 deg; without
 the remap 10.7 and 15.8 deg.
 

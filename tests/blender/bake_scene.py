@@ -42,7 +42,7 @@ What we learnt about Cycles' bake (Blender 3.4.1), checked with a plane and line
   i.e. N - Distance * (object-space gradient of h). A linear h = 0.3 u on a 2 x 2 plane baked to
   a tangent-space slope of 0.01498 for Distance 0.1 (analytic 0.015).
 - The Height socket takes the image's Color output converted to a float by LUMINANCE
-  (0.2126 R + 0.7152 G + 0.0722 B): a height in R alone bakes 0.2126x too flat. So the height
+  (0.2127 R + 0.7152 G + 0.0722 B; CYCLES_LUMINANCE): a height in R alone bakes 0.2127x too flat. So the height
   is written into R, G and B (the weights sum to 1); sgbake reads the same value from any channel.
 - The bump's finite difference is isotropic and about half a texel long: Blender passes
   half-texel UV differentials to Cycles, which keeps only their mean length and re-derives two
@@ -176,6 +176,10 @@ REMAPS = {}
 RAMP_STOPS = ((0.15, (0.05, 0.02, 0.0)), (0.45, (0.9, 0.8, 0.3)), (0.7, (0.2, 0.5, 0.9)),
               (0.9, (0.6, 0.6, 0.6)))
 CLAMP_LINE = (2.5, -0.6)  # Math Multiply Add: h x 2.5 - 0.6, clamped to [0, 1]
+# Cycles' luminance of a colour in a float socket (rgb_to_y), measured with an Emission bake of
+# pure R, G and B through a Math node (the config's rounded 0.2126, 0.7152, 0.0722: ramp_sphere's
+# p99 0.0051 deg instead of 0.0026 deg).
+CYCLES_LUMINANCE = (0.212672979, 0.715152621, 0.072175443)
 
 
 def remap_case(name, of_case, kind, size=None):
@@ -206,7 +210,7 @@ def reshape_height(mat, kind):
         links.new(tex.outputs["Color"], node.inputs["Fac"])
         links.new(node.outputs["Color"], bump.inputs["Height"])
         table = [ramp.evaluate(i / 255) for i in range(256)]
-        return [[i / 255, 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]]
+        return [[i / 255, sum(w * v for w, v in zip(CYCLES_LUMINANCE, c[:3]))]
                 for i, c in enumerate(table)]
     node = nodes.new("ShaderNodeMath")
     node.operation, node.use_clamp = "MULTIPLY_ADD", True

@@ -90,10 +90,11 @@ class Image {
 enum class ImageChannels {
   kAll,    ///< every channel of the file, in the file's order (OIIO puts R, G, B, A first)
   kFirst,  ///< channel 0 only (grey, or R): the usual height-map channel → C = 1
-  /// Rec. 709 luminance `0.2126 R + 0.7152 G + 0.0722 B` of channels 0–2 when the file has at
-  /// least three channels, else channel 0 → C = 1. These are the weights of Blender's default
-  /// OCIO configuration, which Cycles uses when a colour is plugged into a float socket (e.g. an
-  /// RGB image into the Bump node's Height); the values are not linearised (Non-Color).
+  /// Rec. 709 luminance `0.212672979 R + 0.715152621 G + 0.072175443 B` of channels 0–2 when
+  /// the file has at least three channels, else channel 0 → C = 1. These are the weights Cycles
+  /// uses when a colour is plugged into a float socket (e.g. an RGB image into the Bump node's
+  /// Height): the Y row of Blender's scene-linear to XYZ matrix, measured from Cycles 3.4 (not
+  /// the config's rounded 0.2126, 0.7152, 0.0722); the values are not linearised (Non-Color).
   kLuminance,
   kRgb,  ///< channels 0, 1, 2 (normal maps) → C = 3; files with fewer channels fail
   /// One channel as it is stored → C = 1 (a height packed into a channel of another map):
