@@ -4,6 +4,7 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -24,6 +25,7 @@
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/bake/planner.hpp"
 #include "sgbake/bake/scene.hpp"
+#include "sgbake/gradient/remap.hpp"
 
 namespace sgbake::cli {
 namespace {
@@ -54,6 +56,7 @@ struct BakeArguments {
   std::string filter = "bilinear";
   std::string heightGradient = "analytic";
   std::string heightSpace = "world";
+  std::string heightRemap;  ///< "X:Y,X:Y,…": the points of the height's remap
   std::string normalImage;
   std::string normalSpace = "tangent";
   std::string normalGreen = "opengl";
@@ -118,7 +121,9 @@ constexpr const char* kFooter =
     "  Heights (height, volume, planar and triplanar of kind height) take strength = 1 (the\n"
     "  Bump node's), gradient = bump-node (slopes as Cycles' Bump node takes them when it\n"
     "  bakes), height_space = world|object (object: the scale in object units along the\n"
-    "  normal, as a Displacement node's in Object space) and base =\n"
+    "  normal, as a Displacement node's in Object space), remap = [[x, y], ...] (the value read\n"
+    "  through the piecewise-linear function through these points, constant beyond the ends,\n"
+    "  a repeated x a step: levels, clamps, a Color Ramp as Cycles tabulates it) and base =\n"
     "  surface|above: 'above' bumps the normal the layers before it make, as a Bump node whose\n"
     "  Normal input is linked to the node before it (a Normal Map, another Bump); 'surface'\n"
     "  (the default) adds the layer's surface gradient to the others'.\n"
@@ -175,6 +180,7 @@ const char* const kOneMapOptions[] = {"--mesh",
                                       "--filter",
                                       "--height-gradient",
                                       "--height-space",
+                                      "--height-remap",
                                       "--normal",
                                       "--normal-space",
                                       "--normal-green",
@@ -316,6 +322,33 @@ std::string inFlagWords(std::string message, const BakeArguments& args) {
 }
 
 /// The scene of the one-map form: one output and the layers its options name.
+/// The points of --height-remap "X:Y,X:Y,…", checked as a HeightRemap checks them.
+Result<std::vector<Vec2d>> parseRemapPoints(const std::string& text) {
+  const std::string where = "bake: --height-remap: ";
+  std::vector<Vec2d> points;
+  std::size_t i = 0;
+  while (i <= text.size()) {
+    const std::size_t end = std::min(text.find(',', i), text.size());
+    const std::string pair = text.substr(i, end - i);
+    const std::size_t colon = pair.find(':');
+    double xy[2] = {0, 0};
+    bool ok = colon != std::string::npos;
+    for (int k = 0; ok && k < 2; ++k) {
+      const std::string word = k == 0 ? pair.substr(0, colon) : pair.substr(colon + 1);
+      char* stop = nullptr;
+      xy[k] = std::strtod(word.c_str(), &stop);
+      ok = !word.empty() && *stop == '\0' && std::isfinite(xy[k]);
+    }
+    if (!ok) return Error::badInput(where + "'" + pair + "' is not X:Y (two finite numbers)");
+    points.push_back({xy[0], xy[1]});
+    i = end + 1;
+  }
+  if (Result<HeightRemap> remap = HeightRemap::create(points); !remap) {
+    return Error::badInput(where + remap.error().message);
+  }
+  return points;
+}
+
 Result<Scene> oneMapScene(const BakeArguments& args) {
   if (args.mesh.empty()) return Error::badInput("bake: --mesh is required without a SCENE file");
   if (args.output.empty()) return Error::badInput("bake: -o/--output is required with --mesh");
@@ -351,6 +384,11 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     SceneLayer height;
     height.type = SceneLayerType::kHeight;
     height.objectSpaceHeight = args.heightSpace == "object";
+    if (!args.heightRemap.empty()) {
+      Result<std::vector<Vec2d>> points = parseRemapPoints(args.heightRemap);
+      if (!points) return points.error();
+      height.remap = std::move(*points);
+    }
     height.heightGradient =
         args.heightGradient == "bump-node" ? HeightGradient::kBumpNode : HeightGradient::kAnalytic;
     height.image = args.heightImage;
@@ -494,6 +532,7 @@ Status runBake(const BakeArguments& args, const CLI::App& app) {
        {std::tuple{"--height-scale", height, "--height"},
         {"--height-gradient", height, "--height"},
         {"--height-space", height, "--height"},
+        {"--height-remap", height, "--height"},
         {"--filter", height || normal, "--height or --normal"},
         {"--normal-space", normal, "--normal"},
         {"--normal-green", normal, "--normal"},
@@ -696,6 +735,11 @@ CommandAction defineBakeCommand(CLI::App& app) {
                  "--transform)")
       ->type_name("SPACE")
       ->capture_default_str()
+      ->group(oneMap);
+  app.add_option("--height-remap", args->heightRemap,
+                 "Read --height through the piecewise-linear function through these points, "
+                 "constant beyond the ends (a repeated X: a step), e.g. 0.2:0,0.6:1 for levels")
+      ->type_name("X:Y,...")
       ->group(oneMap);
   app.add_option("--normal", args->normalImage, "Normal-map layer")
       ->type_name("IMAGE")

@@ -689,6 +689,36 @@ TEST_F(BakeCliTest, OneMapShorthand) {
            "--height-gradient", "bump-node", "--size", "8", "-o", (dir_ / "bn.exr").string()});
   ASSERT_EQ(bumpNode.exitCode, 0) << bumpNode.err;
   EXPECT_TRUE(fs::exists(dir_ / "bn.exr"));
+  // --height-remap X:Y,…: the layer's "remap", the same bake as the scene's.
+  const ProcessResult remapped =
+      run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--height", (dir_ / "h.png").string(),
+           "--height-remap", "0.1:0,0.3:0.6,0.3:0.2", "--map", "height", "--size", "8",
+           "--bit-depth", "32", "--no-manifest", "-o", (dir_ / "remap_flags.exr").string()});
+  ASSERT_EQ(remapped.exitCode, 0) << remapped.err;
+  writeFile(dir_ / "remap.json",
+            R"({"mesh": "plane.obj", "layers": [{"type": "height", "image": "h.png",
+                "remap": [[0.1, 0], [0.3, 0.6], [0.3, 0.2]]}],
+                "outputs": [{"map": "height", "file": "remap_scene.exr", "size": 8,
+                             "bit_depth": 32}]})");
+  const ProcessResult scene = run({"bake", (dir_ / "remap.json").string(), "--no-manifest"});
+  ASSERT_EQ(scene.exitCode, 0) << scene.err;
+  const auto pixels = [](const fs::path& path) {
+    std::unique_ptr<OIIO::ImageInput> file = OIIO::ImageInput::open(path.string());
+    std::vector<float> values;
+    if (!file) return values;
+    const OIIO::ImageSpec& spec = file->spec();
+    values.resize(static_cast<std::size_t>(spec.image_pixels()) * spec.nchannels);
+    if (!file->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, values.data()))
+      values.clear();
+    return values;
+  };
+  const std::vector<float> flags = pixels(dir_ / "remap_flags.exr");
+  ASSERT_EQ(flags.size(), std::size_t{8 * 8});
+  EXPECT_EQ(flags, pixels(dir_ / "remap_scene.exr"));
+  const auto [low, high] = std::minmax_element(flags.begin(), flags.end());
+  EXPECT_GE(*low, 0.0f);
+  EXPECT_LE(*high, 0.6f);  // the remap's range
+  EXPECT_GT(*high, *low);
   const ProcessResult adjacent =
       run({"bake", "--mesh", (dir_ / "plane.obj").string(), "--map", "object-normal", "--size", "8",
            "--margin", "2", "--padding", "adjacent-faces", "-o", (dir_ / "adj.exr").string()});
@@ -747,6 +777,11 @@ TEST_F(BakeCliTest, OneMapShorthandErrors) {
            {"bake", "--mesh", mesh, "--filter", "bicubic", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--height-gradient", "bump-node", "-o",
             (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--height-remap", "0:0,1:1", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--height-remap",
+            "0.5:0,0.2:1", "-o", (dir_ / "o.png").string()},
+           {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--height-remap",
+            "0.5:0,1", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--height-gradient",
             "central", "-o", (dir_ / "o.png").string()},
            {"bake", "--mesh", mesh, "--height", (dir_ / "h.png").string(), "--normal-space",
