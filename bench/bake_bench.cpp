@@ -17,6 +17,10 @@
 //   - BM_TangentNormalStretched, BM_ObjectNormalStretched, BM_SurfaceGradientStretched — the
 //     same three maps of Suzanne placed with the scale (2, 1, 0.5), shaded in world space as
 //     Cycles shades an object whose scale was never applied (BakeInput::transform);
+//   - BM_TangentNormalRamp/threads:N, BM_TangentNormalRampBumpNode/threads:N — the same maps with
+//     the height read through a remap of 256 points, evenly spaced as Cycles tabulates a Color
+//     Ramp, on the line y = x: the same bumps (no more texels bent by the valid-reflection
+//     guard), so the difference is the remap's own cost;
 //   - BM_TangentNormalNoLayers/threads:N — the frame and encoding alone;
 //   - BM_Mask/threads:N — the raster and coverage alone (no shading);
 //   - BM_ExtendMargin16/threads:N, BM_PushPull/threads:N — padding of the 4096² tangent map;
@@ -41,6 +45,7 @@
 #include "sgbake/frames/tangents.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/image.hpp"
+#include "sgbake/gradient/remap.hpp"
 #include "sgbake/gradient/world_shading.hpp"
 #include "sgbake/mesh/io.hpp"
 #include "sgbake/subdiv/limit_surface.hpp"
@@ -58,6 +63,8 @@ struct Scene {
   std::optional<ImageScalarTexture> height;
   std::vector<Layer> layers;
   std::vector<Layer> bumpNodeLayers;  ///< the same height, slopes as Cycles' Bump node takes them
+  std::optional<RemappedScalarTexture> ramp;          ///< the height through 256 points
+  std::vector<Layer> rampLayers, rampBumpNodeLayers;  ///< layers and bumpNodeLayers through it
 };
 
 /// Loaded once: the mesh, its tangents and a 2048² height map of a few summed sines.
@@ -92,6 +99,15 @@ const Scene& scene() {
     UvHeightSource bumpNode{&*out->height, 0, 0.02};
     bumpNode.gradient = HeightGradient::kBumpNode;
     out->bumpNodeLayers.push_back(Layer{bumpNode, 1.0, {}});
+    // A Color Ramp's 256 entries, on y = x (the heights lie in [0.15, 0.85]).
+    std::vector<Vec2d> table;
+    for (int i = 0; i < 256; ++i) table.push_back({i / 255.0, i / 255.0});
+    Result<HeightRemap> remap = HeightRemap::create(std::move(table));
+    if (!remap) std::exit(1);
+    out->ramp.emplace(*out->height, std::move(*remap));
+    out->rampLayers.push_back(Layer{UvHeightSource{&*out->ramp, 0, 0.02}, 1.0, {}});
+    bumpNode.texture = &*out->ramp;
+    out->rampBumpNodeLayers.push_back(Layer{bumpNode, 1.0, {}});
     return out;
   }();
   return *s;
@@ -102,13 +118,14 @@ const Scene& scene() {
 const ObjectTransform kStretched{Mat3::diagonal({2, 1, 0.5}), {}};
 
 void bake(benchmark::State& state, MapKind kind, bool withLayers,
-          const ObjectTransform* transform = nullptr, bool bumpNode = false) {
+          const ObjectTransform* transform = nullptr, bool bumpNode = false, bool ramp = false) {
   const Scene& s = scene();
   BakeSettings settings;
   settings.map = kind;
   settings.width = settings.height = kBakeSize;
   settings.threads = static_cast<int>(state.range(0));
-  const std::span<const Layer> layers = bumpNode ? s.bumpNodeLayers : s.layers;
+  const std::span<const Layer> layers = ramp ? (bumpNode ? s.rampBumpNodeLayers : s.rampLayers)
+                                             : (bumpNode ? s.bumpNodeLayers : s.layers);
   BakeInput input{&s.mesh, &s.tangents, withLayers ? layers : std::span<const Layer>()};
   input.transform = transform;
   for (auto _ : state) {
@@ -161,6 +178,12 @@ void BM_TangentNormalLimit(benchmark::State& state) { bakeSubdivided(state, true
 void BM_TangentNormalLevel3(benchmark::State& state) { bakeSubdivided(state, false); }
 void BM_TangentNormalBumpNode(benchmark::State& state) {
   bake(state, MapKind::kTangentNormal, true, nullptr, true);
+}
+void BM_TangentNormalRamp(benchmark::State& state) {
+  bake(state, MapKind::kTangentNormal, true, nullptr, false, true);
+}
+void BM_TangentNormalRampBumpNode(benchmark::State& state) {
+  bake(state, MapKind::kTangentNormal, true, nullptr, true, true);
 }
 void BM_ObjectNormal(benchmark::State& state) { bake(state, MapKind::kObjectNormal, true); }
 void BM_TangentNormalStretched(benchmark::State& state) {
@@ -240,6 +263,8 @@ void threadArgs(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_TangentNormal)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBumpNode)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalRamp)->Apply(threadArgs);
+BENCHMARK(BM_TangentNormalRampBumpNode)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBands)->Apply(threadArgs);
 BENCHMARK(BM_TangentNormalBandsMargin16)->Apply(threadArgs);
 BENCHMARK(BM_ObjectNormal)->Apply(threadArgs);

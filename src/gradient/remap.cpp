@@ -23,26 +23,44 @@ Result<HeightRemap> HeightRemap::create(std::vector<Vec2d> points) {
       return Error::badInput(which + " has a smaller x than the point before it");
     if (i >= 2 && points[i].x == points[i - 2].x)
       return Error::badInput(which + " is the third of one x (a step takes two)");
+    const double dx = points[i].x - points[i - 1].x;
+    if (dx > 0 && !std::isfinite((points[i].y - points[i - 1].y) / dx))
+      return Error::badInput(which + " is too close to the point before it for a finite slope");
   }
   return HeightRemap(std::move(points));
 }
 
-void HeightRemap::evaluate(double x, double& value, double& slope) const {
-  if (std::isnan(x)) {
-    value = slope = std::numeric_limits<double>::quiet_NaN();
+HeightRemap::HeightRemap(std::vector<Vec2d> points) : points_(std::move(points)) {
+  slopes_.assign(points_.size(), 0.0);
+  for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
+    const Vec2d a = points_[i], b = points_[i + 1];
+    if (b.x > a.x) slopes_[i] = (b.y - a.y) / (b.x - a.x);
+  }
+  const double first = points_.front().x, width = points_.back().x - first;
+  // A single step (width 0) has every x beyond an end; an overflowing width is bisected.
+  if (!(width > 0) || !std::isfinite(width)) return;
+  // One cell per segment: evenly spaced points (a Color Ramp's table) start a cell each, and the
+  // cell of x is then its segment but where rounding puts x in the cell beside it.
+  const std::size_t count = points_.size() - 1;
+  cellsPerUnit_ = static_cast<double>(count) / width;
+  if (!std::isfinite(cellsPerUnit_)) {
+    cellsPerUnit_ = 0;
     return;
   }
-  // The first point right of x: x lies on the segment that ends there.
-  const auto right = std::upper_bound(points_.begin(), points_.end(), x,
-                                      [](double v, const Vec2d& p) { return v < p.x; });
-  if (right == points_.begin() || right == points_.end()) {
-    value = right == points_.begin() ? points_.front().y : points_.back().y;
-    slope = 0;
-    return;
+  cells_.resize(count);
+  std::size_t point = 0;
+  for (std::size_t c = 0; c < count; ++c) {
+    const double start = first + static_cast<double>(c) / cellsPerUnit_;
+    while (point + 1 < points_.size() && points_[point + 1].x <= start) ++point;
+    cells_[c] = static_cast<std::uint32_t>(point);
   }
-  const Vec2d a = *(right - 1), b = *right;  // a.x <= x < b.x, so b.x > a.x
-  slope = (b.y - a.y) / (b.x - a.x);
-  value = a.y + (x - a.x) * slope;
+}
+
+std::size_t HeightRemap::searchLeft(double x) const {
+  return static_cast<std::size_t>(
+      std::upper_bound(points_.begin(), points_.end(), x,
+                       [](double v, const Vec2d& p) { return v < p.x; }) -
+      points_.begin() - 1);
 }
 
 double HeightRemap::value(double x) const {

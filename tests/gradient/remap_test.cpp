@@ -59,6 +59,36 @@ TEST(HeightRemap, TakesTheSegmentToTheRightAtAPointAndTheSecondValueAtAStep) {
   EXPECT_EQ(constant.slope(0.3), 0);
 }
 
+// Uneven points, steps and points crowded into one cell of the lookup grid (seven in [1, 1.06]:
+// found by bisection): every value is the one the segment whose start is the last point at or
+// left of x gives.
+TEST(HeightRemap, FindsTheSegmentOfEveryValueAsBisectionDoes) {
+  const std::vector<Vec2d> points{{-1, 0},   {-0.999, 1}, {-0.998, 0}, {0.3, 2},   {0.3, -1},
+                                  {0.31, 0}, {0.75, 3},   {0.75, 1},   {0.751, 2}, {1, 0},
+                                  {1.01, 1}, {1.02, 0},   {1.03, 1},   {1.04, 0},  {1.05, 1},
+                                  {1.06, 0}, {5, 0}};
+  const HeightRemap g = makeRemap(points);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> along(-1.5, 5.5);
+  std::vector<double> xs;
+  for (const Vec2d& p : points) xs.insert(xs.end(), {p.x, std::nextafter(p.x, -10.0)});
+  for (int i = 0; i < 2000; ++i) xs.push_back(along(rng));
+  for (const double x : xs) {
+    std::size_t right = 0;
+    while (right < points.size() && points[right].x <= x) ++right;
+    double value = points.back().y, slope = 0;
+    if (right == 0) {
+      value = points.front().y;
+    } else if (right < points.size()) {
+      const Vec2d a = points[right - 1], b = points[right];
+      slope = (b.y - a.y) / (b.x - a.x);
+      value = a.y + (x - a.x) * slope;
+    }
+    EXPECT_EQ(g.value(x), value) << x;
+    EXPECT_EQ(g.slope(x), slope) << x;
+  }
+}
+
 TEST(HeightRemap, RejectsWhatIsNotAFunction) {
   const auto message = [](std::vector<Vec2d> points) {
     Result<HeightRemap> made = HeightRemap::create(std::move(points));
@@ -71,6 +101,8 @@ TEST(HeightRemap, RejectsWhatIsNotAFunction) {
             "remap point 2 is the third of one x (a step takes two)");
   EXPECT_EQ(message({{0, 0}, {1, std::numeric_limits<double>::infinity()}}),
             "remap point 1 is not finite");
+  EXPECT_EQ(message({{0, 0}, {1e-320, 1e10}}),
+            "remap point 1 is too close to the point before it for a finite slope");
   EXPECT_EQ(message({{0, 0}, {0, 1}}), "accepted");  // a single step is a function
 }
 

@@ -13,6 +13,10 @@
 /// for Constant a step at every entry.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -41,13 +45,45 @@ class HeightRemap {
   /// ends and on a step.
   double slope(double x) const;
   /// G(x) and G′(x) together.
-  void evaluate(double x, double& value, double& slope) const;
+  void evaluate(double x, double& value, double& slope) const {
+    if (std::isnan(x)) {
+      value = slope = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    if (x < points_.front().x || x >= points_.back().x) {
+      value = x < points_.front().x ? points_.front().y : points_.back().y;
+      slope = 0;
+      return;
+    }
+    const std::size_t left = segmentOf(x);
+    slope = slopes_[left];
+    value = points_[left].y + (x - points_[left].x) * slope;
+  }
 
   std::span<const Vec2d> points() const { return points_; }
 
  private:
-  explicit HeightRemap(std::vector<Vec2d> points) : points_(std::move(points)) {}
+  explicit HeightRemap(std::vector<Vec2d> points);
+  /// The last point at or left of @p x, for points.front().x <= x < points.back().x: x lies on
+  /// the segment that starts there. Its cell gives a point at or left of x; a few steps find it
+  /// (none for evenly spaced points), bisection where the cell is crowded.
+  std::size_t segmentOf(double x) const {
+    if (cells_.empty()) return searchLeft(x);
+    const auto cell = static_cast<std::int64_t>((x - points_.front().x) * cellsPerUnit_);
+    std::size_t left = cells_[std::min(static_cast<std::size_t>(cell), cells_.size() - 1)];
+    while (left > 0 && points_[left].x > x) --left;  // rounding in the cell's start
+    for (int step = 0; step < 4; ++step, ++left) {   // x < the last point's x: stops there
+      if (points_[left + 1].x > x) return left;
+    }
+    return searchLeft(x);
+  }
+  std::size_t searchLeft(double x) const;  ///< segmentOf by bisection
   std::vector<Vec2d> points_;
+  /// Where to start looking: one cell of equal width per segment over [first x, last x], each
+  /// holding the last point at or left of the cell's start (evenly spaced points: its own).
+  std::vector<std::uint32_t> cells_;
+  std::vector<double> slopes_;  ///< of the segment starting at each point (0 at a step, the last)
+  double cellsPerUnit_ = 0;
 };
 
 /// @brief A ScalarTexture read through a HeightRemap: value G(h), gradient G′(h) ∇h.
