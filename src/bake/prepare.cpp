@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "sgbake/gradient/blender_noise.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/remap.hpp"
 #include "sgbake/gradient/udim.hpp"
@@ -282,6 +283,17 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
     if (!sine) return sine.error();
     return std::unique_ptr<HeightVolume>(std::make_unique<DirectionalSine>(std::move(*sine)));
   }
+  if (layer.function == VolumeFunction::kBlenderNoise) {
+    BlenderNoiseParams params;
+    params.amplitude = layer.amplitude;
+    params.scale = layer.frequency;
+    params.detail = layer.noiseDetail;
+    params.roughness = layer.noiseRoughness;
+    params.distortion = layer.noiseDistortion;
+    Result<BlenderNoise> noise = BlenderNoise::create(params);
+    if (!noise) return noise.error();
+    return std::unique_ptr<HeightVolume>(std::make_unique<BlenderNoise>(std::move(*noise)));
+  }
   GradientNoiseParams params;
   params.amplitude = layer.amplitude;
   params.frequency = layer.frequency;
@@ -446,6 +458,10 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
                                volume.error().message);
       }
       loaded.volumes.push_back(std::move(*volume));
+      if (layer.mapping) {  // a Mapping node, or other coordinates, before the texture
+        loaded.volumes.push_back(
+            std::make_unique<MappedHeightVolume>(*loaded.volumes.back(), coordinateMapping(layer)));
+      }
       if (remap) {
         loaded.volumes.push_back(
             std::make_unique<RemappedHeightVolume>(*loaded.volumes.back(), std::move(*remap)));

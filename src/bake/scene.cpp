@@ -111,8 +111,18 @@ constexpr Named<TriplanarProjection> kPlanarProjections[] = {
     {"tube", TriplanarProjection::kTube}};
 constexpr Named<ProjectionAxis> kAxes[] = {
     {"x", ProjectionAxis::kX}, {"y", ProjectionAxis::kY}, {"z", ProjectionAxis::kZ}};
+/// The scene name of @p value in @p table.
+template <class E, std::size_t N>
+std::string nameIn(const Named<E> (&table)[N], E value) {
+  for (const Named<E>& entry : table) {
+    if (entry.value == value) return entry.name;
+  }
+  return "?";
+}
+
 constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
-                                                {"noise", VolumeFunction::kNoise}};
+                                                {"noise", VolumeFunction::kNoise},
+                                                {"blender-noise", VolumeFunction::kBlenderNoise}};
 constexpr Named<GradientScheme> kSchemes[] = {{"analytic", GradientScheme::kAnalytic},
                                               {"central", GradientScheme::kCentral},
                                               {"tetrahedral", GradientScheme::kTetrahedral}};
@@ -406,8 +416,9 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
-      add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves",
-           "gradient", "step", "base", "strength", "height_space", "remap"});
+      add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves", "detail",
+           "roughness", "distortion", "mapping", "gradient", "step", "base", "strength",
+           "height_space", "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
@@ -804,21 +815,29 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (layer.type == SceneLayerType::kVolume) {
     reader.optionalName("function", kFunctions, layer.function);
     const bool sine = layer.function == VolumeFunction::kSine;
-    for (const char* key : {"direction", "phase"}) {
-      if (!sine && reader.has(key)) {
-        fail(where, "key " + quote(key) + " does not apply to a noise volume (it is for sine)");
+    const bool blender = layer.function == VolumeFunction::kBlenderNoise;
+    const std::string function = nameIn(kFunctions, layer.function);
+    const auto onlyFor = [&](std::initializer_list<const char*> keys, bool applies,
+                             const char* owner) {
+      for (const char* key : keys) {
+        if (!applies && reader.has(key)) {
+          fail(where, "key " + quote(key) + " does not apply to a " + function +
+                          " volume (it is for " + owner + ")");
+        }
       }
-    }
-    for (const char* key : {"seed", "octaves"}) {
-      if (sine && reader.has(key)) {
-        fail(where, "key " + quote(key) + " does not apply to a sine volume (it is for noise)");
-      }
-    }
+    };
+    onlyFor({"direction", "phase"}, sine, "sine");
+    onlyFor({"seed", "octaves"}, layer.function == VolumeFunction::kNoise, "noise");
+    onlyFor({"detail", "roughness", "distortion"}, blender, "blender-noise");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
+    if (blender) layer.frequency = 5;  // the Noise Texture's default Scale
     if (reader.has("frequency")) {
-      layer.frequency = sine ? reader.number("frequency")
-                             : reader.numberAtLeast("frequency", 0, /*exclusive=*/true);
+      layer.frequency = sine || blender ? reader.number("frequency")
+                                        : reader.numberAtLeast("frequency", 0, /*exclusive=*/true);
     }
+    if (reader.has("detail")) layer.noiseDetail = reader.number("detail");
+    if (reader.has("roughness")) layer.noiseRoughness = reader.number("roughness");
+    if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
     if (reader.has("direction")) layer.direction = reader.vec3("direction");
     if (reader.has("phase")) layer.phase = reader.number("phase");
     if (reader.has("seed")) layer.seed = reader.unsignedInteger("seed");
@@ -1348,19 +1367,6 @@ bool SceneOutput::storesSignedRange() const {
   return f == ImageFormat::kPng || (f == ImageFormat::kTiff && resolvedBitDepth() != 32);
 }
 
-namespace {
-
-/// The scene name of @p value in @p table.
-template <class E, std::size_t N>
-std::string nameIn(const Named<E> (&table)[N], E value) {
-  for (const Named<E>& entry : table) {
-    if (entry.value == value) return entry.name;
-  }
-  return "?";
-}
-
-}  // namespace
-
 std::string_view filterName(Filter filter) {
   for (const Named<Filter>& entry : kFilters) {
     if (entry.value == filter) return entry.name;
@@ -1524,9 +1530,13 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
       if (layer.function == VolumeFunction::kSine) {
         j["direction"] = {layer.direction.x, layer.direction.y, layer.direction.z};
         j["phase"] = layer.phase;
-      } else {
+      } else if (layer.function == VolumeFunction::kNoise) {
         j["seed"] = layer.seed;
         j["octaves"] = layer.octaves;
+      } else {
+        j["detail"] = layer.noiseDetail;
+        j["roughness"] = layer.noiseRoughness;
+        j["distortion"] = layer.noiseDistortion;
       }
       j["gradient"] = layer.heightGradient == HeightGradient::kBumpNode
                           ? nameIn(kHeightGradients, layer.heightGradient)

@@ -819,6 +819,38 @@ TEST(Scene, RemapIsParsedForHeightsAndInTheParametersOnlyWhenGiven) {
             "scene.json: layers[0]: 'remap' must be an array of [x, y] points, not an array");
 }
 
+// "function": "blender-noise": Blender's Noise Texture, Blender's defaults (Scale 5 as
+// "frequency", Detail 2, Roughness 0.5, Distortion 0), a Mapping node before it as "mapping".
+TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
+  Result<Scene> plain =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-noise"})"), options());
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_EQ(plain->layers[0].function, VolumeFunction::kBlenderNoise);
+  EXPECT_EQ(plain->layers[0].frequency, 5);
+  EXPECT_EQ(plain->layers[0].noiseDetail, 2);
+  EXPECT_EQ(plain->layers[0].noiseRoughness, 0.5);
+  EXPECT_EQ(plain->layers[0].noiseDistortion, 0);
+  Result<Scene> set =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-noise", "frequency": -2.5,
+                    "detail": 3.5, "roughness": 0.7, "distortion": 0.4,
+                    "mapping": {"location": [1, 0, 0]}})"),
+                 options());
+  ASSERT_TRUE(set) << set.error().message;
+  EXPECT_EQ(set->layers[0].frequency, -2.5);  // any Scale, as the node takes
+  ASSERT_TRUE(set->layers[0].mapping);
+  const std::string parameters = layerParametersJson(set->layers[0]);
+  for (const char* expected : {R"("detail":3.5)", R"("roughness":0.7)", R"("distortion":0.4)",
+                               R"("mapping":{"location":[1.0,0.0,0.0])"}) {
+    EXPECT_NE(parameters.find(expected), std::string::npos) << expected << " in " << parameters;
+  }
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "sine", "detail": 3})")),
+            "scene.json: layers[0]: key 'detail' does not apply to a sine volume (it is for "
+            "blender-noise)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "seed": 3})")),
+            "scene.json: layers[0]: key 'seed' does not apply to a blender-noise volume (it is "
+            "for noise)");
+}
+
 TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
   Result<Scene> mapped = parseScene(withLayer(R"({"type": "planar", "image": "h.png",
                     "mapping": {"location": [1, 2, 3], "rotation": [0, 0.5, 0]}})"),
@@ -875,7 +907,7 @@ TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
             "scene.json: layers[0].mapping: matrix row 3 must be [0, 0, 0, 1] (an affine map)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "mapping": {}})")),
             "scene.json: layers[0]: key 'mapping' does not apply to a height layer (it is for "
-            "planar or triplanar layers)");
+            "volume, planar or triplanar layers)");
 }
 
 TEST(Scene, SubdivisionIsParsedAndValidated) {

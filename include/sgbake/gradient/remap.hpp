@@ -11,6 +11,9 @@
 /// with the value clamped to [0, 1]: linearly between entries, or the entry at or below it when
 /// the ramp's interpolation is Constant. Both are HeightRemap points: (i / 255, table[i]), and
 /// for Constant a step at every entry.
+///
+/// MappedHeightVolume is the same kind of view of a volume's position: a Mapping node (or another
+/// affine map of the coordinates) between Texture Coordinate Object and a procedural texture.
 #pragma once
 
 #include <algorithm>
@@ -22,6 +25,7 @@
 
 #include "sgbake/core/result.hpp"
 #include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/projection.hpp"
 #include "sgbake/gradient/texture.hpp"
 #include "sgbake/gradient/volume.hpp"
 
@@ -117,6 +121,24 @@ class RemappedHeightVolume final : public HeightVolume {
  private:
   const HeightVolume* volume_;
   HeightRemap remap_;
+};
+
+/// @brief A HeightVolume read at mapped coordinates: value h(P′), P′ = mapping.apply(P), gradient
+/// mappingᵀ ∇h(P′) (CoordinateMapping::pullBack).
+///
+/// The volume is **not owned**; it must outlive this one.
+class MappedHeightVolume final : public HeightVolume {
+ public:
+  MappedHeightVolume(const HeightVolume& volume, const CoordinateMapping& mapping)
+      : volume_(&volume), mapping_(mapping) {}
+  double value(Vec3d p) const override { return volume_->value(mapping_.apply(p)); }
+  Vec3d analyticGradient(Vec3d p) const override {
+    return mapping_.pullBack(volume_->analyticGradient(mapping_.apply(p)));
+  }
+
+ private:
+  const HeightVolume* volume_;
+  CoordinateMapping mapping_;
 };
 
 }  // namespace sgbake

@@ -1,0 +1,65 @@
+/// @file blender_noise.hpp
+/// @brief Blender's Noise Texture (3D, Cycles 3.4) as a height volume, with its exact gradient.
+///
+/// The most common procedural bump in Blender is a Noise Texture's Fac into a Bump node. To bake
+/// it as Cycles does, sgbake evaluates the same function (in double precision; Cycles in float):
+///
+///     Fac(P) = fbm(p + distortion · (snoise(p + o₀), snoise(p + o₁), snoise(p + o₂))),  p = scale
+///     · P
+///
+/// - snoise(x) = 0.982 · perlin(x): Perlin's improved noise with the quintic fade
+///   6t⁵ − 15t⁴ + 10t³, trilinear over the 8 corners of the unit cell, each corner's gradient
+///   chosen by Perlin's 12-direction rule from the low 4 bits of a hash of the corner's integer
+///   coordinates (Bob Jenkins' lookup3 final mix of the three 32-bit words). noise = ½ snoise + ½.
+/// - fbm: octaves i = 0 … ⌊detail⌋ of noise(2ⁱ p) weighted roughnessⁱ (roughness clamped to
+///   [0, 1]), divided by the sum of the weights; a fractional detail blends in one more octave
+///   linearly. detail is clamped to [0, 15].
+/// - oₖ: the offsets Cycles seeds the distortion with, 100 + 100 · hash(k) per axis.
+///
+/// The gradient is exact for this function: the fade's and the corner terms' derivatives, the
+/// octaves' chain-rule factors 2ⁱ, and the distortion's Jacobian I + distortion · ∇snoise(p + oₖ).
+#pragma once
+
+#include <array>
+
+#include "sgbake/core/result.hpp"
+#include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/volume.hpp"
+
+namespace sgbake {
+
+/// @brief The Noise Texture node's settings (Dimensions 3D) and the height's scale.
+struct BlenderNoiseParams {
+  double amplitude = 1;    ///< height per unit of Fac (a Bump node's Distance)
+  double scale = 5;        ///< the node's Scale: P is multiplied by it
+  double detail = 2;       ///< the node's Detail (clamped to [0, 15] as Cycles clamps it)
+  double roughness = 0.5;  ///< the node's Roughness (clamped to [0, 1] as Cycles clamps it)
+  double distortion = 0;   ///< the node's Distortion
+};
+
+/// @brief Blender's Noise Texture Fac, times an amplitude: a HeightVolume.
+class BlenderNoise final : public HeightVolume {
+ public:
+  /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale
+  /// (|amplitude| · |scale| · (1 + |distortion|) · 2^detail).
+  static Result<BlenderNoise> create(const BlenderNoiseParams& params);
+
+  double value(Vec3d p) const override;
+  Vec3d analyticGradient(Vec3d p) const override;
+
+  /// The node's Fac at @p p (object space, before the amplitude), and its gradient.
+  double fac(Vec3d p, Vec3d* gradient) const;
+
+  const BlenderNoiseParams& params() const { return params_; }
+
+ private:
+  explicit BlenderNoise(const BlenderNoiseParams& params);
+  BlenderNoiseParams params_;
+  std::array<Vec3d, 3> distortionOffsets_{};
+};
+
+/// @brief Cycles' signed Perlin noise snoise(x) = 0.982 · perlin(x) at @p x, and its gradient
+/// (exposed for tests).
+double blenderSignedNoise(Vec3d x, Vec3d* gradient);
+
+}  // namespace sgbake

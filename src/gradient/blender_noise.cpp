@@ -1,0 +1,210 @@
+/// @file blender_noise.cpp
+/// @brief Blender's Noise Texture (blender_noise.hpp), written from its description: Perlin's
+/// improved noise on a hashed lattice, fBm octaves, distortion.
+#include "sgbake/gradient/blender_noise.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace sgbake {
+namespace {
+
+constexpr std::uint32_t rotate(std::uint32_t x, int k) { return (x << k) | (x >> (32 - k)); }
+
+/// Bob Jenkins' lookup3 `final` mix of (a, b, c); returns c.
+constexpr std::uint32_t finalMix(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+  c ^= b;
+  c -= rotate(b, 14);
+  a ^= c;
+  a -= rotate(c, 11);
+  b ^= a;
+  b -= rotate(a, 25);
+  c ^= b;
+  c -= rotate(b, 16);
+  a ^= c;
+  a -= rotate(c, 4);
+  b ^= a;
+  b -= rotate(a, 14);
+  c ^= b;
+  c -= rotate(b, 24);
+  return c;
+}
+
+/// lookup3's hash of three words (Cycles' hash_uint3): the initial value 0xdeadbeef + (3 << 2) +
+/// 13 in a, b and c, the words added, then the final mix.
+constexpr std::uint32_t hashWords(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  constexpr std::uint32_t init = 0xdeadbeefu + (3u << 2) + 13u;
+  return finalMix(init + x, init + y, init + z);
+}
+
+/// Of two words (Cycles' hash_uint2), the third word not added.
+constexpr std::uint32_t hashWords(std::uint32_t x, std::uint32_t y) {
+  constexpr std::uint32_t init = 0xdeadbeefu + (2u << 2) + 13u;
+  return finalMix(init + x, init + y, init);
+}
+
+/// Component @p axis of the offset Cycles adds to seed noise number @p seed (its
+/// random_float3_offset): 100 + 100 · hash(seed, axis) / (2³² − 1), the two floats' bits hashed,
+/// in float as Cycles computes it.
+float seedOffset(int seed, int axis) {
+  const std::uint32_t h = hashWords(std::bit_cast<std::uint32_t>(float(seed)),
+                                    std::bit_cast<std::uint32_t>(float(axis)));
+  const float unit = static_cast<float>(h) / static_cast<float>(0xFFFFFFFFu);
+  return 100.0f + unit * 100.0f;
+}
+
+constexpr double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
+constexpr double fadeSlope(double t) { return 30 * t * t * (t - 1) * (t - 1); }
+
+/// Perlin's gradient for hash @p h at offset @p d from the corner: the 12 directions (with 4
+/// repeated) of his improved noise, ±d_u ± d_v; its gradient with respect to d is the direction.
+Vec3d cornerDirection(std::uint32_t hash) {
+  const std::uint32_t h = hash & 15u;
+  // u: x for h < 8, else y; v: y for h < 4, x for 12 and 14, else z.
+  Vec3d u = h < 8 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
+  Vec3d v = h < 4 ? Vec3d{0, 1, 0} : (h == 12 || h == 14) ? Vec3d{1, 0, 0} : Vec3d{0, 0, 1};
+  if (h & 1u) u = -1.0 * u;
+  if (h & 2u) v = -1.0 * v;
+  return u + v;
+}
+
+/// The integer cell coordinate of x as Cycles casts it to a word (floor, two's complement),
+/// clamped to the int range for coordinates beyond it.
+std::uint32_t cellWord(double floored) {
+  const double clamped = std::clamp(floored, -2147483648.0, 2147483647.0);
+  return static_cast<std::uint32_t>(static_cast<std::int32_t>(clamped));
+}
+
+/// perlin(x) and its gradient: Σ over the cell's corners of the trilinear fade weights times the
+/// corner's direction · (x − corner).
+double perlin(Vec3d x, Vec3d* gradient) {
+  const Vec3d cell{std::floor(x.x), std::floor(x.y), std::floor(x.z)};
+  const Vec3d f = x - cell;
+  const std::uint32_t ix = cellWord(cell.x), iy = cellWord(cell.y), iz = cellWord(cell.z);
+  const double w[3][2] = {
+      {1 - fade(f.x), fade(f.x)}, {1 - fade(f.y), fade(f.y)}, {1 - fade(f.z), fade(f.z)}};
+  const double dw[3][2] = {{-fadeSlope(f.x), fadeSlope(f.x)},
+                           {-fadeSlope(f.y), fadeSlope(f.y)},
+                           {-fadeSlope(f.z), fadeSlope(f.z)}};
+  double sum = 0;
+  Vec3d slope{};
+  for (int c = 0; c < 8; ++c) {
+    const int cx = c & 1, cy = (c >> 1) & 1, cz = (c >> 2) & 1;
+    const Vec3d g = cornerDirection(hashWords(ix + static_cast<std::uint32_t>(cx),
+                                              iy + static_cast<std::uint32_t>(cy),
+                                              iz + static_cast<std::uint32_t>(cz)));
+    const double term = dot(g, f - Vec3d{double(cx), double(cy), double(cz)});
+    const double weight = w[0][cx] * w[1][cy] * w[2][cz];
+    sum += weight * term;
+    if (gradient != nullptr) {
+      slope = slope + weight * g +
+              term * Vec3d{dw[0][cx] * w[1][cy] * w[2][cz], w[0][cx] * dw[1][cy] * w[2][cz],
+                           w[0][cx] * w[1][cy] * dw[2][cz]};
+    }
+  }
+  if (gradient != nullptr) *gradient = slope;
+  return sum;
+}
+
+constexpr double kNoiseScale3 = 0.9820;  // Cycles' noise_scale3
+
+}  // namespace
+
+double blenderSignedNoise(Vec3d x, Vec3d* gradient) {
+  const double value = perlin(x, gradient);
+  if (gradient != nullptr) *gradient = kNoiseScale3 * *gradient;
+  return kNoiseScale3 * value;
+}
+
+Result<BlenderNoise> BlenderNoise::create(const BlenderNoiseParams& params) {
+  for (const double v :
+       {params.amplitude, params.scale, params.detail, params.roughness, params.distortion}) {
+    if (!std::isfinite(v)) return Error::badInput("a Noise Texture setting is not finite");
+  }
+  const double detail = std::clamp(params.detail, 0.0, 15.0);
+  const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
+                        (1 + std::abs(params.distortion)) * std::exp2(std::ceil(detail));
+  if (!(slopes <= kMaxVolumeScale)) {
+    return Error::badInput(
+        "Noise Texture slopes beyond 1e300 (amplitude × scale × (1 + "
+        "distortion) × 2^detail)");
+  }
+  return BlenderNoise(params);
+}
+
+BlenderNoise::BlenderNoise(const BlenderNoiseParams& params) : params_(params) {
+  for (int k = 0; k < 3; ++k) {  // the distortion of axis k reads noise seeded k
+    distortionOffsets_[static_cast<std::size_t>(k)] = {seedOffset(k, 0), seedOffset(k, 1),
+                                                       seedOffset(k, 2)};
+  }
+}
+
+double BlenderNoise::fac(Vec3d position, Vec3d* gradient) const {
+  const double scale = params_.scale;
+  Vec3d p = scale * position;
+  // Distortion: p + d · (snoise(p + o₀), snoise(p + o₁), snoise(p + o₂)); its Jacobian's rows
+  // are e_k + d ∇snoise(p + o_k).
+  std::array<Vec3d, 3> jacobianRows{Vec3d{1, 0, 0}, Vec3d{0, 1, 0}, Vec3d{0, 0, 1}};
+  if (params_.distortion != 0) {
+    Vec3d moved = p;
+    for (std::size_t k = 0; k < 3; ++k) {
+      Vec3d g;
+      const double n = blenderSignedNoise(p + distortionOffsets_[k], gradient ? &g : nullptr);
+      (k == 0 ? moved.x : k == 1 ? moved.y : moved.z) += n * params_.distortion;
+      if (gradient != nullptr) jacobianRows[k] = jacobianRows[k] + params_.distortion * g;
+    }
+    p = moved;
+  }
+  // fBm of noise = ½ snoise + ½.
+  const double detail = std::clamp(params_.detail, 0.0, 15.0);
+  const double roughness = std::clamp(params_.roughness, 0.0, 1.0);
+  const int octaves = static_cast<int>(detail);
+  double frequency = 1, amplitude = 1, weights = 0, sum = 0;
+  Vec3d slope{};
+  const auto octave = [&](double& value, Vec3d& g) {
+    value = 0.5 * blenderSignedNoise(frequency * p, gradient ? &g : nullptr) + 0.5;
+    g = (0.5 * frequency) * g;
+  };
+  for (int i = 0; i <= octaves; ++i) {
+    double t;
+    Vec3d g{};
+    octave(t, g);
+    sum += t * amplitude;
+    slope = slope + amplitude * g;
+    weights += amplitude;
+    amplitude *= roughness;
+    frequency *= 2;
+  }
+  double value = sum / weights;
+  Vec3d valueSlope = (1 / weights) * slope;
+  const double rest = detail - std::floor(detail);
+  if (rest != 0) {
+    double t;
+    Vec3d g{};
+    octave(t, g);
+    const double more = (sum + t * amplitude) / (weights + amplitude);
+    const Vec3d moreSlope = (1 / (weights + amplitude)) * (slope + amplitude * g);
+    value = (1 - rest) * value + rest * more;
+    valueSlope = (1 - rest) * valueSlope + rest * moreSlope;
+  }
+  if (gradient != nullptr) {
+    // d Fac / d position = scale · Jᵀ · ∇fbm.
+    const Vec3d pulled = valueSlope.x * jacobianRows[0] + valueSlope.y * jacobianRows[1] +
+                         valueSlope.z * jacobianRows[2];
+    *gradient = scale * pulled;
+  }
+  return value;
+}
+
+double BlenderNoise::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
+
+Vec3d BlenderNoise::analyticGradient(Vec3d p) const {
+  Vec3d g;
+  fac(p, &g);
+  return params_.amplitude * g;
+}
+
+}  // namespace sgbake

@@ -1,0 +1,119 @@
+/// @file blender_noise_test.cpp
+/// @brief Blender's Noise Texture as a volume: its invariants and its exact gradient. (Its values
+/// against Cycles' own are checked by BlenderBakeOracle's noise cases.)
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "sgbake/gradient/blender_noise.hpp"
+#include "sgbake/gradient/remap.hpp"
+#include "support/analytic_textures.hpp"
+
+namespace sgbake {
+namespace {
+
+using test::maxAbsDiff;
+
+BlenderNoise makeNoise(const BlenderNoiseParams& params) {
+  Result<BlenderNoise> made = BlenderNoise::create(params);
+  EXPECT_TRUE(made) << made.error().message;
+  return std::move(made).value();
+}
+
+/// Central differences of @p f at @p p, step @p h.
+template <class F>
+Vec3d centralGradient(const F& f, Vec3d p, double h) {
+  return {(f(p + Vec3d{h, 0, 0}) - f(p - Vec3d{h, 0, 0})) / (2 * h),
+          (f(p + Vec3d{0, h, 0}) - f(p - Vec3d{0, h, 0})) / (2 * h),
+          (f(p + Vec3d{0, 0, h}) - f(p - Vec3d{0, 0, h})) / (2 * h)};
+}
+
+// Perlin noise is 0 at every lattice point, so without distortion each octave there reads ½:
+// Fac = ½ wherever scale · P is integer, whatever the detail and roughness.
+TEST(BlenderNoise, IsOneHalfAtLatticePoints) {
+  const BlenderNoise noise =
+      makeNoise({.amplitude = 1, .scale = 4, .detail = 3.5, .roughness = 0.7});
+  for (const Vec3d lattice : {Vec3d{0, 0, 0}, Vec3d{1, -2, 3}, Vec3d{-7, 5, 11}}) {
+    EXPECT_NEAR(noise.value((1.0 / 4) * lattice), 0.5, 1e-15) << lattice.x;
+    EXPECT_EQ(blenderSignedNoise(lattice, nullptr), 0.0);
+  }
+}
+
+// Cycles scales Perlin noise by 0.982 so that the Fac of the node stays within [0, 1]: so does
+// sgbake's, with distortion and many octaves, at 5000 points.
+TEST(BlenderNoise, FacStaysWithinZeroAndOne) {
+  const BlenderNoise noise = makeNoise({.detail = 4, .roughness = 0.9, .distortion = 1.5});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> along(-20, 20);
+  for (int i = 0; i < 5000; ++i) {
+    const double v = noise.value({along(rng), along(rng), along(rng)});
+    EXPECT_GE(v, 0.0);
+    EXPECT_LE(v, 1.0);
+  }
+}
+
+// The gradient is exact: central differences agree to their own error, with distortion, a
+// fractional detail (the extra octave's blend) and an amplitude.
+TEST(BlenderNoise, AnalyticGradientIsTheDerivativeOfTheValue) {
+  for (const BlenderNoiseParams params :
+       {BlenderNoiseParams{.amplitude = 0.3, .scale = 5, .detail = 2, .roughness = 0.5},
+        BlenderNoiseParams{
+            .amplitude = -1.2, .scale = 2.5, .detail = 3.4, .roughness = 0.8, .distortion = 0.9},
+        BlenderNoiseParams{.amplitude = 1, .scale = 1.5, .detail = 0, .roughness = 1.7}}) {
+    const BlenderNoise noise = makeNoise(params);
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> along(-3, 3);
+    for (int i = 0; i < 300; ++i) {
+      const Vec3d p{along(rng), along(rng), along(rng)};
+      const Vec3d exact = noise.analyticGradient(p);
+      const Vec3d central = centralGradient([&](Vec3d q) { return noise.value(q); }, p, 1e-6);
+      EXPECT_LT(maxAbsDiff(exact, central), 2e-6 * (1 + std::abs(params.amplitude) * 100))
+          << params.detail << " at " << p.x << ", " << p.y << ", " << p.z;
+    }
+  }
+}
+
+// The signed noise's gradient, on its own.
+TEST(BlenderNoise, SignedNoiseGradientIsItsDerivative) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> along(-50, 50);
+  for (int i = 0; i < 500; ++i) {
+    const Vec3d p{along(rng), along(rng), along(rng)};
+    Vec3d exact;
+    blenderSignedNoise(p, &exact);
+    const Vec3d central =
+        centralGradient([](Vec3d q) { return blenderSignedNoise(q, nullptr); }, p, 1e-6);
+    EXPECT_LT(maxAbsDiff(exact, central), 1e-7);
+  }
+}
+
+// A Mapping node before the texture: the value at the mapped point, the gradient pulled back.
+TEST(MappedHeightVolume, ReadsTheMappedPointAndPullsTheGradientBack) {
+  const BlenderNoise noise = makeNoise({.scale = 3, .detail = 1});
+  const CoordinateMapping mapping =
+      CoordinateMapping::fromMappingNode({0.2, -1, 0.5}, {0.3, 0.1, -0.7}, {2, 0.5, 1.5});
+  const MappedHeightVolume mapped(noise, mapping);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> along(-2, 2);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3d p{along(rng), along(rng), along(rng)};
+    EXPECT_EQ(mapped.value(p), noise.value(mapping.apply(p)));
+    const Vec3d central = centralGradient([&](Vec3d q) { return mapped.value(q); }, p, 1e-6);
+    EXPECT_LT(maxAbsDiff(mapped.analyticGradient(p), central), 1e-6);
+  }
+}
+
+TEST(BlenderNoise, RejectsSettingsThatAreNotFinite) {
+  BlenderNoiseParams params;
+  params.distortion = std::nan("");
+  Result<BlenderNoise> made = BlenderNoise::create(params);
+  ASSERT_FALSE(made);
+  EXPECT_EQ(made.error().message, "a Noise Texture setting is not finite");
+  params.distortion = 0;
+  params.amplitude = 1e300;
+  EXPECT_FALSE(BlenderNoise::create(params));
+}
+
+}  // namespace
+}  // namespace sgbake
