@@ -79,7 +79,12 @@ Cycles tabulates it, 256 entries, luminance of the colour), baked from scenes as
 cases are; their control ours_bake_unremapped.exr, the layer without it, must fail (b) and (e).
 Measured with Cycles' slopes: median 0.0016-0.0017 deg, p99 0.0026-0.0029 deg (one Suzanne
 texel 6.4 deg, its height on the clamp's corner); exact slopes median 0.40 and 0.70 deg; without
-the remap 10.7 and 15.8 deg.
+the remap 10.7 and 15.8 deg. noise_sphere and noise_stretch_suzanne (stretched and turned) bump
+with Blender's Noise Texture (3D, on object coordinates through a Mapping node; Detail 2.5 and
+Distortion 0.3, Detail 3 and Roughness 0.6): a "blender-noise" volume layer with that "mapping",
+baked from scenes; their control ours_bake_unmapped.exr, the layer without its mapping, must
+fail (b) and (e). Measured with Cycles' slopes: median 0.0016-0.0018 deg, p99 0.0019-0.0054
+deg; exact slopes median 0.16 and 0.45 deg; without the mapping 3.7 and 4.1 deg.
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -239,7 +244,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "sphere_nmap_sphere", "tube_nmap_sphere_object", "sphere_wrap_stretch_sphere",
                  "displacement_sphere",
                  "displacement_stretch_sphere", "displacement_object_sphere",
-                 "displacement_object_stretch_sphere", "ramp_sphere", "clamp_suzanne")
+                 "displacement_object_stretch_sphere", "ramp_sphere", "clamp_suzanne",
+                 "noise_sphere", "noise_stretch_suzanne")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
@@ -351,16 +357,30 @@ def sgbake_case(cli, entry, sabotage, threads):
                                 "-o", p("ours_mask.exr")] + common, log):
             failed.append(log[-1])
         return failed
-    if "remap" in entry:  # a height reshaped before the Bump: its layer's "remap", scenes only
-        for name, layer_scale, gradient, remap in (
+    if "remap" in entry or "noise" in entry:  # scenes only
+        # A height reshaped before the Bump (its layer's "remap"; the control without it), or
+        # Blender's Noise Texture (a "blender-noise" volume; the control without its Mapping).
+        control = "ours_bake_unremapped" if "remap" in entry else "ours_bake_unmapped"
+        for name, layer_scale, gradient, complete in (
                 ("ours_bake", bake_scale, "analytic", True),
                 ("ours_bake_x2", 2 * scale, "analytic", True),
                 ("ours_bake_bump_node", bake_scale, "bump-node", True),
-                ("ours_bake_unremapped", bake_scale, "bump-node", False)):
-            layer = {"type": "height", "image": p("height.exr"), "scale": layer_scale,
-                     "filter": entry["filter"], "gradient": gradient}
-            if remap:
-                layer["remap"] = entry["remap"]
+                (control, bake_scale, "bump-node", False)):
+            if "noise" in entry:
+                noise = entry["noise"]
+                layer = {"type": "volume", "function": "blender-noise", "amplitude": layer_scale,
+                         "frequency": noise["scale"], "detail": noise["detail"],
+                         "roughness": noise["roughness"], "distortion": noise["distortion"],
+                         "gradient": gradient}
+                if complete:
+                    location, rotation, mapping_scale = noise["mapping"]
+                    layer["mapping"] = {"location": location, "rotation": rotation,
+                                        "scale": mapping_scale}
+            else:
+                layer = {"type": "height", "image": p("height.exr"), "scale": layer_scale,
+                         "filter": entry["filter"], "gradient": gradient}
+                if complete:
+                    layer["remap"] = entry["remap"]
             scene = {"mesh": p("mesh.obj"), "subdivision": {"level": entry["subdivision"]},
                      "layers": [layer],
                      "outputs": [{"map": "tangent-normal", "file": p(name + ".exr"),
@@ -804,7 +824,7 @@ def main():
                                           transformed(entry))
             else:
                 failures += evaluate(entry["name"], results[entry["name"]],
-                                     "planar" in entry or "remap" in entry)
+                                     "planar" in entry or "remap" in entry or "noise" in entry)
         if args.keep:
             print(f"files kept in {work}")
     return bc.report(failures)

@@ -221,6 +221,43 @@ def reshape_height(mat, kind):
     return [[-b / a, 0.0], [(1 - b) / a, 1.0]]
 
 
+# name -> a Noise Texture (3D) feeding the Bump node instead of the image, read at the object's
+# coordinates (Texture Coordinate Object) through a Mapping node (Point): {"scale", "detail",
+# "roughness", "distortion", "mapping": (location, rotation, scale)}. The manifest entry has
+# "noise": these settings, sgbake's "blender-noise" volume layer with that "mapping".
+NOISE = {}
+
+
+def noise_case(name, of_case, size, distance, **settings):
+    """Registers case `name`: the mesh (and transform) of case `of_case` at `size`, its Bump
+    (Distance `distance`) fed by a Noise Texture of `settings` (NOISE)."""
+    builder = CASES[of_case][0]
+    CASES[name] = (builder, size, distance)
+    SUBDIVISION[name] = SUBDIVISION[of_case]
+    if of_case in TRANSFORMS:
+        TRANSFORMS[name] = TRANSFORMS[of_case]
+    NOISE[name] = settings
+
+
+def bump_by_noise(mat, settings):
+    """Replaces the texture feeding `mat`'s Bump node by a Noise Texture of `settings` (NOISE) on
+    object coordinates through a Mapping node."""
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bump = next(n for n in nodes if n.bl_idname == "ShaderNodeBump")
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "POINT"
+    for socket, value in zip(("Location", "Rotation", "Scale"), settings["mapping"]):
+        mapping.inputs[socket].default_value = value
+    noise = nodes.new("ShaderNodeTexNoise")
+    noise.noise_dimensions = "3D"
+    for socket in ("Scale", "Detail", "Roughness", "Distortion"):
+        noise.inputs[socket].default_value = settings[socket.lower()]
+    links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
+    links.new(noise.outputs["Fac"], bump.inputs["Height"])
+
+
 # name -> the object transform of a case (location, XYZ Euler rotation in radians, scale):
 # mesh.obj stays in object space, Cycles shades the object in world space, and sgbake is given
 # the object's matrix_world ("transform" in the JSON scene). Cases not listed sit at the origin
@@ -510,6 +547,13 @@ displacement_case("displacement_object_stretch_sphere", "stretch_sphere", "OBJEC
 # Cycles' differences half a texel long, over the bar of 1 deg; at 512^2 0.70 deg.)
 remap_case("ramp_sphere", "sphere", "ramp", size=512)
 remap_case("clamp_suzanne", "suzanne", "clamp")
+# Blender's Noise Texture into the Bump node: on the sphere (Detail 2.5, Distortion 0.3), and on
+# Suzanne stretched and turned (in world space; Detail 3, Roughness 0.6), both through a Mapping.
+NOISE_MAPPING = ((0.3, -0.2, 0.1), (0.4, 0.0, -0.6), (1.0, 1.5, 0.8))
+noise_case("noise_sphere", "sphere", 512, 0.05, scale=2.0, detail=2.5, roughness=0.5,
+           distortion=0.3, mapping=NOISE_MAPPING)
+noise_case("noise_stretch_suzanne", "stretch_chain_suzanne", 512, 0.03, scale=3.0, detail=3.0,
+           roughness=0.6, distortion=0.0, mapping=NOISE_MAPPING)
 projected_normal_map_case("sphere_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "SPHERE",
                           mapping=WRAP_MAPPING)
 projected_normal_map_case("tube_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "TUBE",
@@ -739,6 +783,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
             bump_by_displacement(mat, DISPLACEMENT[name]["space"])
         if name in REMAPS:
             remap = reshape_height(mat, REMAPS[name])
+        if name in NOISE:
+            bump_by_noise(mat, NOISE[name])
     else:
         if nmap["space"] == "TANGENT" or name in PLANAR:
             field = normal_field(height_size, nmap["tilt_deg"])
@@ -789,6 +835,8 @@ def build_case(name, out_dir, size=None, passes=("object", "tangent", "mask"), m
         entry["displacement"] = {"space": DISPLACEMENT[name]["space"].lower()}
     if name in REMAPS:
         entry["remap"] = remap
+    if name in NOISE:
+        entry["noise"] = dict(NOISE[name], mapping=[list(v) for v in NOISE[name]["mapping"]])
     if nmap is not None:
         entry["normal_map"] = {"space": nmap["space"].lower(), "strength": nmap["strength"],
                                "tilt_deg": nmap["tilt_deg"], "size": height_size}
