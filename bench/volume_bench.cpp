@@ -8,7 +8,9 @@
 /// Benchmarks (time is per batch of kNumPoints points; `time_per_point` is the CPU time per point,
 /// in seconds):
 ///   - `Volume/<field>/<what>`: value(), and volumeGradient with kAnalytic, kCentral and
-///     kTetrahedral (at the default step), for the directional sine and 1- and 4-octave noise.
+///     kTetrahedral (at the default step), for the directional sine, 1- and 4-octave noise, and
+///     Blender's Noise Texture at Blender's defaults (Scale 5, Detail 2: three octaves) and
+///     with Distortion 0.5 (three more noises and their gradients).
 ///   - `EqualError/<scheme>/target:<t>`: on the 1-octave noise, the step at which each finite
 ///     difference scheme reaches a max error of t (relative to the RMS analytic gradient
 ///     magnitude over a fixed point set, measured against the analytic gradient in the setup),
@@ -29,6 +31,7 @@
 #include <vector>
 
 #include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/blender_noise.hpp"
 #include "sgbake/gradient/volume.hpp"
 
 namespace {
@@ -69,14 +72,29 @@ const sgbake::GradientNoise& noiseField(int octaves) {
   return octaves == 1 ? one : four;
 }
 
+/// Blender's Noise Texture at its defaults, or with Distortion 0.5.
+const sgbake::BlenderNoise& blenderNoiseField(bool distorted) {
+  static const sgbake::BlenderNoise plain =
+      sgbake::BlenderNoise::create({.amplitude = 0.05}).value();
+  static const sgbake::BlenderNoise twisted =
+      sgbake::BlenderNoise::create({.amplitude = 0.05, .distortion = 0.5}).value();
+  return distorted ? twisted : plain;
+}
+
+constexpr int kNumFields = 5;
+
 const HeightVolume& field(int which) {
   switch (which) {
     case 0:
       return sineField();
     case 1:
       return noiseField(1);
-    default:
+    case 2:
       return noiseField(4);
+    case 3:
+      return blenderNoiseField(false);
+    default:
+      return blenderNoiseField(true);
   }
 }
 
@@ -86,8 +104,12 @@ const char* fieldName(int which) {
       return "sine";
     case 1:
       return "noise1";
-    default:
+    case 2:
       return "noise4";
+    case 3:
+      return "blender-noise";
+    default:
+      return "blender-noise-distorted";
   }
 }
 
@@ -209,7 +231,7 @@ void benchEqualError(benchmark::State& state, GradientScheme scheme, double targ
 
 void registerAll() {
   const double step = sgbake::defaultStep(kObjectSize);
-  for (int which = 0; which < 3; ++which) {
+  for (int which = 0; which < kNumFields; ++which) {
     const std::string base = std::string("Volume/") + fieldName(which);
     benchmark::RegisterBenchmark((base + "/value").c_str(),
                                  [which](benchmark::State& s) { benchValue(s, which); });

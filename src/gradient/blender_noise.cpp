@@ -56,57 +56,73 @@ float seedOffset(int seed, int axis) {
   return 100.0f + unit * 100.0f;
 }
 
-constexpr double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
-constexpr double fadeSlope(double t) { return 30 * t * t * (t - 1) * (t - 1); }
+inline constexpr double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
+inline constexpr double fadeSlope(double t) { return 30 * t * t * (t - 1) * (t - 1); }
 
-/// Perlin's gradient for hash @p h at offset @p d from the corner: the 12 directions (with 4
-/// repeated) of his improved noise, ±d_u ± d_v; its gradient with respect to d is the direction.
-Vec3d cornerDirection(std::uint32_t hash) {
+/// Perlin's gradient for corner hash @p hash dotted with the offset @p d from the corner: the 12
+/// directions (4 of them twice) of his improved noise, ±d_u ± d_v with u = x for the low 4 bits
+/// h < 8, else y, and v = y for h < 4, x for 12 and 14, else z. With @p direction, the direction
+/// itself (the term's gradient with respect to d).
+template <bool kDirection>
+inline double cornerTerm(std::uint32_t hash, const double (&d)[3], double (&direction)[3]) {
   const std::uint32_t h = hash & 15u;
-  // u: x for h < 8, else y; v: y for h < 4, x for 12 and 14, else z.
-  Vec3d u = h < 8 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
-  Vec3d v = h < 4 ? Vec3d{0, 1, 0} : (h == 12 || h == 14) ? Vec3d{1, 0, 0} : Vec3d{0, 0, 1};
-  if (h & 1u) u = -1.0 * u;
-  if (h & 2u) v = -1.0 * v;
-  return u + v;
+  const int u = h < 8 ? 0 : 1;
+  const int v = h < 4 ? 1 : (h == 12 || h == 14) ? 0 : 2;
+  const double su = (h & 1u) ? -1.0 : 1.0, sv = (h & 2u) ? -1.0 : 1.0;
+  if constexpr (kDirection) {
+    direction[0] = direction[1] = direction[2] = 0;
+    direction[u] += su;
+    direction[v] += sv;
+  }
+  return su * d[u] + sv * d[v];
 }
 
 /// The integer cell coordinate of x as Cycles casts it to a word (floor, two's complement),
 /// clamped to the int range for coordinates beyond it.
-std::uint32_t cellWord(double floored) {
+inline std::uint32_t cellWord(double floored) {
   const double clamped = std::clamp(floored, -2147483648.0, 2147483647.0);
   return static_cast<std::uint32_t>(static_cast<std::int32_t>(clamped));
 }
 
-/// perlin(x) and its gradient: Σ over the cell's corners of the trilinear fade weights times the
-/// corner's direction · (x − corner).
+/// perlin(x), and with kGradient its gradient: the corners' terms blended trilinearly by the
+/// faded fractions (x first, then y, then z).
+template <bool kGradient>
 double perlin(Vec3d x, Vec3d* gradient) {
-  const Vec3d cell{std::floor(x.x), std::floor(x.y), std::floor(x.z)};
-  const Vec3d f = x - cell;
-  const std::uint32_t ix = cellWord(cell.x), iy = cellWord(cell.y), iz = cellWord(cell.z);
-  const double w[3][2] = {
-      {1 - fade(f.x), fade(f.x)}, {1 - fade(f.y), fade(f.y)}, {1 - fade(f.z), fade(f.z)}};
-  const double dw[3][2] = {{-fadeSlope(f.x), fadeSlope(f.x)},
-                           {-fadeSlope(f.y), fadeSlope(f.y)},
-                           {-fadeSlope(f.z), fadeSlope(f.z)}};
-  double sum = 0;
-  Vec3d slope{};
-  for (int c = 0; c < 8; ++c) {
-    const int cx = c & 1, cy = (c >> 1) & 1, cz = (c >> 2) & 1;
-    const Vec3d g = cornerDirection(hashWords(ix + static_cast<std::uint32_t>(cx),
-                                              iy + static_cast<std::uint32_t>(cy),
-                                              iz + static_cast<std::uint32_t>(cz)));
-    const double term = dot(g, f - Vec3d{double(cx), double(cy), double(cz)});
-    const double weight = w[0][cx] * w[1][cy] * w[2][cz];
-    sum += weight * term;
-    if (gradient != nullptr) {
-      slope = slope + weight * g +
-              term * Vec3d{dw[0][cx] * w[1][cy] * w[2][cz], w[0][cx] * dw[1][cy] * w[2][cz],
-                           w[0][cx] * w[1][cy] * dw[2][cz]};
-    }
+  const double cell[3] = {std::floor(x.x), std::floor(x.y), std::floor(x.z)};
+  const double f[3] = {x.x - cell[0], x.y - cell[1], x.z - cell[2]};
+  const std::uint32_t ix = cellWord(cell[0]), iy = cellWord(cell[1]), iz = cellWord(cell[2]);
+  double s[3], ds[3];
+  for (int a = 0; a < 3; ++a) {
+    s[a] = fade(f[a]);
+    ds[a] = fadeSlope(f[a]);
   }
-  if (gradient != nullptr) *gradient = slope;
-  return sum;
+  double term[8], dir[8][3];
+  for (int c = 0; c < 8; ++c) {
+    const std::uint32_t cx = c & 1, cy = (c >> 1) & 1, cz = (c >> 2) & 1;
+    const double d[3] = {f[0] - cx, f[1] - cy, f[2] - cz};
+    term[c] = cornerTerm<kGradient>(hashWords(ix + cx, iy + cy, iz + cz), d, dir[c]);
+  }
+  // Blend along x, then y, then z (the value, and for the gradient the blends of the terms'
+  // directions and the fade's slopes times the differences of the terms).
+  const auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
+  double xy[4];
+  for (int k = 0; k < 4; ++k) xy[k] = lerp(term[2 * k], term[2 * k + 1], s[0]);
+  const double z0 = lerp(xy[0], xy[1], s[1]), z1 = lerp(xy[2], xy[3], s[1]);
+  const double value = lerp(z0, z1, s[2]);
+  if constexpr (kGradient) {
+    double g[3] = {0, 0, 0};
+    for (int c = 0; c < 8; ++c) {
+      const int cx = c & 1, cy = (c >> 1) & 1, cz = (c >> 2) & 1;
+      const double wx = cx ? s[0] : 1 - s[0], wy = cy ? s[1] : 1 - s[1], wz = cz ? s[2] : 1 - s[2];
+      const double weight = wx * wy * wz;
+      const double sx = cx ? 1.0 : -1.0, sy = cy ? 1.0 : -1.0, sz = cz ? 1.0 : -1.0;
+      g[0] += weight * dir[c][0] + term[c] * sx * ds[0] * wy * wz;
+      g[1] += weight * dir[c][1] + term[c] * sy * ds[1] * wx * wz;
+      g[2] += weight * dir[c][2] + term[c] * sz * ds[2] * wx * wy;
+    }
+    *gradient = {g[0], g[1], g[2]};
+  }
+  return value;
 }
 
 constexpr double kNoiseScale3 = 0.9820;  // Cycles' noise_scale3
@@ -114,8 +130,9 @@ constexpr double kNoiseScale3 = 0.9820;  // Cycles' noise_scale3
 }  // namespace
 
 double blenderSignedNoise(Vec3d x, Vec3d* gradient) {
-  const double value = perlin(x, gradient);
-  if (gradient != nullptr) *gradient = kNoiseScale3 * *gradient;
+  if (gradient == nullptr) return kNoiseScale3 * perlin<false>(x, nullptr);
+  const double value = perlin<true>(x, gradient);
+  *gradient = kNoiseScale3 * *gradient;
   return kNoiseScale3 * value;
 }
 
