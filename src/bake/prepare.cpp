@@ -271,37 +271,34 @@ Status loadTextures(const Plan& plan, const ImageSource& source, Loaded& loaded,
 
 namespace {
 
+/// A volume made by its create(), owned.
+template <class V>
+Result<std::unique_ptr<HeightVolume>> owned(Result<V> made) {
+  if (!made) return made.error();
+  return std::unique_ptr<HeightVolume>(std::make_unique<V>(std::move(*made)));
+}
+
 /// Builds the volume of a volume layer.
 Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
-  if (layer.function == VolumeFunction::kSine) {
-    DirectionalSineParams params;
-    params.amplitude = layer.amplitude;
-    params.frequency = layer.frequency;
-    params.direction = layer.direction;
-    params.phase = layer.phase;
-    Result<DirectionalSine> sine = DirectionalSine::create(params);
-    if (!sine) return sine.error();
-    return std::unique_ptr<HeightVolume>(std::make_unique<DirectionalSine>(std::move(*sine)));
+  switch (layer.function) {
+    case VolumeFunction::kSine:
+      return owned(DirectionalSine::create({.amplitude = layer.amplitude,
+                                            .frequency = layer.frequency,
+                                            .direction = layer.direction,
+                                            .phase = layer.phase}));
+    case VolumeFunction::kBlenderNoise:
+      return owned(BlenderNoise::create({.amplitude = layer.amplitude,
+                                         .scale = layer.frequency,
+                                         .detail = layer.noiseDetail,
+                                         .roughness = layer.noiseRoughness,
+                                         .distortion = layer.noiseDistortion}));
+    case VolumeFunction::kNoise:
+      break;
   }
-  if (layer.function == VolumeFunction::kBlenderNoise) {
-    BlenderNoiseParams params;
-    params.amplitude = layer.amplitude;
-    params.scale = layer.frequency;
-    params.detail = layer.noiseDetail;
-    params.roughness = layer.noiseRoughness;
-    params.distortion = layer.noiseDistortion;
-    Result<BlenderNoise> noise = BlenderNoise::create(params);
-    if (!noise) return noise.error();
-    return std::unique_ptr<HeightVolume>(std::make_unique<BlenderNoise>(std::move(*noise)));
-  }
-  GradientNoiseParams params;
-  params.amplitude = layer.amplitude;
-  params.frequency = layer.frequency;
-  params.seed = layer.seed;
-  params.octaves = layer.octaves;
-  Result<GradientNoise> noise = GradientNoise::create(params);
-  if (!noise) return noise.error();
-  return std::unique_ptr<HeightVolume>(std::make_unique<GradientNoise>(std::move(*noise)));
+  return owned(GradientNoise::create({.amplitude = layer.amplitude,
+                                      .frequency = layer.frequency,
+                                      .seed = layer.seed,
+                                      .octaves = layer.octaves}));
 }
 
 /// The material index of scene layer @p index (Layer::material: −1 for every face): its

@@ -14,22 +14,20 @@ namespace {
 
 constexpr std::uint32_t rotate(std::uint32_t x, int k) { return (x << k) | (x >> (32 - k)); }
 
-/// Bob Jenkins' lookup3 `final` mix of (a, b, c); returns c.
+/// Bob Jenkins' lookup3 `final` mix of (a, b, c); returns c. Seven steps x ^= y, x −= y rotated
+/// left by k, round the words c ← b, a ← c, b ← a, …
 constexpr std::uint32_t finalMix(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-  c ^= b;
-  c -= rotate(b, 14);
-  a ^= c;
-  a -= rotate(c, 11);
-  b ^= a;
-  b -= rotate(a, 25);
-  c ^= b;
-  c -= rotate(b, 16);
-  a ^= c;
-  a -= rotate(c, 4);
-  b ^= a;
-  b -= rotate(a, 14);
-  c ^= b;
-  c -= rotate(b, 24);
+  const auto step = [](std::uint32_t& x, std::uint32_t y, int k) {
+    x ^= y;
+    x -= rotate(y, k);
+  };
+  step(c, b, 14);
+  step(a, c, 11);
+  step(b, a, 25);
+  step(c, b, 16);
+  step(a, c, 4);
+  step(b, a, 14);
+  step(c, b, 24);
   return c;
 }
 

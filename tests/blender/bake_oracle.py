@@ -287,6 +287,27 @@ def transform_flags(entry):
     return ["--transform", ",".join(repr(float(v)) for row in entry["transform"] for v in row)]
 
 
+def bake_layer_scenes(cli, entry, layers, green, common, failed, log):
+    """Bakes each (name, layer) of `layers` from a scene of its own on the case's mesh (and its
+    subdivision and transform) into name.exr, then the mask; returns `failed` with the command
+    lines that failed added."""
+    d, size = entry["dir"], entry["size"]
+    p = lambda name: os.path.join(d, name)  # noqa: E731
+    for name, layer in layers:
+        scene = {"mesh": p("mesh.obj"), "subdivision": {"level": entry.get("subdivision", 0)},
+                 "layers": [layer],
+                 "outputs": [{"map": "tangent-normal", "file": p(name + ".exr"), "size": size,
+                              "margin": 0, "samples": 1, "green": green, "bit_depth": 32}]}
+        if transformed(entry):
+            scene["transform"] = entry["transform"]
+        if not bc.bake_scene_file(cli, d, name, scene):
+            failed.append(f"sgbake bake {p(name + '.json')}")
+    if not run_sgbake(cli, ["bake", "--mesh", p("mesh.obj"), "--map", "mask", "--size", size,
+                            "-o", p("ours_mask.exr")] + common, log):
+        failed.append(log[-1])
+    return failed
+
+
 def sgbake_case(cli, entry, sabotage, threads):
     """Runs every sgbake command of one case; returns a list of failed command lines."""
     d = entry["dir"]
@@ -330,6 +351,7 @@ def sgbake_case(cli, entry, sabotage, threads):
         strength = entry["planar"].get("strength", 1.0)
         if strength != 1.0:
             bakes.append(("ours_bake_full_strength", bake_scale, "bump-node"))
+        layers = []
         for name, layer_scale, gradient in bakes:
             layer = {"type": "planar", "image": p("height.exr"), "kind": "height", "axis": "z",
                      "scale": layer_scale, "filter": entry["filter"], "gradient": gradient}
@@ -345,22 +367,13 @@ def sgbake_case(cli, entry, sabotage, threads):
                 layer["type"] = "triplanar"
                 if name != "ours_bake_blended":
                     layer.update(projection="box", box_blend=entry["planar"]["blend"])
-            scene = {"mesh": p("mesh.obj"), "layers": [layer],
-                     "outputs": [{"map": "tangent-normal", "file": p(name + ".exr"),
-                                  "size": size, "margin": 0, "samples": 1, "green": green,
-                                  "bit_depth": 32}]}
-            if transformed(entry):
-                scene["transform"] = entry["transform"]
-            if not bc.bake_scene_file(cli, d, name, scene):
-                failed.append(f"sgbake bake {p(name + '.json')}")
-        if not run_sgbake(cli, ["bake", "--mesh", p("mesh.obj"), "--map", "mask", "--size", size,
-                                "-o", p("ours_mask.exr")] + common, log):
-            failed.append(log[-1])
-        return failed
+            layers.append((name, layer))
+        return bake_layer_scenes(cli, entry, layers, green, common, failed, log)
     if "remap" in entry or "noise" in entry:  # scenes only
         # A height reshaped before the Bump (its layer's "remap"; the control without it), or
         # Blender's Noise Texture (a "blender-noise" volume; the control without its Mapping).
         control = "ours_bake_unremapped" if "remap" in entry else "ours_bake_unmapped"
+        layers = []
         for name, layer_scale, gradient, complete in (
                 ("ours_bake", bake_scale, "analytic", True),
                 ("ours_bake_x2", 2 * scale, "analytic", True),
@@ -381,19 +394,8 @@ def sgbake_case(cli, entry, sabotage, threads):
                          "filter": entry["filter"], "gradient": gradient}
                 if complete:
                     layer["remap"] = entry["remap"]
-            scene = {"mesh": p("mesh.obj"), "subdivision": {"level": entry["subdivision"]},
-                     "layers": [layer],
-                     "outputs": [{"map": "tangent-normal", "file": p(name + ".exr"),
-                                  "size": size, "margin": 0, "samples": 1, "green": green,
-                                  "bit_depth": 32}]}
-            if transformed(entry):
-                scene["transform"] = entry["transform"]
-            if not bc.bake_scene_file(cli, d, name, scene):
-                failed.append(f"sgbake bake {p(name + '.json')}")
-        if not run_sgbake(cli, ["bake", "--mesh", p("mesh.obj"), "--map", "mask", "--size", size,
-                                "-o", p("ours_mask.exr")] + common, log):
-            failed.append(log[-1])
-        return failed
+            layers.append((name, layer))
+        return bake_layer_scenes(cli, entry, layers, green, common, failed, log)
     bake = ["bake", "--mesh", p("mesh.obj"), "--height", p("height.exr"), "--filter",
             entry["filter"], "--map", "tangent-normal", "--size", size, "--green", green] + common
     world_units = list(bake)  # (the control of an object-space displacement)
