@@ -43,11 +43,11 @@ def coordinates_matrix(ob, other=None, generated=False):
 
 
 def follow_coordinates(layers, ob):
-    """Sets the Coordinates (mapping_matrix) of every projected layer that reads another
-    object's or the Generated coordinates to what they are now on `ob`, so that a moved
+    """Sets the Coordinates (mapping_matrix) of every projected or volume layer that reads
+    another object's or the Generated coordinates to what they are now on `ob`, so that a moved
     projector or an edited mesh bakes as Cycles renders it without Layers from Material again."""
     for layer in layers:
-        if layer.type not in ("planar", "triplanar"):
+        if layer.type not in ("planar", "triplanar", "volume"):
             continue
         if layer.coordinates_object is None and not layer.coordinates_generated:
             continue

@@ -256,9 +256,9 @@ def _tile_list(tiles):
 
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
-    """Add sgbake layers for the Bump and Normal Map nodes fed by an Image Texture node in the
-    active object's materials (with several material slots, each layer applies to its slot's
-    faces)"""
+    """Add sgbake layers for the Bump and Normal Map nodes fed by an Image Texture node, and the
+    Bump nodes fed by a Noise Texture's Fac, in the active object's materials (with several
+    material slots, each layer applies to its slot's faces)"""
     bl_idname = "object.sgbake_layers_from_material"
     bl_label = "Layers from Material"
     bl_options = {"REGISTER", "UNDO"}
@@ -284,7 +284,7 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             what = (f"material '{sources[0][1].name}' has no" if single
                     else f"no material of object '{ob.name}' has a")
             self.report({"ERROR"}, f"{what} Bump or Normal Map node fed by an Image Texture "
-                                   "node" + _notes(skipped))
+                                   "node (or a Bump fed by a Noise Texture)" + _notes(skipped))
             return {"CANCELLED"}
         settings = context.scene.sgbake
         if self.replace:
@@ -294,7 +294,7 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             for key, value in values.items():
                 setattr(layer, key, scene.remap_text(value) if key == "remap" else value)
         settings.active_layer_index = len(settings.layers) - 1
-        added = ", ".join(f"{v['type']} '{v['image'].name}' x {v['scale']:.4g}"
+        added = ", ".join(f"{v['type']} '{v['name']}' x {v[_scale_key(v)]:.4g}"
                           + (f" remapped ({len(v['remap'])} points)" if "remap" in v else "")
                           + (f" on slot {v['material_index']}" if "material_index" in v else "")
                           for v in found)
@@ -354,7 +354,9 @@ def object_layers(sources, render_uv=None, ob=None):
             for entry in values:
                 entry["material_index"] = slot
             if not values and not slot_skipped:
-                slot_skipped.append("no Bump, Normal Map or Displacement node fed by an Image Texture node")
+                slot_skipped.append("no Bump, Normal Map or Displacement node fed by an Image "
+                                    "Texture node (or a Bump or Displacement by a Noise "
+                                    "Texture)")
             slot_skipped = [f"{where}: {note}" for note in slot_skipped]
             slot_ignored = [f"{where}: {note}" for note in slot_ignored]
         found += values
@@ -545,11 +547,13 @@ def _chain_step(node, link, channel):
 
 
 def _height_source(socket):
-    """The Image Texture node (with an image) that feeds height input `socket`, the channel it
-    is read on and the function of its value the nodes between make: (node, channel, factor,
-    points), or None when the chain is not followed, or a string saying why its height cannot
-    bump (it is constant). Followed back through Reroutes, RGB to BW (the luminance, as the
-    input's own conversion), Separate RGB or Color (RGB mode: channel r, g or b; the texture's
+    """The texture node that feeds height input `socket`, the channel it is read on and the
+    function of its value the nodes between make: (node, channel, factor, points), or None when
+    the chain is not followed, or a string saying why its height is not taken (a constant, a
+    Noise Texture's Color). The texture: an Image Texture node with an image, or a Noise
+    Texture node's Fac (a float: every channel its value; _noise_settings says whether a
+    volume layer takes the node). Followed back through Reroutes, RGB to BW (the luminance, as
+    the input's own conversion), Separate RGB or Color (RGB mode: channel r, g or b; the image's
     Alpha output is channel a, its Color the luminance) and the nodes of _chain_step (Math, Map
     Range, Clamp, Color Ramp, Invert), composed into one function (remap.compose). Without a
     clamp or Color Ramp it is factor x value + an offset no slope sees: points is None; with
@@ -569,6 +573,12 @@ def _height_source(socket):
                     return None
                 channel = "a"
             break
+        if node.type == "TEX_NOISE":
+            if link.from_socket.name != "Fac":
+                return (f"'{node.name}' {link.from_socket.name} output (three noises seeded "
+                        "apart; a volume layer is the noise of its Fac)")
+            channel = None  # (a grey: any channel of it is the Fac)
+            break
         if node.type in ("SEPRGB", "SEPARATE_COLOR"):
             if channel is not None or getattr(node, "mode", "RGB") != "RGB":
                 return None
@@ -587,14 +597,14 @@ def _height_source(socket):
         function = remap.compose(function, inner)
     channel = channel or "luminance"
     if not remap.finite(function):
-        return "the nodes between it and its Image Texture make a height that is not finite"
+        return "the nodes between it and its texture make a height that is not finite"
     if function[0] == "affine":
         return node, channel, function[1], None
     if remap.is_constant(function):
-        return ("the nodes between it and its Image Texture make a constant height (no bump, "
-                "as in Cycles)")
+        return ("the nodes between it and its texture make a constant height (no bump, as in "
+                "Cycles)")
     if len(function[1]) > remap.MAX_POINTS:
-        return (f"the nodes between it and its Image Texture make a remap of "
+        return (f"the nodes between it and its texture make a remap of "
                 f"{len(function[1])} points (libsgbake takes {remap.MAX_POINTS})")
     return node, channel, 1.0, [[x, y] for x, y in function[1]]
 
@@ -667,12 +677,15 @@ def _surface_nodes(node_tree):
 
 
 def _not_image(socket):
-    """Why `socket` gave no layer: what is linked into it instead of an Image Texture node."""
+    """Why `socket` gave no layer: what is linked into it instead of an Image Texture node
+    (or, into a height, a Noise Texture's Fac)."""
     link = _source_link(socket)
     if link is not None and link.from_node.type == "TEX_IMAGE":
         return f"{socket.name}'s Image Texture node has no image"
     if socket.is_linked and link is None:
         return f"{socket.name}'s link is muted"
+    if socket.name == "Height":
+        return f"{socket.name} is not an Image Texture or Noise Texture node"
     return f"{socket.name} is not an Image Texture node"
 
 
@@ -694,40 +707,83 @@ def _coordinates_source(link):
 def _object_coordinates(tex, ob=None):
     """How Image Texture node `tex` reads object coordinates: None when it does not; else the
     layer settings of what lies between (empty for the object's own). It does when its
-    projection is Flat, Box, Sphere or Tube and its Vector comes from a Texture Coordinate
-    node's Object output (the baked object's own coordinates; another object's, or its
-    Generated output, when the baked object `ob` is known: mapping_matrix), straight or through
-    one Mapping node of type Point, Texture or Vector whose Location, Rotation and Scale are
-    constants (_constant: their own values, or Value, Combine XYZ and Math nodes of constants;
-    not type Normal, which normalizes the coordinates). Its height is then sgbake's planar
-    layer on axis z (Flat), with its Sphere or Tube projection (Sphere, Tube), or its triplanar
-    layer with Blender's Box projection (Box)."""
+    projection is Flat, Box, Sphere or Tube and its Vector reads them (_vector_coordinates: a
+    Texture Coordinate node's Object output, the baked object's own coordinates; another
+    object's, or its Generated output, when the baked object `ob` is known; straight or
+    through one Mapping node). Its height is then sgbake's planar layer on axis z (Flat), with
+    its Sphere or Tube projection (Sphere, Tube), or its triplanar layer with Blender's Box
+    projection (Box)."""
     if tex.projection not in ("FLAT", "BOX", "SPHERE", "TUBE"):
         return None
-    link = _source_link(tex.inputs["Vector"])
+    settings = _vector_coordinates(tex.inputs["Vector"], ob)
+    if isinstance(settings, str) or ("mapping_matrix" not in settings
+                                     and _coordinates_of(settings)):
+        return None  # (another object's or the Generated coordinates with no object to map)
+    return settings
+
+
+def _coordinates_of(settings):
+    """Whether layer `settings` read another object's or the Generated coordinates."""
+    return "coordinates_object" in settings or "coordinates_generated" in settings
+
+
+def _vector_coordinates(socket, ob=None, generated=False):
+    """The object coordinates texture input `socket` (a Vector) reads, as layer settings (empty
+    for the object's own), or a string saying why they are not object coordinates. They are
+    when it comes from a Texture Coordinate node's Object output (the object's own, or another
+    object's: coordinates_object) or Generated output (coordinates_generated), straight or
+    through one Mapping node of type Point, Texture or Vector whose Location, Rotation and
+    Scale are constants (_constant: their own values, or Value, Combine XYZ and Math nodes of
+    constants; not type Normal, which normalizes the coordinates); with `generated` (a
+    procedural texture, which Cycles reads on the Generated coordinates when its Vector is
+    unlinked) also when nothing is linked. Other objects' and the Generated coordinates get
+    their affine map of the object's own as `ob` has them now (mapping_matrix;
+    gather.follow_coordinates brings it up to date at every bake), none when `ob` is None."""
+    link = _source_link(socket)
     settings = {}
+    if link is None and generated:
+        return _mapped_coordinates(settings, {"coordinates_generated": True}, ob)
     if link is not None and link.from_node.type == "MAPPING":
         node = link.from_node
         values = {name: _constant(node.inputs[name]) for name in MAPPING_INPUTS}
-        if node.vector_type == "NORMAL" or any(v is None for v in values.values()):
-            return None
+        if node.vector_type == "NORMAL":
+            return f"'{node.name}' is of type Normal (it normalizes the coordinates)"
+        varying = [name for name, value in values.items() if value is None]
+        if varying:
+            return f"'{node.name}' {' and '.join(varying)} from a node (not constants)"
         settings["mapping_type"] = node.vector_type
         for name, value in values.items():
             settings[f"mapping_{name.lower()}"] = value
         link = _source_link(node.inputs["Vector"])
-    if link is None or link.from_node.type != "TEX_COORD":
-        return None
-    own = link.from_socket.name == "Object" and link.from_node.object is None
-    if own:
-        return settings
+        if link is None:
+            return f"'{node.name}' Vector is not linked (a constant: no bump)"
+    if link is None:
+        return f"{socket.name} is not linked"
+    if link.from_node.type != "TEX_COORD":
+        return (f"{socket.name} from '{link.from_node.name}' (not a Texture Coordinate "
+                "node's Object or Generated output)")
+    if link.from_socket.name == "Object" and link.from_node.object is None:
+        return settings  # the object's own coordinates
     source = _coordinates_source(link)
-    # Another object's or the Generated coordinates: the layer keeps which, and their map now
-    # (gather.follow_coordinates brings it up to date at every bake).
-    matrix = None if source is None or ob is None else gather.coordinates_matrix(
-        ob, source.get("coordinates_object"), source.get("coordinates_generated", False))
+    if source is None:
+        return (f"{socket.name} from '{link.from_node.name}' {link.from_socket.name} (not "
+                "object or Generated coordinates)")
+    return _mapped_coordinates(settings, source, ob)
+
+
+def _mapped_coordinates(settings, source, ob):
+    """`settings` with another object's or the Generated coordinates, `source`
+    (_coordinates_source), and their map now on `ob` (gather.coordinates_matrix; none when
+    `ob` is None); a string when the Generated coordinates have no map (a flat texture
+    space)."""
+    settings.update(source)
+    if ob is None:
+        return settings
+    matrix = gather.coordinates_matrix(ob, source.get("coordinates_object"),
+                                       source.get("coordinates_generated", False))
     if matrix is None:
-        return None
-    settings.update(source, mapping_matrix=matrix)
+        return f"the Generated coordinates of object '{ob.name}' have a flat texture space"
+    settings["mapping_matrix"] = matrix
     return settings
 
 
@@ -766,9 +822,65 @@ def _height_settings(node, tex, channel, render_uv, ob, ignored, points=None):
     return values
 
 
+def _height_layer(node, source, inputs, render_uv, ob, ignored):
+    """The settings of the layer of height input "Height" of `node` (a Bump or a Displacement
+    node) fed as `source` says (_height_source), before its scale (_scale_key): an Image
+    Texture's (_height_settings), a Noise Texture's volume (_noise_settings; a string when it
+    is not taken); what of `node` (its `inputs` fed by nodes) and the texture the layer cannot
+    take over goes into `ignored`."""
+    tex, channel, _, points = source
+    if tex.type == "TEX_NOISE":
+        values = _noise_settings(tex, ob)
+        if isinstance(values, str):
+            return values
+        ignored += _inputs_ignored(node, inputs)
+        if points is not None:
+            values["remap"] = points
+        return values
+    ignored += _ignored(node, tex, inputs, "Height", ob)
+    return _height_settings(node, tex, channel, render_uv, ob, ignored, points)
+
+
+def _scale_key(values):
+    """The setting that holds the height per unit of a layer's value (the Bump's Distance,
+    times the chain's factor): a volume's amplitude, any other layer's scale."""
+    return "amplitude" if values["type"] == "volume" else "scale"
+
+
+NOISE_INPUTS = ("Scale", "Detail", "Roughness", "Distortion")
+
+
+def _noise_settings(tex, ob=None):
+    """The settings of the volume layer of Noise Texture node `tex`'s Fac: function
+    "blender-noise" with its Scale (frequency), Detail, Roughness and Distortion, the slopes as
+    Cycles' Bump node takes them (gradient "bump-node"), on the coordinates its Vector reads
+    (_vector_coordinates; unlinked, the Generated coordinates, as Cycles reads a procedural
+    texture); or a string saying why none is made: Dimensions other than 3D, an input fed by
+    anything but constants (_constant), a Vector that is not object coordinates (a UV map, a
+    position in world space, ...)."""
+    if tex.noise_dimensions != "3D":
+        return (f"'{tex.name}' Dimensions {tex.noise_dimensions} (a volume layer is the 3D "
+                "noise)")
+    values = {name: _constant(tex.inputs[name]) for name in NOISE_INPUTS}
+    varying = [name for name, value in values.items() if value is None]
+    if varying:
+        return (f"'{tex.name}' {' and '.join(varying)} from a node (a volume layer takes "
+                "constants)")
+    coordinates = _vector_coordinates(tex.inputs["Vector"], ob, generated=True)
+    if isinstance(coordinates, str):
+        return f"'{tex.name}' {coordinates}"
+    settings = {"type": "volume", "name": tex.name, "function": "blender-noise",
+                "frequency": values["Scale"], "detail": values["Detail"],
+                "roughness": values["Roughness"], "distortion": values["Distortion"],
+                "gradient": "bump-node"}
+    settings.update(coordinates)
+    return settings
+
+
 def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     """The height layer of the Material Output's Displacement (None when there is none to
-    bake): a Displacement node fed by an Image Texture, with the material's Displacement method
+    bake): a Displacement node fed by an Image Texture (or a Noise Texture's Fac: a volume
+    layer, _height_layer, its amplitude the scale below), with the material's Displacement method
     Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the displacement along the
     normal, (height - Midlevel) x Scale in world units (in object space, grown with the
     object's scale along the normal): a height layer of scale Scale in the node's space
@@ -792,14 +904,16 @@ def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     if not isinstance(source, tuple):
         skipped.append(f"'{node.name}': {source or _not_image(node.inputs['Height'])}")
         return None
-    tex, channel, factor, points = source
-    ignored += _ignored(node, tex, ("Scale",), "Height", ob)
+    values = _height_layer(node, source, ("Scale",), render_uv, ob, ignored)
+    if isinstance(values, str):
+        skipped.append(f"'{node.name}': {values}")
+        return None
     if _source_link(node.inputs["Normal"]) is not None:
         ignored.append(f"'{node.name}' Normal from a node (the layer displaces along the "
                        "surface's normal)")
-    values = _height_settings(node, tex, channel, render_uv, ob, ignored, points)
-    values.update(scale=factor * _input_value(node, "Scale"), strength=1.0,
-                  height_space="object" if node.space == "OBJECT" else "world")
+    values.update({_scale_key(values): source[2] * _input_value(node, "Scale"),
+                   "strength": 1.0,
+                   "height_space": "object" if node.space == "OBJECT" else "world"})
     return values
 
 
@@ -843,11 +957,15 @@ def _ignored(node, tex, inputs, socket, ob=None):
             notes.append(f"'{tex.name}' Vector from '{link.from_node.name}'")
     if tex.projection != "FLAT" and not _object_projected(tex, ob):
         notes.append(f"'{tex.name}' {tex.projection.title()} projection")
-    for name in inputs:
-        if _constant(node.inputs[name]) is None:
-            notes.append(f"'{node.name}' {name} from a node (its own value "
-                         f"{node.inputs[name].default_value:.4g} is used)")
-    return notes
+    return notes + _inputs_ignored(node, inputs)
+
+
+def _inputs_ignored(node, inputs):
+    """Notes on the `inputs` of `node` fed by anything but constants (_constant): the layer
+    takes the unconnected value."""
+    return [f"'{node.name}' {name} from a node (its own value "
+            f"{node.inputs[name].default_value:.4g} is used)"
+            for name in inputs if _constant(node.inputs[name]) is None]
 
 
 def _texture_settings(node, render_uv=None):
@@ -978,8 +1096,10 @@ def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUM
 
 def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
-    and each Normal Map node whose Color input is an Image Texture node, among the nodes that
-    reach the Surface of the material's output, and for the output's Displacement
+    and each Normal Map node whose Color input is an Image Texture node, and each Bump node
+    whose Height is a Noise Texture's Fac (a volume layer, _noise_settings, whose amplitude is
+    what a height layer's scale is below), among the nodes that reach the Surface of the
+    material's output, and for the output's Displacement
     (_displacement_layer, with the material's `displacement_method`); and notes on the nodes
     that were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV
     map active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
@@ -1015,12 +1135,14 @@ def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP")
                 skipped.append(f"'{node.name}': "
                                f"{source or _not_image(node.inputs['Height'])}")
                 continue
-            tex, channel, factor, points = source
-            ignored += _ignored(node, tex, ("Strength", "Distance"), "Height", ob)
-            scale = factor * _input_value(node, "Distance")
-            values = _height_settings(node, tex, channel, render_uv, ob, ignored, points)
-            values.update(scale=-scale if node.invert else scale,
-                          strength=max(_input_value(node, "Strength"), 0.0))
+            scale = source[2] * _input_value(node, "Distance")
+            values = _height_layer(node, source, ("Strength", "Distance"), render_uv, ob,
+                                   ignored)
+            if isinstance(values, str):
+                skipped.append(f"'{node.name}': {values}")
+                continue
+            values.update({_scale_key(values): -scale if node.invert else scale,
+                           "strength": max(_input_value(node, "Strength"), 0.0)})
         else:
             tex, green = _linked_image_node(node.inputs["Color"]), "opengl"
             recombined = _recombined_normal_map(node.inputs["Color"]) if tex is None else None

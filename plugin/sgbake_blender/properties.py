@@ -91,11 +91,17 @@ AXES = (("x", "X", "Project along X"), ("y", "Y", "Project along Y"),
 FUNCTIONS = (
     ("sine", "Sine", "amplitude * sin(2 pi frequency (direction . p) + phase)"),
     ("noise", "Noise", "Gradient noise of the given frequency and octaves"),
+    ("blender-noise", "Blender Noise",
+     "Blender's Noise Texture (3D) Fac, as Cycles evaluates it: Frequency is the node's Scale, "
+     "with its Detail, Roughness and Distortion"),
 )
 GRADIENTS = (
     ("analytic", "Analytic", "Exact derivative of the function"),
     ("central", "Central", "Central differences (6 evaluations)"),
     ("tetrahedral", "Tetrahedral", "Tetrahedral differences (4 evaluations)"),
+    ("bump-node", "As Cycles' Bump", "The slopes Cycles' Bump node takes when it bakes: the "
+                                      "height read again a bake texel's step away (changes "
+                                      "with the bake's size, as Cycles' does)"),
 )
 PADDINGS = (
     ("extend", "Extend", "Extend the islands' edge texels by Margin texels (Blender's Extend)"),
@@ -136,8 +142,9 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                                description="Heights: the units of Scale (the scene's "
                                            "\"height_space\")")
     slopes: EnumProperty(name="Slopes", items=SLOPES, default="analytic",
-                         description="How a height layer's slopes are taken (Layers from "
-                                     "Material takes a Bump node's as Cycles does)")
+                         description="How a height image's slopes are taken (Layers from "
+                                     "Material takes a Bump node's as Cycles does; a volume's: "
+                                     "its Gradient)")
     remap: StringProperty(
         name="Remap",
         description="Heights: a piecewise-linear function of the image's value, as JSON "
@@ -168,35 +175,37 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     axis: EnumProperty(name="Axis", items=AXES, default="z")
     mapping_type: EnumProperty(
         name="Type", items=MAPPING_TYPES, default="POINT",
-        description="Projections: the Mapping node's type (how Location, Rotation and Scale "
+        description="Projections and volumes: the Mapping node's type (how Location, Rotation and Scale "
                     "move the object coordinates)")
     mapping_location: FloatVectorProperty(
         name="Location", size=3, default=(0.0, 0.0, 0.0), subtype="TRANSLATION",
-        description="Projections: a Mapping node's Location, added to the object coordinates "
+        description="Projections and volumes: a Mapping node's Location, added to the object coordinates "
                     "after its Rotation and Scale")
     mapping_rotation: FloatVectorProperty(
         name="Rotation", size=3, default=(0.0, 0.0, 0.0), subtype="EULER",
-        description="Projections: a Mapping node's Rotation (XYZ Euler) of the object "
+        description="Projections and volumes: a Mapping node's Rotation (XYZ Euler) of the object "
                     "coordinates")
     mapping_scale: FloatVectorProperty(
         name="Scale", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ",
-        description="Projections: a Mapping node's Scale of the object coordinates")
+        description="Projections and volumes: a Mapping node's Scale of the object "
+                    "coordinates")
     mapping_matrix: FloatVectorProperty(
         name="Coordinates", size=12, default=(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
                                               0.0, 0.0, 1.0, 0.0),
-        description="Projections: the coordinates read, as an affine map of the object's own "
+        description="Projections and volumes: the coordinates read, as an affine map of the object's own "
                     "(3 rows of 4, before the Mapping; set at every bake from Coordinates "
                     "Object or Generated Coordinates when one is given)")
     planar_projection: EnumProperty(name="Projection", items=PLANAR_PROJECTIONS, default="axis",
                                     description="How a planar layer projects its image")
     coordinates_object: PointerProperty(
         name="Coordinates Object", type=bpy.types.Object,
-        description="Projections: the object whose coordinates are read (a Texture Coordinate "
+        description="Projections and volumes: the object whose coordinates are read (a Texture Coordinate "
                     "node's Object output naming it); Coordinates follow it at every bake")
     coordinates_generated: BoolProperty(
         name="Generated Coordinates", default=False,
-        description="Projections: the baked object's Generated coordinates (its texture space "
-                    "to [0, 1]); Coordinates follow them at every bake")
+        description="Projections and volumes: the baked object's Generated coordinates (its "
+                    "texture space to [0, 1], what Cycles reads a Noise Texture on when its "
+                    "Vector is unlinked); Coordinates follow them at every bake")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",
@@ -212,12 +221,24 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                              description="Height amplitude, world units (as a Bump node's "
                                          "Distance)")
     frequency: FloatProperty(name="Frequency", default=1.0, precision=4,
-                             description="Cycles (sine) or noise features per object unit")
+                             description="Cycles (sine) or noise features per object unit; "
+                                         "Blender Noise: the Noise Texture's Scale (Blender's "
+                                         "default 5)")
     direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0),
                                    description="Direction of the sine wave, object space")
     phase: FloatProperty(name="Phase", default=0.0, subtype="ANGLE")
     seed: IntProperty(name="Seed", default=0, min=0)
     octaves: IntProperty(name="Octaves", default=1, min=1, max=16)
+    # The Noise Texture's inputs (Blender's defaults and the ranges Cycles clamps them to).
+    detail: FloatProperty(name="Detail", default=2.0, min=0.0, max=15.0, precision=3,
+                          description="Blender Noise: the Noise Texture's Detail (octaves "
+                                      "beyond the first; a fraction blends one more in)")
+    roughness: FloatProperty(name="Roughness", default=0.5, min=0.0, max=1.0, subtype="FACTOR",
+                             description="Blender Noise: the Noise Texture's Roughness (each "
+                                         "octave's weight relative to the one before)")
+    distortion: FloatProperty(name="Distortion", default=0.0, precision=3,
+                              description="Blender Noise: the Noise Texture's Distortion (the "
+                                          "point moved by three other noises first)")
     gradient: EnumProperty(name="Gradient", items=GRADIENTS, default="analytic",
                            description="How the volume's gradient is computed")
     step: FloatProperty(

@@ -35,7 +35,8 @@ WORLD_SHADED_MAPS = {"tangent-normal", "object-normal", "derivative", "surface-g
 LAYER_TYPES = (
     ("height", "Height", "Height image on a UV map"),
     ("normal", "Normal", "Normal map image on a UV map (tangent or object space)"),
-    ("volume", "Volume", "Procedural height in object space (sine or noise)"),
+    ("volume", "Volume", "Procedural height in object space (sine, noise, or Blender's Noise "
+                         "Texture)"),
     ("planar", "Planar", "Image projected along an object axis"),
     ("triplanar", "Triplanar", "Image projected on the three axis planes and blended"),
 )
@@ -184,6 +185,9 @@ def layer_json(layer, uv_index, default_uv=None):
     scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance, and is
     sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json).
     A height's Remap goes as "remap" (remap_points, which raises LayerError for bad text).
+    A volume sends its function's own settings only (a Blender Noise's detail, roughness and
+    distortion; libsgbake refuses another function's), and like a projection its "mapping"
+    when it has one (a Mapping node, another object's or the Generated coordinates).
     A layer of one material slot (material_index >= 0) sends it as "material": libsgbake then
     applies it to the faces of that slot only (the mesh's face_material)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
@@ -213,13 +217,17 @@ def layer_json(layer, uv_index, default_uv=None):
     elif layer.type == "volume":
         entry.update(function=layer.function, amplitude=_number(layer.amplitude),
                      frequency=_number(layer.frequency), gradient=layer.gradient)
-        if layer.gradient != "analytic" and layer.step > 0:  # 0: the library's default
+        # 0: the library's default; the Bump node's slopes take no step of their own.
+        if layer.gradient in ("central", "tetrahedral") and layer.step > 0:
             entry["step"] = _number(layer.step)
         if layer.function == "sine":
             entry.update(direction=[_number(c) for c in layer.direction],
                          phase=_number(layer.phase))
-        else:
+        elif layer.function == "noise":
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
+        else:  # Blender's Noise Texture: its inputs (its Scale is the frequency)
+            entry.update(detail=_number(layer.detail), roughness=_number(layer.roughness),
+                         distortion=_number(layer.distortion))
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
         if layer.planar_projection != "axis":  # Blender's Flat, Sphere and Tube: about z
@@ -230,7 +238,7 @@ def layer_json(layer, uv_index, default_uv=None):
             entry.update(projection="box", box_blend=_number(layer.box_blend))
         else:
             entry.update(sharpness=_number(layer.sharpness), min_weight=_number(layer.min_weight))
-    if layer.type in ("planar", "triplanar"):
+    if layer.type in ("planar", "triplanar", "volume"):
         mapping = {"location": [_number(c) for c in layer.mapping_location],
                    "rotation": [_number(c) for c in layer.mapping_rotation],
                    "scale": [_number(c) for c in layer.mapping_scale]}
@@ -240,14 +248,14 @@ def layer_json(layer, uv_index, default_uv=None):
         if mapping != {"location": [0.0] * 3, "rotation": [0.0] * 3, "scale": [1.0] * 3}:
             if layer.mapping_type != "POINT":
                 mapping["type"] = layer.mapping_type.lower()
-            entry["mapping"] = mapping  # other coordinates, a Mapping node before the projection
+            entry["mapping"] = mapping  # other coordinates, a Mapping node before the texture
     if reads_tangent_normals(layer):
         entry["green"] = layer.green
     if layer.type == "height" or (layer.type in ("planar", "triplanar") and layer.kind == "height"):
-        if layer.base != "surface":
-            entry["base"] = layer.base
         if layer.slopes != "analytic":
             entry["gradient"] = layer.slopes
+    if bumps_height(layer) and layer.base != "surface":
+        entry["base"] = layer.base
     return entry
 
 

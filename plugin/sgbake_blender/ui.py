@@ -122,16 +122,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
                 if layer.planar_projection == "axis":
                     col.prop(layer, "axis")
             if layer.type in ("planar", "triplanar"):
-                box = col.box()
-                box.label(text="Mapping")
-                for name in ("mapping_type", "mapping_location", "mapping_rotation",
-                             "mapping_scale"):
-                    box.prop(layer, name)
-                box.prop(layer, "coordinates_object")
-                box.prop(layer, "coordinates_generated")
-                if (tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0)
-                        and layer.coordinates_object is None and not layer.coordinates_generated):
-                    box.label(text="Coordinates: an affine map of the object's own")
+                _draw_mapping(col, layer)
             col.prop(layer, "scale", text="Strength" if layer.type == "normal" else "Scale")
             if scene.bumps_height(layer):
                 col.prop(layer, "strength")
@@ -175,16 +166,27 @@ class SGBAKE_PT_layers(bpy.types.Panel):
         if layer.type == "volume":
             col.prop(layer, "function")
             col.prop(layer, "amplitude")
-            col.prop(layer, "frequency")
+            blender_noise = layer.function == "blender-noise"
+            col.prop(layer, "frequency", text="Scale" if blender_noise else "Frequency")
             if layer.function == "sine":
                 col.prop(layer, "direction")
                 col.prop(layer, "phase")
-            else:
+            elif layer.function == "noise":
                 col.prop(layer, "seed")
                 col.prop(layer, "octaves")
+            else:
+                col.prop(layer, "detail")
+                col.prop(layer, "roughness")
+                col.prop(layer, "distortion")
             col.prop(layer, "gradient")
-            if layer.gradient != "analytic":
+            if layer.gradient in ("central", "tetrahedral"):
                 col.prop(layer, "step")
+            col.prop(layer, "strength")
+            col.prop(layer, "height_space")
+            col.prop(layer, "base")
+            if layer.remap.strip():
+                col.label(text=_remap_text(layer), icon="FCURVE")
+            _draw_mapping(col, layer)
 
         col = layout.column(heading="Mask")
         col.template_ID(layer, "mask_image", open="image.open")
@@ -197,6 +199,20 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "mask_tiling", text="Tiling")
             col.prop(layer, "mask_offset", text="Offset")
             col.prop(layer, "mask_filter", text="Filter")
+
+
+def _draw_mapping(col, layer):
+    """The Mapping box of a projected or volume layer: the Mapping node's settings and the
+    coordinates it maps (the object's own, another object's, the Generated ones)."""
+    box = col.box()
+    box.label(text="Mapping")
+    for name in ("mapping_type", "mapping_location", "mapping_rotation", "mapping_scale"):
+        box.prop(layer, name)
+    box.prop(layer, "coordinates_object")
+    box.prop(layer, "coordinates_generated")
+    if (tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0)
+            and layer.coordinates_object is None and not layer.coordinates_generated):
+        box.label(text="Coordinates: an affine map of the object's own")
 
 
 def _remap_text(layer):
