@@ -292,6 +292,12 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                          .detail = layer.noiseDetail,
                                          .roughness = layer.noiseRoughness,
                                          .distortion = layer.noiseDistortion}));
+    case VolumeFunction::kBlenderMusgrave:
+      return owned(BlenderMusgrave::create({.amplitude = layer.amplitude,
+                                            .scale = layer.frequency,
+                                            .detail = layer.noiseDetail,
+                                            .dimension = layer.noiseDimension,
+                                            .lacunarity = layer.noiseLacunarity}));
     case VolumeFunction::kNoise:
       break;
   }

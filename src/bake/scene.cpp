@@ -120,9 +120,11 @@ std::string nameIn(const Named<E> (&table)[N], E value) {
   return "?";
 }
 
-constexpr Named<VolumeFunction> kFunctions[] = {{"sine", VolumeFunction::kSine},
-                                                {"noise", VolumeFunction::kNoise},
-                                                {"blender-noise", VolumeFunction::kBlenderNoise}};
+constexpr Named<VolumeFunction> kFunctions[] = {
+    {"sine", VolumeFunction::kSine},
+    {"noise", VolumeFunction::kNoise},
+    {"blender-noise", VolumeFunction::kBlenderNoise},
+    {"blender-musgrave", VolumeFunction::kBlenderMusgrave}};
 constexpr Named<GradientScheme> kSchemes[] = {{"analytic", GradientScheme::kAnalytic},
                                               {"central", GradientScheme::kCentral},
                                               {"tetrahedral", GradientScheme::kTetrahedral}};
@@ -417,8 +419,8 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       break;
     case SceneLayerType::kVolume:
       add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves", "detail",
-           "roughness", "distortion", "mapping", "gradient", "step", "base", "strength",
-           "height_space", "remap"});
+           "roughness", "distortion", "dimension", "lacunarity", "mapping", "gradient", "step",
+           "base", "strength", "height_space", "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
@@ -815,7 +817,9 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
   if (layer.type == SceneLayerType::kVolume) {
     reader.optionalName("function", kFunctions, layer.function);
     const bool sine = layer.function == VolumeFunction::kSine;
-    const bool blender = layer.function == VolumeFunction::kBlenderNoise;
+    const bool noise = layer.function == VolumeFunction::kBlenderNoise;
+    const bool musgrave = layer.function == VolumeFunction::kBlenderMusgrave;
+    const bool blender = noise || musgrave;
     const std::string function = nameIn(kFunctions, layer.function);
     const auto onlyFor = [&](std::initializer_list<const char*> keys, bool applies,
                              const char* owner) {
@@ -828,9 +832,11 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     };
     onlyFor({"direction", "phase"}, sine, "sine");
     onlyFor({"seed", "octaves"}, layer.function == VolumeFunction::kNoise, "noise");
-    onlyFor({"detail", "roughness", "distortion"}, blender, "blender-noise");
+    onlyFor({"detail"}, blender, "blender-noise and blender-musgrave");
+    onlyFor({"roughness", "distortion"}, noise, "blender-noise");
+    onlyFor({"dimension", "lacunarity"}, musgrave, "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
-    if (blender) layer.frequency = 5;  // the Noise Texture's default Scale
+    if (blender) layer.frequency = 5;  // the Noise and Musgrave Textures' default Scale
     if (reader.has("frequency")) {
       layer.frequency = sine || blender ? reader.number("frequency")
                                         : reader.numberAtLeast("frequency", 0, /*exclusive=*/true);
@@ -838,6 +844,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("detail")) layer.noiseDetail = reader.number("detail");
     if (reader.has("roughness")) layer.noiseRoughness = reader.number("roughness");
     if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
+    if (reader.has("dimension")) layer.noiseDimension = reader.number("dimension");
+    if (reader.has("lacunarity")) layer.noiseLacunarity = reader.number("lacunarity");
     if (reader.has("direction")) layer.direction = reader.vec3("direction");
     if (reader.has("phase")) layer.phase = reader.number("phase");
     if (reader.has("seed")) layer.seed = reader.unsignedInteger("seed");
@@ -1533,10 +1541,14 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
       } else if (layer.function == VolumeFunction::kNoise) {
         j["seed"] = layer.seed;
         j["octaves"] = layer.octaves;
-      } else {
+      } else if (layer.function == VolumeFunction::kBlenderNoise) {
         j["detail"] = layer.noiseDetail;
         j["roughness"] = layer.noiseRoughness;
         j["distortion"] = layer.noiseDistortion;
+      } else {
+        j["detail"] = layer.noiseDetail;
+        j["dimension"] = layer.noiseDimension;
+        j["lacunarity"] = layer.noiseLacunarity;
       }
       j["gradient"] = layer.heightGradient == HeightGradient::kBumpNode
                           ? nameIn(kHeightGradients, layer.heightGradient)

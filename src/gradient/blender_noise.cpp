@@ -222,4 +222,56 @@ Vec3d BlenderNoise::analyticGradient(Vec3d p) const {
   return params_.amplitude * g;
 }
 
+Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& params) {
+  for (const double v :
+       {params.amplitude, params.scale, params.detail, params.dimension, params.lacunarity}) {
+    if (!std::isfinite(v)) return Error::badInput("a Musgrave Texture setting is not finite");
+  }
+  const double detail = std::clamp(params.detail, 0.0, 15.0);
+  const double lacunarity = std::max(params.lacunarity, 1e-5);
+  // The finest octave's slope scale, Lⁿ · L^(−nH) at most Lⁿ · 1e5ⁿ for the smallest H.
+  const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
+                        std::pow(std::max(lacunarity, 1.0), std::ceil(detail)) *
+                        (1 + std::ceil(detail));
+  if (!(slopes <= kMaxVolumeScale)) {
+    return Error::badInput(
+        "Musgrave Texture slopes beyond 1e300 (amplitude × scale × "
+        "lacunarity^detail)");
+  }
+  return BlenderMusgrave(params);
+}
+
+double BlenderMusgrave::fac(Vec3d position, Vec3d* gradient) const {
+  const double detail = std::clamp(params_.detail, 0.0, 15.0);
+  const double h = std::max(params_.dimension, 1e-5);
+  const double lacunarity = std::max(params_.lacunarity, 1e-5);
+  const double weightStep = std::pow(lacunarity, -h);
+  const Vec3d p = params_.scale * position;
+  double value = 0, weight = 1, frequency = 1;
+  Vec3d slope{};
+  const auto add = [&](double factor) {
+    Vec3d g;
+    value += factor * weight * blenderSignedNoise(frequency * p, gradient ? &g : nullptr);
+    if (gradient != nullptr) slope = slope + (factor * weight * frequency) * g;
+  };
+  const int octaves = static_cast<int>(detail);
+  for (int i = 0; i < octaves; ++i) {
+    add(1);
+    weight *= weightStep;
+    frequency *= lacunarity;
+  }
+  const double rest = detail - std::floor(detail);
+  if (rest != 0) add(rest);
+  if (gradient != nullptr) *gradient = params_.scale * slope;
+  return value;
+}
+
+double BlenderMusgrave::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
+
+Vec3d BlenderMusgrave::analyticGradient(Vec3d p) const {
+  Vec3d g;
+  fac(p, &g);
+  return params_.amplitude * g;
+}
+
 }  // namespace sgbake

@@ -845,7 +845,24 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
   }
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "sine", "detail": 3})")),
             "scene.json: layers[0]: key 'detail' does not apply to a sine volume (it is for "
-            "blender-noise)");
+            "blender-noise and blender-musgrave)");
+  Result<Scene> musgrave =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-musgrave", "detail": 3,
+                    "dimension": 1.5, "lacunarity": 2.5})"),
+                 options());
+  ASSERT_TRUE(musgrave) << musgrave.error().message;
+  EXPECT_EQ(musgrave->layers[0].frequency, 5);
+  EXPECT_EQ(musgrave->layers[0].noiseDimension, 1.5);
+  EXPECT_NE(layerParametersJson(musgrave->layers[0]).find(R"("lacunarity":2.5)"),
+            std::string::npos);
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "volume", "function": "blender-musgrave", "roughness": 0.5})")),
+            "scene.json: layers[0]: key 'roughness' does not apply to a blender-musgrave volume "
+            "(it is for blender-noise)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "lacunarity": 2})")),
+      "scene.json: layers[0]: key 'lacunarity' does not apply to a blender-noise volume "
+      "(it is for blender-musgrave)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "seed": 3})")),
             "scene.json: layers[0]: key 'seed' does not apply to a blender-noise volume (it is "
             "for noise)");

@@ -223,8 +223,10 @@ def reshape_height(mat, kind):
 
 # name -> a Noise Texture (3D) feeding the Bump node instead of the image, read at the object's
 # coordinates (Texture Coordinate Object) through a Mapping node (Point): {"scale", "detail",
-# "roughness", "distortion", "mapping": (location, rotation, scale)}. The manifest entry has
-# "noise": these settings, sgbake's "blender-noise" volume layer with that "mapping".
+# "roughness", "distortion", "mapping": (location, rotation, scale)}; or with "kind":
+# "musgrave" a Musgrave Texture (fBM, 3D) of {"scale", "detail", "dimension", "lacunarity",
+# "mapping"}. The manifest entry has "noise": these settings, sgbake's "blender-noise" (or
+# "blender-musgrave") volume layer with that "mapping".
 NOISE = {}
 
 
@@ -249,9 +251,15 @@ def bump_by_noise(mat, settings):
     mapping.vector_type = "POINT"
     for socket, value in zip(("Location", "Rotation", "Scale"), settings["mapping"]):
         mapping.inputs[socket].default_value = value
-    noise = nodes.new("ShaderNodeTexNoise")
-    noise.noise_dimensions = "3D"
-    for socket in ("Scale", "Detail", "Roughness", "Distortion"):
+    if settings.get("kind") == "musgrave":
+        noise = nodes.new("ShaderNodeTexMusgrave")
+        noise.musgrave_dimensions, noise.musgrave_type = "3D", "FBM"
+        inputs = ("Scale", "Detail", "Dimension", "Lacunarity")
+    else:
+        noise = nodes.new("ShaderNodeTexNoise")
+        noise.noise_dimensions = "3D"
+        inputs = ("Scale", "Detail", "Roughness", "Distortion")
+    for socket in inputs:
         noise.inputs[socket].default_value = settings[socket.lower()]
     links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
     links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
@@ -554,6 +562,9 @@ noise_case("noise_sphere", "sphere", 512, 0.05, scale=2.0, detail=2.5, roughness
            distortion=0.3, mapping=NOISE_MAPPING)
 noise_case("noise_stretch_suzanne", "stretch_chain_suzanne", 512, 0.03, scale=3.0, detail=3.0,
            roughness=0.6, distortion=0.0, mapping=NOISE_MAPPING)
+# Blender's Musgrave Texture (fBM) on the sphere: Detail 2.5, Dimension 1.5, Lacunarity 2.3.
+noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, detail=2.5,
+           dimension=1.5, lacunarity=2.3, mapping=NOISE_MAPPING)
 projected_normal_map_case("sphere_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "SPHERE",
                           mapping=WRAP_MAPPING)
 projected_normal_map_case("tube_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "TUBE",

@@ -88,6 +88,27 @@ TEST(BlenderNoise, SignedNoiseGradientIsItsDerivative) {
   }
 }
 
+// Musgrave fBM: the signed noise summed over octaves at Lⁱ p weighted L^(−iH), a fractional
+// Detail adding part of one more; its gradient exact.
+TEST(BlenderMusgrave, SumsTheOctavesAndItsGradientIsTheDerivative) {
+  Result<BlenderMusgrave> made = BlenderMusgrave::create(
+      {.amplitude = 0.4, .scale = 2.5, .detail = 2.5, .dimension = 1.5, .lacunarity = 2.3});
+  ASSERT_TRUE(made) << made.error().message;
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> along(-3, 3);
+  for (int i = 0; i < 300; ++i) {
+    const Vec3d p{along(rng), along(rng), along(rng)};
+    const Vec3d q = 2.5 * p;
+    const double w = std::pow(2.3, -1.5);
+    const double expected = blenderSignedNoise(q, nullptr) +
+                            w * blenderSignedNoise(2.3 * q, nullptr) +
+                            0.5 * w * w * blenderSignedNoise(2.3 * 2.3 * q, nullptr);
+    EXPECT_NEAR(made->value(p), 0.4 * expected, 1e-15);
+    const Vec3d central = centralGradient([&](Vec3d r) { return made->value(r); }, p, 1e-6);
+    EXPECT_LT(maxAbsDiff(made->analyticGradient(p), central), 1e-6);
+  }
+}
+
 // A Mapping node before the texture: the value at the mapped point, the gradient pulled back.
 TEST(MappedHeightVolume, ReadsTheMappedPointAndPullsTheGradientBack) {
   const BlenderNoise noise = makeNoise({.scale = 3, .detail = 1});

@@ -71,9 +71,10 @@ std::string_view sceneLayerTypeName(SceneLayerType type);
 
 /// @brief "function" of a volume layer.
 enum class VolumeFunction {
-  kSine,          ///< DirectionalSine
-  kNoise,         ///< GradientNoise
-  kBlenderNoise,  ///< "blender-noise": BlenderNoise, Blender's Noise Texture (3D)
+  kSine,             ///< DirectionalSine
+  kNoise,            ///< GradientNoise
+  kBlenderNoise,     ///< "blender-noise": BlenderNoise, Blender's Noise Texture (3D)
+  kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (fBM, 3D)
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
@@ -210,11 +211,14 @@ struct SceneLayer {
   double phase = 0;                                     ///< "phase" (sine), radians
   std::uint64_t seed = 0;                               ///< "seed" (noise)
   int octaves = 1;                                      ///< "octaves" (noise)
-  /// "detail", "roughness", "distortion" (blender-noise: the Noise Texture's; its Scale is
-  /// "frequency", 5 unless given, as Blender's default)
+  /// "detail" (blender-noise, blender-musgrave), "roughness", "distortion" (blender-noise),
+  /// "dimension", "lacunarity" (blender-musgrave): the node's inputs; its Scale is "frequency",
+  /// 5 unless given, as Blender's defaults
   double noiseDetail = 2;
   double noiseRoughness = 0.5;
   double noiseDistortion = 0;
+  double noiseDimension = 2;
+  double noiseLacunarity = 2;
   GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
   std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
 

@@ -58,6 +58,36 @@ class BlenderNoise final : public HeightVolume {
   std::array<Vec3d, 3> distortionOffsets_{};
 };
 
+/// @brief The Musgrave Texture node's settings (type fBM, Dimensions 3D) and the height's scale.
+struct BlenderMusgraveParams {
+  double amplitude = 1;   ///< height per unit of Fac
+  double scale = 5;       ///< the node's Scale
+  double detail = 2;      ///< the node's Detail: octaves (clamped to [0, 15])
+  double dimension = 2;   ///< the node's Dimension H (at least 1e-5)
+  double lacunarity = 2;  ///< the node's Lacunarity L (at least 1e-5)
+};
+
+/// @brief Blender's Musgrave Texture, type fBM (3D), times an amplitude: a HeightVolume.
+///
+///     Fac(P) = Σ_{i < ⌊detail⌋} snoise(Lⁱ p) L^(−iH) + (detail − ⌊detail⌋) snoise(L^⌊detail⌋ p)
+///     L^(−⌊detail⌋H)
+///
+/// with p = scale · P and snoise as BlenderNoise's (unnormalized: Fac is signed). Exact gradient.
+class BlenderMusgrave final : public HeightVolume {
+ public:
+  /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale.
+  static Result<BlenderMusgrave> create(const BlenderMusgraveParams& params);
+
+  double value(Vec3d p) const override;
+  Vec3d analyticGradient(Vec3d p) const override;
+  /// The node's Fac at @p p (object space, before the amplitude), and its gradient.
+  double fac(Vec3d p, Vec3d* gradient) const;
+
+ private:
+  explicit BlenderMusgrave(const BlenderMusgraveParams& params) : params_(params) {}
+  BlenderMusgraveParams params_;
+};
+
 /// @brief Cycles' signed Perlin noise snoise(x) = 0.982 · perlin(x) at @p x, and its gradient
 /// (exposed for tests).
 double blenderSignedNoise(Vec3d x, Vec3d* gradient);
