@@ -257,8 +257,8 @@ def _tile_list(tiles):
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
     """Add sgbake layers for the Bump and Normal Map nodes fed by an Image Texture node, and the
-    Bump nodes fed by a Noise Texture's Fac, in the active object's materials (with several
-    material slots, each layer applies to its slot's faces)"""
+    Bump nodes fed by a Noise or Musgrave Texture's Fac, in the active object's materials (with
+    several material slots, each layer applies to its slot's faces)"""
     bl_idname = "object.sgbake_layers_from_material"
     bl_label = "Layers from Material"
     bl_options = {"REGISTER", "UNDO"}
@@ -284,7 +284,8 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             what = (f"material '{sources[0][1].name}' has no" if single
                     else f"no material of object '{ob.name}' has a")
             self.report({"ERROR"}, f"{what} Bump or Normal Map node fed by an Image Texture "
-                                   "node (or a Bump fed by a Noise Texture)" + _notes(skipped))
+                                   "node (or a Bump fed by a Noise or Musgrave Texture)"
+                        + _notes(skipped))
             return {"CANCELLED"}
         settings = context.scene.sgbake
         if self.replace:
@@ -355,8 +356,8 @@ def object_layers(sources, render_uv=None, ob=None):
                 entry["material_index"] = slot
             if not values and not slot_skipped:
                 slot_skipped.append("no Bump, Normal Map or Displacement node fed by an Image "
-                                    "Texture node (or a Bump or Displacement by a Noise "
-                                    "Texture)")
+                                    "Texture node (or a Bump or Displacement by a Noise or "
+                                    "Musgrave Texture)")
             slot_skipped = [f"{where}: {note}" for note in slot_skipped]
             slot_ignored = [f"{where}: {note}" for note in slot_ignored]
         found += values
@@ -550,15 +551,16 @@ def _height_source(socket):
     """The texture node that feeds height input `socket`, the channel it is read on and the
     function of its value the nodes between make: (node, channel, factor, points), or None when
     the chain is not followed, or a string saying why its height is not taken (a constant, a
-    Noise Texture's Color). The texture: an Image Texture node with an image, or a Noise
-    Texture node's Fac (a float: every channel its value; _noise_settings says whether a
-    volume layer takes the node). Followed back through Reroutes, RGB to BW (the luminance, as
-    the input's own conversion), Separate RGB or Color (RGB mode: channel r, g or b; the image's
-    Alpha output is channel a, its Color the luminance) and the nodes of _chain_step (Math, Map
-    Range, Clamp, Color Ramp, Invert), composed into one function (remap.compose). Without a
-    clamp or Color Ramp it is factor x value + an offset no slope sees: points is None; with
-    one, points is the whole function's remap (its y as the chain makes them: the outer affine
-    steps in them, not in factor, which is then 1)."""
+    Noise Texture's Color). The texture: an Image Texture node with an image, or a Noise or
+    Musgrave Texture node's Fac (PROCEDURAL_TEXTURES; a float: every channel its value;
+    _procedural_settings says whether a volume layer takes the node). Followed back through
+    Reroutes, RGB to BW (the luminance, as the input's own conversion), Separate RGB or Color
+    (RGB mode: channel r, g or b; the image's Alpha output is channel a, its Color the
+    luminance) and the nodes of _chain_step (Math, Map Range, Clamp, Color Ramp, Invert),
+    composed into one function (remap.compose). Without a clamp or Color Ramp it is factor x
+    value + an offset no slope sees: points is None; with one, points is the whole function's
+    remap (its y as the chain makes them: the outer affine steps in them, not in factor, which
+    is then 1)."""
     function, channel = remap.IDENTITY, None
     while True:
         link = _source_link(socket)
@@ -573,8 +575,8 @@ def _height_source(socket):
                     return None
                 channel = "a"
             break
-        if node.type == "TEX_NOISE":
-            if link.from_socket.name != "Fac":
+        if node.type in PROCEDURAL_TEXTURES:
+            if link.from_socket.name != "Fac":  # (a Noise Texture's Color)
                 return (f"'{node.name}' {link.from_socket.name} output (three noises seeded "
                         "apart; a volume layer is the noise of its Fac)")
             channel = None  # (a grey: any channel of it is the Fac)
@@ -678,14 +680,14 @@ def _surface_nodes(node_tree):
 
 def _not_image(socket):
     """Why `socket` gave no layer: what is linked into it instead of an Image Texture node
-    (or, into a height, a Noise Texture's Fac)."""
+    (or, into a height, a Noise or Musgrave Texture's Fac)."""
     link = _source_link(socket)
     if link is not None and link.from_node.type == "TEX_IMAGE":
         return f"{socket.name}'s Image Texture node has no image"
     if socket.is_linked and link is None:
         return f"{socket.name}'s link is muted"
     if socket.name == "Height":
-        return f"{socket.name} is not an Image Texture or Noise Texture node"
+        return f"{socket.name} is not an Image Texture, Noise Texture or Musgrave Texture node"
     return f"{socket.name} is not an Image Texture node"
 
 
@@ -825,12 +827,12 @@ def _height_settings(node, tex, channel, render_uv, ob, ignored, points=None):
 def _height_layer(node, source, inputs, render_uv, ob, ignored):
     """The settings of the layer of height input "Height" of `node` (a Bump or a Displacement
     node) fed as `source` says (_height_source), before its scale (_scale_key): an Image
-    Texture's (_height_settings), a Noise Texture's volume (_noise_settings; a string when it
-    is not taken); what of `node` (its `inputs` fed by nodes) and the texture the layer cannot
-    take over goes into `ignored`."""
+    Texture's (_height_settings), a Noise or Musgrave Texture's volume (_procedural_settings;
+    a string when it is not taken); what of `node` (its `inputs` fed by nodes) and the texture
+    the layer cannot take over goes into `ignored`."""
     tex, channel, _, points = source
-    if tex.type == "TEX_NOISE":
-        values = _noise_settings(tex, ob)
+    if tex.type in PROCEDURAL_TEXTURES:
+        values = _procedural_settings(tex, ob)
         if isinstance(values, str):
             return values
         ignored += _inputs_ignored(node, inputs)
@@ -847,21 +849,53 @@ def _scale_key(values):
     return "amplitude" if values["type"] == "volume" else "scale"
 
 
-NOISE_INPUTS = ("Scale", "Detail", "Roughness", "Distortion")
+# The procedural textures whose Fac a volume layer takes: node type -> the volume's function,
+# the node's property holding its Dimensions, and the node's properties that must have one
+# value (property -> that value) for the function to be what Cycles computes.
+PROCEDURAL_TEXTURES = {
+    "TEX_NOISE": ("blender-noise", "noise_dimensions", {}),
+    "TEX_MUSGRAVE": ("blender-musgrave", "musgrave_dimensions", {"musgrave_type": "FBM"}),
+}
 
 
-def _noise_settings(tex, ob=None):
-    """The settings of the volume layer of Noise Texture node `tex`'s Fac: function
-    "blender-noise" with its Scale (frequency), Detail, Roughness and Distortion, the slopes as
-    Cycles' Bump node takes them (gradient "bump-node"), on the coordinates its Vector reads
+def _texture_inputs(function):
+    """The inputs of the texture node of volume function `function` -> the layer settings that
+    hold them: its Scale the frequency, the others (scene.BLENDER_TEXTURE_SETTINGS) under
+    their own names (input Detail -> detail)."""
+    inputs = {"Scale": "frequency"}
+    inputs.update((key.title(), key) for key in scene.BLENDER_TEXTURE_SETTINGS[function])
+    return inputs
+
+
+def _enum_name(node, prop):
+    """The name Blender's interface shows for enum property `prop` of `node` (Ridged
+    Multifractal for RIDGED_MULTIFRACTAL)."""
+    value = getattr(node, prop)
+    item = node.bl_rna.properties[prop].enum_items.get(value)
+    return item.name if item is not None else value
+
+
+def _procedural_settings(tex, ob=None):
+    """The settings of the volume layer of procedural texture node `tex`'s Fac (a Noise or a
+    Musgrave Texture: PROCEDURAL_TEXTURES): its function with the node's inputs
+    (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of a Noise
+    Texture, Detail, Dimension and Lacunarity of a Musgrave Texture), the slopes as Cycles'
+    Bump node takes them (gradient "bump-node"), on the coordinates its Vector reads
     (_vector_coordinates; unlinked, the Generated coordinates, as Cycles reads a procedural
-    texture); or a string saying why none is made: Dimensions other than 3D, an input fed by
-    anything but constants (_constant), a Vector that is not object coordinates (a UV map, a
-    position in world space, ...)."""
-    if tex.noise_dimensions != "3D":
-        return (f"'{tex.name}' Dimensions {tex.noise_dimensions} (a volume layer is the 3D "
-                "noise)")
-    values = {name: _constant(tex.inputs[name]) for name in NOISE_INPUTS}
+    texture); or a string saying why none is made: Dimensions other than 3D, a type the
+    function is not (a Musgrave Texture's other than fBM), an input fed by anything but
+    constants (_constant), a Vector that is not object coordinates (a UV map, a position in
+    world space, ...)."""
+    function, dimensions, fixed = PROCEDURAL_TEXTURES[tex.type]
+    if getattr(tex, dimensions) != "3D":
+        return (f"'{tex.name}' Dimensions {_enum_name(tex, dimensions)} (a volume layer is the "
+                "3D texture)")
+    for prop, value in fixed.items():
+        if getattr(tex, prop) != value:
+            return (f"'{tex.name}' type {_enum_name(tex, prop)} (a volume layer is the "
+                    f"{tex.bl_rna.properties[prop].enum_items[value].name} type)")
+    inputs = _texture_inputs(function)
+    values = {name: _constant(tex.inputs[name]) for name in inputs}
     varying = [name for name, value in values.items() if value is None]
     if varying:
         return (f"'{tex.name}' {' and '.join(varying)} from a node (a volume layer takes "
@@ -869,24 +903,24 @@ def _noise_settings(tex, ob=None):
     coordinates = _vector_coordinates(tex.inputs["Vector"], ob, generated=True)
     if isinstance(coordinates, str):
         return f"'{tex.name}' {coordinates}"
-    settings = {"type": "volume", "name": tex.name, "function": "blender-noise",
-                "frequency": values["Scale"], "detail": values["Detail"],
-                "roughness": values["Roughness"], "distortion": values["Distortion"],
+    settings = {"type": "volume", "name": tex.name, "function": function,
                 "gradient": "bump-node"}
+    settings.update((key, values[name]) for name, key in inputs.items())
     settings.update(coordinates)
     return settings
 
 
 def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     """The height layer of the Material Output's Displacement (None when there is none to
-    bake): a Displacement node fed by an Image Texture (or a Noise Texture's Fac: a volume
-    layer, _height_layer, its amplitude the scale below), with the material's Displacement method
-    Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the displacement along the
-    normal, (height - Midlevel) x Scale in world units (in object space, grown with the
-    object's scale along the normal): a height layer of scale Scale in the node's space
-    (height_space), its slopes as Cycles takes them, its height through the nodes between as
-    _height_source composes them (a factor in the scale, or a "remap"). Other methods displace the mesh, which
-    sgbake does not; other nodes are not read (notes in `skipped`)."""
+    bake): a Displacement node fed by an Image Texture (or a Noise or Musgrave Texture's Fac:
+    a volume layer, _height_layer, its amplitude the scale below), with the material's
+    Displacement method Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the
+    displacement along the normal, (height - Midlevel) x Scale in world units (in object space,
+    grown with the object's scale along the normal): a height layer of scale Scale in the
+    node's space (height_space), its slopes as Cycles takes them, its height through the nodes
+    between as _height_source composes them (a factor in the scale, or a "remap"). Other
+    methods displace the mesh, which sgbake does not; other nodes are not read (notes in
+    `skipped`)."""
     output = node_tree.get_output_node("CYCLES")
     link = _source_link(output.inputs["Displacement"]) if output is not None else None
     if link is None:
@@ -1097,7 +1131,8 @@ def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUM
 def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
     and each Normal Map node whose Color input is an Image Texture node, and each Bump node
-    whose Height is a Noise Texture's Fac (a volume layer, _noise_settings, whose amplitude is
+    whose Height is a Noise or Musgrave Texture's Fac (a volume layer, _procedural_settings,
+    whose amplitude is
     what a height layer's scale is below), among the nodes that reach the Surface of the
     material's output, and for the output's Displacement
     (_displacement_layer, with the material's `displacement_method`); and notes on the nodes

@@ -94,6 +94,9 @@ FUNCTIONS = (
     ("blender-noise", "Blender Noise",
      "Blender's Noise Texture (3D) Fac, as Cycles evaluates it: Frequency is the node's Scale, "
      "with its Detail, Roughness and Distortion"),
+    ("blender-musgrave", "Blender Musgrave",
+     "Blender's Musgrave Texture (fBM, 3D) Fac, as Cycles evaluates it: Frequency is the "
+     "node's Scale, with its Detail, Dimension and Lacunarity"),
 )
 GRADIENTS = (
     ("analytic", "Analytic", "Exact derivative of the function"),
@@ -204,8 +207,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     coordinates_generated: BoolProperty(
         name="Generated Coordinates", default=False,
         description="Projections and volumes: the baked object's Generated coordinates (its "
-                    "texture space to [0, 1], what Cycles reads a Noise Texture on when its "
-                    "Vector is unlinked); Coordinates follow them at every bake")
+                    "texture space to [0, 1], what Cycles reads a Noise or Musgrave Texture on "
+                    "when its Vector is unlinked); Coordinates follow them at every bake")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",
@@ -222,23 +225,33 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                                          "Distance)")
     frequency: FloatProperty(name="Frequency", default=1.0, precision=4,
                              description="Cycles (sine) or noise features per object unit; "
-                                         "Blender Noise: the Noise Texture's Scale (Blender's "
-                                         "default 5)")
+                                         "Blender Noise and Musgrave: the texture node's Scale "
+                                         "(Blender's default 5)")
     direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0),
                                    description="Direction of the sine wave, object space")
     phase: FloatProperty(name="Phase", default=0.0, subtype="ANGLE")
     seed: IntProperty(name="Seed", default=0, min=0)
     octaves: IntProperty(name="Octaves", default=1, min=1, max=16)
-    # The Noise Texture's inputs (Blender's defaults and the ranges Cycles clamps them to).
+    # The Noise and Musgrave Textures' inputs (Blender's defaults and the nodes' ranges).
     detail: FloatProperty(name="Detail", default=2.0, min=0.0, max=15.0, precision=3,
-                          description="Blender Noise: the Noise Texture's Detail (octaves "
-                                      "beyond the first; a fraction blends one more in)")
+                          description="Blender Noise and Musgrave: the texture node's Detail "
+                                      "(Noise: octaves beyond the first; Musgrave: octaves; a "
+                                      "fraction blends one more in)")
     roughness: FloatProperty(name="Roughness", default=0.5, min=0.0, max=1.0, subtype="FACTOR",
                              description="Blender Noise: the Noise Texture's Roughness (each "
                                          "octave's weight relative to the one before)")
     distortion: FloatProperty(name="Distortion", default=0.0, precision=3,
                               description="Blender Noise: the Noise Texture's Distortion (the "
                                           "point moved by three other noises first)")
+    dimension: FloatProperty(name="Dimension", default=2.0, min=0.0, max=1000.0, precision=3,
+                             description="Blender Musgrave: the Musgrave Texture's Dimension "
+                                         "(each octave's weight is Lacunarity^-Dimension times "
+                                         "the one before)")
+    lacunarity: FloatProperty(name="Lacunarity", default=2.0, min=0.0, max=1000.0,
+                              precision=3,
+                              description="Blender Musgrave: the Musgrave Texture's Lacunarity "
+                                          "(each octave's frequency relative to the one "
+                                          "before)")
     gradient: EnumProperty(name="Gradient", items=GRADIENTS, default="analytic",
                            description="How the volume's gradient is computed")
     step: FloatProperty(

@@ -9,7 +9,8 @@ layer types, spaces and maps it applies to (scene.cpp's layerKeys and kMapOutput
 Every per-layer key of the scene format is covered: the common ones (name, weight, material,
 mask with its image, uv, tiling, offset and filter), the image ones (image, filter, wrap, tiling,
 offset), uv, scale/strength, space, green, kind, axis, sharpness, min_weight and the volume's
-function, amplitude, frequency, direction, phase, seed, octaves, gradient and step; a
+function, amplitude, frequency, direction, phase, seed, octaves, detail, roughness,
+distortion, dimension, lacunarity, gradient and step; a
 height's remap (its Remap text, parsed by remap_points: LayerError for text that is not one).
 """
 
@@ -26,6 +27,13 @@ MAPS = (
     ("bitangent", "Bitangent", "Bitangent, sign x N x T (n/2 + 0.5)"),
     ("mask", "Mask", "1 where a triangle covers the texel, else 0"),
 )
+# The volume functions that are Blender's procedural textures -> the layer settings holding the
+# node's inputs besides its Scale (the frequency), sent under the same keys; libsgbake refuses
+# another function's keys (a "roughness" on a blender-musgrave volume).
+BLENDER_TEXTURE_SETTINGS = {
+    "blender-noise": ("detail", "roughness", "distortion"),
+    "blender-musgrave": ("detail", "dimension", "lacunarity"),
+}
 # Maps that read no layer: their bakes send none, so an unfinished layer cannot stop them.
 LAYERLESS_MAPS = {"tangent", "bitangent", "mask"}
 # Maps whose values the object's transform changes (libsgbake's shadedThroughTransform): the
@@ -36,7 +44,7 @@ LAYER_TYPES = (
     ("height", "Height", "Height image on a UV map"),
     ("normal", "Normal", "Normal map image on a UV map (tangent or object space)"),
     ("volume", "Volume", "Procedural height in object space (sine, noise, or Blender's Noise "
-                         "Texture)"),
+                         "or Musgrave Texture)"),
     ("planar", "Planar", "Image projected along an object axis"),
     ("triplanar", "Triplanar", "Image projected on the three axis planes and blended"),
 )
@@ -186,8 +194,9 @@ def layer_json(layer, uv_index, default_uv=None):
     sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json).
     A height's Remap goes as "remap" (remap_points, which raises LayerError for bad text).
     A volume sends its function's own settings only (a Blender Noise's detail, roughness and
-    distortion; libsgbake refuses another function's), and like a projection its "mapping"
-    when it has one (a Mapping node, another object's or the Generated coordinates).
+    distortion, a Blender Musgrave's detail, dimension and lacunarity:
+    BLENDER_TEXTURE_SETTINGS; libsgbake refuses another function's), and like a projection its
+    "mapping" when it has one (a Mapping node, another object's or the Generated coordinates).
     A layer of one material slot (material_index >= 0) sends it as "material": libsgbake then
     applies it to the faces of that slot only (the mesh's face_material)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
@@ -225,9 +234,9 @@ def layer_json(layer, uv_index, default_uv=None):
                          phase=_number(layer.phase))
         elif layer.function == "noise":
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
-        else:  # Blender's Noise Texture: its inputs (its Scale is the frequency)
-            entry.update(detail=_number(layer.detail), roughness=_number(layer.roughness),
-                         distortion=_number(layer.distortion))
+        else:  # Blender's Noise or Musgrave Texture: its inputs (its Scale is the frequency)
+            entry.update({key: _number(getattr(layer, key))
+                          for key in BLENDER_TEXTURE_SETTINGS.get(layer.function, ())})
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
         if layer.planar_projection != "axis":  # Blender's Flat, Sphere and Tube: about z

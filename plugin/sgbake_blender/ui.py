@@ -166,18 +166,16 @@ class SGBAKE_PT_layers(bpy.types.Panel):
         if layer.type == "volume":
             col.prop(layer, "function")
             col.prop(layer, "amplitude")
-            blender_noise = layer.function == "blender-noise"
-            col.prop(layer, "frequency", text="Scale" if blender_noise else "Frequency")
+            texture = scene.BLENDER_TEXTURE_SETTINGS.get(layer.function)
+            col.prop(layer, "frequency", text="Scale" if texture else "Frequency")
             if layer.function == "sine":
                 col.prop(layer, "direction")
                 col.prop(layer, "phase")
             elif layer.function == "noise":
                 col.prop(layer, "seed")
                 col.prop(layer, "octaves")
-            else:
-                col.prop(layer, "detail")
-                col.prop(layer, "roughness")
-                col.prop(layer, "distortion")
+            for name in texture or ():  # a Blender texture's inputs
+                col.prop(layer, name)
             col.prop(layer, "gradient")
             if layer.gradient in ("central", "tetrahedral"):
                 col.prop(layer, "step")

@@ -89,6 +89,17 @@
    by another texture and a UV Map node into its Vector give no layer and a reason; through a
    Color Ramp it gives a blender-noise layer whose remap is the ramp's; a volume layer made by
    hand with function Blender Noise sends its Detail, Roughness and Distortion and bakes.
+   Musgrave Texture (musgrave_case): a Musgrave Texture (fBM, 3D, MUSGRAVE_INPUTS) on Suzanne's
+   own object coordinates through a Mapping node (Point) into the Bump: Layers from Material
+   must make one "blender-musgrave" volume layer of the node's settings and its Mapping (sent
+   so, without a Noise Texture's roughness or distortion), baked as Cycles bakes it
+   (MUSGRAVE_*: median and p99), the same job without its "dimension" and "lacunarity"
+   (Blender's defaults, 2 and 2) clearly worse; Cycles' normals must lean less than
+   MUSGRAVE_LEAN_DEG off the add-on's bake of the layer at amplitude 0. musgrave_checks: type
+   Ridged Multifractal, Dimensions 2D and a Lacunarity fed by another texture give no layer and
+   a reason (the node back as fBM 3D gives one); a volume layer made by hand with function
+   Blender Musgrave sends its Detail, Dimension and Lacunarity (nothing of Blender Noise's) and
+   bakes.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -247,6 +258,20 @@ NOISE_PLACEMENT = ((0.0, 0.0, 0.0), (0.5, -0.3, 0.9), (1.4, 0.8, 1.2))
 NOISE_MEDIAN_DEG = 0.01
 NOISE_P99_DEG = 0.01
 NOISE_CONTROL_FACTOR = 3.0
+# The Musgrave case (musgrave_case): a Musgrave Texture (fBM, 3D, MUSGRAVE_INPUTS) on Suzanne's
+# own object coordinates through a Mapping node (Point, MUSGRAVE_MAPPING) into the Bump
+# (Distance MUSGRAVE_DISTANCE: Cycles' normals lean less than MUSGRAVE_LEAN_DEG off the
+# surface's, checked against the add-on's bake of the layer at amplitude 0). Layers from Material must make a "blender-musgrave" volume layer of
+# those settings and that mapping; its bake must be Cycles' (median <= MUSGRAVE_MEDIAN_DEG, p99
+# <= MUSGRAVE_P99_DEG) and the same job without the layer's "dimension" and "lacunarity"
+# (libsgbake's defaults, Blender's: 2 and 2) at least MUSGRAVE_CONTROL_FACTOR times worse.
+MUSGRAVE_INPUTS = {"Scale": 3.0, "Detail": 3.5, "Dimension": 1.5, "Lacunarity": 2.3}
+MUSGRAVE_MAPPING = ((-0.4, 0.3, 0.2), (0.2, 0.5, -0.6), (0.9, 1.2, 1.1))
+MUSGRAVE_DISTANCE = 0.05
+MUSGRAVE_LEAN_DEG = 35.0
+MUSGRAVE_MEDIAN_DEG = 0.01
+MUSGRAVE_P99_DEG = 0.01
+MUSGRAVE_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -2255,6 +2280,166 @@ def noise_checks(settings, ob, distance):
     return checks
 
 
+def make_musgrave(tree, inputs=None):
+    """A Musgrave Texture node in `tree` (fBM, 3D) with `inputs` (MUSGRAVE_INPUTS by default)."""
+    musgrave = tree.nodes.new("ShaderNodeTexMusgrave")
+    musgrave.musgrave_type, musgrave.musgrave_dimensions = "FBM", "3D"
+    for name, value in (inputs or MUSGRAVE_INPUTS).items():
+        musgrave.inputs[name].default_value = value
+    return musgrave
+
+
+MUSGRAVE_KEYS = {"frequency": "Scale", "detail": "Detail", "dimension": "Dimension",
+                 "lacunarity": "Lacunarity"}  # the layer's settings -> the node's inputs
+
+
+def musgrave_case(settings, ob, work):
+    """The bump material's Height fed by a Musgrave Texture (MUSGRAVE_INPUTS) on the object's
+    own coordinates through a Mapping node (MUSGRAVE_MAPPING), Distance MUSGRAVE_DISTANCE:
+    Layers from Material, then the add-on's tangent-normal bake (addon_musgrave.npy), the same
+    job without the layer's "dimension" and "lacunarity" (addon_musgrave_control.npy) and
+    Cycles' (cycles_musgrave.npy, its mask cycles_musgrave_mask.npy). The material is put back
+    afterwards. Returns the manifest entry (result, the layer sent, checks). Also the add-on's
+    bake of the layer at amplitude 0 (addon_musgrave_flat.npy), the normals Cycles' lean off."""
+    import bpy
+    import numpy as np
+    from sgbake_blender import operators
+    tree = ob.active_material.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    distance = bump.inputs["Distance"].default_value
+    musgrave = make_musgrave(tree)
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "POINT"
+    for name, value in zip(("Location", "Rotation", "Scale"), MUSGRAVE_MAPPING):
+        mapping.inputs[name].default_value = value
+    tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], musgrave.inputs["Vector"])
+    tree.links.new(musgrave.outputs["Fac"], bump.inputs["Height"])
+    bump.inputs["Distance"].default_value = MUSGRAVE_DISTANCE
+    entry = {"result": None, "checks": []}
+    close = lambda a, b: abs(a - b) < 1e-6  # noqa: E731  (float32 properties)
+    try:
+        try:
+            bpy.ops.object.sgbake_layers_from_material()
+            layer = settings.layers[0] if len(settings.layers) == 1 else None
+            sent = operators.BakeJob(bpy.context).scene["layers"][0] if layer else {}
+        except RuntimeError as exc:
+            layer, sent = None, {"error": str(exc).strip()}
+        entry["layer"] = sent
+        mapped = sent.get("mapping", {})
+        entry["checks"].append({
+            "name": "musgrave: Layers from Material makes one blender-musgrave volume of the "
+                    "node's settings and its Mapping, sent so",
+            "ok": (layer is not None and layer.type == "volume"
+                   and layer.function == "blender-musgrave"
+                   and close(layer.amplitude, MUSGRAVE_DISTANCE)
+                   and all(close(getattr(layer, key), MUSGRAVE_INPUTS[name])
+                           for key, name in MUSGRAVE_KEYS.items())
+                   and sent.get("function") == "blender-musgrave"
+                   and sent.get("gradient") == "bump-node"
+                   and close(sent.get("amplitude", 0), MUSGRAVE_DISTANCE)
+                   and all(close(sent.get(key, -1), MUSGRAVE_INPUTS[name])
+                           for key, name in MUSGRAVE_KEYS.items())
+                   and not {"roughness", "distortion", "seed", "octaves", "step"} & set(sent)
+                   and "matrix" not in mapped and "type" not in mapped
+                   and all(close(a, b) for key, want in zip(("location", "rotation", "scale"),
+                                                            MUSGRAVE_MAPPING)
+                           for a, b in zip(mapped.get(key, [9] * 3), want))),
+            "expected": f"one blender-musgrave volume, {MUSGRAVE_INPUTS}, amplitude "
+                        f"{MUSGRAVE_DISTANCE}, bump-node, mapping {MUSGRAVE_MAPPING}, no "
+                        "roughness or distortion",
+            "message": f"{len(settings.layers)} layer(s); sent {sent}"})
+        if layer is not None:
+            entry["result"] = bake_against_cycles(settings, ob, work, "musgrave",
+                                                  ("dimension", "lacunarity"))
+            # The surface's own normals (the layer at amplitude 0), what the bump leans off.
+            job = operators.BakeJob(bpy.context)
+            for scene_of_tile in job.scenes.values():
+                for sent_layer in scene_of_tile["layers"]:
+                    sent_layer["amplitude"] = 0.0
+            job.run()
+            if job.error is None:
+                flat, _ = job.finish()
+                np.save(os.path.join(work, "addon_musgrave_flat.npy"), bc.image_array(flat))
+    finally:
+        for node in (mapping, coordinates, musgrave):
+            tree.nodes.remove(node)
+        tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+        bump.inputs["Distance"].default_value = distance
+    return entry
+
+
+def musgrave_checks(settings, ob):
+    """Layers from Material on Musgrave Textures it does not take (type Ridged Multifractal,
+    Dimensions 2D, a Lacunarity fed by a node: no layer, a reason), and a volume layer made by
+    hand with function Blender Musgrave. Returns check records like expect_error's."""
+    import bpy
+    from sgbake_blender import operators
+    tree = ob.active_material.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    musgrave = make_musgrave(tree)
+    checks = []
+
+    def check(name, ok, expected, message):
+        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
+
+    def refused(what, reason):
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check(f"musgrave: {what} gives no layer and a reason", not found
+              and any(f"'{bump.name}'" in note and reason in note for note in skipped),
+              f"no layer, '{bump.name}' skipped: ...{reason}...", f"{found}; skipped {skipped}")
+
+    try:
+        tree.links.new(musgrave.outputs["Fac"], bump.inputs["Height"])
+        musgrave.musgrave_type = "RIDGED_MULTIFRACTAL"
+        refused("type Ridged Multifractal", "type Ridged Multifractal")
+        musgrave.musgrave_type = "FBM"
+        musgrave.musgrave_dimensions = "2D"
+        refused("Dimensions 2D", "Dimensions 2D")
+        musgrave.musgrave_dimensions = "3D"
+        feeder = tree.nodes.new("ShaderNodeTexNoise")
+        tree.links.new(feeder.outputs["Fac"], musgrave.inputs["Lacunarity"])
+        refused("a Lacunarity fed by another texture", "Lacunarity from a node")
+        tree.nodes.remove(feeder)
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("musgrave: the same node as fBM, 3D, its inputs constants makes a layer",
+              len(found) == 1 and found[0].get("function") == "blender-musgrave"
+              and found[0].get("coordinates_generated"),
+              "one blender-musgrave layer on the Generated coordinates (Vector unlinked)",
+              f"{found}; skipped {skipped}")
+    finally:
+        tree.nodes.remove(musgrave)
+        tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    # A volume layer made by hand, function Blender Musgrave: its inputs sent (none of Blender
+    # Noise's), and it bakes.
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.function = "by hand", "volume", "blender-musgrave"
+    layer.frequency, layer.detail, layer.dimension, layer.lacunarity = 4.0, 2.5, 1.2, 2.6
+    layer.amplitude, layer.gradient = 0.01, "bump-node"
+    settings.width = settings.height = 64
+    try:
+        job = operators.BakeJob(bpy.context)
+        sent = job.scene["layers"][-1]
+        job.run()
+    except Exception as exc:  # (BakeInputError: reported as the check's failure)
+        sent, job = {"error": str(exc)}, None
+    check("musgrave: a Blender Musgrave volume made by hand is sent with its inputs and bakes",
+          job is not None and job.error is None and sent.get("function") == "blender-musgrave"
+          and abs(sent.get("detail", 0) - 2.5) < 1e-6
+          and abs(sent.get("dimension", 0) - 1.2) < 1e-6
+          and abs(sent.get("lacunarity", 0) - 2.6) < 1e-6
+          and not {"roughness", "distortion", "seed", "octaves", "mapping"} & set(sent),
+          "function blender-musgrave, detail 2.5, dimension 1.2, lacunarity 2.6, no roughness, "
+          "distortion, seed, octaves or mapping; baked",
+          f"sent {sent}; error {job.error if job else None}")
+    settings.layers.remove(len(settings.layers) - 1)
+    settings.width = settings.height = SIZE
+    return checks
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -2280,9 +2465,11 @@ def blender_make(work, library_path, sabotage):
     manifest["displacement"] = displacement_case(settings, ob, work)
     manifest["remap"] = remap_case(settings, ob, work)
     manifest["noise"] = noise_case(settings, ob, work)
+    manifest["musgrave"] = musgrave_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
+                          + musgrave_checks(settings, ob)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
@@ -2331,6 +2518,8 @@ def blender_compare(work):
     results["remap"] = against_cycles(work, "remap")
     results["noise"] = against_cycles(work, "noise")
     results["noise_generated"] = against_cycles(work, "noise_generated")
+    results["musgrave"] = against_cycles(work, "musgrave")
+    results["musgrave_lean"] = lean_stats(work, "musgrave")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -2440,6 +2629,22 @@ def against_cycles(work, case):
     return {which: bc.angle_stats(bc.angle_deg(
         bc.decode_normals(np.load(os.path.join(work, files[which]))), cycles)[inner])
         for which in ("addon", "control")}
+
+
+def lean_stats(work, case):
+    """How far Cycles' bumped normals (cycles_CASE.npy) lean off the surface's own
+    (addon_CASE_flat.npy: the add-on's bake of the layer at amplitude 0; not +Z, where a face is
+    flat-shaded), over the mask as against_cycles: angle_stats, or {"error": ...}."""
+    import numpy as np
+    files = {"flat": f"addon_{case}_flat.npy", "cycles": f"cycles_{case}.npy",
+             "mask": f"cycles_{case}_mask.npy"}
+    missing = [f for f in files.values() if not os.path.exists(os.path.join(work, f))]
+    if missing:
+        return {"error": f"missing {', '.join(missing)}"}
+    inner = bc.erode(np.load(os.path.join(work, files["mask"]))[..., 0] > 0.5, 1)
+    normals = {key: bc.decode_normals(np.load(os.path.join(work, files[key])))
+               for key in ("flat", "cycles")}
+    return bc.angle_stats(bc.angle_deg(normals["cycles"], normals["flat"])[inner])
 
 
 def blender_main(argv):
@@ -2568,11 +2773,31 @@ def evaluate(manifest, results):
         {"result": noise.get("generated_result")}, results["noise_generated"],
         "without the layer's mapping (its own coordinates)", NOISE_MEDIAN_DEG,
         NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
+    failures += evaluate_case_against_cycles(
+        "musgrave", "a Musgrave Texture (fBM, 3D, "
+        + ", ".join(f"{k} {v:g}" for k, v in MUSGRAVE_INPUTS.items())
+        + ") on object coordinates through a Mapping node (Point), Distance "
+        f"{MUSGRAVE_DISTANCE:g}", manifest["musgrave"], results["musgrave"],
+        "without the layer's dimension and lacunarity (2 and 2)", MUSGRAVE_MEDIAN_DEG,
+        MUSGRAVE_CONTROL_FACTOR, MUSGRAVE_P99_DEG)
+    lean = results["musgrave_lean"]
+    if "error" in lean:
+        failures.append(f"musgrave, lean: {lean['error']}")
+    else:
+        ok = lean["max_deg"] < MUSGRAVE_LEAN_DEG
+        print(f"    Cycles' normals lean off the surface's: median {lean['median_deg']:.1f}, p99 "
+              f"{lean['p99_deg']:.1f}, max {lean['max_deg']:.1f} deg -> {'ok' if ok else 'FAIL'}"
+              f" (< {MUSGRAVE_LEAN_DEG:g})")
+        if not ok:
+            failures.append(f"musgrave: Cycles' normals lean up to {lean['max_deg']:.1f} deg "
+                            f"off the surface's (bar {MUSGRAVE_LEAN_DEG:g}: lower "
+                            "MUSGRAVE_DISTANCE)")
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
-                  + manifest["noise"]["checks"] + manifest["errors"]):
+                  + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
+                  + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
         if not check["ok"]:
