@@ -298,6 +298,17 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                             .detail = layer.noiseDetail,
                                             .dimension = layer.noiseDimension,
                                             .lacunarity = layer.noiseLacunarity}));
+    case VolumeFunction::kBlenderWave:
+      return owned(BlenderWave::create({.amplitude = layer.amplitude,
+                                        .scale = layer.frequency,
+                                        .type = layer.waveType,
+                                        .direction = layer.waveDirection,
+                                        .profile = layer.waveProfile,
+                                        .distortion = layer.noiseDistortion,
+                                        .detail = layer.noiseDetail,
+                                        .detailScale = layer.noiseDetailScale,
+                                        .detailRoughness = layer.noiseDetailRoughness,
+                                        .phase = layer.phase}));
     case VolumeFunction::kNoise:
       break;
   }

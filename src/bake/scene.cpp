@@ -124,7 +124,16 @@ constexpr Named<VolumeFunction> kFunctions[] = {
     {"sine", VolumeFunction::kSine},
     {"noise", VolumeFunction::kNoise},
     {"blender-noise", VolumeFunction::kBlenderNoise},
-    {"blender-musgrave", VolumeFunction::kBlenderMusgrave}};
+    {"blender-musgrave", VolumeFunction::kBlenderMusgrave},
+    {"blender-wave", VolumeFunction::kBlenderWave}};
+constexpr Named<WaveType> kWaveTypes[] = {{"bands", WaveType::kBands}, {"rings", WaveType::kRings}};
+constexpr Named<WaveDirection> kWaveDirections[] = {{"x", WaveDirection::kX},
+                                                    {"y", WaveDirection::kY},
+                                                    {"z", WaveDirection::kZ},
+                                                    {"diagonal", WaveDirection::kDiagonal},
+                                                    {"spherical", WaveDirection::kSpherical}};
+constexpr Named<WaveProfile> kWaveProfiles[] = {
+    {"sine", WaveProfile::kSine}, {"saw", WaveProfile::kSaw}, {"triangle", WaveProfile::kTriangle}};
 constexpr Named<GradientScheme> kSchemes[] = {{"analytic", GradientScheme::kAnalytic},
                                               {"central", GradientScheme::kCentral},
                                               {"tetrahedral", GradientScheme::kTetrahedral}};
@@ -418,9 +427,11 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
-      add({"function", "amplitude", "frequency", "direction", "phase", "seed", "octaves", "detail",
-           "roughness", "distortion", "dimension", "lacunarity", "mapping", "gradient", "step",
-           "base", "strength", "height_space", "remap"});
+      add({"function",     "amplitude",        "frequency",    "direction",      "phase",
+           "seed",         "octaves",          "detail",       "roughness",      "distortion",
+           "dimension",    "lacunarity",       "wave",         "wave_direction", "profile",
+           "detail_scale", "detail_roughness", "mapping",      "gradient",       "step",
+           "base",         "strength",         "height_space", "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
@@ -819,7 +830,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     const bool sine = layer.function == VolumeFunction::kSine;
     const bool noise = layer.function == VolumeFunction::kBlenderNoise;
     const bool musgrave = layer.function == VolumeFunction::kBlenderMusgrave;
-    const bool blender = noise || musgrave;
+    const bool wave = layer.function == VolumeFunction::kBlenderWave;
+    const bool blender = noise || musgrave || wave;
     const std::string function = nameIn(kFunctions, layer.function);
     const auto onlyFor = [&](std::initializer_list<const char*> keys, bool applies,
                              const char* owner) {
@@ -830,10 +842,14 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
         }
       }
     };
-    onlyFor({"direction", "phase"}, sine, "sine");
+    onlyFor({"direction"}, sine, "sine");
+    onlyFor({"phase"}, sine || wave, "sine and blender-wave");
     onlyFor({"seed", "octaves"}, layer.function == VolumeFunction::kNoise, "noise");
-    onlyFor({"detail"}, blender, "blender-noise and blender-musgrave");
-    onlyFor({"roughness", "distortion"}, noise, "blender-noise");
+    onlyFor({"detail"}, blender, "blender-noise, blender-musgrave and blender-wave");
+    onlyFor({"distortion"}, noise || wave, "blender-noise and blender-wave");
+    onlyFor({"roughness"}, noise, "blender-noise");
+    onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
+            "blender-wave");
     onlyFor({"dimension", "lacunarity"}, musgrave, "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
     if (blender) layer.frequency = 5;  // the Noise and Musgrave Textures' default Scale
@@ -846,6 +862,21 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
     if (reader.has("dimension")) layer.noiseDimension = reader.number("dimension");
     if (reader.has("lacunarity")) layer.noiseLacunarity = reader.number("lacunarity");
+    reader.optionalName("wave", kWaveTypes, layer.waveType);
+    reader.optionalName("wave_direction", kWaveDirections, layer.waveDirection);
+    reader.optionalName("profile", kWaveProfiles, layer.waveProfile);
+    if (reader.has("detail_scale")) layer.noiseDetailScale = reader.number("detail_scale");
+    if (reader.has("detail_roughness")) {
+      layer.noiseDetailRoughness = reader.number("detail_roughness");
+    }
+    if (wave && layer.waveDirection == WaveDirection::kDiagonal &&
+        layer.waveType != WaveType::kBands) {
+      fail(where, "'wave_direction': 'diagonal' applies to 'wave': 'bands' only");
+    }
+    if (wave && layer.waveDirection == WaveDirection::kSpherical &&
+        layer.waveType != WaveType::kRings) {
+      fail(where, "'wave_direction': 'spherical' applies to 'wave': 'rings' only");
+    }
     if (reader.has("direction")) layer.direction = reader.vec3("direction");
     if (reader.has("phase")) layer.phase = reader.number("phase");
     if (reader.has("seed")) layer.seed = reader.unsignedInteger("seed");
@@ -1545,10 +1576,19 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["detail"] = layer.noiseDetail;
         j["roughness"] = layer.noiseRoughness;
         j["distortion"] = layer.noiseDistortion;
-      } else {
+      } else if (layer.function == VolumeFunction::kBlenderMusgrave) {
         j["detail"] = layer.noiseDetail;
         j["dimension"] = layer.noiseDimension;
         j["lacunarity"] = layer.noiseLacunarity;
+      } else {
+        j["wave"] = nameIn(kWaveTypes, layer.waveType);
+        j["wave_direction"] = nameIn(kWaveDirections, layer.waveDirection);
+        j["profile"] = nameIn(kWaveProfiles, layer.waveProfile);
+        j["phase"] = layer.phase;
+        j["distortion"] = layer.noiseDistortion;
+        j["detail"] = layer.noiseDetail;
+        j["detail_scale"] = layer.noiseDetailScale;
+        j["detail_roughness"] = layer.noiseDetailRoughness;
       }
       j["gradient"] = layer.heightGradient == HeightGradient::kBumpNode
                           ? nameIn(kHeightGradients, layer.heightGradient)

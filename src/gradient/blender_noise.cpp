@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "sgbake/core/math.hpp"
+
 namespace sgbake {
 namespace {
 
@@ -134,6 +136,42 @@ double blenderSignedNoise(Vec3d x, Vec3d* gradient) {
   return kNoiseScale3 * value;
 }
 
+double blenderFractalNoise(Vec3d p, double detail, double roughness, Vec3d* gradient) {
+  detail = std::clamp(detail, 0.0, 15.0);
+  roughness = std::clamp(roughness, 0.0, 1.0);
+  const int octaves = static_cast<int>(detail);
+  double frequency = 1, amplitude = 1, weights = 0, sum = 0;
+  Vec3d slope{};
+  const auto octave = [&](double& value, Vec3d& g) {  // noise = ½ snoise + ½, of p · frequency
+    value = 0.5 * blenderSignedNoise(frequency * p, gradient ? &g : nullptr) + 0.5;
+    g = (0.5 * frequency) * g;
+  };
+  for (int i = 0; i <= octaves; ++i) {
+    double t;
+    Vec3d g{};
+    octave(t, g);
+    sum += t * amplitude;
+    slope = slope + amplitude * g;
+    weights += amplitude;
+    amplitude *= roughness;
+    frequency *= 2;
+  }
+  double value = sum / weights;
+  Vec3d valueSlope = (1 / weights) * slope;
+  const double rest = detail - std::floor(detail);
+  if (rest != 0) {  // one more octave, blended in by the fraction
+    double t;
+    Vec3d g{};
+    octave(t, g);
+    const double more = (sum + t * amplitude) / (weights + amplitude);
+    const Vec3d moreSlope = (1 / (weights + amplitude)) * (slope + amplitude * g);
+    value = (1 - rest) * value + rest * more;
+    valueSlope = (1 - rest) * valueSlope + rest * moreSlope;
+  }
+  if (gradient != nullptr) *gradient = valueSlope;
+  return value;
+}
+
 Result<BlenderNoise> BlenderNoise::create(const BlenderNoiseParams& params) {
   for (const double v :
        {params.amplitude, params.scale, params.detail, params.roughness, params.distortion}) {
@@ -173,38 +211,9 @@ double BlenderNoise::fac(Vec3d position, Vec3d* gradient) const {
     }
     p = moved;
   }
-  // fBm of noise = ½ snoise + ½.
-  const double detail = std::clamp(params_.detail, 0.0, 15.0);
-  const double roughness = std::clamp(params_.roughness, 0.0, 1.0);
-  const int octaves = static_cast<int>(detail);
-  double frequency = 1, amplitude = 1, weights = 0, sum = 0;
-  Vec3d slope{};
-  const auto octave = [&](double& value, Vec3d& g) {
-    value = 0.5 * blenderSignedNoise(frequency * p, gradient ? &g : nullptr) + 0.5;
-    g = (0.5 * frequency) * g;
-  };
-  for (int i = 0; i <= octaves; ++i) {
-    double t;
-    Vec3d g{};
-    octave(t, g);
-    sum += t * amplitude;
-    slope = slope + amplitude * g;
-    weights += amplitude;
-    amplitude *= roughness;
-    frequency *= 2;
-  }
-  double value = sum / weights;
-  Vec3d valueSlope = (1 / weights) * slope;
-  const double rest = detail - std::floor(detail);
-  if (rest != 0) {
-    double t;
-    Vec3d g{};
-    octave(t, g);
-    const double more = (sum + t * amplitude) / (weights + amplitude);
-    const Vec3d moreSlope = (1 / (weights + amplitude)) * (slope + amplitude * g);
-    value = (1 - rest) * value + rest * more;
-    valueSlope = (1 - rest) * valueSlope + rest * moreSlope;
-  }
+  Vec3d valueSlope;
+  const double value =
+      blenderFractalNoise(p, params_.detail, params_.roughness, gradient ? &valueSlope : nullptr);
   if (gradient != nullptr) {
     // d Fac / d position = scale · Jᵀ · ∇fbm.
     const Vec3d pulled = valueSlope.x * jacobianRows[0] + valueSlope.y * jacobianRows[1] +
@@ -269,6 +278,90 @@ double BlenderMusgrave::fac(Vec3d position, Vec3d* gradient) const {
 double BlenderMusgrave::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
 
 Vec3d BlenderMusgrave::analyticGradient(Vec3d p) const {
+  Vec3d g;
+  fac(p, &g);
+  return params_.amplitude * g;
+}
+
+Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {
+  for (const double v : {params.amplitude, params.scale, params.distortion, params.detail,
+                         params.detailScale, params.detailRoughness, params.phase}) {
+    if (!std::isfinite(v)) return Error::badInput("a Wave Texture setting is not finite");
+  }
+  const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
+                        (20 + std::abs(params.distortion) * std::abs(params.detailScale) *
+                                  std::exp2(std::ceil(std::clamp(params.detail, 0.0, 15.0))));
+  if (!(slopes <= kMaxVolumeScale)) {
+    return Error::badInput("Wave Texture slopes beyond 1e300");
+  }
+  return BlenderWave(params);
+}
+
+double BlenderWave::fac(Vec3d position, Vec3d* gradient) const {
+  // Cycles nudges the scaled coordinates off the unit lattice: p = (scale P + 1e-6) · 0.999999.
+  constexpr double kNudge = 0.999999;
+  const Vec3d p = kNudge * (params_.scale * position + Vec3d{1e-6, 1e-6, 1e-6});
+  double n;
+  Vec3d dn;  // ∂n/∂p
+  if (params_.type == WaveType::kBands) {
+    switch (params_.direction) {
+      case WaveDirection::kX:
+        n = 20 * p.x, dn = {20, 0, 0};
+        break;
+      case WaveDirection::kY:
+        n = 20 * p.y, dn = {0, 20, 0};
+        break;
+      case WaveDirection::kZ:
+        n = 20 * p.z, dn = {0, 0, 20};
+        break;
+      default:
+        n = 10 * (p.x + p.y + p.z), dn = {10, 10, 10};
+        break;  // diagonal
+    }
+  } else {  // rings around an axis (its coordinate dropped), or spherical
+    const Vec3d r{params_.direction == WaveDirection::kX ? 0 : p.x,
+                  params_.direction == WaveDirection::kY ? 0 : p.y,
+                  params_.direction == WaveDirection::kZ ? 0 : p.z};
+    const double length = std::sqrt(dot(r, r));
+    n = 20 * length;
+    dn = length > 0 ? (20 / length) * r : Vec3d{};
+  }
+  n += params_.phase;
+  if (params_.distortion != 0) {
+    Vec3d g;
+    const double fbm = blenderFractalNoise(params_.detailScale * p, params_.detail,
+                                           params_.detailRoughness, gradient ? &g : nullptr);
+    n += params_.distortion * (2 * fbm - 1);
+    dn = dn + (2 * params_.distortion * params_.detailScale) * g;
+  }
+  double value, slope;
+  constexpr double kTwoPi = 2 * kPi;
+  switch (params_.profile) {
+    case WaveProfile::kSine:
+      value = 0.5 + 0.5 * std::sin(n - kPi / 2);
+      slope = 0.5 * std::cos(n - kPi / 2);
+      break;
+    case WaveProfile::kSaw: {
+      const double t = n / kTwoPi;
+      value = t - std::floor(t);
+      slope = 1 / kTwoPi;
+      break;
+    }
+    default: {  // triangle: |t − round(t)| · 2
+      const double t = n / kTwoPi;
+      const double d = t - std::floor(t + 0.5);
+      value = std::abs(d) * 2;
+      slope = (d < 0 ? -2 : 2) / kTwoPi;
+      break;
+    }
+  }
+  if (gradient != nullptr) *gradient = (slope * kNudge * params_.scale) * dn;
+  return value;
+}
+
+double BlenderWave::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
+
+Vec3d BlenderWave::analyticGradient(Vec3d p) const {
   Vec3d g;
   fac(p, &g);
   return params_.amplitude * g;

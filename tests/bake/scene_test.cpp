@@ -251,7 +251,8 @@ TEST(Scene, KeyOfAnotherLayerTypeSaysWhereItBelongs) {
             "scene.json: layers[0]: key 'amplitude' does not apply to a height layer (it is for "
             "volume layers)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "noise", "phase": 1})")),
-            "scene.json: layers[0]: key 'phase' does not apply to a noise volume (it is for sine)");
+            "scene.json: layers[0]: key 'phase' does not apply to a noise volume (it is for sine "
+            "and blender-wave)");
   EXPECT_EQ(parseError(withOutput(R"({"map": "corners", "file": "c.csv", "size": 4})")),
             "scene.json: outputs[0]: key 'size' does not apply to a corners output (it is for "
             "image maps)");
@@ -845,7 +846,7 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
   }
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "sine", "detail": 3})")),
             "scene.json: layers[0]: key 'detail' does not apply to a sine volume (it is for "
-            "blender-noise and blender-musgrave)");
+            "blender-noise, blender-musgrave and blender-wave)");
   Result<Scene> musgrave =
       parseScene(withLayer(R"({"type": "volume", "function": "blender-musgrave", "detail": 3,
                     "dimension": 1.5, "lacunarity": 2.5})"),
@@ -863,6 +864,28 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
       parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "lacunarity": 2})")),
       "scene.json: layers[0]: key 'lacunarity' does not apply to a blender-noise volume "
       "(it is for blender-musgrave)");
+  Result<Scene> wave =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-wave", "wave": "rings",
+                    "wave_direction": "spherical", "profile": "saw", "phase": 0.5,
+                    "distortion": 2, "detail_scale": 3, "detail_roughness": 0.2})"),
+                 options());
+  ASSERT_TRUE(wave) << wave.error().message;
+  EXPECT_EQ(wave->layers[0].waveType, WaveType::kRings);
+  EXPECT_EQ(wave->layers[0].waveDirection, WaveDirection::kSpherical);
+  EXPECT_EQ(wave->layers[0].waveProfile, WaveProfile::kSaw);
+  EXPECT_NE(layerParametersJson(wave->layers[0]).find(R"("detail_scale":3.0)"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-wave",
+                                     "wave_direction": "spherical"})")),
+            "scene.json: layers[0]: 'wave_direction': 'spherical' applies to 'wave': 'rings' "
+            "only");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-wave",
+                                     "wave": "rings", "wave_direction": "diagonal"})")),
+            "scene.json: layers[0]: 'wave_direction': 'diagonal' applies to 'wave': 'bands' "
+            "only");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise",
+                                     "profile": "saw"})")),
+            "scene.json: layers[0]: key 'profile' does not apply to a blender-noise volume (it "
+            "is for blender-wave)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "seed": 3})")),
             "scene.json: layers[0]: key 'seed' does not apply to a blender-noise volume (it is "
             "for noise)");

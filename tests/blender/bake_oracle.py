@@ -87,7 +87,10 @@ fail (b) and (e). Measured with Cycles' slopes: median 0.0016-0.0018 deg, p99 0.
 deg; exact slopes median 0.16 and 0.45 deg; without the mapping 3.7 and 4.1 deg.
 musgrave_sphere does the same with Blender's Musgrave Texture (fBM, Detail 2.5, Dimension 1.5,
 Lacunarity 2.3), a "blender-musgrave" layer: median 0.0016 deg, p99 0.0018 deg (exact slopes
-0.076 deg; without the mapping 3.6 deg).
+0.076 deg; without the mapping 3.6 deg). wave_sphere (diagonal bands, sine, distorted by its
+noise) and wave_suzanne (spherical rings, triangle) with Blender's Wave Texture, a
+"blender-wave" layer: median 0.0016 deg, p99 0.0020 deg (exact slopes median 0.14 and 0.010
+deg, the triangle's folds p99 1.5 deg; without the mapping 6.8 and 3.4 deg).
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -248,7 +251,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "displacement_sphere",
                  "displacement_stretch_sphere", "displacement_object_sphere",
                  "displacement_object_stretch_sphere", "ramp_sphere", "clamp_suzanne",
-                 "noise_sphere", "noise_stretch_suzanne", "musgrave_sphere")
+                 "noise_sphere", "noise_stretch_suzanne", "musgrave_sphere", "wave_sphere",
+                 "wave_suzanne")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
@@ -384,13 +388,20 @@ def sgbake_case(cli, entry, sabotage, threads):
                 (control, bake_scale, "bump-node", False)):
             if "noise" in entry:
                 noise = entry["noise"]
-                musgrave = noise.get("kind") == "musgrave"
+                kind = noise.get("kind", "noise")
                 layer = {"type": "volume", "amplitude": layer_scale, "frequency": noise["scale"],
                          "detail": noise["detail"], "gradient": gradient,
-                         "function": "blender-musgrave" if musgrave else "blender-noise"}
-                for key in ("dimension", "lacunarity") if musgrave else ("roughness",
-                                                                        "distortion"):
+                         "function": "blender-" + kind}
+                keys = {"noise": ("roughness", "distortion"),
+                        "musgrave": ("dimension", "lacunarity"),
+                        "wave": ("distortion", "detail_scale", "detail_roughness", "phase")}
+                for key in keys[kind]:
                     layer[key] = noise[key]
+                if kind == "wave":  # Blender's enum names, lower case ("SIN" is "sine")
+                    layer.update(wave=noise["wave"].lower(),
+                                 wave_direction=noise["direction"].lower(),
+                                 profile={"SIN": "sine", "SAW": "saw",
+                                          "TRI": "triangle"}[noise["profile"]])
                 if complete:
                     location, rotation, mapping_scale = noise["mapping"]
                     layer["mapping"] = {"location": location, "rotation": rotation,

@@ -225,8 +225,10 @@ def reshape_height(mat, kind):
 # coordinates (Texture Coordinate Object) through a Mapping node (Point): {"scale", "detail",
 # "roughness", "distortion", "mapping": (location, rotation, scale)}; or with "kind":
 # "musgrave" a Musgrave Texture (fBM, 3D) of {"scale", "detail", "dimension", "lacunarity",
+# "mapping"}, with "kind": "wave" a Wave Texture of {"wave", "direction", "profile" (Blender's
+# names), "scale", "distortion", "detail", "detail_scale", "detail_roughness", "phase",
 # "mapping"}. The manifest entry has "noise": these settings, sgbake's "blender-noise" (or
-# "blender-musgrave") volume layer with that "mapping".
+# "blender-musgrave", "blender-wave") volume layer with that "mapping".
 NOISE = {}
 
 
@@ -255,12 +257,22 @@ def bump_by_noise(mat, settings):
         noise = nodes.new("ShaderNodeTexMusgrave")
         noise.musgrave_dimensions, noise.musgrave_type = "3D", "FBM"
         inputs = ("Scale", "Detail", "Dimension", "Lacunarity")
+    elif settings.get("kind") == "wave":
+        noise = nodes.new("ShaderNodeTexWave")
+        noise.wave_type, noise.wave_profile = settings["wave"], settings["profile"]
+        if settings["wave"] == "BANDS":
+            noise.bands_direction = settings["direction"]
+        else:
+            noise.rings_direction = settings["direction"]
+        inputs = ("Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness",
+                  "Phase Offset")
     else:
         noise = nodes.new("ShaderNodeTexNoise")
         noise.noise_dimensions = "3D"
         inputs = ("Scale", "Detail", "Roughness", "Distortion")
     for socket in inputs:
-        noise.inputs[socket].default_value = settings[socket.lower()]
+        key = "phase" if socket == "Phase Offset" else socket.lower().replace(" ", "_")
+        noise.inputs[socket].default_value = settings[key]
     links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
     links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
     links.new(noise.outputs["Fac"], bump.inputs["Height"])
@@ -565,6 +577,14 @@ noise_case("noise_stretch_suzanne", "stretch_chain_suzanne", 512, 0.03, scale=3.
 # Blender's Musgrave Texture (fBM) on the sphere: Detail 2.5, Dimension 1.5, Lacunarity 2.3.
 noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, detail=2.5,
            dimension=1.5, lacunarity=2.3, mapping=NOISE_MAPPING)
+# Blender's Wave Texture: diagonal bands distorted by its noise on the sphere, spherical rings
+# (triangle profile) on Suzanne.
+noise_case("wave_sphere", "sphere", 512, 0.02, kind="wave", wave="BANDS", direction="DIAGONAL",
+           profile="SIN", scale=0.8, distortion=1.5, detail=2.5, detail_scale=1.5,
+           detail_roughness=0.6, phase=0.4, mapping=NOISE_MAPPING)
+noise_case("wave_suzanne", "suzanne", 512, 0.02, kind="wave", wave="RINGS",
+           direction="SPHERICAL", profile="TRI", scale=0.6, distortion=0.0, detail=2.0,
+           detail_scale=1.0, detail_roughness=0.5, phase=0.0, mapping=NOISE_MAPPING)
 projected_normal_map_case("sphere_nmap_sphere", "sphere", 256, "TANGENT", 1.0, 40.0, "SPHERE",
                           mapping=WRAP_MAPPING)
 projected_normal_map_case("tube_nmap_sphere_object", "sphere", 256, "OBJECT", 0.3, 40.0, "TUBE",

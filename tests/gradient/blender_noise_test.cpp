@@ -109,6 +109,51 @@ TEST(BlenderMusgrave, SumsTheOctavesAndItsGradientIsTheDerivative) {
   }
 }
 
+// The Wave Texture's gradient, every type and profile, distorted or not, away from the saw's and
+// triangle's corners (where the value jumps or folds: skipped when the central difference's two
+// sides would straddle one).
+TEST(BlenderWave, AnalyticGradientIsTheDerivativeOfTheValue) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> along(-1, 1);
+  int checked = 0;
+  for (const WaveType type : {WaveType::kBands, WaveType::kRings}) {
+    for (const WaveDirection direction :
+         {WaveDirection::kX, WaveDirection::kZ,
+          type == WaveType::kBands ? WaveDirection::kDiagonal : WaveDirection::kSpherical}) {
+      for (const WaveProfile profile :
+           {WaveProfile::kSine, WaveProfile::kSaw, WaveProfile::kTriangle}) {
+        for (const double distortion : {0.0, 1.3}) {
+          Result<BlenderWave> made = BlenderWave::create({.amplitude = 0.7,
+                                                          .scale = 1.7,
+                                                          .type = type,
+                                                          .direction = direction,
+                                                          .profile = profile,
+                                                          .distortion = distortion,
+                                                          .detail = 2.5,
+                                                          .detailScale = 1.5,
+                                                          .detailRoughness = 0.6,
+                                                          .phase = 0.4});
+          ASSERT_TRUE(made) << made.error().message;
+          for (int i = 0; i < 40; ++i) {
+            const Vec3d p{along(rng), along(rng), along(rng)};
+            const double h = 1e-6;
+            const Vec3d central = centralGradient([&](Vec3d q) { return made->value(q); }, p, h);
+            const Vec3d exact = made->analyticGradient(p);
+            // A corner between the two sides: the difference quotient is far from any slope.
+            if (std::abs(central.x) + std::abs(central.y) + std::abs(central.z) > 1e3) continue;
+            EXPECT_LT(maxAbsDiff(exact, central),
+                      1e-5 * (1 + std::abs(exact.x) + std::abs(exact.y) + std::abs(exact.z)))
+                << static_cast<int>(type) << static_cast<int>(direction)
+                << static_cast<int>(profile) << " " << distortion;
+            ++checked;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 1300);
+}
+
 // A Mapping node before the texture: the value at the mapped point, the gradient pulled back.
 TEST(MappedHeightVolume, ReadsTheMappedPointAndPullsTheGradientBack) {
   const BlenderNoise noise = makeNoise({.scale = 3, .detail = 1});

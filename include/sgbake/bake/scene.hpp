@@ -43,6 +43,7 @@
 #include "sgbake/bake/image_output.hpp"
 #include "sgbake/core/result.hpp"
 #include "sgbake/core/vec.hpp"
+#include "sgbake/gradient/blender_noise.hpp"
 #include "sgbake/gradient/filters.hpp"
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/projection.hpp"
@@ -75,6 +76,7 @@ enum class VolumeFunction {
   kNoise,            ///< GradientNoise
   kBlenderNoise,     ///< "blender-noise": BlenderNoise, Blender's Noise Texture (3D)
   kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (fBM, 3D)
+  kBlenderWave,      ///< "blender-wave": BlenderWave, Blender's Wave Texture
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
@@ -219,6 +221,14 @@ struct SceneLayer {
   double noiseDistortion = 0;
   double noiseDimension = 2;
   double noiseLacunarity = 2;
+  /// blender-wave: "wave" (bands | rings), "wave_direction" (x | y | z | diagonal (bands) |
+  /// spherical (rings)), "profile" (sine | saw | triangle), "detail_scale", "detail_roughness"
+  /// (of its distortion's noise; also "distortion", "detail", and "phase": the Phase Offset)
+  WaveType waveType = WaveType::kBands;
+  WaveDirection waveDirection = WaveDirection::kX;
+  WaveProfile waveProfile = WaveProfile::kSine;
+  double noiseDetailScale = 1;
+  double noiseDetailRoughness = 0.5;
   GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
   std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
 

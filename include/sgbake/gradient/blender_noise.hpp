@@ -88,6 +88,54 @@ class BlenderMusgrave final : public HeightVolume {
   BlenderMusgraveParams params_;
 };
 
+/// The Wave Texture's Wave Type.
+enum class WaveType { kBands, kRings };
+/// Its Bands Direction (x, y, z, diagonal) or Rings Direction (x, y, z: around that axis;
+/// spherical).
+enum class WaveDirection { kX, kY, kZ, kDiagonal, kSpherical };
+/// Its Wave Profile.
+enum class WaveProfile { kSine, kSaw, kTriangle };
+
+/// @brief The Wave Texture node's settings and the height's scale.
+struct BlenderWaveParams {
+  double amplitude = 1;  ///< height per unit of Fac
+  double scale = 5;      ///< the node's Scale
+  WaveType type = WaveType::kBands;
+  WaveDirection direction = WaveDirection::kX;  ///< diagonal for bands, spherical for rings only
+  WaveProfile profile = WaveProfile::kSine;
+  double distortion = 0;         ///< the node's Distortion
+  double detail = 2;             ///< Detail of the distortion's noise (clamped to [0, 15])
+  double detailScale = 1;        ///< its Detail Scale
+  double detailRoughness = 0.5;  ///< its Detail Roughness (clamped to [0, 1])
+  double phase = 0;              ///< Phase Offset, radians
+};
+
+/// @brief Blender's Wave Texture, times an amplitude: a HeightVolume.
+///
+/// p = (scale · P + 10⁻⁶) · 0.999999 (Cycles' nudge off the lattice); n = 20 p_axis (bands;
+/// diagonal 10 (x + y + z)) or 20 |p without the axis| (rings; spherical 20 |p|), plus the phase
+/// and Distortion · (2 fbm(Detail Scale · p) − 1) with BlenderNoise's fbm; Fac = ½ + ½ sin(n −
+/// π/2), the fraction of n / 2π (saw) or twice its distance to the nearest integer (triangle). The
+/// gradient is exact away from the saw's and triangle's corners (and the rings' axis).
+class BlenderWave final : public HeightVolume {
+ public:
+  /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale.
+  static Result<BlenderWave> create(const BlenderWaveParams& params);
+
+  double value(Vec3d p) const override;
+  Vec3d analyticGradient(Vec3d p) const override;
+  /// The node's Fac at @p p (object space, before the amplitude), and its gradient.
+  double fac(Vec3d p, Vec3d* gradient) const;
+
+ private:
+  explicit BlenderWave(const BlenderWaveParams& params) : params_(params) {}
+  BlenderWaveParams params_;
+};
+
+/// @brief The Noise Texture's fBm of @p p (no Scale, no distortion): octaves of ½ snoise + ½, as
+/// described above, and its gradient with respect to p.
+double blenderFractalNoise(Vec3d p, double detail, double roughness, Vec3d* gradient);
+
 /// @brief Cycles' signed Perlin noise snoise(x) = 0.982 · perlin(x) at @p x, and its gradient
 /// (exposed for tests).
 double blenderSignedNoise(Vec3d x, Vec3d* gradient);
