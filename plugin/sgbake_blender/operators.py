@@ -5,6 +5,7 @@ loaded, a scene libsgbake refuses) is reported with self.report({'ERROR'}, messa
 operator returns {'CANCELLED'}: the user sees one line, never a traceback.
 """
 
+import collections
 import threading
 import time
 
@@ -257,8 +258,8 @@ def _tile_list(tiles):
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
     """Add sgbake layers for the Bump and Normal Map nodes fed by an Image Texture node, and the
-    Bump nodes fed by a Noise or Musgrave Texture's Fac, in the active object's materials (with
-    several material slots, each layer applies to its slot's faces)"""
+    Bump nodes fed by a Noise, Musgrave or Wave Texture's Fac, in the active object's materials
+    (with several material slots, each layer applies to its slot's faces)"""
     bl_idname = "object.sgbake_layers_from_material"
     bl_label = "Layers from Material"
     bl_options = {"REGISTER", "UNDO"}
@@ -284,7 +285,7 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             what = (f"material '{sources[0][1].name}' has no" if single
                     else f"no material of object '{ob.name}' has a")
             self.report({"ERROR"}, f"{what} Bump or Normal Map node fed by an Image Texture "
-                                   "node (or a Bump fed by a Noise or Musgrave Texture)"
+                                   "node (or a Bump fed by a Noise, Musgrave or Wave Texture)"
                         + _notes(skipped))
             return {"CANCELLED"}
         settings = context.scene.sgbake
@@ -356,8 +357,8 @@ def object_layers(sources, render_uv=None, ob=None):
                 entry["material_index"] = slot
             if not values and not slot_skipped:
                 slot_skipped.append("no Bump, Normal Map or Displacement node fed by an Image "
-                                    "Texture node (or a Bump or Displacement by a Noise or "
-                                    "Musgrave Texture)")
+                                    "Texture node (or a Bump or Displacement by a Noise, "
+                                    "Musgrave or Wave Texture)")
             slot_skipped = [f"{where}: {note}" for note in slot_skipped]
             slot_ignored = [f"{where}: {note}" for note in slot_ignored]
         found += values
@@ -551,8 +552,9 @@ def _height_source(socket):
     """The texture node that feeds height input `socket`, the channel it is read on and the
     function of its value the nodes between make: (node, channel, factor, points), or None when
     the chain is not followed, or a string saying why its height is not taken (a constant, a
-    Noise Texture's Color). The texture: an Image Texture node with an image, or a Noise or
-    Musgrave Texture node's Fac (PROCEDURAL_TEXTURES; a float: every channel its value;
+    Noise Texture's Color). The texture: an Image Texture node with an image, or a Noise,
+    Musgrave or Wave Texture node's Fac (or a Wave Texture's Color, the Fac as a grey:
+    PROCEDURAL_TEXTURES' outputs; every channel its value;
     _procedural_settings says whether a volume layer takes the node). Followed back through
     Reroutes, RGB to BW (the luminance, as the input's own conversion), Separate RGB or Color
     (RGB mode: channel r, g or b; the image's Alpha output is channel a, its Color the
@@ -576,7 +578,8 @@ def _height_source(socket):
                 channel = "a"
             break
         if node.type in PROCEDURAL_TEXTURES:
-            if link.from_socket.name != "Fac":  # (a Noise Texture's Color)
+            if link.from_socket.name not in PROCEDURAL_TEXTURES[node.type].outputs:
+                # (a Noise Texture's Color)
                 return (f"'{node.name}' {link.from_socket.name} output (three noises seeded "
                         "apart; a volume layer is the noise of its Fac)")
             channel = None  # (a grey: any channel of it is the Fac)
@@ -680,14 +683,15 @@ def _surface_nodes(node_tree):
 
 def _not_image(socket):
     """Why `socket` gave no layer: what is linked into it instead of an Image Texture node
-    (or, into a height, a Noise or Musgrave Texture's Fac)."""
+    (or, into a height, a Noise, Musgrave or Wave Texture's Fac)."""
     link = _source_link(socket)
     if link is not None and link.from_node.type == "TEX_IMAGE":
         return f"{socket.name}'s Image Texture node has no image"
     if socket.is_linked and link is None:
         return f"{socket.name}'s link is muted"
     if socket.name == "Height":
-        return f"{socket.name} is not an Image Texture, Noise Texture or Musgrave Texture node"
+        return (f"{socket.name} is not an Image Texture, Noise Texture, Musgrave Texture or "
+                "Wave Texture node")
     return f"{socket.name} is not an Image Texture node"
 
 
@@ -827,9 +831,9 @@ def _height_settings(node, tex, channel, render_uv, ob, ignored, points=None):
 def _height_layer(node, source, inputs, render_uv, ob, ignored):
     """The settings of the layer of height input "Height" of `node` (a Bump or a Displacement
     node) fed as `source` says (_height_source), before its scale (_scale_key): an Image
-    Texture's (_height_settings), a Noise or Musgrave Texture's volume (_procedural_settings;
-    a string when it is not taken); what of `node` (its `inputs` fed by nodes) and the texture
-    the layer cannot take over goes into `ignored`."""
+    Texture's (_height_settings), a Noise, Musgrave or Wave Texture's volume
+    (_procedural_settings; a string when it is not taken); what of `node` (its `inputs` fed by
+    nodes) and the texture the layer cannot take over goes into `ignored`."""
     tex, channel, _, points = source
     if tex.type in PROCEDURAL_TEXTURES:
         values = _procedural_settings(tex, ob)
@@ -849,21 +853,41 @@ def _scale_key(values):
     return "amplitude" if values["type"] == "volume" else "scale"
 
 
-# The procedural textures whose Fac a volume layer takes: node type -> the volume's function,
-# the node's property holding its Dimensions, and the node's properties that must have one
-# value (property -> that value) for the function to be what Cycles computes.
+# A procedural texture whose value a volume layer takes: the volume's function; the node's
+# property holding its Dimensions (None: the node is 3D only); the node's properties that must
+# have one value (property -> that value) for the function to be what Cycles computes; the
+# outputs the layer reads (grey: the Fac, a Wave Texture's Color (Fac, Fac, Fac) alike); the
+# node's enum properties the function takes (setting -> (the node's property, or a function of
+# the node naming it; Blender's values -> the scene's names)); and the inputs whose name is not
+# their setting's in title case (setting -> input).
+ProceduralTexture = collections.namedtuple(
+    "ProceduralTexture", "function dimensions fixed outputs enums inputs",
+    defaults=({}, ("Fac",), {}, {}))
 PROCEDURAL_TEXTURES = {
-    "TEX_NOISE": ("blender-noise", "noise_dimensions", {}),
-    "TEX_MUSGRAVE": ("blender-musgrave", "musgrave_dimensions", {"musgrave_type": "FBM"}),
+    "TEX_NOISE": ProceduralTexture("blender-noise", "noise_dimensions"),
+    "TEX_MUSGRAVE": ProceduralTexture("blender-musgrave", "musgrave_dimensions",
+                                      {"musgrave_type": "FBM"}),
+    "TEX_WAVE": ProceduralTexture(
+        "blender-wave", None, outputs=("Fac", "Color"),
+        enums={"wave": ("wave_type", {"BANDS": "bands", "RINGS": "rings"}),
+               "wave_direction": (lambda tex: ("bands_direction" if tex.wave_type == "BANDS"
+                                               else "rings_direction"),
+                                  {"X": "x", "Y": "y", "Z": "z", "DIAGONAL": "diagonal",
+                                   "SPHERICAL": "spherical"}),
+               "profile": ("wave_profile", {"SIN": "sine", "SAW": "saw", "TRI": "triangle"})},
+        inputs={"phase": "Phase Offset"}),
 }
 
 
-def _texture_inputs(function):
-    """The inputs of the texture node of volume function `function` -> the layer settings that
-    hold them: its Scale the frequency, the others (scene.BLENDER_TEXTURE_SETTINGS) under
-    their own names (input Detail -> detail)."""
+def _texture_inputs(texture):
+    """The inputs of procedural texture `texture` (PROCEDURAL_TEXTURES) -> the layer settings
+    that hold them: its Scale the frequency, the others of scene.BLENDER_TEXTURE_SETTINGS but
+    its enums under their own names (input Detail Scale -> detail_scale, but as
+    texture.inputs renames them: Phase Offset -> phase)."""
     inputs = {"Scale": "frequency"}
-    inputs.update((key.title(), key) for key in scene.BLENDER_TEXTURE_SETTINGS[function])
+    inputs.update((texture.inputs.get(key, key.replace("_", " ").title()), key)
+                  for key in scene.BLENDER_TEXTURE_SETTINGS[texture.function]
+                  if key not in texture.enums)
     return inputs
 
 
@@ -876,25 +900,34 @@ def _enum_name(node, prop):
 
 
 def _procedural_settings(tex, ob=None):
-    """The settings of the volume layer of procedural texture node `tex`'s Fac (a Noise or a
-    Musgrave Texture: PROCEDURAL_TEXTURES): its function with the node's inputs
-    (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of a Noise
-    Texture, Detail, Dimension and Lacunarity of a Musgrave Texture), the slopes as Cycles'
+    """The settings of the volume layer of procedural texture node `tex`'s Fac (a Noise,
+    Musgrave or Wave Texture: PROCEDURAL_TEXTURES): its function with the node's enum
+    properties in the scene's names (a Wave Texture's type, direction and profile) and its
+    inputs (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of a
+    Noise Texture, Detail, Dimension and Lacunarity of a Musgrave Texture, Distortion, Detail,
+    Detail Scale, Detail Roughness and Phase Offset of a Wave Texture), the slopes as Cycles'
     Bump node takes them (gradient "bump-node"), on the coordinates its Vector reads
     (_vector_coordinates; unlinked, the Generated coordinates, as Cycles reads a procedural
     texture); or a string saying why none is made: Dimensions other than 3D, a type the
     function is not (a Musgrave Texture's other than fBM), an input fed by anything but
     constants (_constant), a Vector that is not object coordinates (a UV map, a position in
     world space, ...)."""
-    function, dimensions, fixed = PROCEDURAL_TEXTURES[tex.type]
-    if getattr(tex, dimensions) != "3D":
-        return (f"'{tex.name}' Dimensions {_enum_name(tex, dimensions)} (a volume layer is the "
-                "3D texture)")
-    for prop, value in fixed.items():
+    texture = PROCEDURAL_TEXTURES[tex.type]
+    if texture.dimensions and getattr(tex, texture.dimensions) != "3D":
+        return (f"'{tex.name}' Dimensions {_enum_name(tex, texture.dimensions)} (a volume "
+                "layer is the 3D texture)")
+    for prop, value in texture.fixed.items():
         if getattr(tex, prop) != value:
             return (f"'{tex.name}' type {_enum_name(tex, prop)} (a volume layer is the "
                     f"{tex.bl_rna.properties[prop].enum_items[value].name} type)")
-    inputs = _texture_inputs(function)
+    enums = {}  # (in the table's order: a Wave Texture's type before its direction)
+    for key, (prop, names) in texture.enums.items():
+        prop = prop(tex) if callable(prop) else prop
+        enums[key] = names.get(getattr(tex, prop))
+        if enums[key] is None:
+            return (f"'{tex.name}' {tex.bl_rna.properties[prop].name} "
+                    f"{_enum_name(tex, prop)} (not one libsgbake has)")
+    inputs = _texture_inputs(texture)
     values = {name: _constant(tex.inputs[name]) for name in inputs}
     varying = [name for name, value in values.items() if value is None]
     if varying:
@@ -903,8 +936,9 @@ def _procedural_settings(tex, ob=None):
     coordinates = _vector_coordinates(tex.inputs["Vector"], ob, generated=True)
     if isinstance(coordinates, str):
         return f"'{tex.name}' {coordinates}"
-    settings = {"type": "volume", "name": tex.name, "function": function,
+    settings = {"type": "volume", "name": tex.name, "function": texture.function,
                 "gradient": "bump-node"}
+    settings.update(enums)
     settings.update((key, values[name]) for name, key in inputs.items())
     settings.update(coordinates)
     return settings
@@ -912,8 +946,8 @@ def _procedural_settings(tex, ob=None):
 
 def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
     """The height layer of the Material Output's Displacement (None when there is none to
-    bake): a Displacement node fed by an Image Texture (or a Noise or Musgrave Texture's Fac:
-    a volume layer, _height_layer, its amplitude the scale below), with the material's
+    bake): a Displacement node fed by an Image Texture (or a Noise, Musgrave or Wave Texture's
+    Fac: a volume layer, _height_layer, its amplitude the scale below), with the material's
     Displacement method Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the
     displacement along the normal, (height - Midlevel) x Scale in world units (in object space,
     grown with the object's scale along the normal): a height layer of scale Scale in the
@@ -1131,10 +1165,9 @@ def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUM
 def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
     and each Normal Map node whose Color input is an Image Texture node, and each Bump node
-    whose Height is a Noise or Musgrave Texture's Fac (a volume layer, _procedural_settings,
-    whose amplitude is
-    what a height layer's scale is below), among the nodes that reach the Surface of the
-    material's output, and for the output's Displacement
+    whose Height is a Noise, Musgrave or Wave Texture's Fac (a volume layer,
+    _procedural_settings, whose amplitude is what a height layer's scale is below), among the
+    nodes that reach the Surface of the material's output, and for the output's Displacement
     (_displacement_layer, with the material's `displacement_method`); and notes on the nodes
     that were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV
     map active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the

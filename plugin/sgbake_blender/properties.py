@@ -97,7 +97,40 @@ FUNCTIONS = (
     ("blender-musgrave", "Blender Musgrave",
      "Blender's Musgrave Texture (fBM, 3D) Fac, as Cycles evaluates it: Frequency is the "
      "node's Scale, with its Detail, Dimension and Lacunarity"),
+    ("blender-wave", "Blender Wave",
+     "Blender's Wave Texture Fac, as Cycles evaluates it: Frequency is the node's Scale, with "
+     "its type, direction, profile, Phase Offset, Distortion, Detail, Detail Scale and Detail "
+     "Roughness"),
 )
+# The Wave Texture's enums in the scene's names (Blender's Wave Type, Bands or Rings Direction,
+# Wave Profile). The directions depend on the type, as the node's two properties: the fourth
+# is Diagonal for Bands, Spherical for Rings.
+WAVE_TYPES = (
+    ("bands", "Bands", "Bands along the direction"),
+    ("rings", "Rings", "Rings about the direction's axis (or spherical shells)"),
+)
+BANDS_DIRECTIONS = (
+    ("x", "X", "Bands across the X axis"), ("y", "Y", "Bands across the Y axis"),
+    ("z", "Z", "Bands across the Z axis"),
+    ("diagonal", "Diagonal", "Bands across the diagonal (x + y + z)"),
+)
+RINGS_DIRECTIONS = (
+    ("x", "X", "Rings about the X axis"), ("y", "Y", "Rings about the Y axis"),
+    ("z", "Z", "Rings about the Z axis"),
+    ("spherical", "Spherical", "Spherical shells about the origin"),
+)
+WAVE_PROFILES = (
+    ("sine", "Sine", "The Wave Texture's Sine profile"),
+    ("saw", "Saw", "The Wave Texture's Saw profile"),
+    ("triangle", "Triangle", "The Wave Texture's Triangle profile"),
+)
+
+
+def _wave_directions(layer, _context):
+    """The Direction items of a Blender Wave layer of Wave Type `layer.wave`."""
+    return RINGS_DIRECTIONS if layer.wave == "rings" else BANDS_DIRECTIONS
+
+
 GRADIENTS = (
     ("analytic", "Analytic", "Exact derivative of the function"),
     ("central", "Central", "Central differences (6 evaluations)"),
@@ -207,7 +240,7 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     coordinates_generated: BoolProperty(
         name="Generated Coordinates", default=False,
         description="Projections and volumes: the baked object's Generated coordinates (its "
-                    "texture space to [0, 1], what Cycles reads a Noise or Musgrave Texture on "
+                    "texture space to [0, 1], what Cycles reads a procedural texture on "
                     "when its Vector is unlinked); Coordinates follow them at every bake")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
@@ -225,24 +258,45 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                                          "Distance)")
     frequency: FloatProperty(name="Frequency", default=1.0, precision=4,
                              description="Cycles (sine) or noise features per object unit; "
-                                         "Blender Noise and Musgrave: the texture node's Scale "
-                                         "(Blender's default 5)")
+                                         "Blender Noise, Musgrave and Wave: the texture "
+                                         "node's Scale (Blender's default 5)")
     direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0),
                                    description="Direction of the sine wave, object space")
-    phase: FloatProperty(name="Phase", default=0.0, subtype="ANGLE")
+    phase: FloatProperty(name="Phase", default=0.0, subtype="ANGLE",
+                         description="Sine: the wave's phase; Blender Wave: the Wave "
+                                     "Texture's Phase Offset (radians in the node, shown here "
+                                     "in degrees: 0.7 is 40.1 degrees)")
     seed: IntProperty(name="Seed", default=0, min=0)
     octaves: IntProperty(name="Octaves", default=1, min=1, max=16)
-    # The Noise and Musgrave Textures' inputs (Blender's defaults and the nodes' ranges).
+    # The Noise, Musgrave and Wave Textures' settings (Blender's defaults and the nodes'
+    # ranges).
+    wave: EnumProperty(name="Wave Type", items=WAVE_TYPES, default="bands",
+                       description="Blender Wave: the Wave Texture's type")
+    wave_direction: EnumProperty(
+        name="Direction", items=_wave_directions, default=0,
+        description="Blender Wave: the Wave Texture's Bands or Rings Direction (the fourth, "
+                    "Diagonal for Bands, is Spherical for Rings)")
+    profile: EnumProperty(name="Wave Profile", items=WAVE_PROFILES, default="sine",
+                          description="Blender Wave: the Wave Texture's profile")
     detail: FloatProperty(name="Detail", default=2.0, min=0.0, max=15.0, precision=3,
-                          description="Blender Noise and Musgrave: the texture node's Detail "
-                                      "(Noise: octaves beyond the first; Musgrave: octaves; a "
-                                      "fraction blends one more in)")
+                          description="Blender Noise, Musgrave and Wave: the texture node's "
+                                      "Detail (Noise and Wave: octaves beyond the first; "
+                                      "Musgrave: octaves; a fraction blends one more in)")
     roughness: FloatProperty(name="Roughness", default=0.5, min=0.0, max=1.0, subtype="FACTOR",
                              description="Blender Noise: the Noise Texture's Roughness (each "
                                          "octave's weight relative to the one before)")
     distortion: FloatProperty(name="Distortion", default=0.0, precision=3,
                               description="Blender Noise: the Noise Texture's Distortion (the "
-                                          "point moved by three other noises first)")
+                                          "point moved by three other noises first); Blender "
+                                          "Wave: the Wave Texture's (the wave moved by a "
+                                          "noise)")
+    detail_scale: FloatProperty(name="Detail Scale", default=1.0, precision=3,
+                                description="Blender Wave: the Wave Texture's Detail Scale (the "
+                                            "distorting noise's frequency relative to Scale)")
+    detail_roughness: FloatProperty(
+        name="Detail Roughness", default=0.5, min=0.0, max=1.0, subtype="FACTOR",
+        description="Blender Wave: the Wave Texture's Detail Roughness (each octave of the "
+                    "distorting noise's weight relative to the one before)")
     dimension: FloatProperty(name="Dimension", default=2.0, min=0.0, max=1000.0, precision=3,
                              description="Blender Musgrave: the Musgrave Texture's Dimension "
                                          "(each octave's weight is Lacunarity^-Dimension times "

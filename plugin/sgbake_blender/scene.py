@@ -10,7 +10,8 @@ Every per-layer key of the scene format is covered: the common ones (name, weigh
 mask with its image, uv, tiling, offset and filter), the image ones (image, filter, wrap, tiling,
 offset), uv, scale/strength, space, green, kind, axis, sharpness, min_weight and the volume's
 function, amplitude, frequency, direction, phase, seed, octaves, detail, roughness,
-distortion, dimension, lacunarity, gradient and step; a
+distortion, dimension, lacunarity, wave, wave_direction, profile, detail_scale,
+detail_roughness, gradient and step; a
 height's remap (its Remap text, parsed by remap_points: LayerError for text that is not one).
 """
 
@@ -28,11 +29,14 @@ MAPS = (
     ("mask", "Mask", "1 where a triangle covers the texel, else 0"),
 )
 # The volume functions that are Blender's procedural textures -> the layer settings holding the
-# node's inputs besides its Scale (the frequency), sent under the same keys; libsgbake refuses
-# another function's keys (a "roughness" on a blender-musgrave volume).
+# node's enum properties (in the scene's names) and its inputs besides its Scale (the
+# frequency), sent under the same keys; libsgbake refuses another function's keys (a
+# "roughness" on a blender-musgrave volume).
 BLENDER_TEXTURE_SETTINGS = {
     "blender-noise": ("detail", "roughness", "distortion"),
     "blender-musgrave": ("detail", "dimension", "lacunarity"),
+    "blender-wave": ("wave", "wave_direction", "profile", "distortion", "detail", "detail_scale",
+                     "detail_roughness", "phase"),
 }
 # Maps that read no layer: their bakes send none, so an unfinished layer cannot stop them.
 LAYERLESS_MAPS = {"tangent", "bitangent", "mask"}
@@ -43,8 +47,8 @@ WORLD_SHADED_MAPS = {"tangent-normal", "object-normal", "derivative", "surface-g
 LAYER_TYPES = (
     ("height", "Height", "Height image on a UV map"),
     ("normal", "Normal", "Normal map image on a UV map (tangent or object space)"),
-    ("volume", "Volume", "Procedural height in object space (sine, noise, or Blender's Noise "
-                         "or Musgrave Texture)"),
+    ("volume", "Volume", "Procedural height in object space (sine, noise, or Blender's Noise, "
+                         "Musgrave or Wave Texture)"),
     ("planar", "Planar", "Image projected along an object axis"),
     ("triplanar", "Triplanar", "Image projected on the three axis planes and blended"),
 )
@@ -122,6 +126,11 @@ def _number(value):
     return float(value) if isinstance(value, float) else int(value)
 
 
+def _setting(value):
+    """A Blender property as JSON: an enum's name as it is, a number as _number."""
+    return value if isinstance(value, str) else _number(value)
+
+
 def _pair(values):
     """A 2-vector property as a JSON list of two numbers."""
     return [_number(values[0]), _number(values[1])]
@@ -194,7 +203,8 @@ def layer_json(layer, uv_index, default_uv=None):
     sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json).
     A height's Remap goes as "remap" (remap_points, which raises LayerError for bad text).
     A volume sends its function's own settings only (a Blender Noise's detail, roughness and
-    distortion, a Blender Musgrave's detail, dimension and lacunarity:
+    distortion, a Blender Musgrave's detail, dimension and lacunarity, a Blender Wave's type,
+    direction, profile, distortion, detail, detail scale and roughness and phase:
     BLENDER_TEXTURE_SETTINGS; libsgbake refuses another function's), and like a projection its
     "mapping" when it has one (a Mapping node, another object's or the Generated coordinates).
     A layer of one material slot (material_index >= 0) sends it as "material": libsgbake then
@@ -234,8 +244,8 @@ def layer_json(layer, uv_index, default_uv=None):
                          phase=_number(layer.phase))
         elif layer.function == "noise":
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
-        else:  # Blender's Noise or Musgrave Texture: its inputs (its Scale is the frequency)
-            entry.update({key: _number(getattr(layer, key))
+        else:  # Blender's Noise, Musgrave or Wave Texture (its Scale is the frequency)
+            entry.update({key: _setting(getattr(layer, key))
                           for key in BLENDER_TEXTURE_SETTINGS.get(layer.function, ())})
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))

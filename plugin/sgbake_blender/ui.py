@@ -174,7 +174,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             elif layer.function == "noise":
                 col.prop(layer, "seed")
                 col.prop(layer, "octaves")
-            for name in texture or ():  # a Blender texture's inputs
+            for name in texture or ():  # a Blender texture's enums and inputs
                 col.prop(layer, name)
             col.prop(layer, "gradient")
             if layer.gradient in ("central", "tetrahedral"):

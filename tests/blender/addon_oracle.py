@@ -100,6 +100,15 @@
    a reason (the node back as fBM 3D gives one); a volume layer made by hand with function
    Blender Musgrave sends its Detail, Dimension and Lacunarity (nothing of Blender Noise's) and
    bakes.
+   Wave Texture (wave_case): a Wave Texture (WAVE_NODE: Rings, Spherical, Sine; WAVE_INPUTS) on
+   Suzanne's own object coordinates through a Mapping node (Point) into the Bump: Layers from
+   Material must make one "blender-wave" volume layer of the node's settings (its enums in the
+   scene's names, WAVE_ENUMS) and its Mapping, sent so, baked as Cycles bakes it (WAVE_*:
+   median and p99), the same job without its "phase" clearly worse; Cycles' normals must lean
+   less than WAVE_LEAN_DEG off the surface's. wave_checks: Bands Diagonal Saw and Rings Z
+   Triangle give the scene's names, the Color output the Fac's layer, a Phase Offset fed by
+   another texture no layer and a reason; a volume layer made by hand with function Blender
+   Wave sends its settings (nothing of the other functions') and bakes.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -272,6 +281,23 @@ MUSGRAVE_LEAN_DEG = 35.0
 MUSGRAVE_MEDIAN_DEG = 0.01
 MUSGRAVE_P99_DEG = 0.01
 MUSGRAVE_CONTROL_FACTOR = 3.0
+# The Wave case (wave_case): a Wave Texture (WAVE_NODE, WAVE_INPUTS) on Suzanne's own object
+# coordinates through a Mapping node (Point, WAVE_MAPPING) into the Bump (Distance
+# WAVE_DISTANCE: Cycles' normals lean less than WAVE_LEAN_DEG off the surface's, as the
+# Musgrave case checks). Layers from Material must make a "blender-wave" volume layer of those
+# settings (its enums as WAVE_ENUMS) and that mapping; its bake must be Cycles' (median <=
+# WAVE_MEDIAN_DEG, p99 <= WAVE_P99_DEG) and the same job without the layer's "phase" at least
+# WAVE_CONTROL_FACTOR times worse.
+WAVE_NODE = {"wave_type": "RINGS", "rings_direction": "SPHERICAL", "wave_profile": "SIN"}
+WAVE_ENUMS = {"wave": "rings", "wave_direction": "spherical", "profile": "sine"}
+WAVE_INPUTS = {"Scale": 1.5, "Distortion": 1.2, "Detail": 2.5, "Detail Scale": 1.3,
+               "Detail Roughness": 0.6, "Phase Offset": 0.7}
+WAVE_MAPPING = ((0.2, -0.3, 0.1), (0.3, -0.4, 0.5), (1.1, 0.9, 1.2))
+WAVE_DISTANCE = 0.02
+WAVE_LEAN_DEG = 35.0
+WAVE_MEDIAN_DEG = 0.01
+WAVE_P99_DEG = 0.01
+WAVE_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -2296,28 +2322,42 @@ MUSGRAVE_KEYS = {"frequency": "Scale", "detail": "Detail", "dimension": "Dimensi
 def musgrave_case(settings, ob, work):
     """The bump material's Height fed by a Musgrave Texture (MUSGRAVE_INPUTS) on the object's
     own coordinates through a Mapping node (MUSGRAVE_MAPPING), Distance MUSGRAVE_DISTANCE:
-    Layers from Material, then the add-on's tangent-normal bake (addon_musgrave.npy), the same
-    job without the layer's "dimension" and "lacunarity" (addon_musgrave_control.npy) and
-    Cycles' (cycles_musgrave.npy, its mask cycles_musgrave_mask.npy). The material is put back
-    afterwards. Returns the manifest entry (result, the layer sent, checks). Also the add-on's
-    bake of the layer at amplitude 0 (addon_musgrave_flat.npy), the normals Cycles' lean off."""
+    texture_case "musgrave", its control without the layer's "dimension" and "lacunarity"."""
+    return texture_case(settings, ob, work, "musgrave", make_musgrave, MUSGRAVE_KEYS,
+                        MUSGRAVE_INPUTS, {}, {"roughness", "distortion"}, MUSGRAVE_MAPPING,
+                        MUSGRAVE_DISTANCE, ("dimension", "lacunarity"))
+
+
+def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, mapping_values,
+                 distance_value, control_keys):
+    """The bump material's Height fed by the Fac of the procedural texture node make(tree)
+    makes (`inputs`: its inputs -> values; `enums`: the layer settings its enum properties
+    must give, as sent) on the object's own coordinates through a Mapping node (Point,
+    `mapping_values`), Distance `distance_value`: Layers from Material must make one
+    "blender-CASE" volume layer of those settings (`keys`: the layer's settings -> the node's
+    inputs) and that mapping, sending none of `absent`; then the add-on's tangent-normal bake
+    (addon_CASE.npy), the same job without `control_keys` (addon_CASE_control.npy), Cycles'
+    (cycles_CASE.npy, its mask cycles_CASE_mask.npy) and the add-on's bake of the layer at
+    amplitude 0 (addon_CASE_flat.npy), the normals Cycles' lean off. The material is put back
+    afterwards. Returns the manifest entry (result, the layer sent, checks)."""
     import bpy
     import numpy as np
     from sgbake_blender import operators
+    function = f"blender-{case}"
     tree = ob.active_material.node_tree
     tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
     bump = next(n for n in tree.nodes if n.type == "BUMP")
     distance = bump.inputs["Distance"].default_value
-    musgrave = make_musgrave(tree)
+    texture = make(tree)
     coordinates = tree.nodes.new("ShaderNodeTexCoord")
     mapping = tree.nodes.new("ShaderNodeMapping")
     mapping.vector_type = "POINT"
-    for name, value in zip(("Location", "Rotation", "Scale"), MUSGRAVE_MAPPING):
+    for name, value in zip(("Location", "Rotation", "Scale"), mapping_values):
         mapping.inputs[name].default_value = value
     tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
-    tree.links.new(mapping.outputs["Vector"], musgrave.inputs["Vector"])
-    tree.links.new(musgrave.outputs["Fac"], bump.inputs["Height"])
-    bump.inputs["Distance"].default_value = MUSGRAVE_DISTANCE
+    tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    tree.links.new(texture.outputs["Fac"], bump.inputs["Height"])
+    bump.inputs["Distance"].default_value = distance_value
     entry = {"result": None, "checks": []}
     close = lambda a, b: abs(a - b) < 1e-6  # noqa: E731  (float32 properties)
     try:
@@ -2330,30 +2370,31 @@ def musgrave_case(settings, ob, work):
         entry["layer"] = sent
         mapped = sent.get("mapping", {})
         entry["checks"].append({
-            "name": "musgrave: Layers from Material makes one blender-musgrave volume of the "
+            "name": f"{case}: Layers from Material makes one {function} volume of the "
                     "node's settings and its Mapping, sent so",
             "ok": (layer is not None and layer.type == "volume"
-                   and layer.function == "blender-musgrave"
-                   and close(layer.amplitude, MUSGRAVE_DISTANCE)
-                   and all(close(getattr(layer, key), MUSGRAVE_INPUTS[name])
-                           for key, name in MUSGRAVE_KEYS.items())
-                   and sent.get("function") == "blender-musgrave"
+                   and layer.function == function
+                   and close(layer.amplitude, distance_value)
+                   and all(close(getattr(layer, key), inputs[name])
+                           for key, name in keys.items())
+                   and all(getattr(layer, key) == value for key, value in enums.items())
+                   and sent.get("function") == function
                    and sent.get("gradient") == "bump-node"
-                   and close(sent.get("amplitude", 0), MUSGRAVE_DISTANCE)
-                   and all(close(sent.get(key, -1), MUSGRAVE_INPUTS[name])
-                           for key, name in MUSGRAVE_KEYS.items())
-                   and not {"roughness", "distortion", "seed", "octaves", "step"} & set(sent)
+                   and close(sent.get("amplitude", 0), distance_value)
+                   and all(close(sent.get(key, -1), inputs[name])
+                           for key, name in keys.items())
+                   and all(sent.get(key) == value for key, value in enums.items())
+                   and not ({"seed", "octaves", "step"} | set(absent)) & set(sent)
                    and "matrix" not in mapped and "type" not in mapped
                    and all(close(a, b) for key, want in zip(("location", "rotation", "scale"),
-                                                            MUSGRAVE_MAPPING)
+                                                            mapping_values)
                            for a, b in zip(mapped.get(key, [9] * 3), want))),
-            "expected": f"one blender-musgrave volume, {MUSGRAVE_INPUTS}, amplitude "
-                        f"{MUSGRAVE_DISTANCE}, bump-node, mapping {MUSGRAVE_MAPPING}, no "
-                        "roughness or distortion",
+            "expected": f"one {function} volume, {inputs}, {enums}, amplitude "
+                        f"{distance_value}, bump-node, mapping {mapping_values}, none of "
+                        f"{sorted(absent)}",
             "message": f"{len(settings.layers)} layer(s); sent {sent}"})
         if layer is not None:
-            entry["result"] = bake_against_cycles(settings, ob, work, "musgrave",
-                                                  ("dimension", "lacunarity"))
+            entry["result"] = bake_against_cycles(settings, ob, work, case, control_keys)
             # The surface's own normals (the layer at amplitude 0), what the bump leans off.
             job = operators.BakeJob(bpy.context)
             for scene_of_tile in job.scenes.values():
@@ -2362,9 +2403,9 @@ def musgrave_case(settings, ob, work):
             job.run()
             if job.error is None:
                 flat, _ = job.finish()
-                np.save(os.path.join(work, "addon_musgrave_flat.npy"), bc.image_array(flat))
+                np.save(os.path.join(work, f"addon_{case}_flat.npy"), bc.image_array(flat))
     finally:
-        for node in (mapping, coordinates, musgrave):
+        for node in (mapping, coordinates, texture):
             tree.nodes.remove(node)
         tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
         bump.inputs["Distance"].default_value = distance
@@ -2440,6 +2481,110 @@ def musgrave_checks(settings, ob):
     return checks
 
 
+def make_wave(tree, inputs=None, node=None):
+    """A Wave Texture node in `tree` with its properties `node` (WAVE_NODE by default) and
+    `inputs` (WAVE_INPUTS by default)."""
+    wave = tree.nodes.new("ShaderNodeTexWave")
+    for prop, value in (node or WAVE_NODE).items():
+        setattr(wave, prop, value)
+    for name, value in (inputs or WAVE_INPUTS).items():
+        wave.inputs[name].default_value = value
+    return wave
+
+
+WAVE_KEYS = {"frequency": "Scale", "distortion": "Distortion", "detail": "Detail",
+             "detail_scale": "Detail Scale", "detail_roughness": "Detail Roughness",
+             "phase": "Phase Offset"}  # the layer's settings -> the node's inputs
+
+
+def wave_case(settings, ob, work):
+    """The bump material's Height fed by a Wave Texture (WAVE_NODE, WAVE_INPUTS) on the object's
+    own coordinates through a Mapping node (WAVE_MAPPING), Distance WAVE_DISTANCE:
+    texture_case "wave", its enums WAVE_ENUMS, its control without the layer's "phase"."""
+    return texture_case(settings, ob, work, "wave", make_wave, WAVE_KEYS, WAVE_INPUTS,
+                        WAVE_ENUMS, {"roughness", "dimension", "lacunarity", "direction"},
+                        WAVE_MAPPING, WAVE_DISTANCE, ("phase",))
+
+
+def wave_checks(settings, ob):
+    """Layers from Material on Wave Textures: Bands Diagonal Saw and Rings Z Triangle give the
+    scene's names, the Color output the Fac's layer, a Phase Offset fed by a node no layer and
+    a reason; and a volume layer made by hand with function Blender Wave. Returns check
+    records like expect_error's."""
+    import bpy
+    from sgbake_blender import operators
+    tree = ob.active_material.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    wave = make_wave(tree)
+    checks = []
+
+    def check(name, ok, expected, message):
+        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
+
+    try:
+        tree.links.new(wave.outputs["Fac"], bump.inputs["Height"])
+        for node, names in ((("BANDS", "bands_direction", "DIAGONAL", "SAW"),
+                             ("bands", "diagonal", "saw")),
+                            (("RINGS", "rings_direction", "Z", "TRI"), ("rings", "z", "triangle"))):
+            wave.wave_type, wave.wave_profile = node[0], node[3]
+            setattr(wave, node[1], node[2])
+            found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+            made = {key: found[0].get(key) for key in WAVE_ENUMS} if len(found) == 1 else {}
+            check(f"wave: {node[0].title()} {node[2].title()} {node[3].title()} gives the scene's "
+                  "names", made == dict(zip(WAVE_ENUMS, names))
+                  and found[0].get("function") == "blender-wave",
+                  f"one blender-wave layer, {dict(zip(WAVE_ENUMS, names))}",
+                  f"{found}; skipped {skipped}")
+        tree.links.new(wave.outputs["Color"], bump.inputs["Height"])
+        from_color, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("wave: the Color output (Fac, Fac, Fac) gives the Fac's layer",
+              len(from_color) == 1 and from_color == found,
+              f"the Fac's layer {found}", f"{from_color}; skipped {skipped}")
+        tree.links.new(wave.outputs["Fac"], bump.inputs["Height"])
+        feeder = tree.nodes.new("ShaderNodeTexNoise")
+        tree.links.new(feeder.outputs["Fac"], wave.inputs["Phase Offset"])
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        reason = "Phase Offset from a node"
+        check("wave: a Phase Offset fed by another texture gives no layer and a reason",
+              not found and any(f"'{bump.name}'" in note and reason in note
+                                for note in skipped),
+              f"no layer, '{bump.name}' skipped: ...{reason}...", f"{found}; skipped {skipped}")
+        tree.nodes.remove(feeder)
+    finally:
+        tree.nodes.remove(wave)
+        tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    # A volume layer made by hand, function Blender Wave: its settings sent (none of the other
+    # functions'), and it bakes.
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.function = "by hand", "volume", "blender-wave"
+    layer.wave, layer.wave_direction, layer.profile = "bands", "diagonal", "triangle"
+    layer.frequency, layer.phase, layer.distortion, layer.detail = 4.0, 0.5, 0.8, 1.5
+    layer.detail_scale, layer.detail_roughness = 2.0, 0.7
+    layer.amplitude, layer.gradient = 0.01, "bump-node"
+    want = {"function": "blender-wave", "wave": "bands", "wave_direction": "diagonal",
+            "profile": "triangle", "frequency": 4.0, "phase": 0.5, "distortion": 0.8,
+            "detail": 1.5, "detail_scale": 2.0, "detail_roughness": 0.7}
+    settings.width = settings.height = 64
+    try:
+        job = operators.BakeJob(bpy.context)
+        sent = job.scene["layers"][-1]
+        job.run()
+    except Exception as exc:  # (BakeInputError: reported as the check's failure)
+        sent, job = {"error": str(exc)}, None
+    check("wave: a Blender Wave volume made by hand is sent with its settings and bakes",
+          job is not None and job.error is None
+          and all(sent.get(key) == value if isinstance(value, str)
+                  else abs(sent.get(key, -1) - value) < 1e-6 for key, value in want.items())
+          and not {"roughness", "dimension", "lacunarity", "direction", "seed", "octaves",
+                   "mapping"} & set(sent),
+          f"{want}; no roughness, dimension, lacunarity, direction, seed, octaves or mapping; "
+          "baked", f"sent {sent}; error {job.error if job else None}")
+    settings.layers.remove(len(settings.layers) - 1)
+    settings.width = settings.height = SIZE
+    return checks
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -2466,10 +2611,12 @@ def blender_make(work, library_path, sabotage):
     manifest["remap"] = remap_case(settings, ob, work)
     manifest["noise"] = noise_case(settings, ob, work)
     manifest["musgrave"] = musgrave_case(settings, ob, work)
+    manifest["wave"] = wave_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
                           + musgrave_checks(settings, ob)
+                          + wave_checks(settings, ob)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
@@ -2520,6 +2667,8 @@ def blender_compare(work):
     results["noise_generated"] = against_cycles(work, "noise_generated")
     results["musgrave"] = against_cycles(work, "musgrave")
     results["musgrave_lean"] = lean_stats(work, "musgrave")
+    results["wave"] = against_cycles(work, "wave")
+    results["wave_lean"] = lean_stats(work, "wave")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -2780,23 +2929,20 @@ def evaluate(manifest, results):
         f"{MUSGRAVE_DISTANCE:g}", manifest["musgrave"], results["musgrave"],
         "without the layer's dimension and lacunarity (2 and 2)", MUSGRAVE_MEDIAN_DEG,
         MUSGRAVE_CONTROL_FACTOR, MUSGRAVE_P99_DEG)
-    lean = results["musgrave_lean"]
-    if "error" in lean:
-        failures.append(f"musgrave, lean: {lean['error']}")
-    else:
-        ok = lean["max_deg"] < MUSGRAVE_LEAN_DEG
-        print(f"    Cycles' normals lean off the surface's: median {lean['median_deg']:.1f}, p99 "
-              f"{lean['p99_deg']:.1f}, max {lean['max_deg']:.1f} deg -> {'ok' if ok else 'FAIL'}"
-              f" (< {MUSGRAVE_LEAN_DEG:g})")
-        if not ok:
-            failures.append(f"musgrave: Cycles' normals lean up to {lean['max_deg']:.1f} deg "
-                            f"off the surface's (bar {MUSGRAVE_LEAN_DEG:g}: lower "
-                            "MUSGRAVE_DISTANCE)")
+    failures += evaluate_lean("musgrave", results["musgrave_lean"], MUSGRAVE_LEAN_DEG)
+    failures += evaluate_case_against_cycles(
+        "wave", "a Wave Texture (" + ", ".join(WAVE_ENUMS.values()) + ", "
+        + ", ".join(f"{k} {v:g}" for k, v in WAVE_INPUTS.items())
+        + ") on object coordinates through a Mapping node (Point), Distance "
+        f"{WAVE_DISTANCE:g}", manifest["wave"], results["wave"],
+        "without the layer's phase", WAVE_MEDIAN_DEG, WAVE_CONTROL_FACTOR, WAVE_P99_DEG)
+    failures += evaluate_lean("wave", results["wave_lean"], WAVE_LEAN_DEG)
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
+                  + manifest["wave"]["checks"]
                   + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
@@ -2825,6 +2971,19 @@ def evaluate_world(entry, results):
                                          r["control"], "without the transform",
                                          WORLD_MEDIAN_DEG, WORLD_CONTROL_FACTOR)
     return failures
+
+
+def evaluate_lean(case, lean, bar):
+    """Prints how far Cycles' normals of `case` lean off the surface's (lean_stats); returns
+    failures: a lean of `bar` degrees or more (the case's Distance is too large)."""
+    if "error" in lean:
+        return [f"{case}, lean: {lean['error']}"]
+    ok = lean["max_deg"] < bar
+    print(f"    Cycles' normals lean off the surface's: median {lean['median_deg']:.1f}, p99 "
+          f"{lean['p99_deg']:.1f}, max {lean['max_deg']:.1f} deg -> {'ok' if ok else 'FAIL'}"
+          f" (< {bar:g})")
+    return [] if ok else [f"{case}: Cycles' normals lean up to {lean['max_deg']:.1f} deg off "
+                          f"the surface's (bar {bar:g}: lower {case.upper()}_DISTANCE)"]
 
 
 def judge_against_cycles(name, label, ours, control, control_what, bar, factor):
