@@ -309,6 +309,12 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                         .detailScale = layer.noiseDetailScale,
                                         .detailRoughness = layer.noiseDetailRoughness,
                                         .phase = layer.phase}));
+    case VolumeFunction::kBlenderVoronoi:
+      return owned(BlenderVoronoi::create({.amplitude = layer.amplitude,
+                                           .scale = layer.frequency,
+                                           .randomness = layer.voronoiRandomness,
+                                           .metric = layer.voronoiMetric,
+                                           .exponent = layer.voronoiExponent}));
     case VolumeFunction::kNoise:
       break;
   }

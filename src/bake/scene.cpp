@@ -125,7 +125,12 @@ constexpr Named<VolumeFunction> kFunctions[] = {
     {"noise", VolumeFunction::kNoise},
     {"blender-noise", VolumeFunction::kBlenderNoise},
     {"blender-musgrave", VolumeFunction::kBlenderMusgrave},
-    {"blender-wave", VolumeFunction::kBlenderWave}};
+    {"blender-wave", VolumeFunction::kBlenderWave},
+    {"blender-voronoi", VolumeFunction::kBlenderVoronoi}};
+constexpr Named<VoronoiMetric> kVoronoiMetrics[] = {{"euclidean", VoronoiMetric::kEuclidean},
+                                                    {"manhattan", VoronoiMetric::kManhattan},
+                                                    {"chebyshev", VoronoiMetric::kChebyshev},
+                                                    {"minkowski", VoronoiMetric::kMinkowski}};
 constexpr Named<WaveType> kWaveTypes[] = {{"bands", WaveType::kBands}, {"rings", WaveType::kRings}};
 constexpr Named<WaveDirection> kWaveDirections[] = {{"x", WaveDirection::kX},
                                                     {"y", WaveDirection::kY},
@@ -427,11 +432,33 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
-      add({"function",     "amplitude",        "frequency",    "direction",      "phase",
-           "seed",         "octaves",          "detail",       "roughness",      "distortion",
-           "dimension",    "lacunarity",       "wave",         "wave_direction", "profile",
-           "detail_scale", "detail_roughness", "mapping",      "gradient",       "step",
-           "base",         "strength",         "height_space", "remap"});
+      add({"function",
+           "amplitude",
+           "frequency",
+           "direction",
+           "phase",
+           "seed",
+           "octaves",
+           "detail",
+           "roughness",
+           "distortion",
+           "dimension",
+           "lacunarity",
+           "wave",
+           "wave_direction",
+           "profile",
+           "detail_scale",
+           "detail_roughness",
+           "randomness",
+           "metric",
+           "exponent",
+           "mapping",
+           "gradient",
+           "step",
+           "base",
+           "strength",
+           "height_space",
+           "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
@@ -831,7 +858,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     const bool noise = layer.function == VolumeFunction::kBlenderNoise;
     const bool musgrave = layer.function == VolumeFunction::kBlenderMusgrave;
     const bool wave = layer.function == VolumeFunction::kBlenderWave;
-    const bool blender = noise || musgrave || wave;
+    const bool voronoi = layer.function == VolumeFunction::kBlenderVoronoi;
+    const bool blender = noise || musgrave || wave || voronoi;
     const std::string function = nameIn(kFunctions, layer.function);
     const auto onlyFor = [&](std::initializer_list<const char*> keys, bool applies,
                              const char* owner) {
@@ -850,6 +878,7 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"roughness"}, noise, "blender-noise");
     onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
             "blender-wave");
+    onlyFor({"randomness", "metric", "exponent"}, voronoi, "blender-voronoi");
     onlyFor({"dimension", "lacunarity"}, musgrave, "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
     if (blender) layer.frequency = 5;  // the Noise and Musgrave Textures' default Scale
@@ -862,6 +891,9 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
     if (reader.has("dimension")) layer.noiseDimension = reader.number("dimension");
     if (reader.has("lacunarity")) layer.noiseLacunarity = reader.number("lacunarity");
+    if (reader.has("randomness")) layer.voronoiRandomness = reader.number("randomness");
+    reader.optionalName("metric", kVoronoiMetrics, layer.voronoiMetric);
+    if (reader.has("exponent")) layer.voronoiExponent = reader.number("exponent");
     reader.optionalName("wave", kWaveTypes, layer.waveType);
     reader.optionalName("wave_direction", kWaveDirections, layer.waveDirection);
     reader.optionalName("profile", kWaveProfiles, layer.waveProfile);
@@ -1580,6 +1612,10 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["detail"] = layer.noiseDetail;
         j["dimension"] = layer.noiseDimension;
         j["lacunarity"] = layer.noiseLacunarity;
+      } else if (layer.function == VolumeFunction::kBlenderVoronoi) {
+        j["randomness"] = layer.voronoiRandomness;
+        j["metric"] = nameIn(kVoronoiMetrics, layer.voronoiMetric);
+        j["exponent"] = layer.voronoiExponent;
       } else {
         j["wave"] = nameIn(kWaveTypes, layer.waveType);
         j["wave_direction"] = nameIn(kWaveDirections, layer.waveDirection);

@@ -40,6 +40,37 @@ constexpr std::uint32_t hashWords(std::uint32_t x, std::uint32_t y, std::uint32_
   return finalMix(init + x, init + y, init + z);
 }
 
+/// lookup3's `mix` of (a, b, c): six rounds of x −= z, x ^= z rotated left by k, z += y, round the
+/// words.
+constexpr void mixWords(std::uint32_t& a, std::uint32_t& b, std::uint32_t& c) {
+  const auto round = [](std::uint32_t& x, std::uint32_t& y, std::uint32_t& z, int k) {
+    x -= z;
+    x ^= rotate(z, k);
+    z += y;
+  };
+  round(a, b, c, 4);
+  round(b, c, a, 6);
+  round(c, a, b, 8);
+  round(a, b, c, 16);
+  round(b, c, a, 19);
+  round(c, a, b, 4);
+}
+
+/// lookup3's hash of four words (Cycles' hash_uint4): three words mixed in, then the fourth
+/// added to a and the final mix.
+constexpr std::uint32_t hashWords(std::uint32_t x, std::uint32_t y, std::uint32_t z,
+                                  std::uint32_t w) {
+  constexpr std::uint32_t init = 0xdeadbeefu + (4u << 2) + 13u;
+  std::uint32_t a = init + x, b = init + y, c = init + z;
+  mixWords(a, b, c);
+  return finalMix(a + w, b, c);
+}
+
+/// A hash as Cycles maps it into [0, 1]: in float, divided by 2³² − 1.
+inline float unitFloat(std::uint32_t h) {
+  return static_cast<float>(h) / static_cast<float>(0xFFFFFFFFu);
+}
+
 /// Of two words (Cycles' hash_uint2), the third word not added.
 constexpr std::uint32_t hashWords(std::uint32_t x, std::uint32_t y) {
   constexpr std::uint32_t init = 0xdeadbeefu + (2u << 2) + 13u;
@@ -126,6 +157,19 @@ double perlin(Vec3d x, Vec3d* gradient) {
 }
 
 constexpr double kNoiseScale3 = 0.9820;  // Cycles' noise_scale3
+
+/// The bits of @p v as the float Cycles hashes.
+inline std::uint32_t floatBits(double v) {
+  return std::bit_cast<std::uint32_t>(static_cast<float>(v));
+}
+
+/// The offset of the point in the Voronoi cell at integer coordinates @p cell, in [0, 1)³ before
+/// the randomness: Cycles' hash_float3_to_float3 of the cell's coordinates.
+Vec3d voronoiCellPoint(Vec3d cell) {
+  const std::uint32_t x = floatBits(cell.x), y = floatBits(cell.y), z = floatBits(cell.z);
+  return {unitFloat(hashWords(x, y, z)), unitFloat(hashWords(x, y, z, floatBits(1.0))),
+          unitFloat(hashWords(x, y, z, floatBits(2.0)))};
+}
 
 }  // namespace
 
@@ -280,6 +324,91 @@ double BlenderMusgrave::value(Vec3d p) const { return params_.amplitude * fac(p,
 Vec3d BlenderMusgrave::analyticGradient(Vec3d p) const {
   Vec3d g;
   fac(p, &g);
+  return params_.amplitude * g;
+}
+
+Result<BlenderVoronoi> BlenderVoronoi::create(const BlenderVoronoiParams& params) {
+  for (const double v : {params.amplitude, params.scale, params.randomness, params.exponent}) {
+    if (!std::isfinite(v)) return Error::badInput("a Voronoi Texture setting is not finite");
+  }
+  if (params.metric == VoronoiMetric::kMinkowski && !(params.exponent > 0)) {
+    return Error::badInput("a Voronoi Texture's Minkowski exponent must be greater than 0");
+  }
+  if (!(std::abs(params.amplitude) * std::abs(params.scale) * 2 <= kMaxVolumeScale)) {
+    return Error::badInput("Voronoi Texture slopes beyond 1e300");
+  }
+  return BlenderVoronoi(params);
+}
+
+double BlenderVoronoi::distance(Vec3d position, Vec3d* gradient) const {
+  const Vec3d p = params_.scale * position;
+  const Vec3d cell{std::floor(p.x), std::floor(p.y), std::floor(p.z)};
+  const Vec3d local = p - cell;
+  const double randomness = std::clamp(params_.randomness, 0.0, 1.0);
+  const double e = params_.exponent;
+  // The metric's distance of d = local − point, and its gradient with respect to local.
+  const auto measure = [&](Vec3d d, Vec3d* slope) {
+    const Vec3d a{std::abs(d.x), std::abs(d.y), std::abs(d.z)};
+    const Vec3d sign{d.x < 0 ? -1.0 : 1.0, d.y < 0 ? -1.0 : 1.0, d.z < 0 ? -1.0 : 1.0};
+    switch (params_.metric) {
+      case VoronoiMetric::kManhattan:
+        if (slope) *slope = sign;
+        return a.x + a.y + a.z;
+      case VoronoiMetric::kChebyshev: {
+        const double m = std::max({a.x, a.y, a.z});
+        if (slope) {
+          *slope = a.x == m   ? Vec3d{sign.x, 0, 0}
+                   : a.y == m ? Vec3d{0, sign.y, 0}
+                              : Vec3d{0, 0, sign.z};
+        }
+        return m;
+      }
+      case VoronoiMetric::kMinkowski: {
+        const double sum = std::pow(a.x, e) + std::pow(a.y, e) + std::pow(a.z, e);
+        const double r = std::pow(sum, 1 / e);
+        if (slope) {
+          const auto part = [&](double v, double s) {
+            return v > 0 ? s * std::pow(v, e - 1) * std::pow(sum, 1 / e - 1) : 0.0;
+          };
+          *slope = {part(a.x, sign.x), part(a.y, sign.y), part(a.z, sign.z)};
+        }
+        return r;
+      }
+      default: {
+        const double r = std::sqrt(dot(d, d));
+        if (slope) *slope = r > 0 ? (1 / r) * d : Vec3d{};
+        return r;
+      }
+    }
+  };
+  double best = 8;  // Cycles' start: farther than any point of the 27 cells
+  Vec3d bestOffset{};
+  for (int k = -1; k <= 1; ++k) {
+    for (int j = -1; j <= 1; ++j) {
+      for (int i = -1; i <= 1; ++i) {
+        const Vec3d offset{double(i), double(j), double(k)};
+        const Vec3d point = offset + randomness * voronoiCellPoint(cell + offset);
+        const double d = measure(local - point, nullptr);
+        if (d < best) {
+          best = d;
+          bestOffset = point;
+        }
+      }
+    }
+  }
+  if (gradient != nullptr) {
+    Vec3d slope;
+    measure(local - bestOffset, &slope);
+    *gradient = params_.scale * slope;
+  }
+  return best;
+}
+
+double BlenderVoronoi::value(Vec3d p) const { return params_.amplitude * distance(p, nullptr); }
+
+Vec3d BlenderVoronoi::analyticGradient(Vec3d p) const {
+  Vec3d g;
+  distance(p, &g);
   return params_.amplitude * g;
 }
 

@@ -882,6 +882,18 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
                                      "wave": "rings", "wave_direction": "diagonal"})")),
             "scene.json: layers[0]: 'wave_direction': 'diagonal' applies to 'wave': 'bands' "
             "only");
+  Result<Scene> voronoi =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-voronoi", "randomness": 0.7,
+                    "metric": "minkowski", "exponent": 1.5})"),
+                 options());
+  ASSERT_TRUE(voronoi) << voronoi.error().message;
+  EXPECT_EQ(voronoi->layers[0].voronoiMetric, VoronoiMetric::kMinkowski);
+  EXPECT_NE(layerParametersJson(voronoi->layers[0]).find(R"("metric":"minkowski")"),
+            std::string::npos);
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                                     "metric": "cosine"})")),
+            "scene.json: layers[0]: unknown metric 'cosine' (expected euclidean, manhattan, "
+            "chebyshev or minkowski)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise",
                                      "profile": "saw"})")),
             "scene.json: layers[0]: key 'profile' does not apply to a blender-noise volume (it "

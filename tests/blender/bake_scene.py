@@ -227,8 +227,10 @@ def reshape_height(mat, kind):
 # "musgrave" a Musgrave Texture (fBM, 3D) of {"scale", "detail", "dimension", "lacunarity",
 # "mapping"}, with "kind": "wave" a Wave Texture of {"wave", "direction", "profile" (Blender's
 # names), "scale", "distortion", "detail", "detail_scale", "detail_roughness", "phase",
-# "mapping"}. The manifest entry has "noise": these settings, sgbake's "blender-noise" (or
-# "blender-musgrave", "blender-wave") volume layer with that "mapping".
+# "mapping"}, with "kind": "voronoi" a Voronoi Texture (F1, 3D, its Distance) of {"scale",
+# "randomness", "metric" (Blender's name), "exponent", "mapping"}. The manifest entry has
+# "noise": these settings, sgbake's "blender-noise" (or "blender-musgrave", "blender-wave",
+# "blender-voronoi") volume layer with that "mapping".
 NOISE = {}
 
 
@@ -257,6 +259,11 @@ def bump_by_noise(mat, settings):
         noise = nodes.new("ShaderNodeTexMusgrave")
         noise.musgrave_dimensions, noise.musgrave_type = "3D", "FBM"
         inputs = ("Scale", "Detail", "Dimension", "Lacunarity")
+    elif settings.get("kind") == "voronoi":
+        noise = nodes.new("ShaderNodeTexVoronoi")
+        noise.voronoi_dimensions, noise.feature = "3D", "F1"
+        noise.distance = settings["metric"]
+        inputs = ("Scale", "Randomness", "Exponent")
     elif settings.get("kind") == "wave":
         noise = nodes.new("ShaderNodeTexWave")
         noise.wave_type, noise.wave_profile = settings["wave"], settings["profile"]
@@ -275,7 +282,8 @@ def bump_by_noise(mat, settings):
         noise.inputs[socket].default_value = settings[key]
     links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
     links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
-    links.new(noise.outputs["Fac"], bump.inputs["Height"])
+    output = "Distance" if settings.get("kind") == "voronoi" else "Fac"
+    links.new(noise.outputs[output], bump.inputs["Height"])
 
 
 # name -> the object transform of a case (location, XYZ Euler rotation in radians, scale):
@@ -582,6 +590,11 @@ noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, d
 noise_case("wave_sphere", "sphere", 512, 0.02, kind="wave", wave="BANDS", direction="DIAGONAL",
            profile="SIN", scale=0.8, distortion=1.5, detail=2.5, detail_scale=1.5,
            detail_roughness=0.6, phase=0.4, mapping=NOISE_MAPPING)
+# Blender's Voronoi Texture's F1 Distance (cells) on the sphere, Euclidean and Minkowski.
+noise_case("voronoi_sphere", "sphere", 512, 0.03, kind="voronoi", scale=3.0, randomness=0.8,
+           metric="EUCLIDEAN", exponent=0.5, mapping=NOISE_MAPPING)
+noise_case("voronoi_minkowski_suzanne", "suzanne", 512, 0.025, kind="voronoi", scale=4.0,
+           randomness=1.0, metric="MINKOWSKI", exponent=1.6, mapping=NOISE_MAPPING)
 noise_case("wave_suzanne", "suzanne", 512, 0.02, kind="wave", wave="RINGS",
            direction="SPHERICAL", profile="TRI", scale=0.6, distortion=0.0, detail=2.0,
            detail_scale=1.0, detail_roughness=0.5, phase=0.0, mapping=NOISE_MAPPING)

@@ -154,6 +154,56 @@ TEST(BlenderWave, AnalyticGradientIsTheDerivativeOfTheValue) {
   EXPECT_GT(checked, 1300);
 }
 
+// With Randomness 0 every cell's point is its corner: Distance is the metric's distance to the
+// nearest lattice point, per axis min(f, 1 − f).
+TEST(BlenderVoronoi, WithoutRandomnessMeasuresToTheNearestLatticePoint) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> along(-4, 4);
+  for (const VoronoiMetric metric : {VoronoiMetric::kEuclidean, VoronoiMetric::kManhattan,
+                                     VoronoiMetric::kChebyshev, VoronoiMetric::kMinkowski}) {
+    Result<BlenderVoronoi> made =
+        BlenderVoronoi::create({.scale = 2, .randomness = 0, .metric = metric, .exponent = 1.5});
+    ASSERT_TRUE(made) << made.error().message;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3d p{along(rng), along(rng), along(rng)};
+      const auto nearest = [](double v) {
+        const double f = v - std::floor(v);
+        return std::min(f, 1 - f);
+      };
+      const Vec3d a{nearest(2 * p.x), nearest(2 * p.y), nearest(2 * p.z)};
+      const double expected =
+          metric == VoronoiMetric::kEuclidean   ? std::sqrt(dot(a, a))
+          : metric == VoronoiMetric::kManhattan ? a.x + a.y + a.z
+          : metric == VoronoiMetric::kChebyshev
+              ? std::max({a.x, a.y, a.z})
+              : std::pow(std::pow(a.x, 1.5) + std::pow(a.y, 1.5) + std::pow(a.z, 1.5), 1 / 1.5);
+      EXPECT_NEAR(made->value(p), expected, 1e-12) << static_cast<int>(metric);
+    }
+  }
+}
+
+// Away from the borders between cells' points the Distance's gradient is the metric's.
+TEST(BlenderVoronoi, AnalyticGradientIsTheDerivativeOfTheValue) {
+  std::mt19937_64 rng(32);
+  std::uniform_real_distribution<double> along(-2, 2);
+  int checked = 0;
+  for (const VoronoiMetric metric : {VoronoiMetric::kEuclidean, VoronoiMetric::kManhattan,
+                                     VoronoiMetric::kChebyshev, VoronoiMetric::kMinkowski}) {
+    Result<BlenderVoronoi> made = BlenderVoronoi::create(
+        {.amplitude = 0.3, .scale = 3, .randomness = 0.9, .metric = metric, .exponent = 1.7});
+    ASSERT_TRUE(made) << made.error().message;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3d p{along(rng), along(rng), along(rng)};
+      const Vec3d central = centralGradient([&](Vec3d q) { return made->value(q); }, p, 1e-7);
+      const Vec3d exact = made->analyticGradient(p);
+      if (maxAbsDiff(exact, central) > 1e-3) continue;  // a border between the two sides
+      EXPECT_LT(maxAbsDiff(exact, central), 1e-6) << static_cast<int>(metric);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1150);  // borders are rare at this step
+}
+
 // A Mapping node before the texture: the value at the mapped point, the gradient pulled back.
 TEST(MappedHeightVolume, ReadsTheMappedPointAndPullsTheGradientBack) {
   const BlenderNoise noise = makeNoise({.scale = 3, .detail = 1});

@@ -77,6 +77,7 @@ enum class VolumeFunction {
   kBlenderNoise,     ///< "blender-noise": BlenderNoise, Blender's Noise Texture (3D)
   kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (fBM, 3D)
   kBlenderWave,      ///< "blender-wave": BlenderWave, Blender's Wave Texture
+  kBlenderVoronoi,   ///< "blender-voronoi": BlenderVoronoi, Blender's Voronoi Texture (F1, 3D)
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
@@ -229,6 +230,11 @@ struct SceneLayer {
   WaveProfile waveProfile = WaveProfile::kSine;
   double noiseDetailScale = 1;
   double noiseDetailRoughness = 0.5;
+  /// blender-voronoi: "randomness", "metric" (euclidean | manhattan | chebyshev | minkowski),
+  /// "exponent" (Minkowski's)
+  double voronoiRandomness = 1;
+  VoronoiMetric voronoiMetric = VoronoiMetric::kEuclidean;
+  double voronoiExponent = 0.5;
   GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
   std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
 

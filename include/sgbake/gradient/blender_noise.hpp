@@ -132,6 +132,43 @@ class BlenderWave final : public HeightVolume {
   BlenderWaveParams params_;
 };
 
+/// The Voronoi Texture's Distance Metric.
+enum class VoronoiMetric { kEuclidean, kManhattan, kChebyshev, kMinkowski };
+
+/// @brief The Voronoi Texture node's settings (Feature F1, 3D: its Distance output) and the
+/// height's scale.
+struct BlenderVoronoiParams {
+  double amplitude = 1;   ///< height per unit of Distance
+  double scale = 5;       ///< the node's Scale
+  double randomness = 1;  ///< the node's Randomness (clamped to [0, 1])
+  VoronoiMetric metric = VoronoiMetric::kEuclidean;
+  double exponent = 0.5;  ///< the node's Exponent (Minkowski)
+};
+
+/// @brief Blender's Voronoi Texture, Feature F1 (3D), its Distance output, times an amplitude: a
+/// HeightVolume.
+///
+/// p = scale · P; each of the 27 cells around p's holds one point, the cell's corner plus
+/// randomness · a hash of the cell's coordinates (three lookup3 hashes of the coordinates' float
+/// bits, the second and third with a fourth word 1 and 2, as Cycles hashes them); Distance is the
+/// metric's distance from p to the nearest (the first of equals, cells in z, y, x order). Its
+/// gradient is the metric's, exact but where the nearest point changes.
+class BlenderVoronoi final : public HeightVolume {
+ public:
+  /// @return kBadInput for a non-finite setting, an exponent ≤ 0 with Minkowski, or slopes beyond
+  /// kMaxVolumeScale.
+  static Result<BlenderVoronoi> create(const BlenderVoronoiParams& params);
+
+  double value(Vec3d p) const override;
+  Vec3d analyticGradient(Vec3d p) const override;
+  /// The node's Distance at @p p (object space, before the amplitude), and its gradient.
+  double distance(Vec3d p, Vec3d* gradient) const;
+
+ private:
+  explicit BlenderVoronoi(const BlenderVoronoiParams& params) : params_(params) {}
+  BlenderVoronoiParams params_;
+};
+
 /// @brief The Noise Texture's fBm of @p p (no Scale, no distortion): octaves of ½ snoise + ½, as
 /// described above, and its gradient with respect to p.
 double blenderFractalNoise(Vec3d p, double detail, double roughness, Vec3d* gradient);
