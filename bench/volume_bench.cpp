@@ -10,7 +10,9 @@
 ///   - `Volume/<field>/<what>`: value(), and volumeGradient with kAnalytic, kCentral and
 ///     kTetrahedral (at the default step), for the directional sine, 1- and 4-octave noise, and
 ///     Blender's Noise Texture at Blender's defaults (Scale 5, Detail 2: three octaves) and
-///     with Distortion 0.5 (three more noises and their gradients).
+///     with Distortion 0.5 (three more noises and their gradients), and Blender's Musgrave
+///     (fBM), Wave (bands, distorted: its fbm) and Voronoi (F1, Euclidean) Textures at their
+///     defaults.
 ///   - `EqualError/<scheme>/target:<t>`: on the 1-octave noise, the step at which each finite
 ///     difference scheme reaches a max error of t (relative to the RMS analytic gradient
 ///     magnitude over a fixed point set, measured against the analytic gradient in the setup),
@@ -81,7 +83,24 @@ const sgbake::BlenderNoise& blenderNoiseField(bool distorted) {
   return distorted ? twisted : plain;
 }
 
-constexpr int kNumFields = 5;
+const HeightVolume& blenderField(int which) {
+  static const sgbake::BlenderMusgrave musgrave =
+      sgbake::BlenderMusgrave::create({.amplitude = 0.05}).value();
+  static const sgbake::BlenderWave wave =
+      sgbake::BlenderWave::create({.amplitude = 0.05, .distortion = 1}).value();
+  static const sgbake::BlenderVoronoi voronoi =
+      sgbake::BlenderVoronoi::create({.amplitude = 0.05}).value();
+  switch (which) {
+    case 0:
+      return musgrave;
+    case 1:
+      return wave;
+    default:
+      return voronoi;
+  }
+}
+
+constexpr int kNumFields = 8;
 
 const HeightVolume& field(int which) {
   switch (which) {
@@ -93,8 +112,10 @@ const HeightVolume& field(int which) {
       return noiseField(4);
     case 3:
       return blenderNoiseField(false);
-    default:
+    case 4:
       return blenderNoiseField(true);
+    default:
+      return blenderField(which - 5);
   }
 }
 
@@ -108,8 +129,14 @@ const char* fieldName(int which) {
       return "noise4";
     case 3:
       return "blender-noise";
-    default:
+    case 4:
       return "blender-noise-distorted";
+    case 5:
+      return "blender-musgrave";
+    case 6:
+      return "blender-wave-distorted";
+    default:
+      return "blender-voronoi";
   }
 }
 
