@@ -258,8 +258,9 @@ def _tile_list(tiles):
 
 class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
     """Add sgbake layers for the Bump and Normal Map nodes fed by an Image Texture node, and the
-    Bump nodes fed by a Noise, Musgrave or Wave Texture's Fac, in the active object's materials
-    (with several material slots, each layer applies to its slot's faces)"""
+    Bump nodes fed by a Noise, Musgrave or Wave Texture's Fac or a Voronoi Texture's Distance,
+    in the active object's materials (with several material slots, each layer applies to its
+    slot's faces)"""
     bl_idname = "object.sgbake_layers_from_material"
     bl_label = "Layers from Material"
     bl_options = {"REGISTER", "UNDO"}
@@ -285,7 +286,8 @@ class OBJECT_OT_sgbake_layers_from_material(bpy.types.Operator):
             what = (f"material '{sources[0][1].name}' has no" if single
                     else f"no material of object '{ob.name}' has a")
             self.report({"ERROR"}, f"{what} Bump or Normal Map node fed by an Image Texture "
-                                   "node (or a Bump fed by a Noise, Musgrave or Wave Texture)"
+                                   "node (or a Bump fed by a Noise, Musgrave, Wave or Voronoi "
+                                   "Texture)"
                         + _notes(skipped))
             return {"CANCELLED"}
         settings = context.scene.sgbake
@@ -358,7 +360,7 @@ def object_layers(sources, render_uv=None, ob=None):
             if not values and not slot_skipped:
                 slot_skipped.append("no Bump, Normal Map or Displacement node fed by an Image "
                                     "Texture node (or a Bump or Displacement by a Noise, "
-                                    "Musgrave or Wave Texture)")
+                                    "Musgrave, Wave or Voronoi Texture)")
             slot_skipped = [f"{where}: {note}" for note in slot_skipped]
             slot_ignored = [f"{where}: {note}" for note in slot_ignored]
         found += values
@@ -553,8 +555,8 @@ def _height_source(socket):
     function of its value the nodes between make: (node, channel, factor, points), or None when
     the chain is not followed, or a string saying why its height is not taken (a constant, a
     Noise Texture's Color). The texture: an Image Texture node with an image, or a Noise,
-    Musgrave or Wave Texture node's Fac (or a Wave Texture's Color, the Fac as a grey:
-    PROCEDURAL_TEXTURES' outputs; every channel its value;
+    Musgrave or Wave Texture node's Fac (or a Wave Texture's Color, the Fac as a grey), a
+    Voronoi Texture's Distance (PROCEDURAL_TEXTURES' outputs; every channel its value;
     _procedural_settings says whether a volume layer takes the node). Followed back through
     Reroutes, RGB to BW (the luminance, as the input's own conversion), Separate RGB or Color
     (RGB mode: channel r, g or b; the image's Alpha output is channel a, its Color the
@@ -578,10 +580,9 @@ def _height_source(socket):
                 channel = "a"
             break
         if node.type in PROCEDURAL_TEXTURES:
-            if link.from_socket.name not in PROCEDURAL_TEXTURES[node.type].outputs:
-                # (a Noise Texture's Color)
-                return (f"'{node.name}' {link.from_socket.name} output (three noises seeded "
-                        "apart; a volume layer is the noise of its Fac)")
+            texture = PROCEDURAL_TEXTURES[node.type]
+            if link.from_socket.name not in texture.outputs:
+                return f"'{node.name}' {link.from_socket.name} output ({texture.others})"
             channel = None  # (a grey: any channel of it is the Fac)
             break
         if node.type in ("SEPRGB", "SEPARATE_COLOR"):
@@ -683,7 +684,8 @@ def _surface_nodes(node_tree):
 
 def _not_image(socket):
     """Why `socket` gave no layer: what is linked into it instead of an Image Texture node
-    (or, into a height, a Noise, Musgrave or Wave Texture's Fac)."""
+    (or, into a height, a Noise, Musgrave or Wave Texture's Fac, a Voronoi Texture's
+    Distance)."""
     link = _source_link(socket)
     if link is not None and link.from_node.type == "TEX_IMAGE":
         return f"{socket.name}'s Image Texture node has no image"
@@ -831,7 +833,7 @@ def _height_settings(node, tex, channel, render_uv, ob, ignored, points=None):
 def _height_layer(node, source, inputs, render_uv, ob, ignored):
     """The settings of the layer of height input "Height" of `node` (a Bump or a Displacement
     node) fed as `source` says (_height_source), before its scale (_scale_key): an Image
-    Texture's (_height_settings), a Noise, Musgrave or Wave Texture's volume
+    Texture's (_height_settings), a Noise, Musgrave, Wave or Voronoi Texture's volume
     (_procedural_settings; a string when it is not taken); what of `node` (its `inputs` fed by
     nodes) and the texture the layer cannot take over goes into `ignored`."""
     tex, channel, _, points = source
@@ -858,11 +860,12 @@ def _scale_key(values):
 # have one value (property -> that value) for the function to be what Cycles computes; the
 # outputs the layer reads (grey: the Fac, a Wave Texture's Color (Fac, Fac, Fac) alike); the
 # node's enum properties the function takes (setting -> (the node's property, or a function of
-# the node naming it; Blender's values -> the scene's names)); and the inputs whose name is not
-# their setting's in title case (setting -> input).
+# the node naming it; Blender's values -> the scene's names)); the inputs whose name is not
+# their setting's in title case (setting -> input); and why its other outputs make no layer.
 ProceduralTexture = collections.namedtuple(
-    "ProceduralTexture", "function dimensions fixed outputs enums inputs",
-    defaults=({}, ("Fac",), {}, {}))
+    "ProceduralTexture", "function dimensions fixed outputs enums inputs others",
+    defaults=({}, ("Fac",), {}, {}, "three noises seeded apart; a volume layer is the noise of "
+                                    "its Fac"))
 PROCEDURAL_TEXTURES = {
     "TEX_NOISE": ProceduralTexture("blender-noise", "noise_dimensions"),
     "TEX_MUSGRAVE": ProceduralTexture("blender-musgrave", "musgrave_dimensions",
@@ -876,6 +879,12 @@ PROCEDURAL_TEXTURES = {
                                    "SPHERICAL": "spherical"}),
                "profile": ("wave_profile", {"SIN": "sine", "SAW": "saw", "TRI": "triangle"})},
         inputs={"phase": "Phase Offset"}),
+    "TEX_VORONOI": ProceduralTexture(
+        "blender-voronoi", "voronoi_dimensions", {"feature": "F1"}, outputs=("Distance",),
+        enums={"metric": ("distance", {"EUCLIDEAN": "euclidean", "MANHATTAN": "manhattan",
+                                       "CHEBYCHEV": "chebyshev", "MINKOWSKI": "minkowski"})},
+        others="each cell's random colour or its point, not a height; a volume layer is the "
+               "Distance"),
 }
 
 
@@ -900,16 +909,18 @@ def _enum_name(node, prop):
 
 
 def _procedural_settings(tex, ob=None):
-    """The settings of the volume layer of procedural texture node `tex`'s Fac (a Noise,
-    Musgrave or Wave Texture: PROCEDURAL_TEXTURES): its function with the node's enum
-    properties in the scene's names (a Wave Texture's type, direction and profile) and its
-    inputs (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of a
-    Noise Texture, Detail, Dimension and Lacunarity of a Musgrave Texture, Distortion, Detail,
-    Detail Scale, Detail Roughness and Phase Offset of a Wave Texture), the slopes as Cycles'
-    Bump node takes them (gradient "bump-node"), on the coordinates its Vector reads
-    (_vector_coordinates; unlinked, the Generated coordinates, as Cycles reads a procedural
-    texture); or a string saying why none is made: Dimensions other than 3D, a type the
-    function is not (a Musgrave Texture's other than fBM), an input fed by anything but
+    """The settings of the volume layer of procedural texture node `tex`'s height output (a
+    Noise, Musgrave or Wave Texture's Fac, a Voronoi Texture's Distance: PROCEDURAL_TEXTURES):
+    its function with the node's enum properties in the scene's names (a Wave Texture's type,
+    direction and profile, a Voronoi Texture's Distance Metric) and its inputs
+    (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of a Noise
+    Texture, Detail, Dimension and Lacunarity of a Musgrave Texture, Distortion, Detail, Detail
+    Scale, Detail Roughness and Phase Offset of a Wave Texture, Randomness and Exponent of a
+    Voronoi Texture), the slopes as Cycles' Bump node takes them (gradient "bump-node"), on the
+    coordinates its Vector reads (_vector_coordinates; unlinked, the Generated coordinates, as
+    Cycles reads a procedural texture); or a string saying why none is made: Dimensions other
+    than 3D, a type the function is not (a Musgrave Texture's other than fBM, a Voronoi
+    Texture's Feature Output other than F1), an input fed by anything but
     constants (_constant), a Vector that is not object coordinates (a UV map, a position in
     world space, ...)."""
     texture = PROCEDURAL_TEXTURES[tex.type]
@@ -917,9 +928,10 @@ def _procedural_settings(tex, ob=None):
         return (f"'{tex.name}' Dimensions {_enum_name(tex, texture.dimensions)} (a volume "
                 "layer is the 3D texture)")
     for prop, value in texture.fixed.items():
-        if getattr(tex, prop) != value:
-            return (f"'{tex.name}' type {_enum_name(tex, prop)} (a volume layer is the "
-                    f"{tex.bl_rna.properties[prop].enum_items[value].name} type)")
+        if getattr(tex, prop) != value:  # (Musgrave's Type, Voronoi's Feature Output)
+            rna = tex.bl_rna.properties[prop]
+            return (f"'{tex.name}' {rna.name.lower()} {_enum_name(tex, prop)} (a volume layer "
+                    f"is the {rna.enum_items[value].name} {rna.name.lower()})")
     enums = {}  # (in the table's order: a Wave Texture's type before its direction)
     for key, (prop, names) in texture.enums.items():
         prop = prop(tex) if callable(prop) else prop
@@ -945,16 +957,16 @@ def _procedural_settings(tex, ob=None):
 
 
 def _displacement_layer(node_tree, render_uv, ob, method, skipped, ignored):
-    """The height layer of the Material Output's Displacement (None when there is none to
-    bake): a Displacement node fed by an Image Texture (or a Noise, Musgrave or Wave Texture's
-    Fac: a volume layer, _height_layer, its amplitude the scale below), with the material's
-    Displacement method Bump Only, which Cycles bakes as a Bump node of Distance 1 fed by the
-    displacement along the normal, (height - Midlevel) x Scale in world units (in object space,
-    grown with the object's scale along the normal): a height layer of scale Scale in the
-    node's space (height_space), its slopes as Cycles takes them, its height through the nodes
-    between as _height_source composes them (a factor in the scale, or a "remap"). Other
-    methods displace the mesh, which sgbake does not; other nodes are not read (notes in
-    `skipped`)."""
+    """The height layer of the Material Output's Displacement (None when there is none to bake): a
+    Displacement node fed by an Image Texture (or a Noise, Musgrave or Wave Texture's Fac, a
+    Voronoi Texture's Distance: a volume layer, _height_layer, its amplitude the scale below),
+    with the material's Displacement method Bump Only, which Cycles bakes as a Bump node of
+    Distance 1 fed by the displacement along the normal, (height - Midlevel) x Scale in world
+    units (in object space, grown with the object's scale along the normal): a height layer of
+    scale Scale in the node's space (height_space), its slopes as Cycles takes them, its height
+    through the nodes between as _height_source composes them (a factor in the scale, or a
+    "remap"). Other methods displace the mesh, which sgbake does not; other nodes are not read
+    (notes in `skipped`)."""
     output = node_tree.get_output_node("CYCLES")
     link = _source_link(output.inputs["Displacement"]) if output is not None else None
     if link is None:
@@ -1165,13 +1177,14 @@ def material_layers(node_tree, render_uv=None, ob=None, displacement_method="BUM
 def _tree_layers(node_tree, render_uv=None, ob=None, displacement_method="BUMP"):
     """Layer settings (dicts of SgbakeLayer attributes) for each Bump node whose Height input
     and each Normal Map node whose Color input is an Image Texture node, and each Bump node
-    whose Height is a Noise, Musgrave or Wave Texture's Fac (a volume layer,
-    _procedural_settings, whose amplitude is what a height layer's scale is below), among the
-    nodes that reach the Surface of the material's output, and for the output's Displacement
-    (_displacement_layer, with the material's `displacement_method`); and notes on the nodes
-    that were not used, and on what the layers cannot take over. `render_uv` is the mesh's UV
-    map active for rendering (what Cycles reads a texture without a UV Map node on); `ob` the
-    object baked (for textures on another object's or Generated coordinates).
+    whose Height is a Noise, Musgrave or Wave Texture's Fac or a Voronoi Texture's Distance
+    (a volume layer, _procedural_settings, whose amplitude is what a height layer's scale is
+    below), among the nodes that reach the Surface of the material's output, and for the
+    output's Displacement (_displacement_layer, with the material's `displacement_method`);
+    and notes on the nodes that were not used, and on what the layers cannot take over.
+    `render_uv` is the mesh's UV map active for rendering (what Cycles reads a texture without
+    a UV Map node on); `ob` the object baked (for textures on another object's or Generated
+    coordinates).
 
     Bump: scale = Distance (times the factor of affine nodes on the height, _height_source;
     through a clamp or a Color Ramp the layer's "remap" holds the whole function of the

@@ -101,6 +101,9 @@ FUNCTIONS = (
      "Blender's Wave Texture Fac, as Cycles evaluates it: Frequency is the node's Scale, with "
      "its type, direction, profile, Phase Offset, Distortion, Detail, Detail Scale and Detail "
      "Roughness"),
+    ("blender-voronoi", "Blender Voronoi",
+     "Blender's Voronoi Texture (F1, 3D) Distance, as Cycles evaluates it: Frequency is the "
+     "node's Scale, with its Distance Metric, Randomness and Exponent"),
 )
 # The Wave Texture's enums in the scene's names (Blender's Wave Type, Bands or Rings Direction,
 # Wave Profile). The directions depend on the type, as the node's two properties: the fourth
@@ -123,6 +126,15 @@ WAVE_PROFILES = (
     ("sine", "Sine", "The Wave Texture's Sine profile"),
     ("saw", "Saw", "The Wave Texture's Saw profile"),
     ("triangle", "Triangle", "The Wave Texture's Triangle profile"),
+)
+
+
+# The Voronoi Texture's Distance Metric in the scene's names (Blender spells one Chebychev).
+METRICS = (
+    ("euclidean", "Euclidean", "Straight-line distance to the nearest cell point"),
+    ("manhattan", "Manhattan", "Sum of the coordinates' distances"),
+    ("chebyshev", "Chebyshev", "Largest of the coordinates' distances"),
+    ("minkowski", "Minkowski", "(sum of |d|^Exponent)^(1/Exponent)"),
 )
 
 
@@ -258,8 +270,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                                          "Distance)")
     frequency: FloatProperty(name="Frequency", default=1.0, precision=4,
                              description="Cycles (sine) or noise features per object unit; "
-                                         "Blender Noise, Musgrave and Wave: the texture "
-                                         "node's Scale (Blender's default 5)")
+                                         "Blender Noise, Musgrave, Wave and Voronoi: the "
+                                         "texture node's Scale (Blender's default 5)")
     direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0),
                                    description="Direction of the sine wave, object space")
     phase: FloatProperty(name="Phase", default=0.0, subtype="ANGLE",
@@ -268,8 +280,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                                      "in degrees: 0.7 is 40.1 degrees)")
     seed: IntProperty(name="Seed", default=0, min=0)
     octaves: IntProperty(name="Octaves", default=1, min=1, max=16)
-    # The Noise, Musgrave and Wave Textures' settings (Blender's defaults and the nodes'
-    # ranges).
+    # The Noise, Musgrave, Wave and Voronoi Textures' settings (Blender's defaults and the
+    # nodes' ranges).
     wave: EnumProperty(name="Wave Type", items=WAVE_TYPES, default="bands",
                        description="Blender Wave: the Wave Texture's type")
     wave_direction: EnumProperty(
@@ -306,6 +318,15 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                               description="Blender Musgrave: the Musgrave Texture's Lacunarity "
                                           "(each octave's frequency relative to the one "
                                           "before)")
+    metric: EnumProperty(name="Distance Metric", items=METRICS, default="euclidean",
+                         description="Blender Voronoi: the Voronoi Texture's Distance Metric")
+    randomness: FloatProperty(name="Randomness", default=1.0, min=0.0, max=1.0,
+                              subtype="FACTOR",
+                              description="Blender Voronoi: the Voronoi Texture's Randomness "
+                                          "(0: each cell's point at its centre)")
+    exponent: FloatProperty(name="Exponent", default=0.5, min=0.0, precision=3,
+                            description="Blender Voronoi: the Voronoi Texture's Exponent (of "
+                                        "the Minkowski metric; the others ignore it)")
     gradient: EnumProperty(name="Gradient", items=GRADIENTS, default="analytic",
                            description="How the volume's gradient is computed")
     step: FloatProperty(

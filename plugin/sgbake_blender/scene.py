@@ -37,6 +37,7 @@ BLENDER_TEXTURE_SETTINGS = {
     "blender-musgrave": ("detail", "dimension", "lacunarity"),
     "blender-wave": ("wave", "wave_direction", "profile", "distortion", "detail", "detail_scale",
                      "detail_roughness", "phase"),
+    "blender-voronoi": ("metric", "randomness", "exponent"),
 }
 # Maps that read no layer: their bakes send none, so an unfinished layer cannot stop them.
 LAYERLESS_MAPS = {"tangent", "bitangent", "mask"}
@@ -48,7 +49,7 @@ LAYER_TYPES = (
     ("height", "Height", "Height image on a UV map"),
     ("normal", "Normal", "Normal map image on a UV map (tangent or object space)"),
     ("volume", "Volume", "Procedural height in object space (sine, noise, or Blender's Noise, "
-                         "Musgrave or Wave Texture)"),
+                         "Musgrave, Wave or Voronoi Texture)"),
     ("planar", "Planar", "Image projected along an object axis"),
     ("triplanar", "Triplanar", "Image projected on the three axis planes and blended"),
 )
@@ -200,15 +201,16 @@ def layer_json(layer, uv_index, default_uv=None):
     """One entry of "layers". uv_index(name) gives the UV set of a UV map name (for height and
     normal layers: the layer's own UV map, else `default_uv`, the render UV map, else the
     scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance, and is
-    sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json).
-    A height's Remap goes as "remap" (remap_points, which raises LayerError for bad text).
-    A volume sends its function's own settings only (a Blender Noise's detail, roughness and
+    sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json). A
+    height's Remap goes as "remap" (remap_points, which raises LayerError for bad text). A
+    volume sends its function's own settings only (a Blender Noise's detail, roughness and
     distortion, a Blender Musgrave's detail, dimension and lacunarity, a Blender Wave's type,
-    direction, profile, distortion, detail, detail scale and roughness and phase:
-    BLENDER_TEXTURE_SETTINGS; libsgbake refuses another function's), and like a projection its
-    "mapping" when it has one (a Mapping node, another object's or the Generated coordinates).
-    A layer of one material slot (material_index >= 0) sends it as "material": libsgbake then
-    applies it to the faces of that slot only (the mesh's face_material)."""
+    direction, profile, distortion, detail, detail scale and roughness and phase, a Blender
+    Voronoi's metric, randomness and exponent: BLENDER_TEXTURE_SETTINGS; libsgbake refuses
+    another function's), and like a projection its "mapping" when it has one (a Mapping node,
+    another object's or the Generated coordinates). A layer of one material slot
+    (material_index >= 0) sends it as "material": libsgbake then applies it to the faces of
+    that slot only (the mesh's face_material)."""
     entry = {"type": layer.type, "name": layer.name, "weight": _number(layer.weight)}
     if layer.material_index >= 0:  # the faces of one material slot (-1: every face)
         entry["material"] = int(layer.material_index)
@@ -244,7 +246,7 @@ def layer_json(layer, uv_index, default_uv=None):
                          phase=_number(layer.phase))
         elif layer.function == "noise":
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
-        else:  # Blender's Noise, Musgrave or Wave Texture (its Scale is the frequency)
+        else:  # Blender's Noise, Musgrave, Wave or Voronoi Texture (its Scale: frequency)
             entry.update({key: _setting(getattr(layer, key))
                           for key in BLENDER_TEXTURE_SETTINGS.get(layer.function, ())})
     elif layer.type == "planar":

@@ -109,6 +109,16 @@
    Triangle give the scene's names, the Color output the Fac's layer, a Phase Offset fed by
    another texture no layer and a reason; a volume layer made by hand with function Blender
    Wave sends its settings (nothing of the other functions') and bakes.
+   Voronoi Texture (voronoi_case): a Voronoi Texture (VORONOI_NODE: F1, 3D, Euclidean;
+   VORONOI_INPUTS) on Suzanne's own object coordinates through a Mapping node (Point), its
+   Distance into the Bump: Layers from Material must make one "blender-voronoi" volume layer of
+   the node's settings (its metric in the scene's name) and its Mapping, sent so, baked as
+   Cycles bakes it (VORONOI_*: median and p99), the same job without its "mapping" clearly
+   worse; Cycles' normals must lean less than VORONOI_LEAN_DEG off the surface's.
+   voronoi_checks: Manhattan, Chebychev and Minkowski give the scene's metrics (Chebychev ->
+   chebyshev), Feature Output F2 and the Color output no layer and a reason; a volume layer
+   made by hand with function Blender Voronoi sends its settings (nothing of the other
+   functions') and bakes.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -298,6 +308,22 @@ WAVE_LEAN_DEG = 35.0
 WAVE_MEDIAN_DEG = 0.01
 WAVE_P99_DEG = 0.01
 WAVE_CONTROL_FACTOR = 3.0
+# The Voronoi case (voronoi_case): a Voronoi Texture (VORONOI_NODE: F1, 3D, Euclidean;
+# VORONOI_INPUTS) on Suzanne's own object coordinates through a Mapping node (Point,
+# VORONOI_MAPPING), its Distance into the Bump (Distance VORONOI_DISTANCE: Cycles' normals lean
+# less than VORONOI_LEAN_DEG off the surface's). Layers from Material must make a
+# "blender-voronoi" volume layer of those settings (its metric as VORONOI_ENUMS) and that
+# mapping; its bake must be Cycles' (median <= VORONOI_MEDIAN_DEG, p99 <= VORONOI_P99_DEG) and
+# the same job without the layer's "mapping" at least VORONOI_CONTROL_FACTOR times worse.
+VORONOI_NODE = {"voronoi_dimensions": "3D", "feature": "F1", "distance": "EUCLIDEAN"}
+VORONOI_ENUMS = {"metric": "euclidean"}
+VORONOI_INPUTS = {"Scale": 4.0, "Randomness": 0.85, "Exponent": 0.5}
+VORONOI_MAPPING = ((0.3, 0.2, -0.1), (-0.2, 0.4, 0.3), (1.2, 1.0, 0.9))
+VORONOI_DISTANCE = 0.08
+VORONOI_LEAN_DEG = 35.0
+VORONOI_MEDIAN_DEG = 0.01
+VORONOI_P99_DEG = 0.01
+VORONOI_CONTROL_FACTOR = 3.0
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -2329,8 +2355,8 @@ def musgrave_case(settings, ob, work):
 
 
 def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, mapping_values,
-                 distance_value, control_keys):
-    """The bump material's Height fed by the Fac of the procedural texture node make(tree)
+                 distance_value, control_keys, output="Fac"):
+    """The bump material's Height fed by the `output` of the procedural texture node make(tree)
     makes (`inputs`: its inputs -> values; `enums`: the layer settings its enum properties
     must give, as sent) on the object's own coordinates through a Mapping node (Point,
     `mapping_values`), Distance `distance_value`: Layers from Material must make one
@@ -2356,7 +2382,7 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
         mapping.inputs[name].default_value = value
     tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
-    tree.links.new(texture.outputs["Fac"], bump.inputs["Height"])
+    tree.links.new(texture.outputs[output], bump.inputs["Height"])
     bump.inputs["Distance"].default_value = distance_value
     entry = {"result": None, "checks": []}
     close = lambda a, b: abs(a - b) < 1e-6  # noqa: E731  (float32 properties)
@@ -2585,6 +2611,102 @@ def wave_checks(settings, ob):
     return checks
 
 
+def make_voronoi(tree, inputs=None):
+    """A Voronoi Texture node in `tree` with its properties VORONOI_NODE and `inputs`
+    (VORONOI_INPUTS by default)."""
+    voronoi = tree.nodes.new("ShaderNodeTexVoronoi")
+    for prop, value in VORONOI_NODE.items():
+        setattr(voronoi, prop, value)
+    for name, value in (inputs or VORONOI_INPUTS).items():
+        voronoi.inputs[name].default_value = value
+    return voronoi
+
+
+VORONOI_KEYS = {"frequency": "Scale", "randomness": "Randomness",
+                "exponent": "Exponent"}  # the layer's settings -> the node's inputs
+
+
+def voronoi_case(settings, ob, work):
+    """The bump material's Height fed by a Voronoi Texture's Distance (VORONOI_NODE,
+    VORONOI_INPUTS) on the object's own coordinates through a Mapping node (VORONOI_MAPPING),
+    Distance VORONOI_DISTANCE: texture_case "voronoi", its enums VORONOI_ENUMS, its control
+    without the layer's "mapping"."""
+    return texture_case(settings, ob, work, "voronoi", make_voronoi, VORONOI_KEYS,
+                        VORONOI_INPUTS, VORONOI_ENUMS,
+                        {"roughness", "distortion", "detail", "dimension", "lacunarity",
+                         "direction", "phase", "wave"}, VORONOI_MAPPING, VORONOI_DISTANCE,
+                        ("mapping",), output="Distance")
+
+
+def voronoi_checks(settings, ob):
+    """Layers from Material on Voronoi Textures: Manhattan, Chebychev and Minkowski give the
+    scene's metrics, Feature Output F2 and the Color output no layer and a reason; and a volume
+    layer made by hand with function Blender Voronoi. Returns check records like
+    expect_error's."""
+    import bpy
+    from sgbake_blender import operators
+    tree = ob.active_material.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    voronoi = make_voronoi(tree)
+    checks = []
+
+    def check(name, ok, expected, message):
+        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
+
+    def refused(what, reason):
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check(f"voronoi: {what} gives no layer and a reason", not found
+              and any(f"'{bump.name}'" in note and reason in note for note in skipped),
+              f"no layer, '{bump.name}' skipped: ...{reason}...", f"{found}; skipped {skipped}")
+
+    try:
+        tree.links.new(voronoi.outputs["Distance"], bump.inputs["Height"])
+        for distance, metric in (("MANHATTAN", "manhattan"), ("CHEBYCHEV", "chebyshev"),
+                                 ("MINKOWSKI", "minkowski")):
+            voronoi.distance = distance
+            found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+            check(f"voronoi: {distance.title()} gives the scene's metric {metric}",
+                  len(found) == 1 and found[0].get("function") == "blender-voronoi"
+                  and found[0].get("metric") == metric,
+                  f"one blender-voronoi layer, metric {metric}", f"{found}; skipped {skipped}")
+        voronoi.distance = "EUCLIDEAN"
+        voronoi.feature = "F2"
+        refused("Feature Output F2", "feature output F2")
+        voronoi.feature = "F1"
+        tree.links.new(voronoi.outputs["Color"], bump.inputs["Height"])
+        refused("the Color output", "Color output")
+    finally:
+        tree.nodes.remove(voronoi)
+        tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    # A volume layer made by hand, function Blender Voronoi: its settings sent (none of the
+    # other functions'), and it bakes.
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.function = "by hand", "volume", "blender-voronoi"
+    layer.metric, layer.frequency, layer.randomness, layer.exponent = "minkowski", 3.0, 0.6, 1.5
+    layer.amplitude, layer.gradient = 0.01, "bump-node"
+    want = {"function": "blender-voronoi", "metric": "minkowski", "frequency": 3.0,
+            "randomness": 0.6, "exponent": 1.5}
+    settings.width = settings.height = 64
+    try:
+        job = operators.BakeJob(bpy.context)
+        sent = job.scene["layers"][-1]
+        job.run()
+    except Exception as exc:  # (BakeInputError: reported as the check's failure)
+        sent, job = {"error": str(exc)}, None
+    check("voronoi: a Blender Voronoi volume made by hand is sent with its settings and bakes",
+          job is not None and job.error is None
+          and all(sent.get(key) == value if isinstance(value, str)
+                  else abs(sent.get(key, -1) - value) < 1e-6 for key, value in want.items())
+          and not {"roughness", "detail", "distortion", "dimension", "lacunarity", "phase",
+                   "direction", "seed", "octaves", "mapping"} & set(sent),
+          f"{want}; none of the other functions' settings, no mapping; baked",
+          f"sent {sent}; error {job.error if job else None}")
+    settings.layers.remove(len(settings.layers) - 1)
+    settings.width = settings.height = SIZE
+    return checks
+
+
 def blender_make(work, library_path, sabotage):
     """Builds the scene, runs the add-on (see the module docstring), writes manifest.json."""
     import bpy
@@ -2612,11 +2734,13 @@ def blender_make(work, library_path, sabotage):
     manifest["noise"] = noise_case(settings, ob, work)
     manifest["musgrave"] = musgrave_case(settings, ob, work)
     manifest["wave"] = wave_case(settings, ob, work)
+    manifest["voronoi"] = voronoi_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
                           + musgrave_checks(settings, ob)
                           + wave_checks(settings, ob)
+                          + voronoi_checks(settings, ob)
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
@@ -2669,6 +2793,8 @@ def blender_compare(work):
     results["musgrave_lean"] = lean_stats(work, "musgrave")
     results["wave"] = against_cycles(work, "wave")
     results["wave_lean"] = lean_stats(work, "wave")
+    results["voronoi"] = against_cycles(work, "voronoi")
+    results["voronoi_lean"] = lean_stats(work, "voronoi")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -2937,12 +3063,20 @@ def evaluate(manifest, results):
         f"{WAVE_DISTANCE:g}", manifest["wave"], results["wave"],
         "without the layer's phase", WAVE_MEDIAN_DEG, WAVE_CONTROL_FACTOR, WAVE_P99_DEG)
     failures += evaluate_lean("wave", results["wave_lean"], WAVE_LEAN_DEG)
+    failures += evaluate_case_against_cycles(
+        "voronoi", "a Voronoi Texture's Distance (F1, 3D, euclidean, "
+        + ", ".join(f"{k} {v:g}" for k, v in VORONOI_INPUTS.items())
+        + ") on object coordinates through a Mapping node (Point), Distance "
+        f"{VORONOI_DISTANCE:g}", manifest["voronoi"], results["voronoi"],
+        "without the layer's mapping", VORONOI_MEDIAN_DEG, VORONOI_CONTROL_FACTOR,
+        VORONOI_P99_DEG)
+    failures += evaluate_lean("voronoi", results["voronoi_lean"], VORONOI_LEAN_DEG)
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
-                  + manifest["wave"]["checks"]
+                  + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
                   + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
