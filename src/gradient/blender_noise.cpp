@@ -232,14 +232,14 @@ Result<BlenderNoise> BlenderNoise::create(const BlenderNoiseParams& params) {
   return BlenderNoise(params);
 }
 
-BlenderNoise::BlenderNoise(const BlenderNoiseParams& params) : params_(params) {
+BlenderNoise::BlenderNoise(const BlenderNoiseParams& params) : BlenderTextureVolume(params) {
   for (int k = 0; k < 3; ++k) {  // the distortion of axis k reads noise seeded k
     distortionOffsets_[static_cast<std::size_t>(k)] = {seedOffset(k, 0), seedOffset(k, 1),
                                                        seedOffset(k, 2)};
   }
 }
 
-double BlenderNoise::fac(Vec3d position, Vec3d* gradient) const {
+double BlenderNoise::output(Vec3d position, Vec3d* gradient) const {
   const double scale = params_.scale;
   Vec3d p = scale * position;
   // Distortion: p + d · (snoise(p + o₀), snoise(p + o₁), snoise(p + o₂)); its Jacobian's rows
@@ -267,14 +267,6 @@ double BlenderNoise::fac(Vec3d position, Vec3d* gradient) const {
   return value;
 }
 
-double BlenderNoise::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
-
-Vec3d BlenderNoise::analyticGradient(Vec3d p) const {
-  Vec3d g;
-  fac(p, &g);
-  return params_.amplitude * g;
-}
-
 Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& params) {
   for (const double v :
        {params.amplitude, params.scale, params.detail, params.dimension, params.lacunarity}) {
@@ -294,7 +286,7 @@ Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& par
   return BlenderMusgrave(params);
 }
 
-double BlenderMusgrave::fac(Vec3d position, Vec3d* gradient) const {
+double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
   const double detail = std::clamp(params_.detail, 0.0, 15.0);
   const double h = std::max(params_.dimension, 1e-5);
   const double lacunarity = std::max(params_.lacunarity, 1e-5);
@@ -319,14 +311,6 @@ double BlenderMusgrave::fac(Vec3d position, Vec3d* gradient) const {
   return value;
 }
 
-double BlenderMusgrave::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
-
-Vec3d BlenderMusgrave::analyticGradient(Vec3d p) const {
-  Vec3d g;
-  fac(p, &g);
-  return params_.amplitude * g;
-}
-
 Result<BlenderVoronoi> BlenderVoronoi::create(const BlenderVoronoiParams& params) {
   for (const double v : {params.amplitude, params.scale, params.randomness, params.exponent}) {
     if (!std::isfinite(v)) return Error::badInput("a Voronoi Texture setting is not finite");
@@ -340,7 +324,7 @@ Result<BlenderVoronoi> BlenderVoronoi::create(const BlenderVoronoiParams& params
   return BlenderVoronoi(params);
 }
 
-double BlenderVoronoi::distance(Vec3d position, Vec3d* gradient) const {
+double BlenderVoronoi::output(Vec3d position, Vec3d* gradient) const {
   const Vec3d p = params_.scale * position;
   const Vec3d cell{std::floor(p.x), std::floor(p.y), std::floor(p.z)};
   const Vec3d local = p - cell;
@@ -404,14 +388,6 @@ double BlenderVoronoi::distance(Vec3d position, Vec3d* gradient) const {
   return best;
 }
 
-double BlenderVoronoi::value(Vec3d p) const { return params_.amplitude * distance(p, nullptr); }
-
-Vec3d BlenderVoronoi::analyticGradient(Vec3d p) const {
-  Vec3d g;
-  distance(p, &g);
-  return params_.amplitude * g;
-}
-
 Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {
   for (const double v : {params.amplitude, params.scale, params.distortion, params.detail,
                          params.detailScale, params.detailRoughness, params.phase}) {
@@ -426,7 +402,7 @@ Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {
   return BlenderWave(params);
 }
 
-double BlenderWave::fac(Vec3d position, Vec3d* gradient) const {
+double BlenderWave::output(Vec3d position, Vec3d* gradient) const {
   // Cycles nudges the scaled coordinates off the unit lattice: p = (scale P + 1e-6) · 0.999999.
   constexpr double kNudge = 0.999999;
   const Vec3d p = kNudge * (params_.scale * position + Vec3d{1e-6, 1e-6, 1e-6});
@@ -486,14 +462,6 @@ double BlenderWave::fac(Vec3d position, Vec3d* gradient) const {
   }
   if (gradient != nullptr) *gradient = (slope * kNudge * params_.scale) * dn;
   return value;
-}
-
-double BlenderWave::value(Vec3d p) const { return params_.amplitude * fac(p, nullptr); }
-
-Vec3d BlenderWave::analyticGradient(Vec3d p) const {
-  Vec3d g;
-  fac(p, &g);
-  return params_.amplitude * g;
 }
 
 }  // namespace sgbake

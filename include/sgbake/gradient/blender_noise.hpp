@@ -28,6 +28,26 @@
 
 namespace sgbake {
 
+/// @brief What Blender's procedural textures share as height volumes: the height is amplitude
+/// times the node's output (Fac, or the Voronoi's Distance), its gradient that of the output.
+template <class Params>
+class BlenderTextureVolume : public HeightVolume {
+ public:
+  double value(Vec3d p) const final { return params_.amplitude * output(p, nullptr); }
+  Vec3d analyticGradient(Vec3d p) const final {
+    Vec3d g;
+    output(p, &g);
+    return params_.amplitude * g;
+  }
+  /// The node's output at @p p (object space, before the amplitude), and its gradient.
+  virtual double output(Vec3d p, Vec3d* gradient) const = 0;
+  const Params& params() const { return params_; }
+
+ protected:
+  explicit BlenderTextureVolume(const Params& params) : params_(params) {}
+  Params params_;
+};
+
 /// @brief The Noise Texture node's settings (Dimensions 3D) and the height's scale.
 struct BlenderNoiseParams {
   double amplitude = 1;    ///< height per unit of Fac (a Bump node's Distance)
@@ -38,23 +58,17 @@ struct BlenderNoiseParams {
 };
 
 /// @brief Blender's Noise Texture Fac, times an amplitude: a HeightVolume.
-class BlenderNoise final : public HeightVolume {
+class BlenderNoise final : public BlenderTextureVolume<BlenderNoiseParams> {
  public:
   /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale
   /// (|amplitude| · |scale| · (1 + |distortion|) · 2^detail).
   static Result<BlenderNoise> create(const BlenderNoiseParams& params);
 
-  double value(Vec3d p) const override;
-  Vec3d analyticGradient(Vec3d p) const override;
-
-  /// The node's Fac at @p p (object space, before the amplitude), and its gradient.
-  double fac(Vec3d p, Vec3d* gradient) const;
-
-  const BlenderNoiseParams& params() const { return params_; }
+  /// The node's Fac.
+  double output(Vec3d p, Vec3d* gradient) const override;
 
  private:
   explicit BlenderNoise(const BlenderNoiseParams& params);
-  BlenderNoiseParams params_;
   std::array<Vec3d, 3> distortionOffsets_{};
 };
 
@@ -73,19 +87,15 @@ struct BlenderMusgraveParams {
 ///     L^(−⌊detail⌋H)
 ///
 /// with p = scale · P and snoise as BlenderNoise's (unnormalized: Fac is signed). Exact gradient.
-class BlenderMusgrave final : public HeightVolume {
+class BlenderMusgrave final : public BlenderTextureVolume<BlenderMusgraveParams> {
  public:
   /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale.
   static Result<BlenderMusgrave> create(const BlenderMusgraveParams& params);
-
-  double value(Vec3d p) const override;
-  Vec3d analyticGradient(Vec3d p) const override;
-  /// The node's Fac at @p p (object space, before the amplitude), and its gradient.
-  double fac(Vec3d p, Vec3d* gradient) const;
+  /// The node's Fac.
+  double output(Vec3d p, Vec3d* gradient) const override;
 
  private:
-  explicit BlenderMusgrave(const BlenderMusgraveParams& params) : params_(params) {}
-  BlenderMusgraveParams params_;
+  using BlenderTextureVolume::BlenderTextureVolume;
 };
 
 /// The Wave Texture's Wave Type.
@@ -117,19 +127,15 @@ struct BlenderWaveParams {
 /// and Distortion · (2 fbm(Detail Scale · p) − 1) with BlenderNoise's fbm; Fac = ½ + ½ sin(n −
 /// π/2), the fraction of n / 2π (saw) or twice its distance to the nearest integer (triangle). The
 /// gradient is exact away from the saw's and triangle's corners (and the rings' axis).
-class BlenderWave final : public HeightVolume {
+class BlenderWave final : public BlenderTextureVolume<BlenderWaveParams> {
  public:
   /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale.
   static Result<BlenderWave> create(const BlenderWaveParams& params);
-
-  double value(Vec3d p) const override;
-  Vec3d analyticGradient(Vec3d p) const override;
-  /// The node's Fac at @p p (object space, before the amplitude), and its gradient.
-  double fac(Vec3d p, Vec3d* gradient) const;
+  /// The node's Fac.
+  double output(Vec3d p, Vec3d* gradient) const override;
 
  private:
-  explicit BlenderWave(const BlenderWaveParams& params) : params_(params) {}
-  BlenderWaveParams params_;
+  using BlenderTextureVolume::BlenderTextureVolume;
 };
 
 /// The Voronoi Texture's Distance Metric.
@@ -153,20 +159,17 @@ struct BlenderVoronoiParams {
 /// bits, the second and third with a fourth word 1 and 2, as Cycles hashes them); Distance is the
 /// metric's distance from p to the nearest (the first of equals, cells in z, y, x order). Its
 /// gradient is the metric's, exact but where the nearest point changes.
-class BlenderVoronoi final : public HeightVolume {
+class BlenderVoronoi final : public BlenderTextureVolume<BlenderVoronoiParams> {
  public:
   /// @return kBadInput for a non-finite setting, an exponent ≤ 0 with Minkowski, or slopes beyond
   /// kMaxVolumeScale.
   static Result<BlenderVoronoi> create(const BlenderVoronoiParams& params);
 
-  double value(Vec3d p) const override;
-  Vec3d analyticGradient(Vec3d p) const override;
-  /// The node's Distance at @p p (object space, before the amplitude), and its gradient.
-  double distance(Vec3d p, Vec3d* gradient) const;
+  /// The node's Distance.
+  double output(Vec3d p, Vec3d* gradient) const override;
 
  private:
-  explicit BlenderVoronoi(const BlenderVoronoiParams& params) : params_(params) {}
-  BlenderVoronoiParams params_;
+  using BlenderTextureVolume::BlenderTextureVolume;
 };
 
 /// @brief The Noise Texture's fBm of @p p (no Scale, no distortion): octaves of ½ snoise + ½, as
