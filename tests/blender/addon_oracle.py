@@ -2247,6 +2247,35 @@ def noise_case(settings, ob, work):
     return entry
 
 
+def hand_made_check(settings, label, title, values, want, absent):
+    """One check record: a volume layer made by hand (named "by hand", slopes "bump-node") with
+    properties `values`, baked at 64^2, must be sent with the settings `want` (key -> value;
+    numbers within 1e-6) and none of the keys `absent`, and bake. The layer is removed again."""
+    import bpy
+    from sgbake_blender import operators
+    layer = settings.layers.add()
+    layer.name, layer.type, layer.gradient = "by hand", "volume", "bump-node"
+    for prop, value in values.items():
+        setattr(layer, prop, value)
+    settings.width = settings.height = 64
+    try:
+        job = operators.BakeJob(bpy.context)
+        sent = job.scene["layers"][-1]
+        job.run()
+    except Exception as exc:  # (BakeInputError: reported as the check's failure)
+        sent, job = {"error": str(exc)}, None
+    finally:
+        settings.layers.remove(len(settings.layers) - 1)
+        settings.width = settings.height = SIZE
+    ok = (job is not None and job.error is None
+          and all(sent.get(key) == value if isinstance(value, str)
+                  else abs(sent.get(key, -1) - value) < 1e-6 for key, value in want.items())
+          and not set(absent) & set(sent))
+    return {"name": f"{label}: a {title} volume made by hand is sent with its settings and bakes",
+            "ok": bool(ok), "expected": f"{want}; none of {', '.join(absent)}; baked",
+            "message": f"sent {sent}; error {job.error if job else None}"}
+
+
 def noise_checks(settings, ob, distance):
     """Layers from Material on Noise Textures it does not take (its Color output, 2D, a Detail
     fed by a node, a UV map into its Vector: no layer, a reason), through a Color Ramp (a
@@ -2308,27 +2337,13 @@ def noise_checks(settings, ob, distance):
         tree.nodes.remove(noise)
         tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     # A volume layer made by hand, function Blender Noise: its inputs sent (no seed or
-    # octaves), and it bakes.
-    layer = settings.layers.add()
-    layer.name, layer.type, layer.function = "by hand", "volume", "blender-noise"
-    layer.frequency, layer.detail, layer.roughness, layer.distortion = 5.0, 1.5, 0.7, 0.2
-    layer.amplitude, layer.gradient = 0.02, "bump-node"
-    settings.width = settings.height = 64
-    try:
-        job = operators.BakeJob(bpy.context)
-        sent = job.scene["layers"][-1]
-        job.run()
-    except Exception as exc:  # (BakeInputError: reported as the check's failure)
-        sent, job = {"error": str(exc)}, None
-    check("noise: a Blender Noise volume made by hand is sent with its inputs and bakes",
-          job is not None and job.error is None and sent.get("function") == "blender-noise"
-          and abs(sent.get("detail", 0) - 1.5) < 1e-6 and abs(sent.get("roughness", 0) - 0.7) < 1e-6
-          and abs(sent.get("distortion", 0) - 0.2) < 1e-6 and "seed" not in sent
-          and "octaves" not in sent and "mapping" not in sent,
-          "function blender-noise, detail 1.5, roughness 0.7, distortion 0.2, no seed, octaves "
-          "or mapping; baked", f"sent {sent}; error {job.error if job else None}")
-    settings.layers.remove(len(settings.layers) - 1)
-    settings.width = settings.height = SIZE
+    # octaves, no mapping), and it bakes.
+    checks.append(hand_made_check(
+        settings, "noise", "Blender Noise",
+        {"function": "blender-noise", "frequency": 5.0, "detail": 1.5, "roughness": 0.7,
+         "distortion": 0.2, "amplitude": 0.02},
+        {"function": "blender-noise", "detail": 1.5, "roughness": 0.7, "distortion": 0.2},
+        ("seed", "octaves", "mapping")))
     return checks
 
 
@@ -2482,28 +2497,12 @@ def musgrave_checks(settings, ob):
         tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     # A volume layer made by hand, function Blender Musgrave: its inputs sent (none of Blender
     # Noise's), and it bakes.
-    layer = settings.layers.add()
-    layer.name, layer.type, layer.function = "by hand", "volume", "blender-musgrave"
-    layer.frequency, layer.detail, layer.dimension, layer.lacunarity = 4.0, 2.5, 1.2, 2.6
-    layer.amplitude, layer.gradient = 0.01, "bump-node"
-    settings.width = settings.height = 64
-    try:
-        job = operators.BakeJob(bpy.context)
-        sent = job.scene["layers"][-1]
-        job.run()
-    except Exception as exc:  # (BakeInputError: reported as the check's failure)
-        sent, job = {"error": str(exc)}, None
-    check("musgrave: a Blender Musgrave volume made by hand is sent with its inputs and bakes",
-          job is not None and job.error is None and sent.get("function") == "blender-musgrave"
-          and abs(sent.get("detail", 0) - 2.5) < 1e-6
-          and abs(sent.get("dimension", 0) - 1.2) < 1e-6
-          and abs(sent.get("lacunarity", 0) - 2.6) < 1e-6
-          and not {"roughness", "distortion", "seed", "octaves", "mapping"} & set(sent),
-          "function blender-musgrave, detail 2.5, dimension 1.2, lacunarity 2.6, no roughness, "
-          "distortion, seed, octaves or mapping; baked",
-          f"sent {sent}; error {job.error if job else None}")
-    settings.layers.remove(len(settings.layers) - 1)
-    settings.width = settings.height = SIZE
+    checks.append(hand_made_check(
+        settings, "musgrave", "Blender Musgrave",
+        {"function": "blender-musgrave", "frequency": 4.0, "detail": 2.5, "dimension": 1.2,
+         "lacunarity": 2.6, "amplitude": 0.01},
+        {"function": "blender-musgrave", "detail": 2.5, "dimension": 1.2, "lacunarity": 2.6},
+        ("roughness", "distortion", "seed", "octaves", "mapping")))
     return checks
 
 
@@ -2582,32 +2581,15 @@ def wave_checks(settings, ob):
         tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     # A volume layer made by hand, function Blender Wave: its settings sent (none of the other
     # functions'), and it bakes.
-    layer = settings.layers.add()
-    layer.name, layer.type, layer.function = "by hand", "volume", "blender-wave"
-    layer.wave, layer.wave_direction, layer.profile = "bands", "diagonal", "triangle"
-    layer.frequency, layer.phase, layer.distortion, layer.detail = 4.0, 0.5, 0.8, 1.5
-    layer.detail_scale, layer.detail_roughness = 2.0, 0.7
-    layer.amplitude, layer.gradient = 0.01, "bump-node"
-    want = {"function": "blender-wave", "wave": "bands", "wave_direction": "diagonal",
-            "profile": "triangle", "frequency": 4.0, "phase": 0.5, "distortion": 0.8,
-            "detail": 1.5, "detail_scale": 2.0, "detail_roughness": 0.7}
-    settings.width = settings.height = 64
-    try:
-        job = operators.BakeJob(bpy.context)
-        sent = job.scene["layers"][-1]
-        job.run()
-    except Exception as exc:  # (BakeInputError: reported as the check's failure)
-        sent, job = {"error": str(exc)}, None
-    check("wave: a Blender Wave volume made by hand is sent with its settings and bakes",
-          job is not None and job.error is None
-          and all(sent.get(key) == value if isinstance(value, str)
-                  else abs(sent.get(key, -1) - value) < 1e-6 for key, value in want.items())
-          and not {"roughness", "dimension", "lacunarity", "direction", "seed", "octaves",
-                   "mapping"} & set(sent),
-          f"{want}; no roughness, dimension, lacunarity, direction, seed, octaves or mapping; "
-          "baked", f"sent {sent}; error {job.error if job else None}")
-    settings.layers.remove(len(settings.layers) - 1)
-    settings.width = settings.height = SIZE
+    checks.append(hand_made_check(
+        settings, "wave", "Blender Wave",
+        {"function": "blender-wave", "wave": "bands", "wave_direction": "diagonal",
+         "profile": "triangle", "frequency": 4.0, "phase": 0.5, "distortion": 0.8,
+         "detail": 1.5, "detail_scale": 2.0, "detail_roughness": 0.7, "amplitude": 0.01},
+        {"function": "blender-wave", "wave": "bands", "wave_direction": "diagonal",
+         "profile": "triangle", "frequency": 4.0, "phase": 0.5, "distortion": 0.8,
+         "detail": 1.5, "detail_scale": 2.0, "detail_roughness": 0.7},
+        ("roughness", "dimension", "lacunarity", "direction", "seed", "octaves", "mapping")))
     return checks
 
 
@@ -2681,29 +2663,14 @@ def voronoi_checks(settings, ob):
         tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
     # A volume layer made by hand, function Blender Voronoi: its settings sent (none of the
     # other functions'), and it bakes.
-    layer = settings.layers.add()
-    layer.name, layer.type, layer.function = "by hand", "volume", "blender-voronoi"
-    layer.metric, layer.frequency, layer.randomness, layer.exponent = "minkowski", 3.0, 0.6, 1.5
-    layer.amplitude, layer.gradient = 0.01, "bump-node"
-    want = {"function": "blender-voronoi", "metric": "minkowski", "frequency": 3.0,
-            "randomness": 0.6, "exponent": 1.5}
-    settings.width = settings.height = 64
-    try:
-        job = operators.BakeJob(bpy.context)
-        sent = job.scene["layers"][-1]
-        job.run()
-    except Exception as exc:  # (BakeInputError: reported as the check's failure)
-        sent, job = {"error": str(exc)}, None
-    check("voronoi: a Blender Voronoi volume made by hand is sent with its settings and bakes",
-          job is not None and job.error is None
-          and all(sent.get(key) == value if isinstance(value, str)
-                  else abs(sent.get(key, -1) - value) < 1e-6 for key, value in want.items())
-          and not {"roughness", "detail", "distortion", "dimension", "lacunarity", "phase",
-                   "direction", "seed", "octaves", "mapping"} & set(sent),
-          f"{want}; none of the other functions' settings, no mapping; baked",
-          f"sent {sent}; error {job.error if job else None}")
-    settings.layers.remove(len(settings.layers) - 1)
-    settings.width = settings.height = SIZE
+    checks.append(hand_made_check(
+        settings, "voronoi", "Blender Voronoi",
+        {"function": "blender-voronoi", "metric": "minkowski", "frequency": 3.0,
+         "randomness": 0.6, "exponent": 1.5, "amplitude": 0.01},
+        {"function": "blender-voronoi", "metric": "minkowski", "frequency": 3.0,
+         "randomness": 0.6, "exponent": 1.5},
+        ("roughness", "detail", "distortion", "dimension", "lacunarity", "phase", "direction",
+         "seed", "octaves", "mapping")))
     return checks
 
 
