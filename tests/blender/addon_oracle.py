@@ -2247,6 +2247,32 @@ def noise_case(settings, ob, work):
     return entry
 
 
+class TextureChecks:
+    """What the Layers from Material checks of one procedural texture share: the test material's
+    tree, its Image Texture and Bump nodes, the check records, and two ways to add one."""
+
+    def __init__(self, ob, label):
+        from sgbake_blender import operators
+        self.ob, self.label, self.operators = ob, label, operators
+        self.tree = ob.active_material.node_tree
+        self.tex = next(n for n in self.tree.nodes
+                        if n.type == "TEX_IMAGE" and n.name != "bake_target")
+        self.bump = next(n for n in self.tree.nodes if n.type == "BUMP")
+        self.checks = []
+
+    def check(self, name, ok, expected, message):
+        self.checks.append({"name": name, "ok": bool(ok), "expected": expected,
+                            "message": message})
+
+    def refused(self, what, reason):
+        """A check that the material makes no layer and names `reason` for the Bump node."""
+        found, skipped, _ = self.operators.material_layers(self.tree, "UVMap", self.ob)
+        bump = f"'{self.bump.name}'"
+        self.check(f"{self.label}: {what} gives no layer and a reason",
+                   not found and any(bump in note and reason in note for note in skipped),
+                   f"no layer, {bump} skipped: ...{reason}...", f"{found}; skipped {skipped}")
+
+
 def hand_made_check(settings, label, title, values, want, absent):
     """One check record: a volume layer made by hand (named "by hand", slopes "bump-node") with
     properties `values`, baked at 64^2, must be sent with the settings `want` (key -> value;
@@ -2283,20 +2309,9 @@ def noise_checks(settings, ob, distance):
     like expect_error's."""
     import bpy
     from sgbake_blender import operators
-    tree = ob.active_material.node_tree
-    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
-    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    c = TextureChecks(ob, "noise")
+    tree, tex, bump, checks, check, refused = c.tree, c.tex, c.bump, c.checks, c.check, c.refused
     noise = make_noise(tree)
-    checks = []
-
-    def check(name, ok, expected, message):
-        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
-
-    def refused(what, reason):
-        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
-        check(f"noise: {what} gives no layer and a reason", not found
-              and any(f"'{bump.name}'" in note and reason in note for note in skipped),
-              f"no layer, '{bump.name}' skipped: ...{reason}...", f"{found}; skipped {skipped}")
 
     try:
         tree.links.new(noise.outputs["Color"], bump.inputs["Height"])
@@ -2459,20 +2474,9 @@ def musgrave_checks(settings, ob):
     hand with function Blender Musgrave. Returns check records like expect_error's."""
     import bpy
     from sgbake_blender import operators
-    tree = ob.active_material.node_tree
-    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
-    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    c = TextureChecks(ob, "musgrave")
+    tree, tex, bump, checks, check, refused = c.tree, c.tex, c.bump, c.checks, c.check, c.refused
     musgrave = make_musgrave(tree)
-    checks = []
-
-    def check(name, ok, expected, message):
-        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
-
-    def refused(what, reason):
-        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
-        check(f"musgrave: {what} gives no layer and a reason", not found
-              and any(f"'{bump.name}'" in note and reason in note for note in skipped),
-              f"no layer, '{bump.name}' skipped: ...{reason}...", f"{found}; skipped {skipped}")
 
     try:
         tree.links.new(musgrave.outputs["Fac"], bump.inputs["Height"])
@@ -2538,14 +2542,9 @@ def wave_checks(settings, ob):
     records like expect_error's."""
     import bpy
     from sgbake_blender import operators
-    tree = ob.active_material.node_tree
-    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
-    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    c = TextureChecks(ob, "wave")
+    tree, tex, bump, checks, check, refused = c.tree, c.tex, c.bump, c.checks, c.check, c.refused
     wave = make_wave(tree)
-    checks = []
-
-    def check(name, ok, expected, message):
-        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
 
     try:
         tree.links.new(wave.outputs["Fac"], bump.inputs["Height"])
@@ -2627,20 +2626,9 @@ def voronoi_checks(settings, ob):
     expect_error's."""
     import bpy
     from sgbake_blender import operators
-    tree = ob.active_material.node_tree
-    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
-    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    c = TextureChecks(ob, "voronoi")
+    tree, tex, bump, checks, check, refused = c.tree, c.tex, c.bump, c.checks, c.check, c.refused
     voronoi = make_voronoi(tree)
-    checks = []
-
-    def check(name, ok, expected, message):
-        checks.append({"name": name, "ok": bool(ok), "expected": expected, "message": message})
-
-    def refused(what, reason):
-        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
-        check(f"voronoi: {what} gives no layer and a reason", not found
-              and any(f"'{bump.name}'" in note and reason in note for note in skipped),
-              f"no layer, '{bump.name}' skipped: ...{reason}...", f"{found}; skipped {skipped}")
 
     try:
         tree.links.new(voronoi.outputs["Distance"], bump.inputs["Height"])
