@@ -1236,6 +1236,12 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
   if (layer.step && !(*layer.step > 0 && std::isfinite(*layer.step))) {
     return "step must be a finite number > 0";
   }
+  if (!layer.remap.empty()) {
+    if (layer.readsNormals()) return "key 'remap' applies only to heights";
+    if (Result<HeightRemap> remap = HeightRemap::create(layer.remap); !remap) {
+      return "'remap': " + remap.error().message;
+    }
+  }
   if (layer.type == SceneLayerType::kVolume && layer.function == VolumeFunction::kNoise) {
     if (!(layer.frequency > 0)) return "frequency must be greater than 0";
     if (layer.octaves < 1 || layer.octaves > kMaxNoiseOctaves) {

@@ -1279,6 +1279,19 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
             "layers, and projected ones with 'projection': 'box', 'flat', 'sphere' or 'tube')");
   scene.layers[0].kind = ProjectedKind::kTangentNormal;
   EXPECT_TRUE(validateScene(scene));
+  // A remap built in code: on a normal map, or not a function, is refused as in a scene file.
+  scene.layers[0].remap = {{0, 0}, {1, 1}};
+  status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message, "layers[0]: key 'remap' applies only to heights");
+  scene.layers[0].kind = ProjectedKind::kHeight;
+  scene.layers[0].tangentUvSet.reset();
+  EXPECT_TRUE(validateScene(scene));
+  scene.layers[0].remap = {{1, 0}, {0, 1}};
+  status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message,
+            "layers[0]: 'remap': remap point 1 has a smaller x than the point before it");
 }
 
 TEST(Scene, PaddingModesAreParsedByTheirSceneNames) {
