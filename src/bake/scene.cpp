@@ -881,7 +881,7 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"randomness", "metric", "exponent"}, voronoi, "blender-voronoi");
     onlyFor({"dimension", "lacunarity"}, musgrave, "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
-    if (blender) layer.frequency = 5;  // the Noise and Musgrave Textures' default Scale
+    if (blender) layer.frequency = 5;  // Blender's textures' default Scale
     if (reader.has("frequency")) {
       layer.frequency = sine || blender ? reader.number("frequency")
                                         : reader.numberAtLeast("frequency", 0, /*exclusive=*/true);

@@ -393,6 +393,12 @@ Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {
                          params.detailScale, params.detailRoughness, params.phase}) {
     if (!std::isfinite(v)) return Error::badInput("a Wave Texture setting is not finite");
   }
+  if ((params.direction == WaveDirection::kDiagonal && params.type != WaveType::kBands) ||
+      (params.direction == WaveDirection::kSpherical && params.type != WaveType::kRings)) {
+    return Error::badInput(
+        "a Wave Texture's direction is diagonal for bands only, spherical "
+        "for rings only");
+  }
   const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
                         (20 + std::abs(params.distortion) * std::abs(params.detailScale) *
                                   std::exp2(std::ceil(std::clamp(params.detail, 0.0, 15.0))));

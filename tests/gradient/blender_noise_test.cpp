@@ -204,6 +204,18 @@ TEST(BlenderVoronoi, AnalyticGradientIsTheDerivativeOfTheValue) {
   EXPECT_GT(checked, 1150);  // borders are rare at this step
 }
 
+TEST(BlenderWave, RefusesADirectionItsTypeHasNot) {
+  Result<BlenderWave> rings =
+      BlenderWave::create({.type = WaveType::kRings, .direction = WaveDirection::kDiagonal});
+  ASSERT_FALSE(rings);
+  EXPECT_EQ(rings.error().message,
+            "a Wave Texture's direction is diagonal for bands only, spherical for rings only");
+  EXPECT_FALSE(
+      BlenderWave::create({.type = WaveType::kBands, .direction = WaveDirection::kSpherical}));
+  EXPECT_TRUE(
+      BlenderWave::create({.type = WaveType::kRings, .direction = WaveDirection::kSpherical}));
+}
+
 // A Mapping node before the texture: the value at the mapped point, the gradient pulled back.
 TEST(MappedHeightVolume, ReadsTheMappedPointAndPullsTheGradientBack) {
   const BlenderNoise noise = makeNoise({.scale = 3, .detail = 1});

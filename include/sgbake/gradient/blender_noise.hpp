@@ -129,7 +129,8 @@ struct BlenderWaveParams {
 /// gradient is exact away from the saw's and triangle's corners (and the rings' axis).
 class BlenderWave final : public BlenderTextureVolume<BlenderWaveParams> {
  public:
-  /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale.
+  /// @return kBadInput for a non-finite setting, a direction the type has not (diagonal rings,
+  /// spherical bands), or slopes beyond kMaxVolumeScale.
   static Result<BlenderWave> create(const BlenderWaveParams& params);
   /// The node's Fac.
   double output(Vec3d p, Vec3d* gradient) const override;
