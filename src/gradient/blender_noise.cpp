@@ -7,7 +7,10 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
+#include <string>
+#include <string_view>
 
 #include "sgbake/core/math.hpp"
 
@@ -171,6 +174,29 @@ Vec3d voronoiCellPoint(Vec3d cell) {
           unitFloat(hashWords(x, y, z, floatBits(2.0)))};
 }
 
+/// The check every texture's create() starts with: "a <texture> setting is not finite".
+Status finiteSettings(std::string_view texture, std::initializer_list<double> settings) {
+  for (const double v : settings) {
+    if (!std::isfinite(v)) {
+      return Error::badInput("a " + std::string(texture) + " setting is not finite");
+    }
+  }
+  return Ok{};
+}
+
+/// The bound every texture's create() puts on its slopes' scale @p slopes (kMaxVolumeScale), the
+/// message naming the @p formula it was computed by (if any).
+Status boundedSlopes(std::string_view texture, double slopes, std::string_view formula) {
+  if (slopes <= kMaxVolumeScale) return Ok{};
+  std::string message(texture);
+  message += " slopes beyond 1e300";
+  if (!formula.empty()) {
+    message += ' ';
+    message += formula;
+  }
+  return Error::badInput(std::move(message));
+}
+
 }  // namespace
 
 double blenderSignedNoise(Vec3d x, Vec3d* gradient) {
@@ -217,18 +243,18 @@ double blenderFractalNoise(Vec3d p, double detail, double roughness, Vec3d* grad
 }
 
 Result<BlenderNoise> BlenderNoise::create(const BlenderNoiseParams& params) {
-  for (const double v :
-       {params.amplitude, params.scale, params.detail, params.roughness, params.distortion}) {
-    if (!std::isfinite(v)) return Error::badInput("a Noise Texture setting is not finite");
-  }
+  if (Status finite = finiteSettings(
+          "Noise Texture",
+          {params.amplitude, params.scale, params.detail, params.roughness, params.distortion});
+      !finite)
+    return finite.error();
   const double detail = std::clamp(params.detail, 0.0, 15.0);
   const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
                         (1 + std::abs(params.distortion)) * std::exp2(std::ceil(detail));
-  if (!(slopes <= kMaxVolumeScale)) {
-    return Error::badInput(
-        "Noise Texture slopes beyond 1e300 (amplitude × scale × (1 + "
-        "distortion) × 2^detail)");
-  }
+  if (Status bounded = boundedSlopes("Noise Texture", slopes,
+                                     "(amplitude × scale × (1 + distortion) × 2^detail)");
+      !bounded)
+    return bounded.error();
   return BlenderNoise(params);
 }
 
@@ -268,21 +294,21 @@ double BlenderNoise::output(Vec3d position, Vec3d* gradient) const {
 }
 
 Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& params) {
-  for (const double v :
-       {params.amplitude, params.scale, params.detail, params.dimension, params.lacunarity}) {
-    if (!std::isfinite(v)) return Error::badInput("a Musgrave Texture setting is not finite");
-  }
+  if (Status finite = finiteSettings(
+          "Musgrave Texture",
+          {params.amplitude, params.scale, params.detail, params.dimension, params.lacunarity});
+      !finite)
+    return finite.error();
   const double detail = std::clamp(params.detail, 0.0, 15.0);
   const double lacunarity = std::max(params.lacunarity, 1e-5);
   // The finest octave's slope scale, Lⁿ · L^(−nH) at most Lⁿ · 1e5ⁿ for the smallest H.
   const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
                         std::pow(std::max(lacunarity, 1.0), std::ceil(detail)) *
                         (1 + std::ceil(detail));
-  if (!(slopes <= kMaxVolumeScale)) {
-    return Error::badInput(
-        "Musgrave Texture slopes beyond 1e300 (amplitude × scale × "
-        "lacunarity^detail)");
-  }
+  if (Status bounded =
+          boundedSlopes("Musgrave Texture", slopes, "(amplitude × scale × lacunarity^detail)");
+      !bounded)
+    return bounded.error();
   return BlenderMusgrave(params);
 }
 
@@ -312,15 +338,17 @@ double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
 }
 
 Result<BlenderVoronoi> BlenderVoronoi::create(const BlenderVoronoiParams& params) {
-  for (const double v : {params.amplitude, params.scale, params.randomness, params.exponent}) {
-    if (!std::isfinite(v)) return Error::badInput("a Voronoi Texture setting is not finite");
-  }
+  if (Status finite = finiteSettings(
+          "Voronoi Texture", {params.amplitude, params.scale, params.randomness, params.exponent});
+      !finite)
+    return finite.error();
   if (params.metric == VoronoiMetric::kMinkowski && !(params.exponent > 0)) {
     return Error::badInput("a Voronoi Texture's Minkowski exponent must be greater than 0");
   }
-  if (!(std::abs(params.amplitude) * std::abs(params.scale) * 2 <= kMaxVolumeScale)) {
-    return Error::badInput("Voronoi Texture slopes beyond 1e300");
-  }
+  if (Status bounded = boundedSlopes("Voronoi Texture",
+                                     std::abs(params.amplitude) * std::abs(params.scale) * 2, "");
+      !bounded)
+    return bounded.error();
   return BlenderVoronoi(params);
 }
 
@@ -389,10 +417,11 @@ double BlenderVoronoi::output(Vec3d position, Vec3d* gradient) const {
 }
 
 Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {
-  for (const double v : {params.amplitude, params.scale, params.distortion, params.detail,
-                         params.detailScale, params.detailRoughness, params.phase}) {
-    if (!std::isfinite(v)) return Error::badInput("a Wave Texture setting is not finite");
-  }
+  if (Status finite = finiteSettings(
+          "Wave Texture", {params.amplitude, params.scale, params.distortion, params.detail,
+                           params.detailScale, params.detailRoughness, params.phase});
+      !finite)
+    return finite.error();
   if ((params.direction == WaveDirection::kDiagonal && params.type != WaveType::kBands) ||
       (params.direction == WaveDirection::kSpherical && params.type != WaveType::kRings)) {
     return Error::badInput(
@@ -402,9 +431,7 @@ Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {
   const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
                         (20 + std::abs(params.distortion) * std::abs(params.detailScale) *
                                   std::exp2(std::ceil(std::clamp(params.detail, 0.0, 15.0))));
-  if (!(slopes <= kMaxVolumeScale)) {
-    return Error::badInput("Wave Texture slopes beyond 1e300");
-  }
+  if (Status bounded = boundedSlopes("Wave Texture", slopes, ""); !bounded) return bounded.error();
   return BlenderWave(params);
 }
 
