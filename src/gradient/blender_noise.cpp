@@ -301,12 +301,15 @@ Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& par
     return finite.error();
   const double detail = std::clamp(params.detail, 0.0, 15.0);
   const double lacunarity = std::max(params.lacunarity, 1e-5);
-  // The finest octave's slope scale, Lⁿ · L^(−nH) at most Lⁿ · 1e5ⁿ for the smallest H.
-  const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
-                        std::pow(std::max(lacunarity, 1.0), std::ceil(detail)) *
-                        (1 + std::ceil(detail));
-  if (Status bounded =
-          boundedSlopes("Musgrave Texture", slopes, "(amplitude × scale × lacunarity^detail)");
+  const double h = std::max(params.dimension, 1e-5);
+  // Octave i's slopes are scaled by its weight times its frequency, L^(−iH) · Lⁱ = (L^(1−H))ⁱ:
+  // the n + 1 octaves (n = ⌈detail⌉) at most (n + 1) · max(1, L^(1−H))ⁿ.
+  const double n = std::ceil(detail);
+  const double slopes = std::abs(params.amplitude) * std::abs(params.scale) * (1 + n) *
+                        std::pow(std::max(1.0, std::pow(lacunarity, 1 - h)), n);
+  if (Status bounded = boundedSlopes(
+          "Musgrave Texture", slopes,
+          "(amplitude × scale × (1 + detail) × lacunarity^((1 − dimension) · detail))");
       !bounded)
     return bounded.error();
   return BlenderMusgrave(params);

@@ -216,6 +216,20 @@ TEST(BlenderWave, RefusesADirectionItsTypeHasNot) {
       BlenderWave::create({.type = WaveType::kRings, .direction = WaveDirection::kSpherical}));
 }
 
+// Octave i's slopes grow as (L^(1−H))ⁱ: a Lacunarity below 1 with a large Dimension grows them as
+// surely as a large Lacunarity does, and both are refused before they overflow.
+TEST(BlenderMusgrave, RefusesSlopesThatWouldOverflow) {
+  EXPECT_FALSE(BlenderMusgrave::create({.detail = 15, .dimension = 200, .lacunarity = 0.5}));
+  EXPECT_FALSE(BlenderMusgrave::create({.detail = 15, .dimension = 0, .lacunarity = 1e30}));
+  EXPECT_TRUE(BlenderMusgrave::create({.detail = 15, .dimension = 2, .lacunarity = 0.5}));
+  Result<BlenderMusgrave> made =
+      BlenderMusgrave::create({.detail = 15, .dimension = 200, .lacunarity = 0.5});
+  ASSERT_FALSE(made);
+  EXPECT_EQ(made.error().message,
+            "Musgrave Texture slopes beyond 1e300 (amplitude × scale × (1 + detail) × "
+            "lacunarity^((1 − dimension) · detail))");
+}
+
 // A Mapping node before the texture: the value at the mapped point, the gradient pulled back.
 TEST(MappedHeightVolume, ReadsTheMappedPointAndPullsTheGradientBack) {
   const BlenderNoise noise = makeNoise({.scale = 3, .detail = 1});
