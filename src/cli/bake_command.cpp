@@ -344,16 +344,12 @@ Result<std::vector<Vec2d>> parseRemapPoints(const std::string& text) {
     const std::size_t end = std::min(text.find(',', i), text.size());
     const std::string pair = text.substr(i, end - i);
     const std::size_t colon = pair.find(':');
-    double xy[2] = {0, 0};
-    bool ok = colon != std::string::npos;
-    for (int k = 0; ok && k < 2; ++k) {
-      const std::string word = k == 0 ? pair.substr(0, colon) : pair.substr(colon + 1);
-      char* stop = nullptr;
-      xy[k] = std::strtod(word.c_str(), &stop);
-      ok = !word.empty() && *stop == '\0' && std::isfinite(xy[k]);
-    }
-    if (!ok) return Error::badInput(where + "'" + pair + "' is not X:Y (two finite numbers)");
-    points.push_back({xy[0], xy[1]});
+    const std::optional<double> x =
+        colon == std::string::npos ? std::nullopt : parseFiniteNumber(pair.substr(0, colon));
+    const std::optional<double> y =
+        colon == std::string::npos ? std::nullopt : parseFiniteNumber(pair.substr(colon + 1));
+    if (!x || !y) return Error::badInput(where + "'" + pair + "' is not X:Y (two finite numbers)");
+    points.push_back({*x, *y});
     i = end + 1;
   }
   if (Result<HeightRemap> remap = HeightRemap::create(points); !remap) {
@@ -471,13 +467,12 @@ Result<Scene> oneMapScene(const BakeArguments& args) {
     if (*args.range == "auto") {
       output.rangeAuto = true;
     } else {
-      char* end = nullptr;
-      output.range = std::strtod(args.range->c_str(), &end);
-      if (args.range->empty() || *end != '\0' || !(output.range > 0) ||
-          !std::isfinite(output.range)) {
+      const std::optional<double> range = parseFiniteNumber(*args.range);
+      if (!range || !(*range > 0)) {
         return Error::badInput("bake: --range " + *args.range +
                                " must be a positive number or 'auto'");
       }
+      output.range = *range;
     }
   }
   scene.outputs.push_back(output);

@@ -89,6 +89,10 @@ Status checkSubdivisionOptions(const std::string& command, const SubdivisionOpti
 /// @p text, filed under @p group of --help when non-empty.
 void addTransformOption(CLI::App& app, std::string& text, const std::string& group = {});
 
+/// @brief @p word as a number when the whole of it is one and finite (strtod's syntax), else
+/// none (an empty word too).
+std::optional<double> parseFiniteNumber(const std::string& word);
+
 /// @brief The object transform --transform gave @p command: 16, 12 or 9 numbers separated by
 /// commas (or spaces), row by row (Blender's matrix_world: 4 rows of 4, the last 0 0 0 1; or 3
 /// rows of 4 without it; or the 3 × 3 linear part). Empty @p text: none.

@@ -300,6 +300,13 @@ void addTransformOption(CLI::App& app, std::string& text, const std::string& gro
   if (!group.empty()) option->group(group);
 }
 
+std::optional<double> parseFiniteNumber(const std::string& word) {
+  char* stop = nullptr;
+  const double value = std::strtod(word.c_str(), &stop);
+  if (word.empty() || *stop != '\0' || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
 Result<std::optional<ObjectTransform>> parseTransformOption(const std::string& command,
                                                             const std::string& text) {
   if (text.empty()) return std::optional<ObjectTransform>{};
@@ -313,12 +320,9 @@ Result<std::optional<ObjectTransform>> parseTransformOption(const std::string& c
     }
     const std::size_t end = text.find_first_of(", ", i);
     const std::string word = text.substr(i, end == std::string::npos ? end : end - i);
-    char* stop = nullptr;
-    const double value = std::strtod(word.c_str(), &stop);
-    if (*stop != '\0' || !std::isfinite(value)) {
-      return Error::badInput(where + "'" + word + "' is not a finite number");
-    }
-    numbers.push_back(value);
+    const std::optional<double> value = parseFiniteNumber(word);
+    if (!value) return Error::badInput(where + "'" + word + "' is not a finite number");
+    numbers.push_back(*value);
     i = end == std::string::npos ? text.size() : end;
   }
   const std::size_t n = numbers.size();
