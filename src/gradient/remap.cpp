@@ -99,8 +99,9 @@ void RemappedScalarTexture::sampleMany(std::span<const Vec2d> st,
 
 double RemappedHeightVolume::value(Vec3d p) const { return remap_.value(volume_->value(p)); }
 
-Vec3d RemappedHeightVolume::analyticGradient(Vec3d p) const {
-  return volume_->analyticGradient(p) * remap_.slope(volume_->value(p));
+VolumeSample RemappedHeightVolume::sample(Vec3d p) const {
+  const VolumeSample s = volume_->sample(p);
+  return {remap_.value(s.value), s.gradient * remap_.slope(s.value)};
 }
 
 }  // namespace sgbake

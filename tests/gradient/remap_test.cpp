@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "sgbake/gradient/blender_noise.hpp"
 #include "sgbake/gradient/layers.hpp"
 #include "sgbake/gradient/remap.hpp"
 #include "support/analytic_textures.hpp"
@@ -163,6 +164,59 @@ TEST(RemappedHeightVolume, ScalesTheGradientByTheSlopeAtTheValue) {
   const Vec3d flat{1.2, 0, 0};  // h = 0.94: beyond the step, flat
   EXPECT_EQ(remapped.value(flat), 0.2);
   EXPECT_EQ(remapped.analyticGradient(flat), Vec3d{});
+}
+
+// The views evaluate value and gradient together (HeightVolume::sample) with the same bits as
+// value() and analyticGradient() apart, over a Blender texture whose sample() is one evaluation.
+TEST(HeightVolumeViews, SampleAtOnceGivesTheSameBitsAsValueAndGradientApart) {
+  Result<BlenderNoise> noise = BlenderNoise::create({.amplitude = 0.3, .scale = 2.5});
+  ASSERT_TRUE(noise) << noise.error().message;
+  const MappedHeightVolume mapped(
+      *noise, CoordinateMapping::fromMappingNode({0.2, -1, 0.5}, {0.3, 0, 1.1}, {2, 1, 0.5},
+                                                 MappingType::kPoint));
+  const RemappedHeightVolume remapped(mapped, levelsWithAStep());
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> coordinate(-3, 3);
+  for (int i = 0; i < 100; ++i) {
+    const Vec3d p{coordinate(rng), coordinate(rng), coordinate(rng)};
+    for (const HeightVolume* volume :
+         {static_cast<const HeightVolume*>(&*noise), static_cast<const HeightVolume*>(&mapped),
+          static_cast<const HeightVolume*>(&remapped)}) {
+      const VolumeSample s = volume->sample(p);
+      EXPECT_EQ(s.value, volume->value(p));
+      EXPECT_EQ(s.gradient, volume->analyticGradient(p));
+    }
+  }
+}
+
+// A volume read on UV coordinates is the volume at (s, t, 0), its slopes the gradient's x and y
+// there (a Mapping node before it, a MappedHeightVolume, included).
+TEST(VolumeOnUvTexture, IsTheVolumeOnThePlaneZeroAndItsSlopes) {
+  const PlaneVolume plane;
+  const VolumeOnUvTexture flat(plane);
+  const ScalarSample at = flat.sample({0.5, 2});
+  EXPECT_DOUBLE_EQ(at.value, 0.35 - 0.8 + 0.1);
+  EXPECT_EQ(at.gradient, (Vec2d{0.7, -0.4}));
+  Result<BlenderNoise> noise = BlenderNoise::create({.scale = 3, .detail = 1.5});
+  ASSERT_TRUE(noise) << noise.error().message;
+  const MappedHeightVolume mapped(
+      *noise, CoordinateMapping::fromMappingNode({0, 0.25, 0.1}, {0, 0, 0.6}, {2, 1, 1},
+                                                 MappingType::kPoint));
+  const VolumeOnUvTexture onUv(mapped);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> coordinate(-2, 2);
+  for (int i = 0; i < 100; ++i) {
+    const Vec2d st{coordinate(rng), coordinate(rng)};
+    const ScalarSample s = onUv.sample(st);
+    EXPECT_EQ(s.value, mapped.value({st.x, st.y, 0}));
+    const double h = 1e-6;
+    const double dx =
+        (mapped.value({st.x + h, st.y, 0}) - mapped.value({st.x - h, st.y, 0})) / (2 * h);
+    const double dy =
+        (mapped.value({st.x, st.y + h, 0}) - mapped.value({st.x, st.y - h, 0})) / (2 * h);
+    EXPECT_NEAR(s.gradient.x, dx, 1e-6 * (1 + std::abs(dx)));
+    EXPECT_NEAR(s.gradient.y, dy, 1e-6 * (1 + std::abs(dy)));
+  }
 }
 
 // Every kind of height layer reads a remapped texture as a height G(h): its Γ is G′(h) times the

@@ -34,10 +34,11 @@ template <class Params>
 class BlenderTextureVolume : public HeightVolume {
  public:
   double value(Vec3d p) const final { return params_.amplitude * output(p, nullptr); }
-  Vec3d analyticGradient(Vec3d p) const final {
+  Vec3d analyticGradient(Vec3d p) const final { return sample(p).gradient; }
+  VolumeSample sample(Vec3d p) const final {
     Vec3d g;
-    output(p, &g);
-    return params_.amplitude * g;
+    const double fac = output(p, &g);
+    return {params_.amplitude * fac, params_.amplitude * g};
   }
   /// The node's output at @p p (object space, before the amplitude), and its gradient.
   virtual double output(Vec3d p, Vec3d* gradient) const = 0;

@@ -14,6 +14,7 @@
 ///
 /// MappedHeightVolume is the same kind of view of a volume's position: a Mapping node (or another
 /// affine map of the coordinates) between Texture Coordinate Object and a procedural texture.
+/// VolumeOnUvTexture reads a volume on a UV map's coordinates (u, v, 0) instead.
 #pragma once
 
 #include <algorithm>
@@ -116,7 +117,8 @@ class RemappedHeightVolume final : public HeightVolume {
   RemappedHeightVolume(const HeightVolume& volume, HeightRemap remap)
       : volume_(&volume), remap_(std::move(remap)) {}
   double value(Vec3d p) const override;
-  Vec3d analyticGradient(Vec3d p) const override;
+  Vec3d analyticGradient(Vec3d p) const override { return sample(p).gradient; }
+  VolumeSample sample(Vec3d p) const override;
 
  private:
   const HeightVolume* volume_;
@@ -135,10 +137,32 @@ class MappedHeightVolume final : public HeightVolume {
   Vec3d analyticGradient(Vec3d p) const override {
     return mapping_.pullBack(volume_->analyticGradient(mapping_.apply(p)));
   }
+  VolumeSample sample(Vec3d p) const override {
+    const VolumeSample s = volume_->sample(mapping_.apply(p));
+    return {s.value, mapping_.pullBack(s.gradient)};
+  }
 
  private:
   const HeightVolume* volume_;
   CoordinateMapping mapping_;
+};
+
+/// @brief A HeightVolume read as a texture on the plane z = 0 of its coordinates:
+/// h(s, t) = volume((s, t, 0)), slopes (∂h/∂x, ∂h/∂y) there. A procedural texture on a UV map's
+/// coordinates is this: Blender's Texture Coordinate UV (and the UV Map node) give (u, v, 0),
+/// and a Mapping node between them is a MappedHeightVolume under this view.
+///
+/// The volume is **not owned**; it must outlive this one. Thread-safe as the volume is.
+class VolumeOnUvTexture final : public ScalarTexture {
+ public:
+  explicit VolumeOnUvTexture(const HeightVolume& volume) : volume_(&volume) {}
+  ScalarSample sample(Vec2d st) const override {
+    const VolumeSample s = volume_->sample({st.x, st.y, 0});
+    return {s.value, {s.gradient.x, s.gradient.y}};
+  }
+
+ private:
+  const HeightVolume* volume_;
 };
 
 }  // namespace sgbake

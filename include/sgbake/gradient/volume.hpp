@@ -29,6 +29,12 @@
 
 namespace sgbake {
 
+/// @brief A height and its gradient at one point.
+struct VolumeSample {
+  double value = 0;
+  Vec3d gradient{};
+};
+
 /// @brief A scalar height field over object space.
 ///
 /// @note Contract for implementations: value() and analyticGradient() are thread-safe, do not
@@ -44,6 +50,10 @@ class HeightVolume {
 
   /// @brief ∇h(P) = (∂h/∂x, ∂h/∂y, ∂h/∂z), object space, height per unit length.
   virtual Vec3d analyticGradient(Vec3d p) const = 0;
+
+  /// @brief value() and analyticGradient() at once, the same bits as each: volumes that compute
+  /// both together (Blender's textures) override it to evaluate once.
+  virtual VolumeSample sample(Vec3d p) const { return {value(p), analyticGradient(p)}; }
 
  protected:
   HeightVolume() = default;
