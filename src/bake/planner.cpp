@@ -751,7 +751,9 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       const SceneLayer& volume = scene.layers[layer.sceneLayer];
       plan.steps.push_back({"make " + describeLayer(volume) + " for " +
                                 layerLabel(layer.sceneLayer) + remapNote(layer.sceneLayer),
-                            volume.step
+                            volume.coordinates == VolumeCoordinates::kUv
+                                ? "read as a UV height: slopes through the UV map"
+                            : volume.step
                                 ? "gradient step " + formatNumber(*volume.step)
                                 : "gradient step: 2^-20 of the mesh's bounding-box diagonal"});
     }

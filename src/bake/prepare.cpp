@@ -418,8 +418,8 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
     }
     remap = std::move(*made);
     if (scalar != nullptr) {
-      loaded.remapped.push_back(std::make_unique<RemappedScalarTexture>(*scalar, *remap));
-      scalar = loaded.remapped.back().get();
+      loaded.textureViews.push_back(std::make_unique<RemappedScalarTexture>(*scalar, *remap));
+      scalar = loaded.textureViews.back().get();
     }
   }
   Layer result;
@@ -485,6 +485,16 @@ Result<Layer> makeLayer(const Plan& plan, const PlannedLayer& planned, Loaded& l
       if (remap) {
         loaded.volumes.push_back(
             std::make_unique<RemappedHeightVolume>(*loaded.volumes.back(), std::move(*remap)));
+      }
+      if (layer.coordinates == VolumeCoordinates::kUv) {  // read at (u, v, 0): a UV height
+        loaded.textureViews.push_back(std::make_unique<VolumeOnUvTexture>(*loaded.volumes.back()));
+        UvHeightSource source;
+        source.texture = loaded.textureViews.back().get();
+        source.uvSet = layer.uvSet;
+        source.strength = layer.strength;
+        source.gradient = layer.heightGradient;
+        result.source = source;
+        break;
       }
       VolumeSource source;
       source.volume = loaded.volumes.back().get();

@@ -68,8 +68,9 @@ struct Loaded {
   std::vector<std::unique_ptr<ScalarTexture>> scalar;
   std::vector<std::unique_ptr<VectorTexture>> vector;  ///< per plan texture, as scalar
   std::vector<std::unique_ptr<HeightVolume>> volumes;  ///< remapped ones after what they read
-  /// A remapped layer's view of its texture (RemappedScalarTexture), per such layer
-  std::vector<std::unique_ptr<ScalarTexture>> remapped;
+  /// A layer's view of its texture or volume as the texture it reads (RemappedScalarTexture,
+  /// VolumeOnUvTexture), per such layer
+  std::vector<std::unique_ptr<ScalarTexture>> textureViews;
   std::vector<Layer> layers;  ///< per plan layer
   std::optional<CornerTangents> tangents;
   /// computeLoopTriangleTangents per UV set a tangent-space layer decodes on (MikkTSpace frame)

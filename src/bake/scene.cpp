@@ -127,6 +127,8 @@ constexpr Named<VolumeFunction> kFunctions[] = {
     {"blender-musgrave", VolumeFunction::kBlenderMusgrave},
     {"blender-wave", VolumeFunction::kBlenderWave},
     {"blender-voronoi", VolumeFunction::kBlenderVoronoi}};
+constexpr Named<VolumeCoordinates> kVolumeCoordinates[] = {{"object", VolumeCoordinates::kObject},
+                                                           {"uv", VolumeCoordinates::kUv}};
 constexpr Named<VoronoiMetric> kVoronoiMetrics[] = {{"euclidean", VoronoiMetric::kEuclidean},
                                                     {"manhattan", VoronoiMetric::kManhattan},
                                                     {"chebyshev", VoronoiMetric::kChebyshev},
@@ -432,33 +434,12 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
-      add({"function",
-           "amplitude",
-           "frequency",
-           "direction",
-           "phase",
-           "seed",
-           "octaves",
-           "detail",
-           "roughness",
-           "distortion",
-           "dimension",
-           "lacunarity",
-           "wave",
-           "wave_direction",
-           "profile",
-           "detail_scale",
-           "detail_roughness",
-           "randomness",
-           "metric",
-           "exponent",
-           "mapping",
-           "gradient",
-           "step",
-           "base",
-           "strength",
-           "height_space",
-           "remap"});
+      add({"function",     "amplitude",        "frequency",    "direction",      "phase",
+           "seed",         "octaves",          "detail",       "roughness",      "distortion",
+           "dimension",    "lacunarity",       "wave",         "wave_direction", "profile",
+           "detail_scale", "detail_roughness", "randomness",   "metric",         "exponent",
+           "mapping",      "coordinates",      "uv",           "gradient",       "step",
+           "base",         "strength",         "height_space", "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
@@ -924,6 +905,22 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
                                      : GradientScheme::kAnalytic;
     if (gradient == 3) layer.heightGradient = HeightGradient::kBumpNode;
     if (reader.has("step")) layer.step = reader.numberAtLeast("step", 0, /*exclusive=*/true);
+    reader.optionalName("coordinates", kVolumeCoordinates, layer.coordinates);
+    if (layer.coordinates == VolumeCoordinates::kObject && reader.has("uv")) {
+      fail(where,
+           "key 'uv' applies to a volume on 'coordinates': 'uv' (this one is read at the "
+           "object's positions)");
+    }
+    if (layer.coordinates == VolumeCoordinates::kUv && (gradient == 1 || gradient == 2)) {
+      fail(where, "'gradient': '" + std::string(nameIn(kVolumeGradients, gradient)) +
+                      "' applies to volumes on 'coordinates': 'object' (one on UV coordinates "
+                      "takes its slopes 'analytic' or 'bump-node')");
+    }
+    if (layer.coordinates == VolumeCoordinates::kUv && reader.has("step")) {
+      fail(where,
+           "key 'step' applies to volumes on 'coordinates': 'object' (one on UV "
+           "coordinates takes no finite differences)");
+    }
   }
 
   // Combinations the keys alone do not rule out.
@@ -1242,6 +1239,13 @@ std::string checkLayer(const SceneLayer& layer, bool inMemory) {
       return "'remap': " + remap.error().message;
     }
   }
+  if (layer.type != SceneLayerType::kVolume && layer.coordinates != VolumeCoordinates::kObject) {
+    return "key 'coordinates' applies only to volumes";
+  }
+  if (layer.coordinates == VolumeCoordinates::kUv && layer.gradient != GradientScheme::kAnalytic) {
+    return "a volume on UV coordinates takes its slopes 'analytic' or 'bump-node' (no finite "
+           "differences)";
+  }
   if (layer.type == SceneLayerType::kVolume && layer.function == VolumeFunction::kNoise) {
     if (!(layer.frequency > 0)) return "frequency must be greater than 0";
     if (layer.octaves < 1 || layer.octaves > kMaxNoiseOctaves) {
@@ -1538,6 +1542,9 @@ std::string describeLayer(const SceneLayer& layer) {
       break;
     case SceneLayerType::kVolume:
       text = "volume " + nameIn(kFunctions, layer.function);
+      if (layer.coordinates == VolumeCoordinates::kUv) {
+        text += " on UV set " + std::to_string(layer.uvSet) + "'s coordinates";
+      }
       break;
     case SceneLayerType::kPlanar:
     case SceneLayerType::kTriplanar:
@@ -1636,6 +1643,12 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
                           ? nameIn(kHeightGradients, layer.heightGradient)
                           : nameIn(kSchemes, layer.gradient);
       j["step"] = layer.step ? json(*layer.step) : json("default");
+      // (no "coordinates" key on object coordinates: the manifests of scenes before it stay
+      // valid)
+      if (layer.coordinates == VolumeCoordinates::kUv) {
+        j["coordinates"] = nameIn(kVolumeCoordinates, layer.coordinates);
+        j["uv"] = layer.uvSet;
+      }
       break;
     case SceneLayerType::kPlanar:
       j["kind"] = nameIn(kKinds, layer.kind);

@@ -392,6 +392,55 @@ TEST_F(PlannerTest, ARemappedHeightBakesTheRemapOfTheHeightAndItsSlopes) {
       << text;
 }
 
+// A volume on "coordinates": "uv" is read at (u, v, 0): on a plane whose UVs are (2x, y + 0.25)
+// it bakes what the same volume bakes on the object's coordinates through the Mapping node that
+// makes (2x, y + 0.25, z): heights, slopes and normals, exact and as the Bump node takes them.
+TEST_F(PlannerTest, AVolumeOnUvCoordinatesIsReadAtTheUvs) {
+  writeFile(dir_ / "stretched.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+            "vt 0 0.25\nvt 2 0.25\nvt 2 1.25\nvt 0 1.25\n"
+            "vn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
+  const std::string noise = R"({"type": "volume", "function": "blender-noise", "amplitude": 0.05,
+                                "frequency": 3, "detail": 1.5)";
+  const std::string mapping = R"(, "mapping": {"location": [0, 0.25, 0], "scale": [2, 1, 1]})";
+  const auto bakeTo = [&](const std::string& layer, const std::string& prefix) {
+    bake(planeScene(layer,
+                    R"({"map": "height", "file": ")" + prefix +
+                        R"(h.exr", "size": 16, "margin": 0, "bit_depth": 32},
+                       {"map": "derivative", "file": ")" +
+                        prefix + R"(d.exr", "size": 16, "margin": 0, "bit_depth": 32},
+                       {"map": "object-normal", "file": ")" +
+                        prefix + R"(n.exr", "size": 16, "margin": 0, "bit_depth": 32})",
+                    "stretched.obj"));
+    std::vector<float> all;
+    for (const char* map : {"h.exr", "d.exr", "n.exr"}) {
+      const std::vector<float> pixels = readPixels(dir_ / (prefix + map));
+      all.insert(all.end(), pixels.begin(), pixels.end());
+    }
+    return all;
+  };
+  const auto largestDifference = [](const std::vector<float>& a, const std::vector<float>& b) {
+    EXPECT_EQ(a.size(), b.size());
+    double largest = 0;
+    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+      largest = std::max(largest, std::abs(static_cast<double>(a[i]) - b[i]));
+    }
+    return largest;
+  };
+  for (const std::string gradient : {"analytic", "bump-node"}) {
+    const std::string how = R"(, "gradient": ")" + gradient + R"(")";
+    const std::vector<float> onUv = bakeTo(noise + how + R"(, "coordinates": "uv"})", "uv_");
+    const std::vector<float> onObject = bakeTo(noise + how + mapping + "}", "object_");
+    const std::vector<float> unmapped = bakeTo(noise + how + "}", "unmapped_");
+    ASSERT_EQ(onUv.size(), std::size_t{16 * 16 * (1 + 2 + 3)}) << gradient;
+    EXPECT_LT(largestDifference(onUv, onObject), 1e-5) << gradient;
+    EXPECT_GT(largestDifference(onUv, unmapped), 1e-2) << gradient << ": the control must differ";
+  }
+  const std::string text = explainPlan(plan(
+      planeScene(noise + R"(, "coordinates": "uv"})", R"({"map": "height", "file": "h.exr"})")));
+  EXPECT_NE(text.find("volume blender-noise on UV set 0's coordinates"), std::string::npos) << text;
+}
+
 TEST_F(PlannerTest, MissingInputsAreNamed) {
   Result<Plan> image = makePlan(scene(planeScene(R"({"type": "height", "image": "missing.png"})",
                                                  R"({"map": "height", "file": "h.exr"})")));

@@ -822,6 +822,60 @@ TEST(Scene, RemapIsParsedForHeightsAndInTheParametersOnlyWhenGiven) {
 
 // "function": "blender-noise": Blender's Noise Texture, Blender's defaults (Scale 5 as
 // "frequency", Detail 2, Roughness 0.5, Distortion 0), a Mapping node before it as "mapping".
+// "coordinates": "uv" reads a volume at (u, v, 0) of its "uv" set (the scene's by default);
+// finite differences and a UV set on object coordinates are refused, and validateScene refuses
+// the same built in code.
+TEST(Scene, VolumesOnUvCoordinatesNameTheirUvSet) {
+  Result<Scene> onUv = parseScene(
+      R"({"mesh": "m.obj", "uv": 1, "layers": [{"type": "volume", "function": "blender-noise",
+          "coordinates": "uv", "gradient": "bump-node"}], "outputs": [{"map": "height",
+          "file": "h.exr"}]})",
+      options());
+  ASSERT_TRUE(onUv) << onUv.error().message;
+  EXPECT_EQ(onUv->layers[0].coordinates, VolumeCoordinates::kUv);
+  EXPECT_EQ(onUv->layers[0].uvSet, 1);
+  EXPECT_EQ(onUv->layers[0].heightGradient, HeightGradient::kBumpNode);
+  EXPECT_NE(layerParametersJson(onUv->layers[0]).find(R"("coordinates":"uv")"), std::string::npos);
+  EXPECT_NE(layerParametersJson(onUv->layers[0]).find(R"("uv":1)"), std::string::npos);
+  EXPECT_EQ(describeLayer(onUv->layers[0]), "volume blender-noise on UV set 1's coordinates");
+  Result<Scene> onObject = parseScene(
+      withLayer(R"({"type": "volume", "function": "blender-noise", "coordinates": "object"})"),
+      options());
+  ASSERT_TRUE(onObject) << onObject.error().message;
+  EXPECT_EQ(layerParametersJson(onObject->layers[0]).find("coordinates"), std::string::npos)
+      << "object coordinates keep the manifests of scenes before the key";
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "uv": 1})")),
+      "scene.json: layers[0]: key 'uv' applies to a volume on 'coordinates': 'uv' (this one is "
+      "read at the object's positions)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "coordinates": "uv",
+                                     "gradient": "tetrahedral"})")),
+            "scene.json: layers[0]: 'gradient': 'tetrahedral' applies to volumes on "
+            "'coordinates': 'object' (one on UV coordinates takes its slopes 'analytic' or "
+            "'bump-node')");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "coordinates": "uv", "step": 0.1})")),
+            "scene.json: layers[0]: key 'step' applies to volumes on 'coordinates': 'object' "
+            "(one on UV coordinates takes no finite differences)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "height", "image": "h.png", "coordinates": "uv"})")),
+            "scene.json: layers[0]: key 'coordinates' does not apply to a height layer (it is "
+            "for volume layers)");
+
+  Scene scene = *onUv;
+  scene.layers[0].gradient = GradientScheme::kCentral;
+  Status status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message,
+            "layers[0]: a volume on UV coordinates takes its slopes 'analytic' or 'bump-node' "
+            "(no finite differences)");
+  scene.layers[0].gradient = GradientScheme::kAnalytic;
+  EXPECT_TRUE(validateScene(scene));
+  scene.layers[0].type = SceneLayerType::kHeight;
+  scene.layers[0].image = "h.png";
+  status = validateScene(scene);
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().message, "layers[0]: key 'coordinates' applies only to volumes");
+}
+
 TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
   Result<Scene> plain =
       parseScene(withLayer(R"({"type": "volume", "function": "blender-noise"})"), options());

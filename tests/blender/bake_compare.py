@@ -20,6 +20,8 @@ sgbake outputs that bake_oracle.py added next to them. For each case, for every 
                        (a negative control)
   ours_bake_unmapped.exr  a mapped case's bump-node bake without its "mapping" (a negative
                      control)
+  ours_bake_on_object.exr  a case with a texture on UV coordinates: its bump-node bake with the
+                     texture read at the object's coordinates instead (a negative control)
   ours_bake_swapped.exr, ours_nmap_swapped.exr  a Sphere- or Tube-projection case's bake
                      with the other wrap (a negative control)
   ours_bake_unscaled.exr  an object-space displacement case's bump-node bake with the
@@ -124,6 +126,7 @@ def compare_case(entry):
                       ("bake_bump_node", "ours_bake_bump_node.exr"),
                       ("bake_blended", "ours_bake_blended.exr"),
                       ("bake_unmapped", "ours_bake_unmapped.exr"),
+                      ("bake_on_object", "ours_bake_on_object.exr"),
                       ("bake_swapped", "ours_bake_swapped.exr"),
                       ("bake_unscaled", "ours_bake_unscaled.exr"),
                       ("bake_full_strength", "ours_bake_full_strength.exr"),

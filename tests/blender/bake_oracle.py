@@ -95,6 +95,11 @@ deg, the triangle's folds p99 1.5 deg; without the mapping 6.8 and 3.4 deg). vor
 Voronoi Texture's F1 Distance, a "blender-voronoi" layer: median 0.0016 deg, p99 0.0019-0.0020
 deg (exact slopes median 0.074 and 0.11 deg, p99 4.4 and 6.3 deg at the cells' borders, where
 Cycles' differences straddle two points; without the mapping 5.8 and 6.9 deg).
+noise_uv_suzanne and voronoi_uv_sphere read a Noise and a Voronoi Texture on the UV map's
+coordinates (Texture Coordinate UV) through a Mapping node: a volume layer with "coordinates":
+"uv"; their control ours_bake_on_object.exr, the same layer on the object's coordinates, must
+fail (b) and (e). Measured with Cycles' slopes: median 0.0016-0.0017 deg, p99 0.0020-0.0036
+deg; exact slopes median 0.12 and 0.037 deg; on object coordinates 7.4 and 8.3 deg.
 
 Pass criteria, per case (Bump Distance = --height-scale; verified in bake_scene.py):
   (a) convert vs Blender's tangent bake: median <= 0.05 deg and 99th percentile <= 0.5 deg
@@ -255,7 +260,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "displacement_sphere",
                  "displacement_stretch_sphere", "displacement_object_sphere",
                  "displacement_object_stretch_sphere", "ramp_sphere", "clamp_suzanne",
-                 "noise_sphere", "noise_stretch_suzanne", "musgrave_sphere", "wave_sphere",
+                 "noise_sphere", "noise_stretch_suzanne", "noise_uv_suzanne",
+                 "voronoi_uv_sphere", "musgrave_sphere", "wave_sphere",
                  "wave_suzanne", "voronoi_sphere", "voronoi_minkowski_suzanne")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
@@ -383,7 +389,9 @@ def sgbake_case(cli, entry, sabotage, threads):
     if "remap" in entry or "noise" in entry:  # scenes only
         # A height reshaped before the Bump (its layer's "remap"; the control without it), or
         # Blender's Noise Texture (a "blender-noise" volume; the control without its Mapping).
-        control = "ours_bake_unremapped" if "remap" in entry else "ours_bake_unmapped"
+        control = ("ours_bake_unremapped" if "remap" in entry
+                   else "ours_bake_on_object" if entry["noise"].get("coordinates") == "UV"
+                   else "ours_bake_unmapped")
         layers = []
         for name, layer_scale, gradient, complete in (
                 ("ours_bake", bake_scale, "analytic", True),
@@ -409,10 +417,15 @@ def sgbake_case(cli, entry, sabotage, threads):
                                  wave_direction=noise["direction"].lower(),
                                  profile={"SIN": "sine", "SAW": "saw",
                                           "TRI": "triangle"}[noise["profile"]])
-                if complete:
+                # On UV coordinates the control is the texture read at the object's positions
+                # (through the same mapping), elsewhere the texture without its mapping.
+                on_uv = noise.get("coordinates") == "UV"
+                if complete or on_uv:
                     location, rotation, mapping_scale = noise["mapping"]
                     layer["mapping"] = {"location": location, "rotation": rotation,
                                         "scale": mapping_scale}
+                if complete and on_uv:
+                    layer["coordinates"] = "uv"
             else:
                 layer = {"type": "height", "image": p("height.exr"), "scale": layer_scale,
                          "filter": entry["filter"], "gradient": gradient}
@@ -765,6 +778,8 @@ def evaluate(name, r, planar=False):
     for key, label, what in (("bake_blended", "sgbake's blend:   ",
                               "sgbake's own triplanar blend instead of Blender's Box"),
                              ("bake_unmapped", "without Mapping:  ", "its Mapping node left out"),
+                             ("bake_on_object", "object coords:    ",
+                              "the texture read at the object's coordinates, not the UV map's"),
                              ("bake_swapped", "the other wrap:   ",
                               "the Sphere and Tube projections swapped"),
                              ("bake_unscaled", "Scale in world:   ",

@@ -230,7 +230,8 @@ def reshape_height(mat, kind):
 # "mapping"}, with "kind": "voronoi" a Voronoi Texture (F1, 3D, its Distance) of {"scale",
 # "randomness", "metric" (Blender's name), "exponent", "mapping"}. The manifest entry has
 # "noise": these settings, sgbake's "blender-noise" (or "blender-musgrave", "blender-wave",
-# "blender-voronoi") volume layer with that "mapping".
+# "blender-voronoi") volume layer with that "mapping". With "coordinates": "UV" the texture reads
+# the Texture Coordinate node's UV output instead, and the layer has "coordinates": "uv".
 NOISE = {}
 
 
@@ -247,7 +248,8 @@ def noise_case(name, of_case, size, distance, **settings):
 
 def bump_by_noise(mat, settings):
     """Replaces the texture feeding `mat`'s Bump node by a Noise Texture of `settings` (NOISE) on
-    object coordinates through a Mapping node."""
+    object coordinates (or the Texture Coordinate node's output settings["coordinates"], "UV")
+    through a Mapping node."""
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
     bump = next(n for n in nodes if n.bl_idname == "ShaderNodeBump")
     coordinates = nodes.new("ShaderNodeTexCoord")
@@ -280,7 +282,7 @@ def bump_by_noise(mat, settings):
     for socket in inputs:
         key = "phase" if socket == "Phase Offset" else socket.lower().replace(" ", "_")
         noise.inputs[socket].default_value = settings[key]
-    links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
+    links.new(coordinates.outputs[settings.get("coordinates", "Object")], mapping.inputs["Vector"])
     links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
     output = "Distance" if settings.get("kind") == "voronoi" else "Fac"
     links.new(noise.outputs[output], bump.inputs["Height"])
@@ -582,6 +584,14 @@ noise_case("noise_sphere", "sphere", 512, 0.05, scale=2.0, detail=2.5, roughness
            distortion=0.3, mapping=NOISE_MAPPING)
 noise_case("noise_stretch_suzanne", "stretch_chain_suzanne", 512, 0.03, scale=3.0, detail=3.0,
            roughness=0.6, distortion=0.0, mapping=NOISE_MAPPING)
+# Procedural textures on the UV map's coordinates (Texture Coordinate UV, (u, v, 0)) through a
+# Mapping node: a Noise Texture on Suzanne (its UV islands of every size and stretch), a Voronoi
+# Texture on the sphere (its UVs stretched towards the poles).
+UV_MAPPING = ((0.2, -0.1, 0.3), (0.0, 0.0, 0.5), (4.0, 3.0, 1.0))
+noise_case("noise_uv_suzanne", "suzanne", 512, 0.05, scale=2.0, detail=2.5, roughness=0.55,
+           distortion=0.2, mapping=UV_MAPPING, coordinates="UV")
+noise_case("voronoi_uv_sphere", "sphere", 512, 0.02, kind="voronoi", scale=3.0, randomness=0.9,
+           metric="EUCLIDEAN", exponent=0.5, mapping=UV_MAPPING, coordinates="UV")
 # Blender's Musgrave Texture (fBM) on the sphere: Detail 2.5, Dimension 1.5, Lacunarity 2.3.
 noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, detail=2.5,
            dimension=1.5, lacunarity=2.3, mapping=NOISE_MAPPING)

@@ -70,6 +70,14 @@ enum class SceneLayerType {
 /// @brief The scene name of @p type ("height", ...).
 std::string_view sceneLayerTypeName(SceneLayerType type);
 
+/// @brief "coordinates" of a volume layer: where it is read.
+enum class VolumeCoordinates {
+  kObject,  ///< "object": at the object position P (through its "mapping")
+  /// "uv": at (u, v, 0) of its "uv" set (through its "mapping"), as a procedural texture on
+  /// Blender's Texture Coordinate UV or a UV Map node: a UV height (VolumeOnUvTexture)
+  kUv,
+};
+
 /// @brief "function" of a volume layer.
 enum class VolumeFunction {
   kSine,             ///< DirectionalSine
@@ -155,7 +163,7 @@ struct SceneLayer {
   std::filesystem::path image;        ///< "image", resolved against the scene's directory
   Filter filter = Filter::kBilinear;  ///< "filter": bilinear | bicubic | hermite (heights only)
   Wrap wrap = Wrap::kRepeat;          ///< "wrap": repeat | clamp
-  int uvSet = 0;                      ///< "uv" (height, normal)
+  int uvSet = 0;  ///< "uv" (height, normal, and a volume on "coordinates": "uv")
   Vec2d tiling{1, 1};                 ///< "tiling": a number or [s, t]
   Vec2d offset{0, 0};                 ///< "offset": [s, t]
   /// "scale" (height, planar, triplanar: object units per unit of value; strength for projected
@@ -237,6 +245,7 @@ struct SceneLayer {
   double voronoiExponent = 0.5;
   GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
   std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
+  VolumeCoordinates coordinates = VolumeCoordinates::kObject;  ///< "coordinates" (with "uv")
 
   /// @brief Whether the layer reads an image ("image" key): every type but volume.
   bool hasImage() const { return type != SceneLayerType::kVolume; }
