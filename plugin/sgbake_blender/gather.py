@@ -47,7 +47,7 @@ def follow_coordinates(layers, ob):
     another object's or the Generated coordinates to what they are now on `ob`, so that a moved
     projector or an edited mesh bakes as Cycles renders it without Layers from Material again."""
     for layer in layers:
-        if layer.type not in ("planar", "triplanar", "volume"):
+        if not scene.on_object_coordinates(layer):
             continue
         if layer.coordinates_object is None and not layer.coordinates_generated:
             continue
@@ -81,7 +81,7 @@ def uv_sets(mesh, bake_uv_name, layers):
     render_uv = render_uv_name(mesh)
     wanted = [("the bake", bake_uv_name)]
     wanted += [(f"layer '{layer.name}'", layer.uv_map or render_uv) for layer in layers
-               if layer.type in scene.UV_LAYER_TYPES]
+               if scene.reads_uv(layer)]
     wanted += [(f"the tangents of layer '{layer.name}'", scene.tangent_frames_uv(layer, render_uv))
                for layer in layers if scene.tangent_frames_uv(layer, render_uv)]
     wanted += [(f"the mask of layer '{layer.name}'", layer.mask_uv_map) for layer in layers

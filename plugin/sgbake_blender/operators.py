@@ -735,7 +735,7 @@ def _coordinates_of(settings):
     return "coordinates_object" in settings or "coordinates_generated" in settings
 
 
-def _vector_coordinates(socket, ob=None, generated=False):
+def _vector_coordinates(socket, ob=None, generated=False, uv=False):
     """The object coordinates texture input `socket` (a Vector) reads, as layer settings (empty
     for the object's own), or a string saying why they are not object coordinates. They are
     when it comes from a Texture Coordinate node's Object output (the object's own, or another
@@ -746,7 +746,10 @@ def _vector_coordinates(socket, ob=None, generated=False):
     procedural texture, which Cycles reads on the Generated coordinates when its Vector is
     unlinked) also when nothing is linked. Other objects' and the Generated coordinates get
     their affine map of the object's own as `ob` has them now (mapping_matrix;
-    gather.follow_coordinates brings it up to date at every bake), none when `ob` is None."""
+    gather.follow_coordinates brings it up to date at every bake), none when `ob` is None. With
+    `uv` (a procedural texture, which a volume layer reads on a UV map too) a Texture Coordinate
+    node's UV output or a UV Map node is taken as well: coordinates_uv, and the UV Map node's
+    uv_map when it names one (else the layer reads the render UV map, as Cycles does)."""
     link = _source_link(socket)
     settings = {}
     if link is None and generated:
@@ -767,15 +770,22 @@ def _vector_coordinates(socket, ob=None, generated=False):
             return f"'{node.name}' Vector is not linked (a constant: no bump)"
     if link is None:
         return f"{socket.name} is not linked"
+    if uv and (link.from_node.type == "UVMAP"
+               or (link.from_node.type == "TEX_COORD" and link.from_socket.name == "UV")):
+        settings["coordinates_uv"] = True  # (u, v, 0) of the UV map
+        if link.from_node.type == "UVMAP" and link.from_node.uv_map:
+            settings["uv_map"] = link.from_node.uv_map
+        return settings
     if link.from_node.type != "TEX_COORD":
         return (f"{socket.name} from '{link.from_node.name}' (not a Texture Coordinate "
-                "node's Object or Generated output)")
+                "node's Object or Generated output"
+                + (", UV output or UV Map node)" if uv else ")"))
     if link.from_socket.name == "Object" and link.from_node.object is None:
         return settings  # the object's own coordinates
     source = _coordinates_source(link)
     if source is None:
         return (f"{socket.name} from '{link.from_node.name}' {link.from_socket.name} (not "
-                "object or Generated coordinates)")
+                "object or Generated coordinates" + (" or a UV map)" if uv else ")"))
     return _mapped_coordinates(settings, source, ob)
 
 
@@ -917,12 +927,12 @@ def _procedural_settings(tex, ob=None):
     Texture, Detail, Dimension and Lacunarity of a Musgrave Texture, Distortion, Detail, Detail
     Scale, Detail Roughness and Phase Offset of a Wave Texture, Randomness and Exponent of a
     Voronoi Texture), the slopes as Cycles' Bump node takes them (gradient "bump-node"), on the
-    coordinates its Vector reads (_vector_coordinates; unlinked, the Generated coordinates, as
-    Cycles reads a procedural texture); or a string saying why none is made: Dimensions other
-    than 3D, a type the function is not (a Musgrave Texture's other than fBM, a Voronoi
-    Texture's Feature Output other than F1), an input fed by anything but
-    constants (_constant), a Vector that is not object coordinates (a UV map, a position in
-    world space, ...)."""
+    coordinates its Vector reads (_vector_coordinates: object coordinates, or a UV map's;
+    unlinked, the Generated coordinates, as Cycles reads a procedural texture); or a string
+    saying why none is made: Dimensions other than 3D, a type the function is not (a Musgrave
+    Texture's other than fBM, a Voronoi Texture's Feature Output other than F1), an input fed
+    by anything but constants (_constant), a Vector that is neither object nor UV coordinates
+    (a position in world space, a normal, ...)."""
     texture = PROCEDURAL_TEXTURES[tex.type]
     if texture.dimensions and getattr(tex, texture.dimensions) != "3D":
         return (f"'{tex.name}' Dimensions {_enum_name(tex, texture.dimensions)} (a volume "
@@ -945,7 +955,7 @@ def _procedural_settings(tex, ob=None):
     if varying:
         return (f"'{tex.name}' {' and '.join(varying)} from a node (a volume layer takes "
                 "constants)")
-    coordinates = _vector_coordinates(tex.inputs["Vector"], ob, generated=True)
+    coordinates = _vector_coordinates(tex.inputs["Vector"], ob, generated=True, uv=True)
     if isinstance(coordinates, str):
         return f"'{tex.name}' {coordinates}"
     settings = {"type": "volume", "name": tex.name, "function": texture.function,

@@ -254,6 +254,11 @@ class SgbakeLayer(bpy.types.PropertyGroup):
         description="Projections and volumes: the baked object's Generated coordinates (its "
                     "texture space to [0, 1], what Cycles reads a procedural texture on "
                     "when its Vector is unlinked); Coordinates follow them at every bake")
+    coordinates_uv: BoolProperty(
+        name="UV Coordinates", default=False,
+        description="Volumes: read at (u, v, 0) of the layer's UV map (the render UV map when "
+                    "empty), as a procedural texture on a Texture Coordinate node's UV output "
+                    "or a UV Map node, instead of at the object's coordinates")
     projection: EnumProperty(name="Projection", items=PROJECTIONS, default="blended",
                              description="How a triplanar layer lays out and blends its planes")
     box_blend: FloatProperty(name="Blend", default=0.0, min=0.0, max=1.0, subtype="FACTOR",

@@ -54,7 +54,7 @@ LAYER_TYPES = (
     ("triplanar", "Triplanar", "Image projected on the three axis planes and blended"),
 )
 IMAGE_LAYER_TYPES = {"height", "normal", "planar", "triplanar"}
-UV_LAYER_TYPES = {"height", "normal"}  # layer types with their own "uv"
+UV_LAYER_TYPES = {"height", "normal"}  # layer types with their own "uv" (and reads_uv)
 
 SURFACES = (
     ("mesh", "Evaluated Mesh",
@@ -190,6 +190,18 @@ def tangent_frames_uv(layer, default_uv=None):
     return None
 
 
+def reads_uv(layer):
+    """Whether `layer` reads a UV map of its own ("uv"): a height or normal layer, or a volume
+    on UV coordinates (coordinates_uv)."""
+    return layer.type in UV_LAYER_TYPES or (layer.type == "volume" and layer.coordinates_uv)
+
+
+def on_object_coordinates(layer):
+    """Whether `layer` reads object coordinates: a projection, or a volume not on a UV map."""
+    return layer.type in ("planar", "triplanar") or (layer.type == "volume"
+                                                     and not layer.coordinates_uv)
+
+
 def projected_by_blender(layer):
     """Whether the layer projects its image as Blender's Image Texture does: a triplanar
     layer's Box projection, a planar layer's Flat, Sphere or Tube one."""
@@ -219,7 +231,7 @@ def layer_json(layer, uv_index, default_uv=None):
                      tiling=_pair(layer.tiling), offset=_pair(layer.offset))
     if layer.mask_image is not None:
         entry["mask"] = mask_json(layer, uv_index)
-    if layer.type in UV_LAYER_TYPES and (layer.uv_map or default_uv):
+    if reads_uv(layer) and (layer.uv_map or default_uv):
         entry["uv"] = uv_index(layer.uv_map or default_uv)
     if tangent_frames_uv(layer, default_uv):
         entry["tangent_uv"] = uv_index(tangent_frames_uv(layer, default_uv))
@@ -238,6 +250,8 @@ def layer_json(layer, uv_index, default_uv=None):
     elif layer.type == "volume":
         entry.update(function=layer.function, amplitude=_number(layer.amplitude),
                      frequency=_number(layer.frequency), gradient=layer.gradient)
+        if layer.coordinates_uv:  # (u, v, 0) of its UV map, as a texture on a UV output
+            entry["coordinates"] = "uv"
         # 0: the library's default; the Bump node's slopes take no step of their own.
         if layer.gradient in ("central", "tetrahedral") and layer.step > 0:
             entry["step"] = _number(layer.step)
@@ -264,7 +278,9 @@ def layer_json(layer, uv_index, default_uv=None):
                    "rotation": [_number(c) for c in layer.mapping_rotation],
                    "scale": [_number(c) for c in layer.mapping_scale]}
         matrix = [_number(c) for c in layer.mapping_matrix]
-        if matrix != [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]:
+        # (other objects' and the Generated coordinates are object coordinates: not a UV map's)
+        if (on_object_coordinates(layer)
+                and matrix != [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]):
             mapping["matrix"] = [matrix[0:4], matrix[4:8], matrix[8:12]]
         if mapping != {"location": [0.0] * 3, "rotation": [0.0] * 3, "scale": [1.0] * 3}:
             if layer.mapping_type != "POINT":

@@ -139,7 +139,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "wrap")
             col.prop(layer, "tiling")
             col.prop(layer, "offset")
-        if layer.type in scene.UV_LAYER_TYPES:
+        if scene.reads_uv(layer):
             ob = context.active_object
             if ob is not None and ob.type == "MESH":
                 col.prop_search(layer, "uv_map", ob.data, "uv_layers")
@@ -206,6 +206,10 @@ def _draw_mapping(col, layer):
     box.label(text="Mapping")
     for name in ("mapping_type", "mapping_location", "mapping_rotation", "mapping_scale"):
         box.prop(layer, name)
+    if layer.type == "volume":
+        box.prop(layer, "coordinates_uv")
+    if not scene.on_object_coordinates(layer):
+        return  # (a volume on a UV map: its UV Map above)
     box.prop(layer, "coordinates_object")
     box.prop(layer, "coordinates_generated")
     if (tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0)

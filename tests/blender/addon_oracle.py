@@ -119,6 +119,11 @@
    chebyshev), Feature Output F2 and the Color output no layer and a reason; a volume layer
    made by hand with function Blender Voronoi sends its settings (nothing of the other
    functions') and bakes.
+   Noise Texture on UV coordinates (noise_uv_case): the Noise Texture on Suzanne's UV map's
+   coordinates (Texture Coordinate UV) through a Mapping node: Layers from Material must make
+   one "blender-noise" volume layer on "coordinates": "uv" of the render UV map's set, baked as
+   Cycles bakes it (NOISE_*: median and p99), the same layer on object coordinates clearly
+   worse.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -315,6 +320,14 @@ WAVE_CONTROL_FACTOR = 3.0
 # "blender-voronoi" volume layer of those settings (its metric as VORONOI_ENUMS) and that
 # mapping; its bake must be Cycles' (median <= VORONOI_MEDIAN_DEG, p99 <= VORONOI_P99_DEG) and
 # the same job without the layer's "mapping" at least VORONOI_CONTROL_FACTOR times worse.
+# The Noise on UV case (noise_uv_case): the Noise Texture (NOISE_INPUTS) on Suzanne's UV map's
+# coordinates (Texture Coordinate UV, (u, v, 0)) through a Mapping node (Point,
+# NOISE_UV_MAPPING), Distance NOISE_UV_DISTANCE. Layers from Material must make a
+# "blender-noise" volume layer on "coordinates": "uv" (its "uv" the render UV map's set); its
+# bake must be Cycles' (median <= NOISE_MEDIAN_DEG, p99 <= NOISE_P99_DEG) and the same layer on
+# the object's coordinates at least NOISE_CONTROL_FACTOR times worse.
+NOISE_UV_MAPPING = ((0.2, -0.1, 0.3), (0.0, 0.0, 0.4), (3.0, 2.5, 1.0))
+NOISE_UV_DISTANCE = 0.01
 VORONOI_NODE = {"voronoi_dimensions": "3D", "feature": "F1", "distance": "EUCLIDEAN"}
 VORONOI_ENUMS = {"metric": "euclidean"}
 VORONOI_INPUTS = {"Scale": 4.0, "Randomness": 0.85, "Exponent": 0.5}
@@ -2304,9 +2317,9 @@ def hand_made_check(settings, label, title, values, want, absent):
 
 def noise_checks(settings, ob, distance):
     """Layers from Material on Noise Textures it does not take (its Color output, 2D, a Detail
-    fed by a node, a UV map into its Vector: no layer, a reason), through a Color Ramp (a
-    remap), and a volume layer made by hand with function Blender Noise. Returns check records
-    like expect_error's."""
+    fed by a node, world positions into its Vector: no layer, a reason), on a UV Map node's
+    coordinates (a volume on that UV map), through a Color Ramp (a remap), and a volume layer
+    made by hand with function Blender Noise. Returns check records like expect_error's."""
     import bpy
     from sgbake_blender import operators
     c = TextureChecks(ob, "noise")
@@ -2324,10 +2337,23 @@ def noise_checks(settings, ob, distance):
         tree.links.new(feeder.outputs["Fac"], noise.inputs["Detail"])
         refused("a Detail fed by another texture", "Detail from a node")
         tree.nodes.remove(feeder)
+        # A UV Map node naming a UV map: a volume on those UV coordinates; world positions
+        # (the Geometry node's Position) make none.
         uv = tree.nodes.new("ShaderNodeUVMap")
+        uv.uv_map = "UVMap"
         tree.links.new(uv.outputs["UV"], noise.inputs["Vector"])
-        refused("a UV Map node into its Vector", "Vector from")
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("noise: a UV Map node into its Vector makes a volume on that UV map's coordinates",
+              len(found) == 1 and found[0].get("function") == "blender-noise"
+              and found[0].get("coordinates_uv") is True and found[0].get("uv_map") == "UVMap"
+              and "coordinates_generated" not in found[0],
+              "one blender-noise layer, coordinates_uv, uv_map 'UVMap'",
+              f"{found}; skipped {skipped}")
         tree.nodes.remove(uv)
+        geometry = tree.nodes.new("ShaderNodeNewGeometry")
+        tree.links.new(geometry.outputs["Position"], noise.inputs["Vector"])
+        refused("world positions (Geometry Position) into its Vector", "Vector from")
+        tree.nodes.remove(geometry)
         # Through a Color Ramp: the layer's remap is Cycles' table of the ramp.
         ramp = make_ramp(tree)
         tree.links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
@@ -2385,12 +2411,15 @@ def musgrave_case(settings, ob, work):
 
 
 def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, mapping_values,
-                 distance_value, control_keys, output="Fac"):
+                 distance_value, control_keys, output="Fac", coordinates="Object",
+                 function=None):
     """The bump material's Height fed by the `output` of the procedural texture node make(tree)
     makes (`inputs`: its inputs -> values; `enums`: the layer settings its enum properties
-    must give, as sent) on the object's own coordinates through a Mapping node (Point,
-    `mapping_values`), Distance `distance_value`: Layers from Material must make one
-    "blender-CASE" volume layer of those settings (`keys`: the layer's settings -> the node's
+    must give, as sent) on the object's own coordinates (the Texture Coordinate node's output
+    `coordinates`: with "UV", the UV map's, which the layer must read with "coordinates": "uv"
+    on the render UV map's set) through a Mapping node (Point, `mapping_values`), Distance
+    `distance_value`: Layers from Material must make one `function` (default "blender-CASE")
+    volume layer of those settings (`keys`: the layer's settings -> the node's
     inputs) and that mapping, sending none of `absent`; then the add-on's tangent-normal bake
     (addon_CASE.npy), the same job without `control_keys` (addon_CASE_control.npy), Cycles'
     (cycles_CASE.npy, its mask cycles_CASE_mask.npy) and the add-on's bake of the layer at
@@ -2399,18 +2428,20 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
     import bpy
     import numpy as np
     from sgbake_blender import operators
-    function = f"blender-{case}"
+    function = function or f"blender-{case}"
+    on_uv = coordinates == "UV"
     tree = ob.active_material.node_tree
     tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
     bump = next(n for n in tree.nodes if n.type == "BUMP")
     distance = bump.inputs["Distance"].default_value
     texture = make(tree)
-    coordinates = tree.nodes.new("ShaderNodeTexCoord")
     mapping = tree.nodes.new("ShaderNodeMapping")
     mapping.vector_type = "POINT"
     for name, value in zip(("Location", "Rotation", "Scale"), mapping_values):
         mapping.inputs[name].default_value = value
-    tree.links.new(coordinates.outputs["Object"], mapping.inputs["Vector"])
+    coordinates_output = coordinates
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coordinates.outputs[coordinates_output], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
     tree.links.new(texture.outputs[output], bump.inputs["Height"])
     bump.inputs["Distance"].default_value = distance_value
@@ -2441,13 +2472,16 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
                            for key, name in keys.items())
                    and all(sent.get(key) == value for key, value in enums.items())
                    and not ({"seed", "octaves", "step"} | set(absent)) & set(sent)
+                   and bool(layer.coordinates_uv) == on_uv
+                   and (sent.get("coordinates"), "uv" in sent) == (("uv", True) if on_uv
+                                                                   else (None, False))
                    and "matrix" not in mapped and "type" not in mapped
                    and all(close(a, b) for key, want in zip(("location", "rotation", "scale"),
                                                             mapping_values)
                            for a, b in zip(mapped.get(key, [9] * 3), want))),
             "expected": f"one {function} volume, {inputs}, {enums}, amplitude "
                         f"{distance_value}, bump-node, mapping {mapping_values}, none of "
-                        f"{sorted(absent)}",
+                        f"{sorted(absent)}" + (", on the UV map's coordinates" if on_uv else ""),
             "message": f"{len(settings.layers)} layer(s); sent {sent}"})
         if layer is not None:
             entry["result"] = bake_against_cycles(settings, ob, work, case, control_keys)
@@ -2619,6 +2653,21 @@ def voronoi_case(settings, ob, work):
                         ("mapping",), output="Distance")
 
 
+NOISE_KEYS = {"frequency": "Scale", "detail": "Detail", "roughness": "Roughness",
+              "distortion": "Distortion"}
+
+
+def noise_uv_case(settings, ob, work):
+    """The bump material's Height fed by a Noise Texture (NOISE_INPUTS) on the UV map's
+    coordinates (Texture Coordinate UV) through a Mapping node (NOISE_UV_MAPPING), Distance
+    NOISE_UV_DISTANCE: texture_case "noise_uv", a blender-noise volume on "coordinates": "uv",
+    its control the same layer on the object's coordinates (without "coordinates" and "uv")."""
+    return texture_case(settings, ob, work, "noise_uv", make_noise, NOISE_KEYS, NOISE_INPUTS,
+                        {}, {"dimension", "lacunarity", "randomness", "wave"}, NOISE_UV_MAPPING,
+                        NOISE_UV_DISTANCE, ("coordinates", "uv"), coordinates="UV",
+                        function="blender-noise")
+
+
 def voronoi_checks(settings, ob):
     """Layers from Material on Voronoi Textures: Manhattan, Chebychev and Minkowski give the
     scene's metrics, Feature Output F2 and the Color output no layer and a reason; and a volume
@@ -2690,6 +2739,7 @@ def blender_make(work, library_path, sabotage):
     manifest["musgrave"] = musgrave_case(settings, ob, work)
     manifest["wave"] = wave_case(settings, ob, work)
     manifest["voronoi"] = voronoi_case(settings, ob, work)
+    manifest["noise_uv"] = noise_uv_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
@@ -2750,6 +2800,7 @@ def blender_compare(work):
     results["wave_lean"] = lean_stats(work, "wave")
     results["voronoi"] = against_cycles(work, "voronoi")
     results["voronoi_lean"] = lean_stats(work, "voronoi")
+    results["noise_uv"] = against_cycles(work, "noise_uv")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -3026,12 +3077,18 @@ def evaluate(manifest, results):
         "without the layer's mapping", VORONOI_MEDIAN_DEG, VORONOI_CONTROL_FACTOR,
         VORONOI_P99_DEG)
     failures += evaluate_lean("voronoi", results["voronoi_lean"], VORONOI_LEAN_DEG)
+    failures += evaluate_case_against_cycles(
+        "noise_uv", "the Noise Texture on the UV map's coordinates (Texture Coordinate UV) "
+        f"through a Mapping node (Point), Distance {NOISE_UV_DISTANCE:g}", manifest["noise_uv"],
+        results["noise_uv"], "the layer on object coordinates", NOISE_MEDIAN_DEG,
+        NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
     for check in (manifest["udim"]["checks"] + manifest["options"]["checks"]
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
+                  + manifest["noise_uv"]["checks"]
                   + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
