@@ -21,12 +21,16 @@ class BakeInputError(Exception):
     """The object, its UV maps or the layers' images cannot be baked as they are."""
 
 
-def coordinates_matrix(ob, other=None, generated=False):
+def coordinates_matrix(ob, other=None, generated=False, world=False):
     """The coordinates a Texture Coordinate node gives on object `ob`, as an affine map of
     `ob`'s own (12 numbers, row by row), as they are now: with `other`, its Object output naming
     that object, inverse(other.matrix_world) @ ob.matrix_world; with `generated`, its Generated
-    output, the texture space of ob's mesh (the bounding box, by default) to [0, 1]. None when
-    neither is given, or the texture space is flat."""
+    output, the texture space of ob's mesh (the bounding box, by default) to [0, 1]; with
+    `world`, the world positions a Geometry node's Position gives, ob.matrix_world. None when
+    none is given, or the texture space is flat."""
+    if world:
+        m = ob.matrix_world
+        return tuple(m[r][c] for r in range(3) for c in range(4))
     if other is not None:
         m = other.matrix_world.inverted_safe() @ ob.matrix_world
         return tuple(m[r][c] for r in range(3) for c in range(4))
@@ -44,14 +48,17 @@ def coordinates_matrix(ob, other=None, generated=False):
 
 def follow_coordinates(layers, ob):
     """Sets the Coordinates (mapping_matrix) of every projected or volume layer that reads
-    another object's or the Generated coordinates to what they are now on `ob`, so that a moved
-    projector or an edited mesh bakes as Cycles renders it without Layers from Material again."""
+    another object's, the Generated or the world coordinates to what they are now on `ob`, so
+    that a moved projector or object, or an edited mesh, bakes as Cycles renders it without
+    Layers from Material again."""
     for layer in layers:
         if not scene.on_object_coordinates(layer):
             continue
-        if layer.coordinates_object is None and not layer.coordinates_generated:
+        if (layer.coordinates_object is None and not layer.coordinates_generated
+                and not layer.coordinates_world):
             continue
-        matrix = coordinates_matrix(ob, layer.coordinates_object, layer.coordinates_generated)
+        matrix = coordinates_matrix(ob, layer.coordinates_object, layer.coordinates_generated,
+                                    layer.coordinates_world)
         if matrix is None:
             raise BakeInputError(f"layer '{layer.name}': the Generated coordinates of object "
                                  f"'{ob.name}' have a flat texture space")

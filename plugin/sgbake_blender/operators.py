@@ -703,8 +703,11 @@ MAPPING_INPUTS = ("Location", "Rotation", "Scale")
 def _coordinates_source(link):
     """What a Texture Coordinate node's output `link` reads other than the object's own
     coordinates: {"coordinates_object": the object its Object output names} or
-    {"coordinates_generated": True}; None for the object's own, and for other outputs."""
+    {"coordinates_generated": True}, or a Geometry node's Position output (world positions):
+    {"coordinates_world": True}; None for the object's own, and for other outputs."""
     node, output = link.from_node, link.from_socket.name
+    if node.type == "NEW_GEOMETRY":
+        return {"coordinates_world": True} if output == "Position" else None
     if output == "Object" and node.object is not None:
         return {"coordinates_object": node.object}
     if output == "Generated":
@@ -731,21 +734,23 @@ def _object_coordinates(tex, ob=None):
 
 
 def _coordinates_of(settings):
-    """Whether layer `settings` read another object's or the Generated coordinates."""
-    return "coordinates_object" in settings or "coordinates_generated" in settings
+    """Whether layer `settings` read another object's, the Generated or world coordinates."""
+    return any(key in settings
+               for key in ("coordinates_object", "coordinates_generated", "coordinates_world"))
 
 
 def _vector_coordinates(socket, ob=None, generated=False, uv=False):
     """The object coordinates texture input `socket` (a Vector) reads, as layer settings (empty
     for the object's own), or a string saying why they are not object coordinates. They are
     when it comes from a Texture Coordinate node's Object output (the object's own, or another
-    object's: coordinates_object) or Generated output (coordinates_generated), straight or
+    object's: coordinates_object) or Generated output (coordinates_generated), or a Geometry
+    node's Position output (world positions: coordinates_world), straight or
     through one Mapping node of type Point, Texture or Vector whose Location, Rotation and
     Scale are constants (_constant: their own values, or Value, Combine XYZ and Math nodes of
     constants; not type Normal, which normalizes the coordinates); with `generated` (a
     procedural texture, which Cycles reads on the Generated coordinates when its Vector is
-    unlinked) also when nothing is linked. Other objects' and the Generated coordinates get
-    their affine map of the object's own as `ob` has them now (mapping_matrix;
+    unlinked) also when nothing is linked. Other objects', the Generated and world coordinates
+    get their affine map of the object's own as `ob` has them now (mapping_matrix;
     gather.follow_coordinates brings it up to date at every bake), none when `ob` is None. With
     `uv` (a procedural texture, which a volume layer reads on a UV map too) a Texture Coordinate
     node's UV output or a UV Map node is taken as well: coordinates_uv, and the UV Map node's
@@ -776,21 +781,22 @@ def _vector_coordinates(socket, ob=None, generated=False, uv=False):
         if link.from_node.type == "UVMAP" and link.from_node.uv_map:
             settings["uv_map"] = link.from_node.uv_map
         return settings
-    if link.from_node.type != "TEX_COORD":
+    if link.from_node.type not in ("TEX_COORD", "NEW_GEOMETRY"):
         return (f"{socket.name} from '{link.from_node.name}' (not a Texture Coordinate "
-                "node's Object or Generated output"
-                + (", UV output or UV Map node)" if uv else ")"))
-    if link.from_socket.name == "Object" and link.from_node.object is None:
+                "node's Object or Generated output, a Geometry node's Position"
+                + (", a UV output or UV Map node)" if uv else ")"))
+    if (link.from_node.type == "TEX_COORD" and link.from_socket.name == "Object"
+            and link.from_node.object is None):
         return settings  # the object's own coordinates
     source = _coordinates_source(link)
     if source is None:
         return (f"{socket.name} from '{link.from_node.name}' {link.from_socket.name} (not "
-                "object or Generated coordinates" + (" or a UV map)" if uv else ")"))
+                "object, Generated or world coordinates" + (" or a UV map)" if uv else ")"))
     return _mapped_coordinates(settings, source, ob)
 
 
 def _mapped_coordinates(settings, source, ob):
-    """`settings` with another object's or the Generated coordinates, `source`
+    """`settings` with another object's, the Generated or the world coordinates, `source`
     (_coordinates_source), and their map now on `ob` (gather.coordinates_matrix; none when
     `ob` is None); a string when the Generated coordinates have no map (a flat texture
     space)."""
@@ -798,7 +804,8 @@ def _mapped_coordinates(settings, source, ob):
     if ob is None:
         return settings
     matrix = gather.coordinates_matrix(ob, source.get("coordinates_object"),
-                                       source.get("coordinates_generated", False))
+                                       source.get("coordinates_generated", False),
+                                       source.get("coordinates_world", False))
     if matrix is None:
         return f"the Generated coordinates of object '{ob.name}' have a flat texture space"
     settings["mapping_matrix"] = matrix

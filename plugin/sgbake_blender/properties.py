@@ -254,6 +254,10 @@ class SgbakeLayer(bpy.types.PropertyGroup):
         description="Projections and volumes: the baked object's Generated coordinates (its "
                     "texture space to [0, 1], what Cycles reads a procedural texture on "
                     "when its Vector is unlinked); Coordinates follow them at every bake")
+    coordinates_world: BoolProperty(
+        name="World Coordinates", default=False,
+        description="Projections and volumes: the world positions (a Geometry node's Position): "
+                    "Coordinates follow the object's placement at every bake")
     coordinates_uv: BoolProperty(
         name="UV Coordinates", default=False,
         description="Volumes: read at (u, v, 0) of the layer's UV map (the render UV map when "

@@ -212,8 +212,10 @@ def _draw_mapping(col, layer):
         return  # (a volume on a UV map: its UV Map above)
     box.prop(layer, "coordinates_object")
     box.prop(layer, "coordinates_generated")
+    box.prop(layer, "coordinates_world")
     if (tuple(layer.mapping_matrix) != (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0)
-            and layer.coordinates_object is None and not layer.coordinates_generated):
+            and layer.coordinates_object is None and not layer.coordinates_generated
+            and not layer.coordinates_world):
         box.label(text="Coordinates: an affine map of the object's own")
 
 

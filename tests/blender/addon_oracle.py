@@ -123,7 +123,9 @@
    coordinates (Texture Coordinate UV) through a Mapping node: Layers from Material must make
    one "blender-noise" volume layer on "coordinates": "uv" of the render UV map's set, baked as
    Cycles bakes it (NOISE_*: median and p99), the same layer on object coordinates clearly
-   worse.
+   worse. noise_world_case: the same on world positions (a Geometry node's Position), Suzanne
+   turned and scaled: a "blender-noise" layer whose mapping's matrix is the object's
+   matrix_world, baked as Cycles bakes it, the layer without its mapping clearly worse.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -328,6 +330,8 @@ WAVE_CONTROL_FACTOR = 3.0
 # the object's coordinates at least NOISE_CONTROL_FACTOR times worse.
 NOISE_UV_MAPPING = ((0.2, -0.1, 0.3), (0.0, 0.0, 0.4), (3.0, 2.5, 1.0))
 NOISE_UV_DISTANCE = 0.01
+# The Noise on world positions case (noise_world_case): Suzanne moved, turned and scaled so.
+NOISE_WORLD_PLACEMENT = ((0.4, -0.3, 0.2), (0.5, -0.3, 0.9), (1.4, 0.8, 1.2))
 VORONOI_NODE = {"voronoi_dimensions": "3D", "feature": "F1", "distance": "EUCLIDEAN"}
 VORONOI_ENUMS = {"metric": "euclidean"}
 VORONOI_INPUTS = {"Scale": 4.0, "Randomness": 0.85, "Exponent": 0.5}
@@ -2317,7 +2321,7 @@ def hand_made_check(settings, label, title, values, want, absent):
 
 def noise_checks(settings, ob, distance):
     """Layers from Material on Noise Textures it does not take (its Color output, 2D, a Detail
-    fed by a node, world positions into its Vector: no layer, a reason), on a UV Map node's
+    fed by a node, the normal into its Vector: no layer, a reason), on a UV Map node's
     coordinates (a volume on that UV map), through a Color Ramp (a remap), and a volume layer
     made by hand with function Blender Noise. Returns check records like expect_error's."""
     import bpy
@@ -2351,8 +2355,8 @@ def noise_checks(settings, ob, distance):
               f"{found}; skipped {skipped}")
         tree.nodes.remove(uv)
         geometry = tree.nodes.new("ShaderNodeNewGeometry")
-        tree.links.new(geometry.outputs["Position"], noise.inputs["Vector"])
-        refused("world positions (Geometry Position) into its Vector", "Vector from")
+        tree.links.new(geometry.outputs["Normal"], noise.inputs["Vector"])
+        refused("the normal (Geometry Normal) into its Vector", "Vector from")
         tree.nodes.remove(geometry)
         # Through a Color Ramp: the layer's remap is Cycles' table of the ramp.
         ramp = make_ramp(tree)
@@ -2412,12 +2416,14 @@ def musgrave_case(settings, ob, work):
 
 def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, mapping_values,
                  distance_value, control_keys, output="Fac", coordinates="Object",
-                 function=None):
+                 function=None, placement=None):
     """The bump material's Height fed by the `output` of the procedural texture node make(tree)
     makes (`inputs`: its inputs -> values; `enums`: the layer settings its enum properties
     must give, as sent) on the object's own coordinates (the Texture Coordinate node's output
     `coordinates`: with "UV", the UV map's, which the layer must read with "coordinates": "uv"
-    on the render UV map's set) through a Mapping node (Point, `mapping_values`), Distance
+    on the render UV map's set; with "Position", a Geometry node's world positions, which the
+    layer must read through the object's matrix_world, the object placed as `placement`
+    (location, rotation, scale) meanwhile) through a Mapping node (Point, `mapping_values`), Distance
     `distance_value`: Layers from Material must make one `function` (default "blender-CASE")
     volume layer of those settings (`keys`: the layer's settings -> the node's
     inputs) and that mapping, sending none of `absent`; then the add-on's tangent-normal bake
@@ -2429,7 +2435,7 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
     import numpy as np
     from sgbake_blender import operators
     function = function or f"blender-{case}"
-    on_uv = coordinates == "UV"
+    on_uv, on_world = coordinates == "UV", coordinates == "Position"
     tree = ob.active_material.node_tree
     tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
     bump = next(n for n in tree.nodes if n.type == "BUMP")
@@ -2440,7 +2446,12 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
     for name, value in zip(("Location", "Rotation", "Scale"), mapping_values):
         mapping.inputs[name].default_value = value
     coordinates_output = coordinates
-    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    coordinates = tree.nodes.new("ShaderNodeNewGeometry" if on_world else "ShaderNodeTexCoord")
+    placed = (tuple(ob.location), tuple(ob.rotation_euler), tuple(ob.scale))
+    if placement is not None:
+        ob.location, ob.rotation_euler, ob.scale = placement
+        bpy.context.view_layer.update()
+    world = [[ob.matrix_world[r][c] for c in range(4)] for r in range(3)]
     tree.links.new(coordinates.outputs[coordinates_output], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
     tree.links.new(texture.outputs[output], bump.inputs["Height"])
@@ -2473,15 +2484,21 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
                    and all(sent.get(key) == value for key, value in enums.items())
                    and not ({"seed", "octaves", "step"} | set(absent)) & set(sent)
                    and bool(layer.coordinates_uv) == on_uv
+                   and bool(layer.coordinates_world) == on_world
                    and (sent.get("coordinates"), "uv" in sent) == (("uv", True) if on_uv
                                                                    else (None, False))
-                   and "matrix" not in mapped and "type" not in mapped
+                   and (all(abs(a - b) < 1e-6 for row, want in zip(mapped["matrix"], world)
+                            for a, b in zip(row, want))
+                        if on_world and len(mapped.get("matrix", ())) == 3
+                        else not on_world and "matrix" not in mapped)
+                   and "type" not in mapped
                    and all(close(a, b) for key, want in zip(("location", "rotation", "scale"),
                                                             mapping_values)
                            for a, b in zip(mapped.get(key, [9] * 3), want))),
             "expected": f"one {function} volume, {inputs}, {enums}, amplitude "
                         f"{distance_value}, bump-node, mapping {mapping_values}, none of "
-                        f"{sorted(absent)}" + (", on the UV map's coordinates" if on_uv else ""),
+                        f"{sorted(absent)}" + (", on the UV map's coordinates" if on_uv
+                                               else f", matrix {world}" if on_world else ""),
             "message": f"{len(settings.layers)} layer(s); sent {sent}"})
         if layer is not None:
             entry["result"] = bake_against_cycles(settings, ob, work, case, control_keys)
@@ -2499,6 +2516,8 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
             tree.nodes.remove(node)
         tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
         bump.inputs["Distance"].default_value = distance
+        ob.location, ob.rotation_euler, ob.scale = placed
+        bpy.context.view_layer.update()
     return entry
 
 
@@ -2668,6 +2687,18 @@ def noise_uv_case(settings, ob, work):
                         function="blender-noise")
 
 
+def noise_world_case(settings, ob, work):
+    """The bump material's Height fed by a Noise Texture (NOISE_INPUTS) on world positions (a
+    Geometry node's Position) through a Mapping node (NOISE_MAPPING), Distance NOISE_DISTANCE,
+    Suzanne placed as NOISE_WORLD_PLACEMENT (moved, turned, scaled): texture_case "noise_world", a blender-noise volume on
+    coordinates ob.matrix_world, its control the same layer without its "mapping" (the
+    object's own coordinates)."""
+    return texture_case(settings, ob, work, "noise_world", make_noise, NOISE_KEYS, NOISE_INPUTS,
+                        {}, {"dimension", "lacunarity", "randomness", "wave"}, NOISE_MAPPING,
+                        NOISE_DISTANCE, ("mapping",), coordinates="Position",
+                        function="blender-noise", placement=NOISE_WORLD_PLACEMENT)
+
+
 def voronoi_checks(settings, ob):
     """Layers from Material on Voronoi Textures: Manhattan, Chebychev and Minkowski give the
     scene's metrics, Feature Output F2 and the Color output no layer and a reason; and a volume
@@ -2740,6 +2771,7 @@ def blender_make(work, library_path, sabotage):
     manifest["wave"] = wave_case(settings, ob, work)
     manifest["voronoi"] = voronoi_case(settings, ob, work)
     manifest["noise_uv"] = noise_uv_case(settings, ob, work)
+    manifest["noise_world"] = noise_world_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
@@ -2801,6 +2833,7 @@ def blender_compare(work):
     results["voronoi"] = against_cycles(work, "voronoi")
     results["voronoi_lean"] = lean_stats(work, "voronoi")
     results["noise_uv"] = against_cycles(work, "noise_uv")
+    results["noise_world"] = against_cycles(work, "noise_world")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -3055,6 +3088,11 @@ def evaluate(manifest, results):
         "without the layer's mapping (its own coordinates)", NOISE_MEDIAN_DEG,
         NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
     failures += evaluate_case_against_cycles(
+        "noise_world", "the Noise Texture on world positions (Geometry Position) through a "
+        f"Mapping node (Point), Suzanne placed {NOISE_WORLD_PLACEMENT}", manifest["noise_world"],
+        results["noise_world"], "without the layer's mapping (its own coordinates)",
+        NOISE_MEDIAN_DEG, NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
+    failures += evaluate_case_against_cycles(
         "musgrave", "a Musgrave Texture (fBM, 3D, "
         + ", ".join(f"{k} {v:g}" for k, v in MUSGRAVE_INPUTS.items())
         + ") on object coordinates through a Mapping node (Point), Distance "
@@ -3088,7 +3126,7 @@ def evaluate(manifest, results):
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
-                  + manifest["noise_uv"]["checks"]
+                  + manifest["noise_uv"]["checks"] + manifest["noise_world"]["checks"]
                   + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
