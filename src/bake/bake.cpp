@@ -330,10 +330,10 @@ void runBake(const BakeInput& input, const BakeSettings& settings, const bake_de
   WorldSpace world;
   if (input.transform != nullptr && !input.transform->shadesAsObjectSpace() &&
       settings.map != MapKind::kHeight) {
-    if (const std::optional<double> s = input.transform->uniformScale();
-        s && !std::ranges::any_of(input.layers, [](const Layer& layer) {
-          return gradient_detail::readsBumpOffsets(layer.source);
-        })) {
+    const bool bumpOffsets = std::ranges::any_of(input.layers, [](const Layer& layer) {
+      return gradient_detail::readsBumpOffsets(layer.source);
+    });
+    if (const std::optional<double> s = input.transform->objectSpaceScale(bumpOffsets)) {
       // (Heights in object units are s times as high in the world: unchanged.)
       for (const Layer& layer : input.layers)
         scaledLayers.push_back(layer.objectSpaceHeight ? layer : withHeightsScaled(layer, 1 / *s));

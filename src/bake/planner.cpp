@@ -773,8 +773,7 @@ void describePlan(Plan& plan, const std::vector<std::string>& tangentReasons) {
       const bool bumpNode = std::ranges::any_of(scene.layers, [](const SceneLayer& layer) {
         return layer.hasHeight() && layer.heightGradient == HeightGradient::kBumpNode;
       });
-      const std::optional<double> uniform =
-          bumpNode ? std::nullopt : scene.transform->uniformScale();
+      const std::optional<double> uniform = scene.transform->objectSpaceScale(bumpNode);
       plan.steps.push_back(
           {uniform ? "shade in object space with heights in world units divided by the "
                      "object's uniform scale " +

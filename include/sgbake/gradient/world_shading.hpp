@@ -55,6 +55,13 @@ struct ObjectTransform {
   /// differenced as the Bump node does: Cycles lays its offsets along its orthonormals of the
   /// world Ng, which do not turn with the object.
   std::optional<double> uniformScale(double tolerance = 1e-6) const;
+  /// @brief The uniform scale s by which the object shades as object space (heights divided by
+  /// s), or nothing when it shades in world space: uniformScale(), unless a layer's heights are
+  /// differenced as the Bump node does (@p readsBumpOffsets). The baker and the planner's
+  /// --explain decide by this one rule.
+  std::optional<double> objectSpaceScale(bool readsBumpOffsets) const {
+    return readsBumpOffsets ? std::nullopt : uniformScale();
+  }
 };
 
 /// @brief The ObjectTransform of a matrix_world given row by row (Blender's Object.matrix_world):
