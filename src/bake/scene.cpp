@@ -131,6 +131,12 @@ constexpr Named<VoronoiMetric> kVoronoiMetrics[] = {{"euclidean", VoronoiMetric:
                                                     {"manhattan", VoronoiMetric::kManhattan},
                                                     {"chebyshev", VoronoiMetric::kChebyshev},
                                                     {"minkowski", VoronoiMetric::kMinkowski}};
+constexpr Named<MusgraveType> kMusgraveTypes[] = {
+    {"fbm", MusgraveType::kFbm},
+    {"multifractal", MusgraveType::kMultifractal},
+    {"ridged-multifractal", MusgraveType::kRidgedMultifractal},
+    {"hybrid-multifractal", MusgraveType::kHybridMultifractal},
+    {"hetero-terrain", MusgraveType::kHeteroTerrain}};
 constexpr Named<WaveType> kWaveTypes[] = {{"bands", WaveType::kBands}, {"rings", WaveType::kRings}};
 constexpr Named<WaveDirection> kWaveDirections[] = {{"x", WaveDirection::kX},
                                                     {"y", WaveDirection::kY},
@@ -444,6 +450,9 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "distortion",
            "dimension",
            "lacunarity",
+           "musgrave_type",  // the Musgrave Texture's type, its offset and gain
+           "offset",
+           "gain",
            "wave",
            "wave_direction",
            "profile",
@@ -879,7 +888,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
             "blender-wave");
     onlyFor({"randomness", "metric", "exponent"}, voronoi, "blender-voronoi");
-    onlyFor({"dimension", "lacunarity"}, musgrave, "blender-musgrave");
+    onlyFor({"dimension", "lacunarity", "musgrave_type", "offset", "gain"}, musgrave,
+            "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
     if (blender) layer.frequency = 5;  // Blender's textures' default Scale
     if (reader.has("frequency")) {
@@ -891,6 +901,25 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
     if (reader.has("dimension")) layer.noiseDimension = reader.number("dimension");
     if (reader.has("lacunarity")) layer.noiseLacunarity = reader.number("lacunarity");
+    reader.optionalName("musgrave_type", kMusgraveTypes, layer.musgraveType);
+    if (musgrave) {
+      // Offset is for the ridged, hybrid and hetero terrain types, gain for ridged and hybrid.
+      const MusgraveType type = layer.musgraveType;
+      const bool ridgedOrHybrid =
+          type == MusgraveType::kRidgedMultifractal || type == MusgraveType::kHybridMultifractal;
+      const auto onlyForTypes = [&](const char* key, bool applies, const char* owner) {
+        if (!applies && reader.has(key)) {
+          fail(where, "key " + quote(key) + " does not apply to a blender-musgrave volume of " +
+                          "musgrave_type " + quote(nameIn(kMusgraveTypes, type)) + " (it is for " +
+                          owner + ")");
+        }
+      };
+      onlyForTypes("offset", ridgedOrHybrid || type == MusgraveType::kHeteroTerrain,
+                   "ridged-multifractal, hybrid-multifractal and hetero-terrain");
+      onlyForTypes("gain", ridgedOrHybrid, "ridged-multifractal and hybrid-multifractal");
+    }
+    if (reader.has("offset")) layer.musgraveOffset = reader.number("offset");
+    if (reader.has("gain")) layer.musgraveGain = reader.number("gain");
     if (reader.has("randomness")) layer.voronoiRandomness = reader.number("randomness");
     reader.optionalName("metric", kVoronoiMetrics, layer.voronoiMetric);
     if (reader.has("exponent")) layer.voronoiExponent = reader.number("exponent");
@@ -1618,6 +1647,15 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["detail"] = layer.noiseDetail;
         j["dimension"] = layer.noiseDimension;
         j["lacunarity"] = layer.noiseLacunarity;
+        j["musgrave_type"] = nameIn(kMusgraveTypes, layer.musgraveType);
+        const MusgraveType type = layer.musgraveType;
+        if (type != MusgraveType::kFbm && type != MusgraveType::kMultifractal) {
+          j["offset"] = layer.musgraveOffset;
+        }
+        if (type == MusgraveType::kRidgedMultifractal ||
+            type == MusgraveType::kHybridMultifractal) {
+          j["gain"] = layer.musgraveGain;
+        }
       } else if (layer.function == VolumeFunction::kBlenderVoronoi) {
         j["randomness"] = layer.voronoiRandomness;
         j["metric"] = nameIn(kVoronoiMetrics, layer.voronoiMetric);
