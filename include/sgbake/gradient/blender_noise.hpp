@@ -102,7 +102,7 @@ struct BlenderMusgraveParams {
 /// - fBM: Fac = Σ_{i < n} wᵢ sᵢ + r wₙ sₙ.
 /// - Multifractal: Fac = Π_{i < n} (1 + wᵢ sᵢ) · (1 + r wₙ sₙ) (the last factor only if r ≠ 0).
 /// - Hetero Terrain: V₀ = offset + s₀, then Vᵢ = Vᵢ₋₁ · (1 + (sᵢ + offset) wᵢ) for 0 < i < n;
-///   Fac = Vₙ₋₁ · (1 + r (sₖ + offset) wₖ), k = max(n, 1) (octave 0 is always whole: with
+///   Fac = Vₖ₋₁ · (1 + r (sₖ + offset) wₖ), k = max(n, 1) (octave 0 is always whole: with
 ///   detail < 1 the fraction reads octave 1).
 /// - Hybrid Multifractal: weights ω₀ = 1 and, for i < n, the signal σᵢ = (sᵢ + offset) wᵢ adds
 ///   min(ωᵢ, 1) σᵢ and ωᵢ₊₁ = min(ωᵢ, 1) · gain · σᵢ; if r ≠ 0 the fraction adds
