@@ -12,7 +12,7 @@
 ///     Blender's Noise Texture at Blender's defaults (Scale 5, Detail 2: three octaves) and
 ///     with Distortion 0.5 (three more noises and their gradients), and Blender's Musgrave
 ///     (fBM), Wave (bands, distorted: its fbm) and Voronoi (F1, Euclidean) Textures at their
-///     defaults.
+///     defaults, and the Musgrave's Ridged (Offset 1) and Hybrid Multifractal (Offset 0.5).
 ///   - `EqualError/<scheme>/target:<t>`: on the 1-octave noise, the step at which each finite
 ///     difference scheme reaches a max error of t (relative to the RMS analytic gradient
 ///     magnitude over a fixed point set, measured against the analytic gradient in the setup),
@@ -90,17 +90,29 @@ const HeightVolume& blenderField(int which) {
       sgbake::BlenderWave::create({.amplitude = 0.05, .distortion = 1}).value();
   static const sgbake::BlenderVoronoi voronoi =
       sgbake::BlenderVoronoi::create({.amplitude = 0.05}).value();
+  static const sgbake::BlenderMusgrave ridged =
+      sgbake::BlenderMusgrave::create(
+          {.amplitude = 0.05, .type = sgbake::MusgraveType::kRidgedMultifractal, .offset = 1})
+          .value();
+  static const sgbake::BlenderMusgrave hybrid =
+      sgbake::BlenderMusgrave::create(
+          {.amplitude = 0.05, .type = sgbake::MusgraveType::kHybridMultifractal, .offset = 0.5})
+          .value();
   switch (which) {
     case 0:
       return musgrave;
     case 1:
       return wave;
-    default:
+    case 2:
       return voronoi;
+    case 3:
+      return ridged;
+    default:
+      return hybrid;
   }
 }
 
-constexpr int kNumFields = 8;
+constexpr int kNumFields = 10;
 
 const HeightVolume& field(int which) {
   switch (which) {
@@ -135,8 +147,12 @@ const char* fieldName(int which) {
       return "blender-musgrave";
     case 6:
       return "blender-wave-distorted";
-    default:
+    case 7:
       return "blender-voronoi";
+    case 8:
+      return "blender-musgrave-ridged";
+    default:
+      return "blender-musgrave-hybrid";
   }
 }
 

@@ -885,8 +885,13 @@ ProceduralTexture = collections.namedtuple(
                                     "its Fac"))
 PROCEDURAL_TEXTURES = {
     "TEX_NOISE": ProceduralTexture("blender-noise", "noise_dimensions"),
-    "TEX_MUSGRAVE": ProceduralTexture("blender-musgrave", "musgrave_dimensions",
-                                      {"musgrave_type": "FBM"}),
+    "TEX_MUSGRAVE": ProceduralTexture(
+        "blender-musgrave", "musgrave_dimensions",
+        enums={"musgrave_type": ("musgrave_type", {
+            "FBM": "fbm", "MULTIFRACTAL": "multifractal",
+            "RIDGED_MULTIFRACTAL": "ridged-multifractal",
+            "HYBRID_MULTIFRACTAL": "hybrid-multifractal", "HETERO_TERRAIN": "hetero-terrain"})},
+        inputs={"musgrave_offset": "Offset"}),
     "TEX_WAVE": ProceduralTexture(
         "blender-wave", None, outputs=("Fac", "Color"),
         enums={"wave": ("wave_type", {"BANDS": "bands", "RINGS": "rings"}),
@@ -905,14 +910,16 @@ PROCEDURAL_TEXTURES = {
 }
 
 
-def _texture_inputs(texture):
-    """The inputs of procedural texture `texture` (PROCEDURAL_TEXTURES) -> the layer settings
-    that hold them: its Scale the frequency, the others of scene.BLENDER_TEXTURE_SETTINGS but
-    its enums under their own names (input Detail Scale -> detail_scale, but as
-    texture.inputs renames them: Phase Offset -> phase)."""
+def _texture_inputs(texture, enums):
+    """The inputs of procedural texture `texture` (PROCEDURAL_TEXTURES) whose enums are `enums`
+    (in the scene's names) -> the layer settings that hold them: its Scale the frequency, the
+    others of scene.texture_settings (a Musgrave Texture's Offset and Gain only where its type
+    uses them) but its enums under their own names (input Detail Scale -> detail_scale, but as
+    texture.inputs renames them: Phase Offset -> phase, Offset -> musgrave_offset)."""
     inputs = {"Scale": "frequency"}
     inputs.update((texture.inputs.get(key, key.replace("_", " ").title()), key)
-                  for key in scene.BLENDER_TEXTURE_SETTINGS[texture.function]
+                  for key in scene.texture_settings(texture.function,
+                                                    enums.get("musgrave_type", "fbm"))
                   if key not in texture.enums)
     return inputs
 
@@ -928,24 +935,24 @@ def _enum_name(node, prop):
 def _procedural_settings(tex, ob=None):
     """The settings of the volume layer of procedural texture node `tex`'s height output (a
     Noise, Musgrave or Wave Texture's Fac, a Voronoi Texture's Distance: PROCEDURAL_TEXTURES):
-    its function with the node's enum properties in the scene's names (a Wave Texture's type,
-    direction and profile, a Voronoi Texture's Distance Metric) and its inputs
-    (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of a Noise
-    Texture, Detail, Dimension and Lacunarity of a Musgrave Texture, Distortion, Detail, Detail
+    its function with the node's enum properties in the scene's names (a Musgrave Texture's
+    type, a Wave Texture's type, direction and profile, a Voronoi Texture's Distance Metric) and
+    its inputs (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of
+    a Noise Texture, Detail, Dimension and Lacunarity of a Musgrave Texture and the Offset and
+    Gain its type uses, Distortion, Detail, Detail
     Scale, Detail Roughness and Phase Offset of a Wave Texture, Randomness and Exponent of a
     Voronoi Texture), the slopes as Cycles' Bump node takes them (gradient "bump-node"), on the
-    coordinates its Vector reads (_vector_coordinates: object coordinates, or a UV map's;
-    unlinked, the Generated coordinates, as Cycles reads a procedural texture); or a string
-    saying why none is made: Dimensions other than 3D, a type the function is not (a Musgrave
-    Texture's other than fBM, a Voronoi Texture's Feature Output other than F1), an input fed
-    by anything but constants (_constant), a Vector that is neither object nor UV coordinates
-    (a position in world space, a normal, ...)."""
+    coordinates its Vector reads (_vector_coordinates: object, Generated or world coordinates,
+    or a UV map's; unlinked, the Generated coordinates, as Cycles reads a procedural texture);
+    or a string saying why none is made: Dimensions other than 3D, a type the function is not
+    (a Voronoi Texture's Feature Output other than F1), an input fed by anything but constants
+    (_constant), a Vector that is none of those coordinates (a normal, ...)."""
     texture = PROCEDURAL_TEXTURES[tex.type]
     if texture.dimensions and getattr(tex, texture.dimensions) != "3D":
         return (f"'{tex.name}' Dimensions {_enum_name(tex, texture.dimensions)} (a volume "
                 "layer is the 3D texture)")
     for prop, value in texture.fixed.items():
-        if getattr(tex, prop) != value:  # (Musgrave's Type, Voronoi's Feature Output)
+        if getattr(tex, prop) != value:  # (Voronoi's Feature Output)
             rna = tex.bl_rna.properties[prop]
             return (f"'{tex.name}' {rna.name.lower()} {_enum_name(tex, prop)} (a volume layer "
                     f"is the {rna.enum_items[value].name} {rna.name.lower()})")
@@ -956,7 +963,7 @@ def _procedural_settings(tex, ob=None):
         if enums[key] is None:
             return (f"'{tex.name}' {tex.bl_rna.properties[prop].name} "
                     f"{_enum_name(tex, prop)} (not one libsgbake has)")
-    inputs = _texture_inputs(texture)
+    inputs = _texture_inputs(texture, enums)
     values = {name: _constant(tex.inputs[name]) for name in inputs}
     varying = [name for name, value in values.items() if value is None]
     if varying:

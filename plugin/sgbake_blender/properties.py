@@ -95,8 +95,8 @@ FUNCTIONS = (
      "Blender's Noise Texture (3D) Fac, as Cycles evaluates it: Frequency is the node's Scale, "
      "with its Detail, Roughness and Distortion"),
     ("blender-musgrave", "Blender Musgrave",
-     "Blender's Musgrave Texture (fBM, 3D) Fac, as Cycles evaluates it: Frequency is the "
-     "node's Scale, with its Detail, Dimension and Lacunarity"),
+     "Blender's Musgrave Texture (3D) Fac, as Cycles evaluates it: Frequency is the node's "
+     "Scale, with its type, Detail, Dimension, Lacunarity, Offset and Gain"),
     ("blender-wave", "Blender Wave",
      "Blender's Wave Texture Fac, as Cycles evaluates it: Frequency is the node's Scale, with "
      "its type, direction, profile, Phase Offset, Distortion, Detail, Detail Scale and Detail "
@@ -126,6 +126,19 @@ WAVE_PROFILES = (
     ("sine", "Sine", "The Wave Texture's Sine profile"),
     ("saw", "Saw", "The Wave Texture's Saw profile"),
     ("triangle", "Triangle", "The Wave Texture's Triangle profile"),
+)
+
+
+# The Musgrave Texture's types in the scene's names (Blender's FBM, MULTIFRACTAL, ...).
+MUSGRAVE_TYPES = (
+    ("fbm", "fBM", "Fractal Brownian motion: the octaves added"),
+    ("multifractal", "Multifractal", "The octaves multiplied"),
+    ("ridged-multifractal", "Ridged Multifractal",
+     "Ridges: each octave (Offset - |noise|)^2, weighted by Gain times the one before"),
+    ("hybrid-multifractal", "Hybrid Multifractal",
+     "The octaves plus Offset added, each weighted by Gain times the ones before"),
+    ("hetero-terrain", "Hetero Terrain",
+     "The octaves plus Offset, each scaled by the height so far"),
 )
 
 
@@ -327,6 +340,17 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                               description="Blender Musgrave: the Musgrave Texture's Lacunarity "
                                           "(each octave's frequency relative to the one "
                                           "before)")
+    musgrave_type: EnumProperty(name="Musgrave Type", items=MUSGRAVE_TYPES, default="fbm",
+                                description="Blender Musgrave: the Musgrave Texture's type")
+    # (Not "offset": an image layer's UV offset holds that name; the scene's key is "offset".)
+    musgrave_offset: FloatProperty(name="Offset", default=0.0, min=-1000.0, max=1000.0,
+                                   precision=3,
+                                   description="Blender Musgrave: the Musgrave Texture's Offset "
+                                               "(Ridged, Hybrid Multifractal and Hetero "
+                                               "Terrain)")
+    gain: FloatProperty(name="Gain", default=1.0, min=0.0, max=1000.0, precision=3,
+                        description="Blender Musgrave: the Musgrave Texture's Gain (Ridged and "
+                                    "Hybrid Multifractal)")
     metric: EnumProperty(name="Distance Metric", items=METRICS, default="euclidean",
                          description="Blender Voronoi: the Voronoi Texture's Distance Metric")
     randomness: FloatProperty(name="Randomness", default=1.0, min=0.0, max=1.0,

@@ -30,15 +30,31 @@ MAPS = (
 )
 # The volume functions that are Blender's procedural textures -> the layer settings holding the
 # node's enum properties (in the scene's names) and its inputs besides its Scale (the
-# frequency), sent under the same keys; libsgbake refuses another function's keys (a
-# "roughness" on a blender-musgrave volume).
+# frequency), sent under the same keys (but SETTING_KEYS'); libsgbake refuses another
+# function's keys (a "roughness" on a blender-musgrave volume).
 BLENDER_TEXTURE_SETTINGS = {
     "blender-noise": ("detail", "roughness", "distortion"),
-    "blender-musgrave": ("detail", "dimension", "lacunarity"),
+    "blender-musgrave": ("musgrave_type", "detail", "dimension", "lacunarity", "musgrave_offset",
+                         "gain"),
     "blender-wave": ("wave", "wave_direction", "profile", "distortion", "detail", "detail_scale",
                      "detail_roughness", "phase"),
     "blender-voronoi": ("metric", "randomness", "exponent"),
 }
+# The scene's keys of the settings whose layer property has another name.
+SETTING_KEYS = {"musgrave_offset": "offset"}
+# The Musgrave Texture's inputs its types do not use (libsgbake refuses them): Multifractal and
+# fBM use neither Offset nor Gain, Hetero Terrain no Gain.
+MUSGRAVE_UNUSED = {"fbm": ("musgrave_offset", "gain"),
+                   "multifractal": ("musgrave_offset", "gain"), "hetero-terrain": ("gain",)}
+
+
+def texture_settings(function, musgrave_type="fbm"):
+    """The settings a volume of `function` sends (BLENDER_TEXTURE_SETTINGS; none for sine and
+    noise), a Blender Musgrave's less the inputs its `musgrave_type` does not use."""
+    unused = MUSGRAVE_UNUSED.get(musgrave_type, ()) if function == "blender-musgrave" else ()
+    return tuple(key for key in BLENDER_TEXTURE_SETTINGS.get(function, ()) if key not in unused)
+
+
 # Maps that read no layer: their bakes send none, so an unfinished layer cannot stop them.
 LAYERLESS_MAPS = {"tangent", "bitangent", "mask"}
 # Maps whose values the object's transform changes (libsgbake's shadedThroughTransform): the
@@ -216,7 +232,8 @@ def layer_json(layer, uv_index, default_uv=None):
     sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json). A
     height's Remap goes as "remap" (remap_points, which raises LayerError for bad text). A
     volume sends its function's own settings only (a Blender Noise's detail, roughness and
-    distortion, a Blender Musgrave's detail, dimension and lacunarity, a Blender Wave's type,
+    distortion, a Blender Musgrave's type, detail, dimension and lacunarity and the offset and
+    gain where its type uses them (texture_settings), a Blender Wave's type,
     direction, profile, distortion, detail, detail scale and roughness and phase, a Blender
     Voronoi's metric, randomness and exponent: BLENDER_TEXTURE_SETTINGS; libsgbake refuses
     another function's), and like a projection its "mapping" when it has one (a Mapping node,
@@ -261,8 +278,8 @@ def layer_json(layer, uv_index, default_uv=None):
         elif layer.function == "noise":
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
         else:  # Blender's Noise, Musgrave, Wave or Voronoi Texture (its Scale: frequency)
-            entry.update({key: _setting(getattr(layer, key))
-                          for key in BLENDER_TEXTURE_SETTINGS.get(layer.function, ())})
+            entry.update({SETTING_KEYS.get(key, key): _setting(getattr(layer, key))
+                          for key in texture_settings(layer.function, layer.musgrave_type)})
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
         if layer.planar_projection != "axis":  # Blender's Flat, Sphere and Tube: about z

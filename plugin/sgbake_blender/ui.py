@@ -174,7 +174,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             elif layer.function == "noise":
                 col.prop(layer, "seed")
                 col.prop(layer, "octaves")
-            for name in texture or ():  # a Blender texture's enums and inputs
+            # A Blender texture's enums and inputs (a Musgrave's those of its type)
+            for name in scene.texture_settings(layer.function, layer.musgrave_type):
                 col.prop(layer, name)
             col.prop(layer, "gradient")
             if layer.gradient in ("central", "tetrahedral"):

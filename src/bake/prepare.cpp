@@ -295,9 +295,12 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
     case VolumeFunction::kBlenderMusgrave:
       return owned(BlenderMusgrave::create({.amplitude = layer.amplitude,
                                             .scale = layer.frequency,
+                                            .type = layer.musgraveType,
                                             .detail = layer.noiseDetail,
                                             .dimension = layer.noiseDimension,
-                                            .lacunarity = layer.noiseLacunarity}));
+                                            .lacunarity = layer.noiseLacunarity,
+                                            .offset = layer.musgraveOffset,
+                                            .gain = layer.musgraveGain}));
     case VolumeFunction::kBlenderWave:
       return owned(BlenderWave::create({.amplitude = layer.amplitude,
                                         .scale = layer.frequency,

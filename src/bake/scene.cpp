@@ -133,6 +133,12 @@ constexpr Named<VoronoiMetric> kVoronoiMetrics[] = {{"euclidean", VoronoiMetric:
                                                     {"manhattan", VoronoiMetric::kManhattan},
                                                     {"chebyshev", VoronoiMetric::kChebyshev},
                                                     {"minkowski", VoronoiMetric::kMinkowski}};
+constexpr Named<MusgraveType> kMusgraveTypes[] = {
+    {"fbm", MusgraveType::kFbm},
+    {"multifractal", MusgraveType::kMultifractal},
+    {"ridged-multifractal", MusgraveType::kRidgedMultifractal},
+    {"hybrid-multifractal", MusgraveType::kHybridMultifractal},
+    {"hetero-terrain", MusgraveType::kHeteroTerrain}};
 constexpr Named<WaveType> kWaveTypes[] = {{"bands", WaveType::kBands}, {"rings", WaveType::kRings}};
 constexpr Named<WaveDirection> kWaveDirections[] = {{"x", WaveDirection::kX},
                                                     {"y", WaveDirection::kY},
@@ -434,12 +440,38 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
       add({"uv", "space", "green", "strength", "tangent_uv"});
       break;
     case SceneLayerType::kVolume:
-      add({"function",     "amplitude",        "frequency",    "direction",      "phase",
-           "seed",         "octaves",          "detail",       "roughness",      "distortion",
-           "dimension",    "lacunarity",       "wave",         "wave_direction", "profile",
-           "detail_scale", "detail_roughness", "randomness",   "metric",         "exponent",
-           "mapping",      "coordinates",      "uv",           "gradient",       "step",
-           "base",         "strength",         "height_space", "remap"});
+      add({"function",
+           "amplitude",
+           "frequency",
+           "direction",
+           "phase",
+           "seed",
+           "octaves",
+           "detail",
+           "roughness",
+           "distortion",
+           "dimension",
+           "lacunarity",
+           "musgrave_type",  // the Musgrave Texture's type, its offset and gain
+           "offset",
+           "gain",
+           "wave",
+           "wave_direction",
+           "profile",
+           "detail_scale",
+           "detail_roughness",
+           "randomness",
+           "metric",
+           "exponent",
+           "mapping",
+           "coordinates",
+           "uv",
+           "gradient",
+           "step",
+           "base",
+           "strength",
+           "height_space",
+           "remap"});
       break;
     case SceneLayerType::kPlanar:
       add({"kind", "axis", "scale", "mapping", "green", "base", "gradient", "strength",
@@ -860,7 +892,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
             "blender-wave");
     onlyFor({"randomness", "metric", "exponent"}, voronoi, "blender-voronoi");
-    onlyFor({"dimension", "lacunarity"}, musgrave, "blender-musgrave");
+    onlyFor({"dimension", "lacunarity", "musgrave_type", "offset", "gain"}, musgrave,
+            "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
     if (blender) layer.frequency = 5;  // Blender's textures' default Scale
     if (reader.has("frequency")) {
@@ -872,6 +905,25 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
     if (reader.has("dimension")) layer.noiseDimension = reader.number("dimension");
     if (reader.has("lacunarity")) layer.noiseLacunarity = reader.number("lacunarity");
+    reader.optionalName("musgrave_type", kMusgraveTypes, layer.musgraveType);
+    if (musgrave) {
+      // Offset is for the ridged, hybrid and hetero terrain types, gain for ridged and hybrid.
+      const MusgraveType type = layer.musgraveType;
+      const bool ridgedOrHybrid =
+          type == MusgraveType::kRidgedMultifractal || type == MusgraveType::kHybridMultifractal;
+      const auto onlyForTypes = [&](const char* key, bool applies, const char* owner) {
+        if (!applies && reader.has(key)) {
+          fail(where, "key " + quote(key) + " does not apply to a blender-musgrave volume of " +
+                          "musgrave_type " + quote(nameIn(kMusgraveTypes, type)) + " (it is for " +
+                          owner + ")");
+        }
+      };
+      onlyForTypes("offset", ridgedOrHybrid || type == MusgraveType::kHeteroTerrain,
+                   "ridged-multifractal, hybrid-multifractal and hetero-terrain");
+      onlyForTypes("gain", ridgedOrHybrid, "ridged-multifractal and hybrid-multifractal");
+    }
+    if (reader.has("offset")) layer.musgraveOffset = reader.number("offset");
+    if (reader.has("gain")) layer.musgraveGain = reader.number("gain");
     if (reader.has("randomness")) layer.voronoiRandomness = reader.number("randomness");
     reader.optionalName("metric", kVoronoiMetrics, layer.voronoiMetric);
     if (reader.has("exponent")) layer.voronoiExponent = reader.number("exponent");
@@ -1625,6 +1677,16 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["detail"] = layer.noiseDetail;
         j["dimension"] = layer.noiseDimension;
         j["lacunarity"] = layer.noiseLacunarity;
+        const MusgraveType type = layer.musgraveType;
+        // (no "musgrave_type" key for fBM: the manifests of scenes before it stay valid)
+        if (type != MusgraveType::kFbm) j["musgrave_type"] = nameIn(kMusgraveTypes, type);
+        if (type != MusgraveType::kFbm && type != MusgraveType::kMultifractal) {
+          j["offset"] = layer.musgraveOffset;
+        }
+        if (type == MusgraveType::kRidgedMultifractal ||
+            type == MusgraveType::kHybridMultifractal) {
+          j["gain"] = layer.musgraveGain;
+        }
       } else if (layer.function == VolumeFunction::kBlenderVoronoi) {
         j["randomness"] = layer.voronoiRandomness;
         j["metric"] = nameIn(kVoronoiMetrics, layer.voronoiMetric);

@@ -295,25 +295,178 @@ double BlenderNoise::output(Vec3d position, Vec3d* gradient) const {
 
 Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& params) {
   if (Status finite = finiteSettings(
-          "Musgrave Texture",
-          {params.amplitude, params.scale, params.detail, params.dimension, params.lacunarity});
+          "Musgrave Texture", {params.amplitude, params.scale, params.detail, params.dimension,
+                               params.lacunarity, params.offset, params.gain});
       !finite)
     return finite.error();
   const double detail = std::clamp(params.detail, 0.0, 15.0);
   const double lacunarity = std::max(params.lacunarity, 1e-5);
   const double h = std::max(params.dimension, 1e-5);
-  // Octave i's slopes are scaled by its weight times its frequency, L^(−iH) · Lⁱ = (L^(1−H))ⁱ:
-  // the n + 1 octaves (n = ⌈detail⌉) at most (n + 1) · max(1, L^(1−H))ⁿ.
   const double n = std::ceil(detail);
-  const double slopes = std::abs(params.amplitude) * std::abs(params.scale) * (1 + n) *
-                        std::pow(std::max(1.0, std::pow(lacunarity, 1 - h)), n);
+  const double scale = std::abs(params.amplitude) * std::abs(params.scale);
+  // Octave i's slopes are scaled by its weight times its frequency, L^(−iH) · Lⁱ = (L^(1−H))ⁱ:
+  // at most qⁿ, q = max(1, L^(1−H)), with n = ⌈detail⌉.
+  const double q = std::max(1.0, std::pow(lacunarity, 1 - h));
+  if (params.type == MusgraveType::kFbm) {
+    // The n + 1 octaves at most (n + 1) · qⁿ.
+    const double slopes = scale * (1 + n) * std::pow(q, n);
+    if (Status bounded = boundedSlopes(
+            "Musgrave Texture", slopes,
+            "(amplitude × scale × (1 + detail) × lacunarity^((1 − dimension) · detail))");
+        !bounded)
+      return bounded.error();
+    return BlenderMusgrave(params);
+  }
+  // The other types multiply octaves (or weight them by earlier ones): with m = max(1, L^(−H))
+  // bounding an octave's weight, a = 1 + |offset| an offset signal and g = max(1, |gain|), the
+  // product of the n + 1 factors (1 + a wᵢ) is at most (2a)ⁿ⁺¹ · m^(n(n+1)/2), and the product
+  // rule's n + 1 terms each take one factor's slopes, at most qⁿ. The hybrid's weights multiply
+  // in g and their own slopes, (n + 1) more terms; the ridged's signals are squares (a²) whose
+  // weights multiply in g, read at frequencies at most max(1, L)ⁿ, weighted at most mⁿ.
+  const double a = 1 + std::abs(params.offset);
+  const double g = std::max(1.0, std::abs(params.gain));
+  const double m = std::max(1.0, std::pow(lacunarity, -h));
+  const double products = std::pow(m, n * (n + 1) / 2) * std::pow(q, n);
+  double slopes = 0;
+  switch (params.type) {
+    case MusgraveType::kMultifractal:
+      slopes = (1 + n) * std::pow(2.0, n + 1) * products;
+      break;
+    case MusgraveType::kHeteroTerrain:
+      slopes = (1 + n) * std::pow(2 * a, n + 1) * products;
+      break;
+    case MusgraveType::kHybridMultifractal:
+      slopes = (1 + n) * (1 + n) * std::pow(2 * a * g, n + 1) * products;
+      break;
+    default:  // ridged
+      slopes = (1 + n) * (1 + n) * 2 * a * std::pow(a * a * g * m * std::max(1.0, lacunarity), n);
+      break;
+  }
   if (Status bounded = boundedSlopes(
-          "Musgrave Texture", slopes,
-          "(amplitude × scale × (1 + detail) × lacunarity^((1 − dimension) · detail))");
+          "Musgrave Texture", scale * slopes,
+          "(amplitude × scale × the type's octaves multiplied: (1 + offset), gain and "
+          "lacunarity^(−dimension) to powers growing with detail)");
       !bounded)
     return bounded.error();
   return BlenderMusgrave(params);
 }
+
+namespace {
+
+/// Cycles' threshold on the hybrid multifractal's weight, its float 0.001.
+constexpr double kHybridThreshold = static_cast<double>(0.001f);
+
+/// The octaves of a Musgrave Texture at p: octave i reads snoise(Lⁱ p), and its gradient with
+/// respect to p (times Lⁱ) if asked.
+struct MusgraveOctaves {
+  Vec3d p;
+  double lacunarity;
+  bool gradient;
+  double frequency = 1;
+  /// snoise at the current frequency, its gradient in @p g; then the next octave.
+  double next(Vec3d& g) {
+    const double s = blenderSignedNoise(frequency * p, gradient ? &g : nullptr);
+    if (gradient) g = frequency * g;
+    frequency *= lacunarity;
+    return s;
+  }
+};
+
+/// Multifractal: the product of the factors 1 + wᵢ sᵢ (the fraction's 1 + r wₙ sₙ), the
+/// gradient by the product rule.
+double musgraveMultifractal(MusgraveOctaves octaves, int n, double rest, double weightStep,
+                            Vec3d& slope) {
+  double value = 1, weight = 1;
+  const auto multiply = [&](double factor) {
+    Vec3d g{};
+    const double s = octaves.next(g);
+    const double f = 1 + factor * weight * s;
+    slope = f * slope + (value * factor * weight) * g;
+    value *= f;
+  };
+  for (int i = 0; i < n; ++i) {
+    multiply(1);
+    weight *= weightStep;
+  }
+  if (rest != 0) multiply(rest);
+  return value;
+}
+
+/// Hetero Terrain: V₀ = offset + s₀, each later octave adding (sᵢ + offset) wᵢ V.
+double musgraveHeteroTerrain(MusgraveOctaves octaves, int n, double rest, double weightStep,
+                             double offset, Vec3d& slope) {
+  Vec3d g{};
+  double value = offset + octaves.next(g);
+  slope = g;
+  double weight = weightStep;
+  const auto add = [&](double factor) {
+    const double s = octaves.next(g) + offset;
+    const double increment = s * weight * value;
+    slope = slope + (factor * weight) * (value * g + s * slope);
+    value += factor * increment;
+  };
+  for (int i = 1; i < n; ++i) {
+    add(1);
+    weight *= weightStep;
+  }
+  if (rest != 0) add(rest);
+  return value;
+}
+
+/// Hybrid Multifractal: each signal (sᵢ + offset) wᵢ added times a weight, min(1, …) of the
+/// previous weight times gain times the previous signal; stops once the weight is ≤ 0.001.
+double musgraveHybrid(MusgraveOctaves octaves, int n, double rest, double weightStep, double offset,
+                      double gain, Vec3d& slope) {
+  double value = 0, power = 1, weight = 1;
+  Vec3d weightSlope{};
+  const auto add = [&](double factor) {
+    if (weight > 1) {  // clamped: its gradient is 0
+      weight = 1;
+      weightSlope = {};
+    }
+    Vec3d g{};
+    const double signal = (octaves.next(g) + offset) * power;
+    const Vec3d signalSlope = power * g;
+    const Vec3d termSlope = signal * weightSlope + weight * signalSlope;
+    value += factor * weight * signal;
+    slope = slope + factor * termSlope;
+    weightSlope = gain * termSlope;
+    weight *= gain * signal;
+    power *= weightStep;
+  };
+  for (int i = 0; weight > kHybridThreshold && i < n; ++i) add(1);
+  if (rest != 0 && weight > kHybridThreshold) add(rest);
+  return value;
+}
+
+/// Ridged Multifractal: signals (offset − |sᵢ|)², each after the first times clamp(gain · the
+/// previous signal, 0, 1), summed weighted wᵢ. |s|'s gradient is sign(s) ∇s, + at s = 0.
+double musgraveRidged(MusgraveOctaves octaves, int n, double weightStep, double offset, double gain,
+                      Vec3d& slope) {
+  double value = 0, power = 1, signal = 0;
+  Vec3d signalSlope{};
+  for (int i = 0; i < std::max(n, 1); ++i) {
+    double weight = 1;
+    Vec3d weightSlope{};
+    if (i > 0) {
+      const double t = signal * gain;
+      weight = std::clamp(t, 0.0, 1.0);
+      if (t > 0 && t < 1) weightSlope = gain * signalSlope;  // else clamped: 0
+    }
+    Vec3d g{};
+    const double s = octaves.next(g);
+    const double ridge = offset - std::abs(s);
+    const Vec3d ridgeSlope = (s < 0 ? 1.0 : -1.0) * g;
+    signal = ridge * ridge * weight;
+    signalSlope = (2 * ridge * weight) * ridgeSlope + (ridge * ridge) * weightSlope;
+    value += signal * power;
+    slope = slope + power * signalSlope;
+    power *= weightStep;
+  }
+  return value;
+}
+
+}  // namespace
 
 double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
   const double detail = std::clamp(params_.detail, 0.0, 15.0);
@@ -321,6 +474,29 @@ double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
   const double lacunarity = std::max(params_.lacunarity, 1e-5);
   const double weightStep = std::pow(lacunarity, -h);
   const Vec3d p = params_.scale * position;
+  const int octaves = static_cast<int>(detail);
+  const double rest = detail - std::floor(detail);
+  if (params_.type != MusgraveType::kFbm) {
+    const MusgraveOctaves at{.p = p, .lacunarity = lacunarity, .gradient = gradient != nullptr};
+    Vec3d slope{};
+    double value = 0;
+    switch (params_.type) {
+      case MusgraveType::kMultifractal:
+        value = musgraveMultifractal(at, octaves, rest, weightStep, slope);
+        break;
+      case MusgraveType::kHeteroTerrain:
+        value = musgraveHeteroTerrain(at, octaves, rest, weightStep, params_.offset, slope);
+        break;
+      case MusgraveType::kHybridMultifractal:
+        value = musgraveHybrid(at, octaves, rest, weightStep, params_.offset, params_.gain, slope);
+        break;
+      default:
+        value = musgraveRidged(at, octaves, weightStep, params_.offset, params_.gain, slope);
+        break;
+    }
+    if (gradient != nullptr) *gradient = params_.scale * slope;
+    return value;
+  }
   double value = 0, weight = 1, frequency = 1;
   Vec3d slope{};
   const auto add = [&](double factor) {
@@ -328,13 +504,11 @@ double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
     value += factor * weight * blenderSignedNoise(frequency * p, gradient ? &g : nullptr);
     if (gradient != nullptr) slope = slope + (factor * weight * frequency) * g;
   };
-  const int octaves = static_cast<int>(detail);
   for (int i = 0; i < octaves; ++i) {
     add(1);
     weight *= weightStep;
     frequency *= lacunarity;
   }
-  const double rest = detail - std::floor(detail);
   if (rest != 0) add(rest);
   if (gradient != nullptr) *gradient = params_.scale * slope;
   return value;

@@ -918,6 +918,54 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
       parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "lacunarity": 2})")),
       "scene.json: layers[0]: key 'lacunarity' does not apply to a blender-noise volume "
       "(it is for blender-musgrave)");
+  // The Musgrave Texture's type, fbm unless given, written back only when not fbm (so that the
+  // manifests of scenes before the key stay valid); Offset and Gain where the type uses them,
+  // written back only there (multifractal and fBM use neither, hetero terrain no gain).
+  EXPECT_EQ(musgrave->layers[0].musgraveType, MusgraveType::kFbm);
+  EXPECT_EQ(layerParametersJson(musgrave->layers[0]).find("musgrave_type"), std::string::npos);
+  EXPECT_EQ(layerParametersJson(musgrave->layers[0]).find(R"("offset")"), std::string::npos);
+  Result<Scene> ridged = parseScene(withLayer(R"({"type": "volume", "function": "blender-musgrave",
+                    "musgrave_type": "ridged-multifractal", "offset": 0.8, "gain": 2.5})"),
+                                    options());
+  ASSERT_TRUE(ridged) << ridged.error().message;
+  EXPECT_EQ(ridged->layers[0].musgraveType, MusgraveType::kRidgedMultifractal);
+  EXPECT_EQ(ridged->layers[0].musgraveOffset, 0.8);
+  EXPECT_EQ(ridged->layers[0].musgraveGain, 2.5);
+  const std::string ridgedJson = layerParametersJson(ridged->layers[0]);
+  for (const char* expected :
+       {R"("musgrave_type":"ridged-multifractal")", R"("offset":0.8)", R"("gain":2.5)"}) {
+    EXPECT_NE(ridgedJson.find(expected), std::string::npos) << expected << " in " << ridgedJson;
+  }
+  Result<Scene> hetero = parseScene(withLayer(R"({"type": "volume", "function": "blender-musgrave",
+                    "musgrave_type": "hetero-terrain", "offset": -0.5})"),
+                                    options());
+  ASSERT_TRUE(hetero) << hetero.error().message;
+  EXPECT_EQ(hetero->layers[0].musgraveType, MusgraveType::kHeteroTerrain);
+  EXPECT_EQ(hetero->layers[0].musgraveGain, 1);  // Blender's default
+  EXPECT_NE(layerParametersJson(hetero->layers[0]).find(R"("offset":-0.5)"), std::string::npos);
+  EXPECT_EQ(layerParametersJson(hetero->layers[0]).find(R"("gain")"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-musgrave",
+                                     "musgrave_type": "multifractal", "offset": 1})")),
+            "scene.json: layers[0]: key 'offset' does not apply to a blender-musgrave volume of "
+            "musgrave_type 'multifractal' (it is for ridged-multifractal, hybrid-multifractal "
+            "and hetero-terrain)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-musgrave",
+                                     "musgrave_type": "hetero-terrain", "gain": 2})")),
+            "scene.json: layers[0]: key 'gain' does not apply to a blender-musgrave volume of "
+            "musgrave_type 'hetero-terrain' (it is for ridged-multifractal and "
+            "hybrid-multifractal)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-musgrave", "gain": 2})")),
+      "scene.json: layers[0]: key 'gain' does not apply to a blender-musgrave volume of "
+      "musgrave_type 'fbm' (it is for ridged-multifractal and hybrid-multifractal)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-musgrave",
+                                     "musgrave_type": "ridged"})")),
+            "scene.json: layers[0]: unknown musgrave_type 'ridged' (expected fbm, multifractal, "
+            "ridged-multifractal, hybrid-multifractal or hetero-terrain)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "offset": 1})")),
+      "scene.json: layers[0]: key 'offset' does not apply to a blender-noise volume "
+      "(it is for blender-musgrave)");
   Result<Scene> wave =
       parseScene(withLayer(R"({"type": "volume", "function": "blender-wave", "wave": "rings",
                     "wave_direction": "spherical", "profile": "saw", "phase": 0.5,

@@ -95,11 +95,16 @@
    so, without a Noise Texture's roughness or distortion), baked as Cycles bakes it
    (MUSGRAVE_*: median and p99), the same job without its "dimension" and "lacunarity"
    (Blender's defaults, 2 and 2) clearly worse; Cycles' normals must lean less than
-   MUSGRAVE_LEAN_DEG off the add-on's bake of the layer at amplitude 0. musgrave_checks: type
-   Ridged Multifractal, Dimensions 2D and a Lacunarity fed by another texture give no layer and
-   a reason (the node back as fBM 3D gives one); a volume layer made by hand with function
-   Blender Musgrave sends its Detail, Dimension and Lacunarity (nothing of Blender Noise's) and
-   bakes.
+   MUSGRAVE_LEAN_DEG off the add-on's bake of the layer at amplitude 0. The same with a Ridged
+   Multifractal (musgrave_ridged_case, MUSGRAVE_RIDGED_INPUTS): a "blender-musgrave" layer of
+   type ridged-multifractal with its Offset and Gain, baked as Cycles bakes it, the same job
+   with the layer left at fBM (without its type, offset and gain) clearly worse.
+   musgrave_checks: each of the five types makes a layer of its type in the scene's name with
+   the Offset and Gain it uses (and not the others; a Hetero Terrain's unused Gain may come
+   from a node); Dimensions 2D, a Lacunarity and a Hetero Terrain's Offset fed by another
+   texture give no layer and a reason (the node back as fBM 3D gives one); volume layers made
+   by hand with function Blender Musgrave send their type, Detail, Dimension and Lacunarity
+   (nothing of Blender Noise's) and the Offset and Gain their type uses, and bake.
    Wave Texture (wave_case): a Wave Texture (WAVE_NODE: Rings, Spherical, Sine; WAVE_INPUTS) on
    Suzanne's own object coordinates through a Mapping node (Point) into the Bump: Layers from
    Material must make one "blender-wave" volume layer of the node's settings (its enums in the
@@ -298,6 +303,12 @@ MUSGRAVE_LEAN_DEG = 35.0
 MUSGRAVE_MEDIAN_DEG = 0.01
 MUSGRAVE_P99_DEG = 0.01
 MUSGRAVE_CONTROL_FACTOR = 3.0
+# The same with a Ridged Multifractal (musgrave_ridged_case: MUSGRAVE_RIDGED_INPUTS, Distance
+# MUSGRAVE_RIDGED_DISTANCE, the same mapping and bars): a "blender-musgrave" layer of type
+# ridged-multifractal with its offset and gain; its control the layer left at fBM.
+MUSGRAVE_RIDGED_INPUTS = {"Scale": 2.5, "Detail": 3.0, "Dimension": 1.2, "Lacunarity": 2.1,
+                          "Offset": 0.9, "Gain": 1.7}
+MUSGRAVE_RIDGED_DISTANCE = 0.02
 # The Wave case (wave_case): a Wave Texture (WAVE_NODE, WAVE_INPUTS) on Suzanne's own object
 # coordinates through a Mapping node (Point, WAVE_MAPPING) into the Bump (Distance
 # WAVE_DISTANCE: Cycles' normals lean less than WAVE_LEAN_DEG off the surface's, as the
@@ -2392,10 +2403,11 @@ def noise_checks(settings, ob, distance):
     return checks
 
 
-def make_musgrave(tree, inputs=None):
-    """A Musgrave Texture node in `tree` (fBM, 3D) with `inputs` (MUSGRAVE_INPUTS by default)."""
+def make_musgrave(tree, inputs=None, musgrave_type="FBM"):
+    """A Musgrave Texture node in `tree` (`musgrave_type`, 3D) with `inputs` (MUSGRAVE_INPUTS
+    by default)."""
     musgrave = tree.nodes.new("ShaderNodeTexMusgrave")
-    musgrave.musgrave_type, musgrave.musgrave_dimensions = "FBM", "3D"
+    musgrave.musgrave_type, musgrave.musgrave_dimensions = musgrave_type, "3D"
     for name, value in (inputs or MUSGRAVE_INPUTS).items():
         musgrave.inputs[name].default_value = value
     return musgrave
@@ -2410,8 +2422,26 @@ def musgrave_case(settings, ob, work):
     own coordinates through a Mapping node (MUSGRAVE_MAPPING), Distance MUSGRAVE_DISTANCE:
     texture_case "musgrave", its control without the layer's "dimension" and "lacunarity"."""
     return texture_case(settings, ob, work, "musgrave", make_musgrave, MUSGRAVE_KEYS,
-                        MUSGRAVE_INPUTS, {}, {"roughness", "distortion"}, MUSGRAVE_MAPPING,
+                        MUSGRAVE_INPUTS, {"musgrave_type": "fbm"},
+                        {"roughness", "distortion", "offset", "gain"}, MUSGRAVE_MAPPING,
                         MUSGRAVE_DISTANCE, ("dimension", "lacunarity"))
+
+
+MUSGRAVE_RIDGED_KEYS = dict(MUSGRAVE_KEYS, musgrave_offset="Offset", gain="Gain")
+
+
+def musgrave_ridged_case(settings, ob, work):
+    """The bump material's Height fed by a Ridged Multifractal Musgrave Texture
+    (MUSGRAVE_RIDGED_INPUTS) on the object's own coordinates through a Mapping node
+    (MUSGRAVE_MAPPING), Distance MUSGRAVE_RIDGED_DISTANCE: texture_case "musgrave_ridged" (a
+    "blender-musgrave" layer of type ridged-multifractal with its offset and gain), its control
+    the layer left at fBM (without its "musgrave_type", "offset" and "gain")."""
+    return texture_case(
+        settings, ob, work, "musgrave_ridged",
+        lambda tree: make_musgrave(tree, MUSGRAVE_RIDGED_INPUTS, "RIDGED_MULTIFRACTAL"),
+        MUSGRAVE_RIDGED_KEYS, MUSGRAVE_RIDGED_INPUTS, {"musgrave_type": "ridged-multifractal"},
+        {"roughness", "distortion"}, MUSGRAVE_MAPPING, MUSGRAVE_RIDGED_DISTANCE,
+        ("musgrave_type", "offset", "gain"), function="blender-musgrave")
 
 
 def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, mapping_values,
@@ -2423,17 +2453,18 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
     `coordinates`: with "UV", the UV map's, which the layer must read with "coordinates": "uv"
     on the render UV map's set; with "Position", a Geometry node's world positions, which the
     layer must read through the object's matrix_world, the object placed as `placement`
-    (location, rotation, scale) meanwhile) through a Mapping node (Point, `mapping_values`), Distance
-    `distance_value`: Layers from Material must make one `function` (default "blender-CASE")
-    volume layer of those settings (`keys`: the layer's settings -> the node's
-    inputs) and that mapping, sending none of `absent`; then the add-on's tangent-normal bake
+    (location, rotation, scale) meanwhile) through a Mapping node (Point, `mapping_values`),
+    Distance `distance_value`: Layers from Material must make one `function` (default
+    "blender-CASE") volume layer of those settings (`keys`: the layer's settings -> the node's
+    inputs, sent under the scene's keys, SETTING_KEYS) and that mapping, sending none of
+    `absent`; then the add-on's tangent-normal bake
     (addon_CASE.npy), the same job without `control_keys` (addon_CASE_control.npy), Cycles'
     (cycles_CASE.npy, its mask cycles_CASE_mask.npy) and the add-on's bake of the layer at
     amplitude 0 (addon_CASE_flat.npy), the normals Cycles' lean off. The material is put back
     afterwards. Returns the manifest entry (result, the layer sent, checks)."""
     import bpy
     import numpy as np
-    from sgbake_blender import operators
+    from sgbake_blender import operators, scene as addon_scene
     function = function or f"blender-{case}"
     on_uv, on_world = coordinates == "UV", coordinates == "Position"
     tree = ob.active_material.node_tree
@@ -2479,8 +2510,8 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
                    and sent.get("function") == function
                    and sent.get("gradient") == "bump-node"
                    and close(sent.get("amplitude", 0), distance_value)
-                   and all(close(sent.get(key, -1), inputs[name])
-                           for key, name in keys.items())
+                   and all(close(sent.get(addon_scene.SETTING_KEYS.get(key, key), -1),
+                                 inputs[name]) for key, name in keys.items())
                    and all(sent.get(key) == value for key, value in enums.items())
                    and not ({"seed", "octaves", "step"} | set(absent)) & set(sent)
                    and bool(layer.coordinates_uv) == on_uv
@@ -2522,9 +2553,11 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
 
 
 def musgrave_checks(settings, ob):
-    """Layers from Material on Musgrave Textures it does not take (type Ridged Multifractal,
-    Dimensions 2D, a Lacunarity fed by a node: no layer, a reason), and a volume layer made by
-    hand with function Blender Musgrave. Returns check records like expect_error's."""
+    """Layers from Material on Musgrave Textures of each type (each taken: its type in the
+    scene's name, the Offset and Gain where the type uses them, a Gain fed by a node where it
+    does not), on those it does not take (Dimensions 2D, a Lacunarity or a used Offset fed by a
+    node: no layer, a reason), and volume layers made by hand with function Blender Musgrave.
+    Returns check records like expect_error's."""
     import bpy
     from sgbake_blender import operators
     c = TextureChecks(ob, "musgrave")
@@ -2533,8 +2566,38 @@ def musgrave_checks(settings, ob):
 
     try:
         tree.links.new(musgrave.outputs["Fac"], bump.inputs["Height"])
-        musgrave.musgrave_type = "RIDGED_MULTIFRACTAL"
-        refused("type Ridged Multifractal", "type Ridged Multifractal")
+        musgrave.inputs["Offset"].default_value = 0.8
+        musgrave.inputs["Gain"].default_value = 1.9
+        for blender_type, name, used in (
+                ("FBM", "fbm", ()), ("MULTIFRACTAL", "multifractal", ()),
+                ("RIDGED_MULTIFRACTAL", "ridged-multifractal", ("musgrave_offset", "gain")),
+                ("HYBRID_MULTIFRACTAL", "hybrid-multifractal", ("musgrave_offset", "gain")),
+                ("HETERO_TERRAIN", "hetero-terrain", ("musgrave_offset",))):
+            musgrave.musgrave_type = blender_type
+            found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+            want = {"musgrave_offset": 0.8, "gain": 1.9}
+            got = found[0] if len(found) == 1 else {}
+            check(f"musgrave: type {blender_type} makes a {name} layer with "
+                  f"{', '.join(used) or 'neither offset nor gain'}",
+                  got.get("function") == "blender-musgrave" and got.get("musgrave_type") == name
+                  and all(abs(got.get(key, -1) - want[key]) < 1e-6 for key in used)
+                  and not (set(want) - set(used)) & set(got),
+                  f"one blender-musgrave layer, musgrave_type {name}, "
+                  f"{ {key: want[key] for key in used} }",
+                  f"{found}; skipped {skipped}")
+        # An input the type does not use may come from a node (Cycles reads none of it); one
+        # it uses may not.
+        feeder = tree.nodes.new("ShaderNodeTexNoise")
+        tree.links.new(feeder.outputs["Fac"], musgrave.inputs["Gain"])
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("musgrave: a Hetero Terrain's Gain fed by another texture still makes a layer",
+              len(found) == 1 and found[0].get("musgrave_type") == "hetero-terrain",
+              "one hetero-terrain layer", f"{found}; skipped {skipped}")
+        tree.nodes.remove(feeder)
+        feeder = tree.nodes.new("ShaderNodeTexNoise")
+        tree.links.new(feeder.outputs["Fac"], musgrave.inputs["Offset"])
+        refused("a Hetero Terrain's Offset fed by another texture", "Offset from a node")
+        tree.nodes.remove(feeder)
         musgrave.musgrave_type = "FBM"
         musgrave.musgrave_dimensions = "2D"
         refused("Dimensions 2D", "Dimensions 2D")
@@ -2558,8 +2621,23 @@ def musgrave_checks(settings, ob):
         settings, "musgrave", "Blender Musgrave",
         {"function": "blender-musgrave", "frequency": 4.0, "detail": 2.5, "dimension": 1.2,
          "lacunarity": 2.6, "amplitude": 0.01},
-        {"function": "blender-musgrave", "detail": 2.5, "dimension": 1.2, "lacunarity": 2.6},
-        ("roughness", "distortion", "seed", "octaves", "mapping")))
+        {"function": "blender-musgrave", "musgrave_type": "fbm", "detail": 2.5, "dimension": 1.2,
+         "lacunarity": 2.6},
+        ("roughness", "distortion", "seed", "octaves", "mapping", "offset", "gain")))
+    # Of type Hybrid Multifractal: its Offset and Gain sent too; of Hetero Terrain its Offset.
+    checks.append(hand_made_check(
+        settings, "musgrave", "Blender Musgrave (Hybrid Multifractal)",
+        {"function": "blender-musgrave", "musgrave_type": "hybrid-multifractal", "detail": 3.0,
+         "musgrave_offset": 0.6, "gain": 2.2, "amplitude": 0.01},
+        {"function": "blender-musgrave", "musgrave_type": "hybrid-multifractal", "detail": 3.0,
+         "offset": 0.6, "gain": 2.2},
+        ("roughness", "distortion", "musgrave_offset")))
+    checks.append(hand_made_check(
+        settings, "musgrave", "Blender Musgrave (Hetero Terrain)",
+        {"function": "blender-musgrave", "musgrave_type": "hetero-terrain",
+         "musgrave_offset": -0.3, "gain": 2.2, "amplitude": 0.01},
+        {"function": "blender-musgrave", "musgrave_type": "hetero-terrain", "offset": -0.3},
+        ("gain", "musgrave_offset")))
     return checks
 
 
@@ -2768,6 +2846,7 @@ def blender_make(work, library_path, sabotage):
     manifest["remap"] = remap_case(settings, ob, work)
     manifest["noise"] = noise_case(settings, ob, work)
     manifest["musgrave"] = musgrave_case(settings, ob, work)
+    manifest["musgrave_ridged"] = musgrave_ridged_case(settings, ob, work)
     manifest["wave"] = wave_case(settings, ob, work)
     manifest["voronoi"] = voronoi_case(settings, ob, work)
     manifest["noise_uv"] = noise_uv_case(settings, ob, work)
@@ -2828,6 +2907,7 @@ def blender_compare(work):
     results["noise_generated"] = against_cycles(work, "noise_generated")
     results["musgrave"] = against_cycles(work, "musgrave")
     results["musgrave_lean"] = lean_stats(work, "musgrave")
+    results["musgrave_ridged"] = against_cycles(work, "musgrave_ridged")
     results["wave"] = against_cycles(work, "wave")
     results["wave_lean"] = lean_stats(work, "wave")
     results["voronoi"] = against_cycles(work, "voronoi")
@@ -3101,6 +3181,13 @@ def evaluate(manifest, results):
         MUSGRAVE_CONTROL_FACTOR, MUSGRAVE_P99_DEG)
     failures += evaluate_lean("musgrave", results["musgrave_lean"], MUSGRAVE_LEAN_DEG)
     failures += evaluate_case_against_cycles(
+        "musgrave_ridged", "a Musgrave Texture (Ridged Multifractal, 3D, "
+        + ", ".join(f"{k} {v:g}" for k, v in MUSGRAVE_RIDGED_INPUTS.items())
+        + ") on object coordinates through a Mapping node (Point), Distance "
+        f"{MUSGRAVE_RIDGED_DISTANCE:g}", manifest["musgrave_ridged"],
+        results["musgrave_ridged"], "the layer left at fBM (no type, offset, gain)",
+        MUSGRAVE_MEDIAN_DEG, MUSGRAVE_CONTROL_FACTOR, MUSGRAVE_P99_DEG)
+    failures += evaluate_case_against_cycles(
         "wave", "a Wave Texture (" + ", ".join(WAVE_ENUMS.values()) + ", "
         + ", ".join(f"{k} {v:g}" for k, v in WAVE_INPUTS.items())
         + ") on object coordinates through a Mapping node (Point), Distance "
@@ -3125,6 +3212,7 @@ def evaluate(manifest, results):
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
+                  + manifest["musgrave_ridged"]["checks"]
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
                   + manifest["noise_uv"]["checks"] + manifest["noise_world"]["checks"]
                   + manifest["errors"]):

@@ -87,14 +87,19 @@ fail (b) and (e). Measured with Cycles' slopes: median 0.0016-0.0018 deg, p99 0.
 deg; exact slopes median 0.16 and 0.45 deg; without the mapping 3.7 and 4.1 deg.
 musgrave_sphere does the same with Blender's Musgrave Texture (fBM, Detail 2.5, Dimension 1.5,
 Lacunarity 2.3), a "blender-musgrave" layer: median 0.0016 deg, p99 0.0018 deg (exact slopes
-0.076 deg; without the mapping 3.6 deg). wave_sphere (diagonal bands, sine, distorted by its
-noise) and wave_suzanne (spherical rings, triangle) with Blender's Wave Texture, a
-"blender-wave" layer: median 0.0016 deg, p99 0.0020 deg (exact slopes median 0.14 and 0.010
-deg, the triangle's folds p99 1.5 deg; without the mapping 6.8 and 3.4 deg). voronoi_sphere
-(Euclidean, Randomness 0.8) and voronoi_minkowski_suzanne (Minkowski 1.6) bump with Blender's
-Voronoi Texture's F1 Distance, a "blender-voronoi" layer: median 0.0016 deg, p99 0.0019-0.0020
-deg (exact slopes median 0.074 and 0.11 deg, p99 4.4 and 6.3 deg at the cells' borders, where
-Cycles' differences straddle two points; without the mapping 5.8 and 6.9 deg).
+0.076 deg; without the mapping 3.6 deg); musgrave_ridged_sphere with its Ridged Multifractal
+(Detail 3, Dimension 1.1, Lacunarity 2.2, Offset 0.9, Gain 1.8) and musgrave_hetero_suzanne
+with its Hetero Terrain (Detail 2.5, Dimension 1.3, Lacunarity 2.1, Offset 0.4), the layer's
+"musgrave_type", "offset" and "gain": median 0.0016 deg, p99 0.0017-0.0018 deg (exact slopes
+median 0.076 and 0.026 deg, the ridges' kinks p99 2.2 deg; without the mapping 2.5 and 1.9
+deg). wave_sphere (diagonal bands, sine, distorted by its noise) and wave_suzanne (spherical
+rings, triangle) with Blender's Wave Texture, a "blender-wave" layer: median 0.0016 deg, p99
+0.0020 deg (exact slopes median 0.14 and 0.010 deg, the triangle's folds p99 1.5 deg; without
+the mapping 6.8 and 3.4 deg). voronoi_sphere (Euclidean, Randomness 0.8) and
+voronoi_minkowski_suzanne (Minkowski 1.6) bump with Blender's Voronoi Texture's F1 Distance,
+a "blender-voronoi" layer: median 0.0016 deg, p99 0.0019-0.0020 deg (exact slopes median 0.074
+and 0.11 deg, p99 4.4 and 6.3 deg at the cells' borders, where Cycles' differences straddle two
+points; without the mapping 5.8 and 6.9 deg).
 noise_uv_suzanne and voronoi_uv_sphere read a Noise and a Voronoi Texture on the UV map's
 coordinates (Texture Coordinate UV) through a Mapping node: a volume layer with "coordinates":
 "uv"; their control ours_bake_on_object.exr, the same layer on the object's coordinates, must
@@ -261,7 +266,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "displacement_stretch_sphere", "displacement_object_sphere",
                  "displacement_object_stretch_sphere", "ramp_sphere", "clamp_suzanne",
                  "noise_sphere", "noise_stretch_suzanne", "noise_uv_suzanne",
-                 "voronoi_uv_sphere", "musgrave_sphere", "wave_sphere",
+                 "voronoi_uv_sphere", "musgrave_sphere", "musgrave_ridged_sphere",
+                 "musgrave_hetero_suzanne", "wave_sphere",
                  "wave_suzanne", "voronoi_sphere", "voronoi_minkowski_suzanne")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
@@ -412,6 +418,10 @@ def sgbake_case(cli, entry, sabotage, threads):
                         "wave": ("distortion", "detail_scale", "detail_roughness", "phase")}
                 for key in keys[kind]:
                     layer[key] = noise[key]
+                if kind == "musgrave":  # Blender's type, lower case, "-" for "_"
+                    layer["musgrave_type"] = noise.get("musgrave_type",
+                                                       "FBM").lower().replace("_", "-")
+                    layer.update((key, noise[key]) for key in ("offset", "gain") if key in noise)
                 if kind == "wave":  # Blender's enum names, lower case ("SIN" is "sine")
                     layer.update(wave=noise["wave"].lower(),
                                  wave_direction=noise["direction"].lower(),

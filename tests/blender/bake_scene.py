@@ -224,8 +224,8 @@ def reshape_height(mat, kind):
 # name -> a Noise Texture (3D) feeding the Bump node instead of the image, read at the object's
 # coordinates (Texture Coordinate Object) through a Mapping node (Point): {"scale", "detail",
 # "roughness", "distortion", "mapping": (location, rotation, scale)}; or with "kind":
-# "musgrave" a Musgrave Texture (fBM, 3D) of {"scale", "detail", "dimension", "lacunarity",
-# "mapping"}, with "kind": "wave" a Wave Texture of {"wave", "direction", "profile" (Blender's
+# "musgrave" a Musgrave Texture (3D; its "musgrave_type", Blender's name, FBM unless given) of
+# {"scale", "detail", "dimension", "lacunarity", "mapping"} and "offset", "gain" where given, with "kind": "wave" a Wave Texture of {"wave", "direction", "profile" (Blender's
 # names), "scale", "distortion", "detail", "detail_scale", "detail_roughness", "phase",
 # "mapping"}, with "kind": "voronoi" a Voronoi Texture (F1, 3D, its Distance) of {"scale",
 # "randomness", "metric" (Blender's name), "exponent", "mapping"}. The manifest entry has
@@ -259,8 +259,10 @@ def bump_by_noise(mat, settings):
         mapping.inputs[socket].default_value = value
     if settings.get("kind") == "musgrave":
         noise = nodes.new("ShaderNodeTexMusgrave")
-        noise.musgrave_dimensions, noise.musgrave_type = "3D", "FBM"
-        inputs = ("Scale", "Detail", "Dimension", "Lacunarity")
+        noise.musgrave_dimensions = "3D"
+        noise.musgrave_type = settings.get("musgrave_type", "FBM")
+        inputs = ("Scale", "Detail", "Dimension", "Lacunarity") + tuple(
+            socket for socket in ("Offset", "Gain") if socket.lower() in settings)
     elif settings.get("kind") == "voronoi":
         noise = nodes.new("ShaderNodeTexVoronoi")
         noise.voronoi_dimensions, noise.feature = "3D", "F1"
@@ -595,6 +597,14 @@ noise_case("voronoi_uv_sphere", "sphere", 512, 0.02, kind="voronoi", scale=3.0, 
 # Blender's Musgrave Texture (fBM) on the sphere: Detail 2.5, Dimension 1.5, Lacunarity 2.3.
 noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, detail=2.5,
            dimension=1.5, lacunarity=2.3, mapping=NOISE_MAPPING)
+# Its Ridged Multifractal on the sphere (Offset 0.9, Gain 1.8), its Hetero Terrain on Suzanne
+# (Offset 0.4; a fractional Detail).
+noise_case("musgrave_ridged_sphere", "sphere", 512, 0.01, kind="musgrave",
+           musgrave_type="RIDGED_MULTIFRACTAL", scale=1.5, detail=3.0, dimension=1.1,
+           lacunarity=2.2, offset=0.9, gain=1.8, mapping=NOISE_MAPPING)
+noise_case("musgrave_hetero_suzanne", "suzanne", 512, 0.01, kind="musgrave",
+           musgrave_type="HETERO_TERRAIN", scale=2.0, detail=2.5, dimension=1.3,
+           lacunarity=2.1, offset=0.4, mapping=NOISE_MAPPING)
 # Blender's Wave Texture: diagonal bands distorted by its noise on the sphere, spherical rings
 # (triangle profile) on Suzanne.
 noise_case("wave_sphere", "sphere", 512, 0.02, kind="wave", wave="BANDS", direction="DIAGONAL",

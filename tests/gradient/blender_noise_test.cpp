@@ -109,6 +109,127 @@ TEST(BlenderMusgrave, SumsTheOctavesAndItsGradientIsTheDerivative) {
   }
 }
 
+/// Cycles 3.4's Musgrave types written out plainly, octave by octave (value only): the reference
+/// the library's values are checked against.
+double musgraveReference(MusgraveType type, Vec3d q, double detail, double h, double l,
+                         double offset, double gain) {
+  const int n = static_cast<int>(detail);
+  const double rest = detail - n;
+  const auto s = [&](int i) { return blenderSignedNoise(std::pow(l, i) * q, nullptr); };
+  const auto w = [&](int i) { return std::pow(l, -h * i); };
+  double value = 0;
+  switch (type) {
+    case MusgraveType::kMultifractal:
+      value = 1;
+      for (int i = 0; i < n; ++i) value *= w(i) * s(i) + 1;
+      if (rest != 0) value *= rest * w(n) * s(n) + 1;
+      break;
+    case MusgraveType::kHeteroTerrain: {
+      value = offset + s(0);
+      int i = 1;
+      for (; i < n; ++i) value += (s(i) + offset) * w(i) * value;
+      if (rest != 0) value += rest * (s(i) + offset) * w(i) * value;
+      break;
+    }
+    case MusgraveType::kHybridMultifractal: {
+      double weight = 1;
+      int i = 0;
+      for (; weight > 0.001f && i < n; ++i) {
+        weight = std::min(weight, 1.0);
+        const double signal = (s(i) + offset) * w(i);
+        value += weight * signal;
+        weight *= gain * signal;
+      }
+      if (rest != 0 && weight > 0.001f)
+        value += rest * std::min(weight, 1.0) * (s(i) + offset) * w(i);
+      break;
+    }
+    case MusgraveType::kRidgedMultifractal: {
+      double signal = (offset - std::abs(s(0))) * (offset - std::abs(s(0)));
+      value = signal;
+      for (int i = 1; i < n; ++i) {
+        const double weight = std::clamp(signal * gain, 0.0, 1.0);
+        signal = (offset - std::abs(s(i))) * (offset - std::abs(s(i))) * weight;
+        value += signal * w(i);
+      }
+      break;
+    }
+    default:
+      break;
+  }
+  return value;
+}
+
+// The other Musgrave types: each Fac is the reference's (octave 0 whole, a fractional Detail's
+// extra octave as Cycles reads it, ridged ignoring the fraction) and the gradient the derivative,
+// at points where no kink (|s| = 0, a weight reaching its clamp, the hybrid's stop) lies within
+// the central difference's step: there its one-sided differences disagree and the point is
+// skipped.
+TEST(BlenderMusgrave, OtherTypesAreCyclesAndTheirGradientsAreTheDerivatives) {
+  int checked = 0;
+  for (const MusgraveType type :
+       {MusgraveType::kMultifractal, MusgraveType::kRidgedMultifractal,
+        MusgraveType::kHybridMultifractal, MusgraveType::kHeteroTerrain}) {
+    // Ridged: signals (1 − |s|)² in [0, 1] times Gain 3 clamp at 1 at about half of the points;
+    // hybrid: weights 1.8 (s + 0.7) too.
+    const bool ridged = type == MusgraveType::kRidgedMultifractal;
+    const double offset = ridged ? 1.0 : 0.7, gain = ridged ? 3.0 : 1.8;
+    for (const double detail : {0.5, 1.0, 2.5, 4.0}) {
+      const BlenderMusgraveParams params{.amplitude = 0.4,
+                                         .scale = 2.5,
+                                         .type = type,
+                                         .detail = detail,
+                                         .dimension = 0.8,
+                                         .lacunarity = 2.3,
+                                         .offset = offset,
+                                         .gain = gain};
+      Result<BlenderMusgrave> made = BlenderMusgrave::create(params);
+      ASSERT_TRUE(made) << made.error().message;
+      std::mt19937_64 rng(31);
+      std::uniform_real_distribution<double> along(-3, 3);
+      for (int i = 0; i < 200; ++i) {
+        const Vec3d p{along(rng), along(rng), along(rng)};
+        const double expected = musgraveReference(type, 2.5 * p, detail, 0.8, 2.3, offset, gain);
+        EXPECT_NEAR(made->value(p), 0.4 * expected, 1e-13) << int(type) << ' ' << detail;
+        const auto f = [&](Vec3d r) { return made->value(r); };
+        const double step = 1e-6;
+        const Vec3d central = centralGradient(f, p, step);
+        const Vec3d forward = centralGradient(f, p + Vec3d{step, step, step} * 0.5, step * 0.5);
+        const Vec3d backward = centralGradient(f, p - Vec3d{step, step, step} * 0.5, step * 0.5);
+        if (maxAbsDiff(forward, backward) > 1e-3) continue;  // a kink within the step
+        ++checked;
+        EXPECT_LT(maxAbsDiff(made->analyticGradient(p), central), 1e-6)
+            << int(type) << ' ' << detail;
+      }
+    }
+  }
+  EXPECT_GT(checked, 3150);  // of 3200
+}
+
+// Special cases: one octave of multifractal is 1 + s₀; ridged with Detail 1 is (offset − |s₀|)²,
+// and its fraction is ignored (Detail 2.9 reads as 2); hetero terrain's first octave is whole
+// (Detail 0 is offset + s₀); fBM is unchanged by offset and gain.
+TEST(BlenderMusgrave, OtherTypesSpecialCases) {
+  const auto fac = [](BlenderMusgraveParams params, Vec3d p) {
+    params.scale = 1;
+    return BlenderMusgrave::create(params).value().value(p);
+  };
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> along(-4, 4);
+  for (int i = 0; i < 100; ++i) {
+    const Vec3d p{along(rng), along(rng), along(rng)};
+    const double s = blenderSignedNoise(p, nullptr);
+    EXPECT_NEAR(fac({.type = MusgraveType::kMultifractal, .detail = 1}, p), 1 + s, 1e-15);
+    EXPECT_NEAR(fac({.type = MusgraveType::kRidgedMultifractal, .detail = 1, .offset = 1}, p),
+                (1 - std::abs(s)) * (1 - std::abs(s)), 1e-15);
+    EXPECT_EQ(fac({.type = MusgraveType::kRidgedMultifractal, .detail = 2.9, .gain = 3}, p),
+              fac({.type = MusgraveType::kRidgedMultifractal, .detail = 2, .gain = 3}, p));
+    EXPECT_NEAR(fac({.type = MusgraveType::kHeteroTerrain, .detail = 0, .offset = 0.3}, p), 0.3 + s,
+                1e-15);
+    EXPECT_EQ(fac({.detail = 3.5, .offset = 0.6, .gain = 2}, p), fac({.detail = 3.5}, p));
+  }
+}
+
 // The Wave Texture's gradient, every type and profile, distorted or not, away from the saw's and
 // triangle's corners (where the value jumps or folds: skipped when the central difference's two
 // sides would straddle one).
@@ -228,6 +349,53 @@ TEST(BlenderMusgrave, RefusesSlopesThatWouldOverflow) {
   EXPECT_EQ(made.error().message,
             "Musgrave Texture slopes beyond 1e300 (amplitude × scale × (1 + detail) × "
             "lacunarity^((1 − dimension) · detail))");
+}
+
+// The other types multiply octaves: a large Offset or Gain, or an octave weight L^(−H) above 1,
+// raised to powers growing with Detail, would overflow; Blender's ranges of them do not.
+TEST(BlenderMusgrave, OtherTypesRefuseSlopesThatWouldOverflow) {
+  using enum MusgraveType;
+  for (const MusgraveType type :
+       {kMultifractal, kRidgedMultifractal, kHybridMultifractal, kHeteroTerrain}) {
+    // Blender's extremes: Detail 15, Dimension 0, Lacunarity 1000, Offset ±1000, Gain 1000.
+    EXPECT_TRUE(BlenderMusgrave::create({.type = type, .detail = 15}));
+    EXPECT_TRUE(BlenderMusgrave::create({.type = type,
+                                         .detail = 15,
+                                         .dimension = 0,
+                                         .lacunarity = 1000,
+                                         .offset = -1000,
+                                         .gain = 1000}));
+    EXPECT_TRUE(BlenderMusgrave::create(
+        {.type = type, .detail = 15, .dimension = 2, .lacunarity = 0.5, .offset = 3, .gain = 4}));
+    // Octave weights 0.5^(−200) as the fBM's, and here multiplied.
+    EXPECT_FALSE(
+        BlenderMusgrave::create({.type = type, .detail = 15, .dimension = 200, .lacunarity = 0.5}))
+        << int(type);
+    // Octave weights (1e-5)^(−2) = 1e10: the products of 16 of them overflow, the ridged's sum
+    // (and fBM's) does not.
+    EXPECT_EQ(bool(BlenderMusgrave::create({.type = type, .detail = 15, .lacunarity = 1e-5})),
+              type == kRidgedMultifractal)
+        << int(type);
+  }
+  EXPECT_TRUE(BlenderMusgrave::create({.detail = 15, .lacunarity = 1e-5}));
+  // Offset and gain grow the octaves the types multiply or weight.
+  EXPECT_FALSE(BlenderMusgrave::create({.type = kHeteroTerrain, .detail = 15, .offset = 1e20}));
+  EXPECT_FALSE(BlenderMusgrave::create({.type = kHybridMultifractal, .detail = 15, .gain = 1e20}));
+  EXPECT_FALSE(
+      BlenderMusgrave::create({.type = kRidgedMultifractal, .detail = 15, .offset = 1e10}));
+  EXPECT_FALSE(BlenderMusgrave::create({.type = kRidgedMultifractal, .detail = 15, .gain = 1e21}));
+  // Offset does not enter the multifractal, which does not refuse it.
+  EXPECT_TRUE(BlenderMusgrave::create({.type = kMultifractal, .detail = 15, .offset = 1e20}));
+  Result<BlenderMusgrave> made =
+      BlenderMusgrave::create({.type = kHeteroTerrain, .detail = 15, .offset = 1e20});
+  ASSERT_FALSE(made);
+  EXPECT_EQ(made.error().message,
+            "Musgrave Texture slopes beyond 1e300 (amplitude × scale × the type's octaves "
+            "multiplied: (1 + offset), gain and lacunarity^(−dimension) to powers growing with "
+            "detail)");
+  EXPECT_EQ(
+      BlenderMusgrave::create({.type = kRidgedMultifractal, .gain = std::nan("")}).error().message,
+      "a Musgrave Texture setting is not finite");
 }
 
 // A Mapping node before the texture: the value at the mapped point, the gradient pulled back.

@@ -83,7 +83,7 @@ enum class VolumeFunction {
   kSine,             ///< DirectionalSine
   kNoise,            ///< GradientNoise
   kBlenderNoise,     ///< "blender-noise": BlenderNoise, Blender's Noise Texture (3D)
-  kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (fBM, 3D)
+  kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (3D)
   kBlenderWave,      ///< "blender-wave": BlenderWave, Blender's Wave Texture
   kBlenderVoronoi,   ///< "blender-voronoi": BlenderVoronoi, Blender's Voronoi Texture (F1, 3D)
 };
@@ -230,6 +230,12 @@ struct SceneLayer {
   double noiseDistortion = 0;
   double noiseDimension = 2;
   double noiseLacunarity = 2;
+  /// blender-musgrave: "musgrave_type" (fbm | multifractal | ridged-multifractal |
+  /// hybrid-multifractal | hetero-terrain), "offset" (ridged, hybrid, hetero terrain) and "gain"
+  /// (ridged, hybrid): the node's Type and inputs, Blender's defaults
+  MusgraveType musgraveType = MusgraveType::kFbm;
+  double musgraveOffset = 0;
+  double musgraveGain = 1;
   /// blender-wave: "wave" (bands | rings), "wave_direction" (x | y | z | diagonal (bands) |
   /// spherical (rings)), "profile" (sine | saw | triangle), "detail_scale", "detail_roughness"
   /// (of its distortion's noise; also "distortion", "detail", and "phase": the Phase Offset)

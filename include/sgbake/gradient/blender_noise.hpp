@@ -73,24 +73,56 @@ class BlenderNoise final : public BlenderTextureVolume<BlenderNoiseParams> {
   std::array<Vec3d, 3> distortionOffsets_{};
 };
 
-/// @brief The Musgrave Texture node's settings (type fBM, Dimensions 3D) and the height's scale.
+/// The Musgrave Texture's Type (Blender's FBM, MULTIFRACTAL, RIDGED_MULTIFRACTAL,
+/// HYBRID_MULTIFRACTAL, HETERO_TERRAIN).
+enum class MusgraveType {
+  kFbm,
+  kMultifractal,
+  kRidgedMultifractal,
+  kHybridMultifractal,
+  kHeteroTerrain
+};
+
+/// @brief The Musgrave Texture node's settings (Dimensions 3D) and the height's scale.
 struct BlenderMusgraveParams {
-  double amplitude = 1;   ///< height per unit of Fac
-  double scale = 5;       ///< the node's Scale
+  double amplitude = 1;  ///< height per unit of Fac
+  double scale = 5;      ///< the node's Scale
+  MusgraveType type = MusgraveType::kFbm;
   double detail = 2;      ///< the node's Detail: octaves (clamped to [0, 15])
   double dimension = 2;   ///< the node's Dimension H (at least 1e-5)
   double lacunarity = 2;  ///< the node's Lacunarity L (at least 1e-5)
+  double offset = 0;      ///< the node's Offset (ridged, hybrid, hetero terrain)
+  double gain = 1;        ///< the node's Gain (ridged, hybrid)
 };
 
-/// @brief Blender's Musgrave Texture, type fBM (3D), times an amplitude: a HeightVolume.
+/// @brief Blender's Musgrave Texture (3D), times an amplitude: a HeightVolume.
 ///
-///     Fac(P) = Σ_{i < ⌊detail⌋} snoise(Lⁱ p) L^(−iH) + (detail − ⌊detail⌋) snoise(L^⌊detail⌋ p)
-///     L^(−⌊detail⌋H)
+/// With p = scale · P, sᵢ = snoise(Lⁱ p) (BlenderNoise's, unnormalized: Fac is signed), wᵢ =
+/// L^(−iH), n = ⌊detail⌋ and r = detail − n (detail clamped to [0, 15]), Cycles 3.4's types:
 ///
-/// with p = scale · P and snoise as BlenderNoise's (unnormalized: Fac is signed). Exact gradient.
+/// - fBM: Fac = Σ_{i < n} wᵢ sᵢ + r wₙ sₙ.
+/// - Multifractal: Fac = Π_{i < n} (1 + wᵢ sᵢ) · (1 + r wₙ sₙ) (the last factor only if r ≠ 0).
+/// - Hetero Terrain: V₀ = offset + s₀, then Vᵢ = Vᵢ₋₁ · (1 + (sᵢ + offset) wᵢ) for 0 < i < n;
+///   Fac = Vₖ₋₁ · (1 + r (sₖ + offset) wₖ), k = max(n, 1) (octave 0 is always whole: with
+///   detail < 1 the fraction reads octave 1).
+/// - Hybrid Multifractal: weights ω₀ = 1 and, for i < n, the signal σᵢ = (sᵢ + offset) wᵢ adds
+///   min(ωᵢ, 1) σᵢ and ωᵢ₊₁ = min(ωᵢ, 1) · gain · σᵢ; if r ≠ 0 the fraction adds
+///   r min(ωₙ, 1) σₙ. The sum stops (the fraction too) at the first ωᵢ ≤ 0.001 (Cycles' float
+///   0.001).
+/// - Ridged Multifractal: σ₀ = (offset − |s₀|)², σᵢ = (offset − |sᵢ|)² · clamp(gain σᵢ₋₁, 0, 1)
+///   for 0 < i < n; Fac = Σ wᵢ σᵢ over i < max(n, 1). The fraction r is not used (Cycles
+///   ignores it).
+///
+/// The gradient is exact: the octaves' chain-rule factors Lⁱ, the product rule over the
+/// multifractal's and hetero terrain's factors, and the weights' gradients where they are not
+/// clamped (0 where min(ω, 1) or clamp(…, 0, 1) holds them at a bound). Where it is not
+/// differentiable it takes one side: |sᵢ| has the gradient sign(sᵢ) ∇sᵢ (+ at sᵢ = 0, the
+/// ridge), a clamped weight at its bound counts as clamped, and the hybrid's jump where a weight
+/// crosses 0.001 is not seen.
 class BlenderMusgrave final : public BlenderTextureVolume<BlenderMusgraveParams> {
  public:
-  /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale.
+  /// @return kBadInput for a non-finite setting, or slopes beyond kMaxVolumeScale (a bound per
+  /// type, growing with detail, 1 + |offset|, |gain| and L^(−H), L^(1−H): see create()).
   static Result<BlenderMusgrave> create(const BlenderMusgraveParams& params);
   /// The node's Fac.
   double output(Vec3d p, Vec3d* gradient) const override;

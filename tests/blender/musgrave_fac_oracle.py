@@ -1,0 +1,193 @@
+#!/usr/bin/env python3
+"""The BlenderMusgraveFacOracle test: the Musgrave Texture's Fac itself against Cycles'.
+
+    python3 tests/blender/musgrave_fac_oracle.py --cli build/src/sgbake [--blender blender]
+        [--keep DIR] [--sabotage]
+
+1. Blender builds a plane of side 2, turned and moved so that its object coordinates vary in
+   x, y and z, UV-mapped onto the whole square, and for each of SETTINGS and each of the five
+   Musgrave types (3D) bakes the node's Fac on the object's coordinates with Cycles (EMIT of
+   an Emission whose Color is the Fac, 1 sample, 128^2, margin 0) into blender_S_TYPE.exr; it
+   writes mesh.obj.
+2. sgbake bakes the "height" map of a "blender-musgrave" volume layer of amplitude 1 with the
+   same settings and type (ours_S_TYPE.exr), and the same layer of the next type in TYPES
+   (control_S_TYPE.exr, the type not read).
+3. Back in Blender (as the EXR reader), the largest |difference| over every texel.
+
+Pass: each of ours within FAC_LIMIT of Cycles' (Cycles computes in float on values up to ~2:
+measured 1.0e-6 for fBM and Multifractal, 1.5e-6 for Ridged Multifractal and Hetero Terrain,
+1.6e-6 for Hybrid Multifractal); each control at least CONTROL_MIN off. --sabotage bakes ours
+with a Gain 10% above the node's (fBM, Multifractal and Hetero Terrain, which have none, keep
+theirs), to see the test fail.
+
+Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed. Takes ~10 s.
+"""
+
+import json
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.dont_write_bytecode = True  # keep __pycache__ out of the source tree
+sys.path.insert(0, HERE)
+import bake_common as bc  # noqa: E402  (needs the sys.path entry above)
+import objio  # noqa: E402
+
+SIZE = 128
+# Blender's Type -> the scene's "musgrave_type", and the inputs the type reads beyond Scale,
+# Detail, Dimension and Lacunarity.
+TYPES = {"FBM": ("fbm", ()), "MULTIFRACTAL": ("multifractal", ()),
+         "RIDGED_MULTIFRACTAL": ("ridged-multifractal", ("Offset", "Gain")),
+         "HYBRID_MULTIFRACTAL": ("hybrid-multifractal", ("Offset", "Gain")),
+         "HETERO_TERRAIN": ("hetero-terrain", ("Offset",))}
+# The node's inputs: a fractional Detail; a Detail below 1 (Hetero Terrain's fraction reads
+# octave 1, Ridged drops it) with a negative Offset and a large Gain.
+SETTINGS = (
+    {"Scale": 2.0, "Detail": 2.5, "Dimension": 0.9, "Lacunarity": 2.3, "Offset": 0.7,
+     "Gain": 1.6},
+    {"Scale": 1.7, "Detail": 4.3, "Dimension": 1.4, "Lacunarity": 2.6, "Offset": 0.2,
+     "Gain": 5.0},
+    {"Scale": 3.0, "Detail": 0.6, "Dimension": 0.4, "Lacunarity": 1.8, "Offset": -0.3,
+     "Gain": 3.0},
+)
+FAC_LIMIT = 5e-6
+CONTROL_MIN = 1e-2
+RESULT_TAG = "MUSGRAVE_FAC_ORACLE_RESULT "
+
+
+def name(index, blender_type):
+    return f"{index}_{blender_type}"
+
+
+# ---- Inside Blender: the bakes and the comparison --------------------------------------------
+
+def bake(out_dir):
+    """Step 1: mesh.obj and blender_S_TYPE.exr."""
+    import bpy
+    import mathutils
+    bc.reset_scene()
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    ob = bpy.context.active_object
+    me = ob.data
+    me.transform(mathutils.Matrix.Rotation(0.6, 4, "X") @ mathutils.Matrix.Rotation(0.3, 4, "Y")
+                 @ mathutils.Matrix.Translation((0.3, -0.2, 0.1)))
+    me.calc_normals_split()
+    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me))
+    scene = bpy.context.scene
+    bc.setup_cycles(scene)
+    mat = bpy.data.materials.new("musgrave")
+    mat.use_nodes = True
+    me.materials.append(mat)
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    musgrave = nodes.new("ShaderNodeTexMusgrave")
+    musgrave.musgrave_dimensions = "3D"
+    emission = nodes.new("ShaderNodeEmission")
+    output = nodes.new("ShaderNodeOutputMaterial")
+    links.new(coordinates.outputs["Object"], musgrave.inputs["Vector"])
+    links.new(musgrave.outputs["Fac"], emission.inputs["Color"])
+    links.new(emission.outputs["Emission"], output.inputs["Surface"])
+    target = nodes.new("ShaderNodeTexImage")
+    nodes.active = target
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    for index, settings in enumerate(SETTINGS):
+        for blender_type in TYPES:
+            musgrave.musgrave_type = blender_type
+            for socket, value in settings.items():
+                musgrave.inputs[socket].default_value = value
+            image = bc.new_float_image(name(index, blender_type), SIZE, SIZE)
+            target.image = image
+            result = bpy.ops.object.bake(type="EMIT", margin=0, use_clear=True,
+                                         target="IMAGE_TEXTURES", save_mode="INTERNAL")
+            if result != {"FINISHED"}:
+                raise RuntimeError(f"bake {blender_type} returned {result}")
+            bc.save_exr(image, os.path.join(out_dir, f"blender_{name(index, blender_type)}.exr"))
+
+
+def compare(out_dir):
+    """Step 3: the largest |difference| of ours_ and control_S_TYPE.exr from Cycles'."""
+    import numpy as np
+    result = {}
+    for index in range(len(SETTINGS)):
+        for blender_type in TYPES:
+            case = name(index, blender_type)
+            theirs = bc.load_raw(os.path.join(out_dir, f"blender_{case}.exr"))[..., 0]
+            result[case] = {
+                prefix: float(np.abs(
+                    bc.load_raw(os.path.join(out_dir, f"{prefix}_{case}.exr"))[..., 0].astype(
+                        np.float64) - theirs).max())
+                for prefix in ("ours", "control")}
+            result[case]["range"] = [float(theirs.min()), float(theirs.max())]
+    return result
+
+
+def blender_main(argv):
+    if argv[0] == "bake":
+        bake(argv[1])
+        print(RESULT_TAG + json.dumps({"baked": True}), flush=True)
+    else:
+        print(RESULT_TAG + json.dumps(compare(argv[1])), flush=True)
+
+
+# ---- The driver ------------------------------------------------------------------------------
+
+def layer(settings, blender_type, gain_factor=1.0):
+    """The "blender-musgrave" volume layer of the node's `settings` and type `blender_type`
+    (its Gain times `gain_factor`), amplitude 1."""
+    musgrave_type, inputs = TYPES[blender_type]
+    values = {"type": "volume", "function": "blender-musgrave", "amplitude": 1.0,
+              "frequency": settings["Scale"], "musgrave_type": musgrave_type,
+              "detail": settings["Detail"], "dimension": settings["Dimension"],
+              "lacunarity": settings["Lacunarity"]}
+    for socket in inputs:
+        values[socket.lower()] = settings[socket] * (gain_factor if socket == "Gain" else 1.0)
+    return values
+
+
+def main():
+    parser = bc.oracle_parser(__doc__, blender_help=None)
+    parser.add_argument("--sabotage", action="store_true",
+                        help="bake ours with a Gain 10%% above the node's")
+    args = parser.parse_args()
+    blender = bc.blender_or_skip(args.blender)
+    bc.require_executable(args.cli, "error: --cli {} is not an executable file")
+
+    with bc.work_dir(args.keep, "sgbake_musgrave_fac_oracle_") as out_dir:
+        script = os.path.abspath(__file__)
+        if objio.run_blender_result(blender, script, ["bake", out_dir], RESULT_TAG) is None:
+            return 1
+        types = list(TYPES)
+        for index, settings in enumerate(SETTINGS):
+            for i, blender_type in enumerate(types):
+                case = name(index, blender_type)
+                other = types[(i + 1) % len(types)]
+                for prefix, layer_of in (
+                        ("ours", layer(settings, blender_type, 1.1 if args.sabotage else 1.0)),
+                        ("control", layer(settings, other))):
+                    scene = {"mesh": "mesh.obj", "layers": [layer_of],
+                             "outputs": [{"map": "height", "file": f"{prefix}_{case}.exr",
+                                          "size": SIZE, "margin": 0, "samples": 1,
+                                          "bit_depth": 32}]}
+                    if not bc.bake_scene_file(args.cli, out_dir, f"{prefix}_{case}", scene):
+                        return 1
+        stats = objio.run_blender_result(blender, script, ["compare", out_dir], RESULT_TAG)
+        if stats is None:
+            return 1
+        failures = []
+        for case, s in stats.items():
+            ok = s["ours"] <= FAC_LIMIT and s["control"] >= CONTROL_MIN
+            print(f"  {case}: Fac in [{s['range'][0]:.3f}, {s['range'][1]:.3f}], max |diff| "
+                  f"{s['ours']:.2g} (<= {FAC_LIMIT:g}), the next type's {s['control']:.3g} "
+                  f"(>= {CONTROL_MIN:g}) -> {'ok' if ok else 'FAIL'}")
+            if s["ours"] > FAC_LIMIT:
+                failures.append(f"{case}: the Fac differs from Cycles' by {s['ours']:.3g}")
+            if s["control"] < CONTROL_MIN:
+                failures.append(f"{case}: the next type's Fac is within {s['control']:.3g} of "
+                                "Cycles' (the control cannot tell the types apart)")
+        return bc.report(failures)
+
+
+if __name__ == "__main__":
+    objio.run_script(blender_main, main)
