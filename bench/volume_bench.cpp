@@ -41,6 +41,7 @@ namespace {
 using sgbake::GradientScheme;
 using sgbake::HeightVolume;
 using sgbake::Vec3d;
+using sgbake::VolumeSample;
 
 /// Points per timed batch (fits in L1 with the values; large enough to hide loop overhead).
 constexpr int kNumPoints = 1024;
@@ -186,6 +187,24 @@ void benchGradient(benchmark::State& state, int which, GradientScheme scheme, do
   setPerPointCounters(state, kNumPoints);
 }
 
+/// Value and gradient together, as a volume read on UV coordinates needs them
+/// (VolumeOnUvTexture): HeightVolume::sample, or (@p apart) value() and analyticGradient().
+void benchValueAndGradient(benchmark::State& state, int which, bool apart) {
+  const HeightVolume& volume = field(which);
+  const std::vector<Vec3d> points = makePoints(kNumPoints, 1);
+  for (auto _ : state) {
+    VolumeSample sum;
+    for (const Vec3d& p : points) {
+      const VolumeSample s =
+          apart ? VolumeSample{volume.value(p), volume.analyticGradient(p)} : volume.sample(p);
+      sum.value += s.value;
+      sum.gradient += s.gradient;
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  setPerPointCounters(state, kNumPoints);
+}
+
 // ------------------------------------------------------------------------------------------------
 // Equal error
 // ------------------------------------------------------------------------------------------------
@@ -280,6 +299,12 @@ void registerAll() {
                                  [which](benchmark::State& s) { benchValue(s, which); });
     benchmark::RegisterBenchmark((base + "/analytic").c_str(), [which](benchmark::State& s) {
       benchGradient(s, which, GradientScheme::kAnalytic, 0);
+    });
+    benchmark::RegisterBenchmark((base + "/sample").c_str(), [which](benchmark::State& s) {
+      benchValueAndGradient(s, which, false);
+    });
+    benchmark::RegisterBenchmark((base + "/value+analytic").c_str(), [which](benchmark::State& s) {
+      benchValueAndGradient(s, which, true);
     });
     benchmark::RegisterBenchmark((base + "/central").c_str(), [which, step](benchmark::State& s) {
       benchGradient(s, which, GradientScheme::kCentral, step);
