@@ -53,6 +53,16 @@ std::string parseError(const std::string& text) {
   return scene.error().message;
 }
 
+/// validateScene's message for @p scene, expecting failure.
+std::string validationError(const Scene& scene) {
+  Status status = validateScene(scene);
+  if (status) {
+    ADD_FAILURE() << "valid";
+    return {};
+  }
+  return status.error().message;
+}
+
 /// A valid scene with @p output as its only output (and no layers).
 std::string withOutput(const std::string& output) {
   return R"({"mesh": "m.obj", "outputs": [)" + output + "]}";
@@ -862,18 +872,14 @@ TEST(Scene, VolumesOnUvCoordinatesNameTheirUvSet) {
 
   Scene scene = *onUv;
   scene.layers[0].gradient = GradientScheme::kCentral;
-  Status status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message,
+  EXPECT_EQ(validationError(scene),
             "layers[0]: a volume on UV coordinates takes its slopes 'analytic' or 'bump-node' "
             "(no finite differences)");
   scene.layers[0].gradient = GradientScheme::kAnalytic;
   EXPECT_TRUE(validateScene(scene));
   scene.layers[0].type = SceneLayerType::kHeight;
   scene.layers[0].image = "h.png";
-  status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message, "layers[0]: key 'coordinates' applies only to volumes");
+  EXPECT_EQ(validationError(scene), "layers[0]: key 'coordinates' applies only to volumes");
 }
 
 TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
@@ -1355,18 +1361,14 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   output.file = "n.png";
   output.width = output.height = 0;
   scene.outputs.push_back(output);
-  Status status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message, "outputs[0]: size 0 is out of range 1..65536");
+  EXPECT_EQ(validationError(scene), "outputs[0]: size 0 is out of range 1..65536");
   scene.outputs[0].width = scene.outputs[0].height = 64;
   EXPECT_TRUE(validateScene(scene));
   SceneLayer layer;
   layer.image = "h.png";
   layer.weight = std::numeric_limits<double>::infinity();
   scene.layers.push_back(layer);
-  status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message, "layers[0]: weight must be a finite number");
+  EXPECT_EQ(validationError(scene), "layers[0]: weight must be a finite number");
   // Tangent frames named for a layer that decodes in none, built in code as in a scene file,
   // are refused.
   scene.layers[0].weight = 1;
@@ -1374,25 +1376,19 @@ TEST(Scene, ValidateSceneChecksScenesBuiltInCode) {
   scene.layers[0].kind = ProjectedKind::kObjectNormal;
   scene.layers[0].projection = TriplanarProjection::kBox;
   scene.layers[0].tangentUvSet = 0;
-  status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message,
+  EXPECT_EQ(validationError(scene),
             "layers[0]: key 'tangent_uv' applies only to tangent-space normal maps (normal "
             "layers, and projected ones with 'projection': 'box', 'flat', 'sphere' or 'tube')");
   scene.layers[0].kind = ProjectedKind::kTangentNormal;
   EXPECT_TRUE(validateScene(scene));
   // A remap built in code: on a normal map, or not a function, is refused as in a scene file.
   scene.layers[0].remap = {{0, 0}, {1, 1}};
-  status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message, "layers[0]: key 'remap' applies only to heights");
+  EXPECT_EQ(validationError(scene), "layers[0]: key 'remap' applies only to heights");
   scene.layers[0].kind = ProjectedKind::kHeight;
   scene.layers[0].tangentUvSet.reset();
   EXPECT_TRUE(validateScene(scene));
   scene.layers[0].remap = {{1, 0}, {0, 1}};
-  status = validateScene(scene);
-  ASSERT_FALSE(status);
-  EXPECT_EQ(status.error().message,
+  EXPECT_EQ(validationError(scene),
             "layers[0]: 'remap': remap point 1 has a smaller x than the point before it");
 }
 
