@@ -507,6 +507,25 @@ def _ramp_values(node, output, channel):
     return values
 
 
+def _float_curve_table(node):
+    """Float Curve node `node`'s function as Cycles reads it (remap.curve): its curve tabulated
+    at RAMP_TABLE_SIZE values from its points' least to greatest x, extrapolated beyond; None
+    when its Fac is not the constant 1 (a blend with the value) or its points share one x."""
+    if _constant(node.inputs["Factor"]) != 1.0:
+        return None
+    mapping = node.mapping
+    curve_map = mapping.curves[0]
+    xs = [point.location[0] for point in curve_map.points]
+    low, high = min(xs), max(xs)
+    if not high > low:
+        return None
+    mapping.initialize()
+    last = remap.RAMP_TABLE_SIZE - 1
+    values = [mapping.evaluate(curve_map, low + i / last * (high - low))
+              for i in range(remap.RAMP_TABLE_SIZE)]
+    return remap.curve(values, low, high)
+
+
 def _chain_step(node, link, channel):
     """How `node` (fed into the chain through `link`) changes the height it is fed, the
     `channel` of its output the chain reads (r, g, b of a colour, or None): (its input the
@@ -516,7 +535,8 @@ def _chain_step(node, link, channel):
     when it clamps) read a float: the channel read before them is the grey's. Clamp (Min and
     Max constants): Min Max, min(max(v, Min), Max) (Max alone when Min > Max); Range, between
     the lower and the higher. Color Ramp: Cycles' table of it read at its Fac (remap.table),
-    its Color's luminance (or the channel read), or its Alpha. Invert of a constant Fac:
+    its Color's luminance (or the channel read), or its Alpha. Float Curve of Factor 1: Cycles'
+    table of its curve, extrapolated (_float_curve_table). Invert of a constant Fac:
     (1 - Fac) c + Fac (1 - c) on each channel."""
     if node.type == "INVERT":
         fac = _constant(node.inputs["Fac"])
@@ -532,6 +552,9 @@ def _chain_step(node, link, channel):
         elif low > high:  # min(max(v, Min), Max) is Max
             low = high
         return node.inputs["Value"], remap.clamp(low, high), None
+    if node.type == "CURVE_FLOAT":
+        table = _float_curve_table(node)
+        return None if table is None else (node.inputs["Value"], table, None)
     if node.type == "VALTORGB":
         output = link.from_socket.name
         constant = node.color_ramp.interpolation == "CONSTANT"

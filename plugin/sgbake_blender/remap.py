@@ -44,6 +44,21 @@ def table(values, constant):
     return ("points", points)
 
 
+def curve(values, low, high, reach=1.0e4):
+    """A Float Curve as Cycles reads its table `values` (the curve at low + i / (n - 1) (high -
+    low), i = 0 .. n - 1; low and high its points' least and greatest x) at v: linearly between
+    entries inside [low, high], and beyond it along its first or last segment (Cycles
+    extrapolates): here to `reach` times the table's span beyond each end (a remap is constant
+    past its last point)."""
+    last = len(values) - 1
+    span = high - low
+    points = [(low + i / last * span, float(y)) for i, y in enumerate(values)]
+    first_slope = (values[1] - values[0]) / (span / last)
+    last_slope = (values[last] - values[last - 1]) / (span / last)
+    return ("points", [(low - reach * span, values[0] - first_slope * reach * span)] + points
+            + [(high + reach * span, values[last] + last_slope * reach * span)])
+
+
 def compose(outer, inner):
     """outer(inner(v)) as a function of the kinds above."""
     if outer[0] == "affine":

@@ -271,6 +271,11 @@ REMAP_FACTOR = 2.0
 REMAP_MEDIAN_DEG = 0.01
 REMAP_P99_DEG = 0.01
 REMAP_CONTROL_FACTOR = 3.0
+# The Float Curve case (float_curve_case): the bump material's texture through a Float Curve
+# node (FLOAT_CURVE_POINTS: its ends inside [0, 1], so that Cycles extrapolates the heights
+# beyond them) into the Bump. Layers from Material must make the curve the layer's "remap"; its
+# bake must be Cycles' (REMAP_* bars) and the same job without the remap clearly worse.
+FLOAT_CURVE_POINTS = ((0.15, 0.2), (0.45, 0.7), (0.85, 0.55))
 # The noise case (noise_case): a Noise Texture (3D, NOISE_INPUTS) on Suzanne's own object
 # coordinates through a Mapping node (Point, NOISE_MAPPING) into the Bump (Distance
 # NOISE_DISTANCE: its normals lean at most 32 deg off the surface's, short of Cycles'
@@ -2137,6 +2142,53 @@ def remap_case(settings, ob, work):
     return entry
 
 
+def float_curve_case(settings, ob, work):
+    """The bump material's texture through a Float Curve node (FLOAT_CURVE_POINTS) into the
+    Bump: Layers from Material (one height layer with a remap), then the add-on's tangent-normal
+    bake (addon_float_curve.npy), the same job without the layer's "remap" and Cycles'. The
+    material is put back afterwards. Returns the manifest entry (result, the layer made,
+    checks)."""
+    import bpy
+    from sgbake_blender import scene
+    tree = ob.active_material.node_tree
+    tex = next(n for n in tree.nodes if n.type == "TEX_IMAGE" and n.name != "bake_target")
+    bump = next(n for n in tree.nodes if n.type == "BUMP")
+    node = tree.nodes.new("ShaderNodeFloatCurve")
+    points = node.mapping.curves[0].points
+    for i, (x, y) in enumerate(FLOAT_CURVE_POINTS):
+        if i < len(points):
+            points[i].location = (x, y)
+        else:
+            points.new(x, y)
+    node.mapping.update()
+    tree.links.new(tex.outputs["Color"], node.inputs["Value"])
+    tree.links.new(node.outputs["Value"], bump.inputs["Height"])
+    entry = {"result": None, "checks": []}
+    try:
+        bpy.ops.object.sgbake_layers_from_material()
+        layer = settings.layers[0] if len(settings.layers) == 1 else None
+        remap_points = (scene.remap_points(layer) or []) if layer else []
+        # Beyond the curve's ends the remap goes on along its first and last segments.
+        xs = [x for x, _ in remap_points]
+        entry["layer"] = {"type": getattr(layer, "type", None), "remap points": len(xs)}
+        entry["checks"].append({
+            "name": "float curve: Layers from Material makes one height layer whose remap is "
+                    "the curve, extrapolated",
+            "ok": (layer is not None and layer.type == "height" and len(xs) >= 256
+                   and xs[0] < -1.0 and xs[-1] > 2.0
+                   and abs(remap_at(remap_points, FLOAT_CURVE_POINTS[1][0])
+                           - FLOAT_CURVE_POINTS[1][1]) < 1e-3),
+            "expected": f"one height layer, a remap through {FLOAT_CURVE_POINTS} reaching past "
+                        "[0, 1]",
+            "message": f"{entry['layer']}"})
+        if layer is not None:
+            entry["result"] = bake_against_cycles(settings, ob, work, "float_curve", ("remap",))
+    finally:
+        tree.nodes.remove(node)
+        tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
+    return entry
+
+
 def make_noise(tree, inputs=None):
     """A Noise Texture node in `tree` (3D) with `inputs` (NOISE_INPUTS by default)."""
     noise = tree.nodes.new("ShaderNodeTexNoise")
@@ -2844,6 +2896,7 @@ def blender_make(work, library_path, sabotage):
     manifest["projector"] = projector_case(settings, ob, work)
     manifest["displacement"] = displacement_case(settings, ob, work)
     manifest["remap"] = remap_case(settings, ob, work)
+    manifest["float_curve"] = float_curve_case(settings, ob, work)
     manifest["noise"] = noise_case(settings, ob, work)
     manifest["musgrave"] = musgrave_case(settings, ob, work)
     manifest["musgrave_ridged"] = musgrave_ridged_case(settings, ob, work)
@@ -2903,6 +2956,7 @@ def blender_compare(work):
     results["projector"] = against_cycles(work, "projector")
     results["displacement"] = against_cycles(work, "displacement")
     results["remap"] = against_cycles(work, "remap")
+    results["float_curve"] = against_cycles(work, "float_curve")
     results["noise"] = against_cycles(work, "noise")
     results["noise_generated"] = against_cycles(work, "noise_generated")
     results["musgrave"] = against_cycles(work, "musgrave")
@@ -3154,6 +3208,11 @@ def evaluate(manifest, results):
         f"{REMAP_FACTOR:g}) on the height ({manifest['remap'].get('layer')})",
         manifest["remap"], results["remap"], "without the remap", REMAP_MEDIAN_DEG,
         REMAP_CONTROL_FACTOR, REMAP_P99_DEG)
+    failures += evaluate_case_against_cycles(
+        "float_curve", f"a Float Curve through {FLOAT_CURVE_POINTS} on the height "
+        f"({manifest['float_curve'].get('layer')})", manifest["float_curve"],
+        results["float_curve"], "without the remap", REMAP_MEDIAN_DEG, REMAP_CONTROL_FACTOR,
+        REMAP_P99_DEG)
     noise = manifest["noise"]
     failures += evaluate_case_against_cycles(
         "noise", "a Noise Texture (3D, "
@@ -3211,6 +3270,7 @@ def evaluate(manifest, results):
                   + manifest["limit"]["checks"] + manifest["world"]["checks"]
                   + manifest["materials"]["checks"] + manifest["projector"]["checks"]
                   + manifest["displacement"]["checks"] + manifest["remap"]["checks"]
+                  + manifest["float_curve"]["checks"]
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
                   + manifest["musgrave_ridged"]["checks"]
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
