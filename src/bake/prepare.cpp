@@ -318,6 +318,12 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                            .randomness = layer.voronoiRandomness,
                                            .metric = layer.voronoiMetric,
                                            .exponent = layer.voronoiExponent}));
+    case VolumeFunction::kBlenderBrick: {
+      BlenderBrickParams params = layer.brick;
+      params.amplitude = layer.amplitude;
+      params.scale = layer.frequency;
+      return owned(BlenderBrick::create(params));
+    }
     case VolumeFunction::kNoise:
       break;
   }

@@ -126,7 +126,8 @@ constexpr Named<VolumeFunction> kFunctions[] = {
     {"blender-noise", VolumeFunction::kBlenderNoise},
     {"blender-musgrave", VolumeFunction::kBlenderMusgrave},
     {"blender-wave", VolumeFunction::kBlenderWave},
-    {"blender-voronoi", VolumeFunction::kBlenderVoronoi}};
+    {"blender-voronoi", VolumeFunction::kBlenderVoronoi},
+    {"blender-brick", VolumeFunction::kBlenderBrick}};
 constexpr Named<VolumeCoordinates> kVolumeCoordinates[] = {{"object", VolumeCoordinates::kObject},
                                                            {"uv", VolumeCoordinates::kUv}};
 constexpr Named<VoronoiMetric> kVoronoiMetrics[] = {{"euclidean", VoronoiMetric::kEuclidean},
@@ -452,6 +453,14 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "distortion",
            "dimension",
            "lacunarity",
+           "mortar_size",  // the Brick Texture's
+           "mortar_smooth",
+           "brick_width",
+           "row_height",
+           "brick_offset",
+           "offset_frequency",
+           "squash",
+           "squash_frequency",
            "musgrave_type",  // the Musgrave Texture's type, its offset and gain
            "offset",
            "gain",
@@ -872,7 +881,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     const bool musgrave = layer.function == VolumeFunction::kBlenderMusgrave;
     const bool wave = layer.function == VolumeFunction::kBlenderWave;
     const bool voronoi = layer.function == VolumeFunction::kBlenderVoronoi;
-    const bool blender = noise || musgrave || wave || voronoi;
+    const bool brick = layer.function == VolumeFunction::kBlenderBrick;
+    const bool blender = noise || musgrave || wave || voronoi || brick;
     const std::string function = nameIn(kFunctions, layer.function);
     const auto onlyFor = [&](std::initializer_list<const char*> keys, bool applies,
                              const char* owner) {
@@ -886,12 +896,16 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"direction"}, sine, "sine");
     onlyFor({"phase"}, sine || wave, "sine and blender-wave");
     onlyFor({"seed", "octaves"}, layer.function == VolumeFunction::kNoise, "noise");
-    onlyFor({"detail"}, blender, "blender-noise, blender-musgrave and blender-wave");
+    onlyFor({"detail"}, noise || musgrave || wave,
+            "blender-noise, blender-musgrave and blender-wave");
     onlyFor({"distortion"}, noise || wave, "blender-noise and blender-wave");
     onlyFor({"roughness"}, noise, "blender-noise");
     onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
             "blender-wave");
     onlyFor({"randomness", "metric", "exponent"}, voronoi, "blender-voronoi");
+    onlyFor({"mortar_size", "mortar_smooth", "brick_width", "row_height", "brick_offset",
+             "offset_frequency", "squash", "squash_frequency"},
+            brick, "blender-brick");
     onlyFor({"dimension", "lacunarity", "musgrave_type", "offset", "gain"}, musgrave,
             "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
@@ -924,6 +938,21 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     }
     if (reader.has("offset")) layer.musgraveOffset = reader.number("offset");
     if (reader.has("gain")) layer.musgraveGain = reader.number("gain");
+    if (brick) {
+      BlenderBrickParams& b = layer.brick;
+      if (reader.has("mortar_size")) b.mortarSize = reader.number("mortar_size");
+      if (reader.has("mortar_smooth")) b.mortarSmooth = reader.number("mortar_smooth");
+      if (reader.has("brick_width"))
+        b.brickWidth = reader.numberAtLeast("brick_width", 0, /*exclusive=*/true);
+      if (reader.has("row_height"))
+        b.rowHeight = reader.numberAtLeast("row_height", 0, /*exclusive=*/true);
+      if (reader.has("brick_offset")) b.offset = reader.number("brick_offset");
+      if (reader.has("offset_frequency"))
+        b.offsetFrequency = reader.smallInteger("offset_frequency", 0, 99);
+      if (reader.has("squash")) b.squash = reader.numberAtLeast("squash", 0, /*exclusive=*/true);
+      if (reader.has("squash_frequency"))
+        b.squashFrequency = reader.smallInteger("squash_frequency", 0, 99);
+    }
     if (reader.has("randomness")) layer.voronoiRandomness = reader.number("randomness");
     reader.optionalName("metric", kVoronoiMetrics, layer.voronoiMetric);
     if (reader.has("exponent")) layer.voronoiExponent = reader.number("exponent");
@@ -1687,6 +1716,16 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
             type == MusgraveType::kHybridMultifractal) {
           j["gain"] = layer.musgraveGain;
         }
+      } else if (layer.function == VolumeFunction::kBlenderBrick) {
+        const BlenderBrickParams& b = layer.brick;
+        j["mortar_size"] = b.mortarSize;
+        j["mortar_smooth"] = b.mortarSmooth;
+        j["brick_width"] = b.brickWidth;
+        j["row_height"] = b.rowHeight;
+        j["brick_offset"] = b.offset;
+        j["offset_frequency"] = b.offsetFrequency;
+        j["squash"] = b.squash;
+        j["squash_frequency"] = b.squashFrequency;
       } else if (layer.function == VolumeFunction::kBlenderVoronoi) {
         j["randomness"] = layer.voronoiRandomness;
         j["metric"] = nameIn(kVoronoiMetrics, layer.voronoiMetric);

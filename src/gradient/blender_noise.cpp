@@ -674,4 +674,70 @@ double BlenderWave::output(Vec3d position, Vec3d* gradient) const {
   return value;
 }
 
+Result<BlenderBrick> BlenderBrick::create(const BlenderBrickParams& params) {
+  if (Status finite = finiteSettings(
+          "Brick Texture", {params.amplitude, params.scale, params.mortarSize, params.mortarSmooth,
+                            params.brickWidth, params.rowHeight, params.offset, params.squash});
+      !finite)
+    return finite.error();
+  if (!(params.brickWidth > 0) || !(params.rowHeight > 0)) {
+    return Error::badInput("a Brick Texture's Brick Width and Row Height must be greater than 0");
+  }
+  if (params.offsetFrequency < 0 || params.squashFrequency < 0) {
+    return Error::badInput("a Brick Texture's frequencies must be 0 or more");
+  }
+  if (params.offsetFrequency != 0 && params.squashFrequency != 0 && !(params.squash > 0)) {
+    return Error::badInput("a Brick Texture's Squash must be greater than 0");
+  }
+  // The smoothstep's steepest slope, 1.5 / (Mortar Size · Mortar Smooth), per unit of p.
+  const double smoothing = std::abs(params.mortarSize * params.mortarSmooth);
+  const double steepest = smoothing > 0 ? 1.5 / smoothing : 0;
+  if (Status bounded = boundedSlopes("Brick Texture",
+                                     std::abs(params.amplitude) * std::abs(params.scale) * steepest,
+                                     "(amplitude × scale × 1.5 / (mortar size × mortar smooth))");
+      !bounded)
+    return bounded.error();
+  return BlenderBrick(params);
+}
+
+double BlenderBrick::output(Vec3d position, Vec3d* gradient) const {
+  const BlenderBrickParams& b = params_;
+  const double px = b.scale * position.x, py = b.scale * position.y;
+  const double row = std::floor(py / b.rowHeight);
+  double width = b.brickWidth, offset = 0;
+  if (b.offsetFrequency != 0 && b.squashFrequency != 0) {
+    // (Rows below zero too: −2 is a multiple of 2.)
+    const auto multiple = [row](int frequency) { return std::fmod(row, frequency) == 0; };
+    if (multiple(b.squashFrequency)) width *= b.squash;
+    if (multiple(b.offsetFrequency)) offset = width * b.offset;
+  }
+  const double brick = std::floor((px + offset) / width);
+  const double x = px + offset - width * brick, y = py - b.rowHeight * row;
+  // d, the distance to the brick's nearest edge, and its slope along p's x and y.
+  double d = x;
+  double dx = 1, dy = 0;
+  const auto nearer = [&](double candidate, double cx, double cy) {
+    if (candidate < d) d = candidate, dx = cx, dy = cy;
+  };
+  nearer(y, 0, 1);
+  nearer(width - x, -1, 0);
+  nearer(b.rowHeight - y, 0, -1);
+  double fac = 0, slope = 0;  // slope: dFac / dd
+  if (d >= b.mortarSize) {
+    fac = 0;
+  } else if (b.mortarSmooth == 0) {
+    fac = 1;
+  } else {
+    const double t = (1 - d / b.mortarSize) / b.mortarSmooth;
+    if (t < 1) {
+      fac = t * t * (3 - 2 * t);
+      slope = 6 * t * (1 - t) * (-1 / (b.mortarSize * b.mortarSmooth));
+    } else {
+      fac = 1;
+    }
+  }
+  if (gradient != nullptr) *gradient = Vec3d{slope * dx, slope * dy, 0} * b.scale;
+  return fac;
+}
+
 }  // namespace sgbake

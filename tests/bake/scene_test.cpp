@@ -882,6 +882,45 @@ TEST(Scene, VolumesOnUvCoordinatesNameTheirUvSet) {
   EXPECT_EQ(validationError(scene), "layers[0]: key 'coordinates' applies only to volumes");
 }
 
+// "blender-brick" takes the Brick Texture's inputs and properties (Blender's defaults unless
+// given) and writes them back; others' keys, and bricks of no width, are refused.
+TEST(Scene, BlenderBrickVolumesTakeTheNodesSettings) {
+  Result<Scene> brick =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-brick", "mortar_size": 0.05,
+                    "brick_width": 0.6, "offset_frequency": 3, "squash": 1.5})"),
+                 options());
+  ASSERT_TRUE(brick) << brick.error().message;
+  const BlenderBrickParams& b = brick->layers[0].brick;
+  EXPECT_EQ(brick->layers[0].frequency, 5);
+  EXPECT_EQ(b.mortarSize, 0.05);
+  EXPECT_EQ(b.mortarSmooth, 0.1);
+  EXPECT_EQ(b.brickWidth, 0.6);
+  EXPECT_EQ(b.rowHeight, 0.25);
+  EXPECT_EQ(b.offsetFrequency, 3);
+  EXPECT_EQ(b.squash, 1.5);
+  EXPECT_EQ(b.squashFrequency, 2);
+  const std::string parameters = layerParametersJson(brick->layers[0]);
+  for (const char* expected : {R"("mortar_size":0.05)", R"("brick_width":0.6)",
+                               R"("offset_frequency":3)", R"("squash":1.5)"}) {
+    EXPECT_NE(parameters.find(expected), std::string::npos) << expected << " in " << parameters;
+  }
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-brick", "detail": 2})")),
+      "scene.json: layers[0]: key 'detail' does not apply to a blender-brick volume (it is for "
+      "blender-noise, blender-musgrave and blender-wave)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "squash": 2})")),
+      "scene.json: layers[0]: key 'squash' does not apply to a blender-noise volume (it is for "
+      "blender-brick)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-brick", "row_height": 0})")),
+      "scene.json: layers[0]: row_height 0 must be greater than 0");
+  EXPECT_NE(parseError(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                                     "detail": 2})"))
+                .find("key 'detail' does not apply to a blender-voronoi volume"),
+            std::string::npos);
+}
+
 TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
   Result<Scene> plain =
       parseScene(withLayer(R"({"type": "volume", "function": "blender-noise"})"), options());

@@ -268,6 +268,11 @@ def bump_by_noise(mat, settings):
         noise.voronoi_dimensions, noise.feature = "3D", "F1"
         noise.distance = settings["metric"]
         inputs = ("Scale", "Randomness", "Exponent")
+    elif settings.get("kind") == "brick":
+        noise = nodes.new("ShaderNodeTexBrick")
+        noise.offset, noise.offset_frequency = settings["brick_offset"], settings["offset_frequency"]
+        noise.squash, noise.squash_frequency = settings["squash"], settings["squash_frequency"]
+        inputs = ("Scale", "Mortar Size", "Mortar Smooth", "Brick Width", "Row Height")
     elif settings.get("kind") == "wave":
         noise = nodes.new("ShaderNodeTexWave")
         noise.wave_type, noise.wave_profile = settings["wave"], settings["profile"]
@@ -594,6 +599,11 @@ noise_case("noise_uv_suzanne", "suzanne", 512, 0.05, scale=2.0, detail=2.5, roug
            distortion=0.2, mapping=UV_MAPPING, coordinates="UV")
 noise_case("voronoi_uv_sphere", "sphere", 512, 0.02, kind="voronoi", scale=3.0, randomness=0.9,
            metric="EUCLIDEAN", exponent=0.5, mapping=UV_MAPPING, coordinates="UV")
+# Blender's Brick Texture's Fac (the mortar) on Suzanne: wide mortar smoothed over all of it,
+# every third row squashed, every second moved.
+noise_case("brick_suzanne", "suzanne", 512, 0.005, kind="brick", scale=3.0, mortar_size=0.08,
+           mortar_smooth=1.0, brick_width=0.6, row_height=0.3, brick_offset=0.4,
+           offset_frequency=2, squash=1.5, squash_frequency=3, mapping=NOISE_MAPPING)
 # Blender's Musgrave Texture (fBM) on the sphere: Detail 2.5, Dimension 1.5, Lacunarity 2.3.
 noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, detail=2.5,
            dimension=1.5, lacunarity=2.3, mapping=NOISE_MAPPING)

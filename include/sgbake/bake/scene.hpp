@@ -86,6 +86,7 @@ enum class VolumeFunction {
   kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (3D)
   kBlenderWave,      ///< "blender-wave": BlenderWave, Blender's Wave Texture
   kBlenderVoronoi,   ///< "blender-voronoi": BlenderVoronoi, Blender's Voronoi Texture (F1, 3D)
+  kBlenderBrick,     ///< "blender-brick": BlenderBrick, Blender's Brick Texture's Fac
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
@@ -249,6 +250,10 @@ struct SceneLayer {
   double voronoiRandomness = 1;
   VoronoiMetric voronoiMetric = VoronoiMetric::kEuclidean;
   double voronoiExponent = 0.5;
+  /// blender-brick: "mortar_size", "mortar_smooth", "brick_width", "row_height",
+  /// "brick_offset", "offset_frequency", "squash", "squash_frequency": the node's inputs and
+  /// properties, Blender's defaults (its amplitude and scale are the layer's)
+  BlenderBrickParams brick{};
   GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
   std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
   VolumeCoordinates coordinates = VolumeCoordinates::kObject;  ///< "coordinates" (with "uv")

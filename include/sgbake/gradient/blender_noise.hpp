@@ -131,6 +131,45 @@ class BlenderMusgrave final : public BlenderTextureVolume<BlenderMusgraveParams>
   using BlenderTextureVolume::BlenderTextureVolume;
 };
 
+/// @brief The Brick Texture node's settings that shape its Fac (the mortar), and the height's
+/// scale. (Its colours and Bias tint the bricks only.)
+struct BlenderBrickParams {
+  double amplitude = 1;       ///< height per unit of Fac
+  double scale = 5;           ///< the node's Scale
+  double mortarSize = 0.02;   ///< Mortar Size
+  double mortarSmooth = 0.1;  ///< Mortar Smooth
+  double brickWidth = 0.5;    ///< Brick Width (greater than 0)
+  double rowHeight = 0.25;    ///< Row Height (greater than 0)
+  double offset = 0.5;        ///< Offset: of every offsetFrequency-th row, in brick widths
+  int offsetFrequency = 2;    ///< its Frequency (0: no offset and no squash)
+  double squash = 1;          ///< Squash: brick width factor of every squashFrequency-th row
+  int squashFrequency = 2;    ///< its Frequency (0: no offset and no squash)
+};
+
+/// @brief Blender's Brick Texture's Fac (1 in the mortar, 0 in the bricks), times an amplitude:
+/// a HeightVolume.
+///
+/// p = scale · P, only its x and y read. Row r = ⌊y / h⌋ (h the Row Height); when both
+/// frequencies are non-zero a row whose r is a multiple of the squash frequency has bricks
+/// Squash times as wide (w), and one whose r is a multiple of the offset frequency is moved by
+/// Offset · w (rows below zero too). Brick b = ⌊(x + offset) / w⌋, and in
+/// it x′ = x + offset − b w, y′ = y − r h; d = min(x′, y′, w − x′, h − y′), the distance to the
+/// brick's edge. Fac = 0 where d ≥ Mortar Size, else 1 without smoothing, else
+/// smoothstep(t) = 3t² − 2t³ of t = (1 − d / Mortar Size) / Mortar Smooth while t < 1, else
+/// 1. Its gradient is exact but where d's nearest edge changes (the bricks' corners) and at
+/// the mortar's borders.
+class BlenderBrick final : public BlenderTextureVolume<BlenderBrickParams> {
+ public:
+  /// @return kBadInput for a non-finite setting, a Brick Width or Row Height not greater than 0,
+  /// a negative frequency, or slopes beyond kMaxVolumeScale.
+  static Result<BlenderBrick> create(const BlenderBrickParams& params);
+  /// The node's Fac.
+  double output(Vec3d p, Vec3d* gradient) const override;
+
+ private:
+  using BlenderTextureVolume::BlenderTextureVolume;
+};
+
 /// The Wave Texture's Wave Type.
 enum class WaveType { kBands, kRings };
 /// Its Bands Direction (x, y, z, diagonal) or Rings Direction (x, y, z: around that axis;
