@@ -901,11 +901,12 @@ def _scale_key(values):
 # outputs the layer reads (grey: the Fac, a Wave Texture's Color (Fac, Fac, Fac) alike); the
 # node's enum properties the function takes (setting -> (the node's property, or a function of
 # the node naming it; Blender's values -> the scene's names)); the inputs whose name is not
-# their setting's in title case (setting -> input); and why its other outputs make no layer.
+# their setting's in title case (setting -> input); why its other outputs make no layer; and
+# the node's other properties the function takes as they are (setting -> property).
 ProceduralTexture = collections.namedtuple(
-    "ProceduralTexture", "function dimensions fixed outputs enums inputs others",
+    "ProceduralTexture", "function dimensions fixed outputs enums inputs others props",
     defaults=({}, ("Fac",), {}, {}, "three noises seeded apart; a volume layer is the noise of "
-                                    "its Fac"))
+                                    "its Fac", {}))
 PROCEDURAL_TEXTURES = {
     "TEX_NOISE": ProceduralTexture("blender-noise", "noise_dimensions"),
     "TEX_MUSGRAVE": ProceduralTexture(
@@ -930,6 +931,12 @@ PROCEDURAL_TEXTURES = {
                                        "CHEBYCHEV": "chebyshev", "MINKOWSKI": "minkowski"})},
         others="each cell's random colour or its point, not a height; a volume layer is the "
                "Distance"),
+    "TEX_BRICK": ProceduralTexture(
+        "blender-brick", None,
+        others="the bricks' colours tinted at random, not a height; a volume layer is the Fac "
+               "(the mortar)",
+        props={"brick_offset": "offset", "offset_frequency": "offset_frequency",
+               "squash": "squash", "squash_frequency": "squash_frequency"}),
 }
 
 
@@ -943,7 +950,7 @@ def _texture_inputs(texture, enums):
     inputs.update((texture.inputs.get(key, key.replace("_", " ").title()), key)
                   for key in scene.texture_settings(texture.function,
                                                     enums.get("musgrave_type", "fbm"))
-                  if key not in texture.enums)
+                  if key not in texture.enums and key not in texture.props)
     return inputs
 
 
@@ -998,6 +1005,7 @@ def _procedural_settings(tex, ob=None):
     settings = {"type": "volume", "name": tex.name, "function": texture.function,
                 "gradient": "bump-node"}
     settings.update(enums)
+    settings.update((key, getattr(tex, prop)) for key, prop in texture.props.items())
     settings.update((key, values[name]) for name, key in inputs.items())
     settings.update(coordinates)
     return settings

@@ -104,6 +104,10 @@ FUNCTIONS = (
     ("blender-voronoi", "Blender Voronoi",
      "Blender's Voronoi Texture (F1, 3D) Distance, as Cycles evaluates it: Frequency is the "
      "node's Scale, with its Distance Metric, Randomness and Exponent"),
+    ("blender-brick", "Blender Brick",
+     "Blender's Brick Texture Fac (the mortar), as Cycles evaluates it: Frequency is the node's "
+     "Scale, with its Mortar Size and Smooth, Brick Width, Row Height, Offset, Squash and their "
+     "Frequencies"),
 )
 # The Wave Texture's enums in the scene's names (Blender's Wave Type, Bands or Rings Direction,
 # Wave Profile). The directions depend on the type, as the node's two properties: the fourth
@@ -360,6 +364,30 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     exponent: FloatProperty(name="Exponent", default=0.5, min=0.0, precision=3,
                             description="Blender Voronoi: the Voronoi Texture's Exponent (of "
                                         "the Minkowski metric; the others ignore it)")
+    mortar_size: FloatProperty(name="Mortar Size", default=0.02, min=0.0, max=0.125,
+                               precision=3, description="Blender Brick: the Brick Texture's "
+                                                        "Mortar Size")
+    mortar_smooth: FloatProperty(name="Mortar Smooth", default=0.1, min=0.0, max=1.0,
+                                 subtype="FACTOR", description="Blender Brick: the Brick "
+                                                               "Texture's Mortar Smooth")
+    brick_width: FloatProperty(name="Brick Width", default=0.5, min=0.01, max=100.0,
+                               precision=3,
+                               description="Blender Brick: the Brick Texture's Brick Width")
+    row_height: FloatProperty(name="Row Height", default=0.25, min=0.01, max=100.0,
+                              precision=3,
+                              description="Blender Brick: the Brick Texture's Row Height")
+    brick_offset: FloatProperty(name="Offset", default=0.5, min=0.0, max=1.0, subtype="FACTOR",
+                                description="Blender Brick: the Brick Texture's Offset of every "
+                                            "Offset Frequency-th row, in brick widths")
+    offset_frequency: IntProperty(name="Offset Frequency", default=2, min=1, max=99,
+                                  description="Blender Brick: the Brick Texture's Offset "
+                                              "Frequency")
+    squash: FloatProperty(name="Squash", default=1.0, min=0.0, max=99.0, precision=3,
+                          description="Blender Brick: the Brick Texture's Squash, the brick "
+                                      "width factor of every Squash Frequency-th row")
+    squash_frequency: IntProperty(name="Squash Frequency", default=2, min=1, max=99,
+                                  description="Blender Brick: the Brick Texture's Squash "
+                                              "Frequency")
     gradient: EnumProperty(name="Gradient", items=GRADIENTS, default="analytic",
                            description="How the volume's gradient is computed")
     step: FloatProperty(

@@ -39,6 +39,8 @@ BLENDER_TEXTURE_SETTINGS = {
     "blender-wave": ("wave", "wave_direction", "profile", "distortion", "detail", "detail_scale",
                      "detail_roughness", "phase"),
     "blender-voronoi": ("metric", "randomness", "exponent"),
+    "blender-brick": ("mortar_size", "mortar_smooth", "brick_width", "row_height", "brick_offset",
+                      "offset_frequency", "squash", "squash_frequency"),
 }
 # The scene's keys of the settings whose layer property has another name.
 SETTING_KEYS = {"musgrave_offset": "offset"}

@@ -131,6 +131,9 @@
    worse. noise_world_case: the same on world positions (a Geometry node's Position), Suzanne
    turned and scaled: a "blender-noise" layer whose mapping's matrix is the object's
    matrix_world, baked as Cycles bakes it, the layer without its mapping clearly worse.
+   Brick Texture (brick_case): a Brick Texture's Fac (BRICK_INPUTS, BRICK_PROPS) on Suzanne's
+   own coordinates through a Mapping node: one "blender-brick" volume layer of its inputs and
+   properties, baked as Cycles bakes it, the layer without its mapping clearly worse.
 2. For each case the CLI bakes the same map from the files:
      sgbake bake --mesh mesh.obj --height height.exr --height-scale S --filter bilinear
                  --map MAP --size 256 --margin M --samples N [--green G] [--alpha]
@@ -346,6 +349,16 @@ WAVE_CONTROL_FACTOR = 3.0
 # the object's coordinates at least NOISE_CONTROL_FACTOR times worse.
 NOISE_UV_MAPPING = ((0.2, -0.1, 0.3), (0.0, 0.0, 0.4), (3.0, 2.5, 1.0))
 NOISE_UV_DISTANCE = 0.01
+# The Brick case (brick_case): a Brick Texture (BRICK_INPUTS, its properties BRICK_PROPS as the
+# layer's settings) on Suzanne's own coordinates through a Mapping node (BRICK_MAPPING), its Fac
+# into the Bump (Distance BRICK_DISTANCE). Layers from Material must make a "blender-brick"
+# volume layer of those settings; its bake must be Cycles' (NOISE_* bars) and the same job
+# without the layer's "mapping" clearly worse.
+BRICK_INPUTS = {"Scale": 3.0, "Mortar Size": 0.08, "Mortar Smooth": 1.0, "Brick Width": 0.6,
+                "Row Height": 0.3}
+BRICK_PROPS = {"brick_offset": 0.25, "offset_frequency": 3, "squash": 1.5, "squash_frequency": 2}
+BRICK_MAPPING = ((0.1, 0.3, -0.2), (0.3, -0.2, 0.4), (1.1, 1.2, 0.9))
+BRICK_DISTANCE = 0.005
 # The Noise on world positions case (noise_world_case): Suzanne moved, turned and scaled so.
 NOISE_WORLD_PLACEMENT = ((0.4, -0.3, 0.2), (0.5, -0.3, 0.9), (1.4, 0.8, 1.2))
 VORONOI_NODE = {"voronoi_dimensions": "3D", "feature": "F1", "distance": "EUCLIDEAN"}
@@ -2829,6 +2842,28 @@ def noise_world_case(settings, ob, work):
                         function="blender-noise", placement=NOISE_WORLD_PLACEMENT)
 
 
+def make_brick(tree):
+    """A Brick Texture node in `tree` with BRICK_INPUTS and BRICK_PROPS."""
+    brick = tree.nodes.new("ShaderNodeTexBrick")
+    for name, value in BRICK_INPUTS.items():
+        brick.inputs[name].default_value = value
+    brick.offset, brick.offset_frequency = BRICK_PROPS["brick_offset"], BRICK_PROPS["offset_frequency"]
+    brick.squash, brick.squash_frequency = BRICK_PROPS["squash"], BRICK_PROPS["squash_frequency"]
+    return brick
+
+
+def brick_case(settings, ob, work):
+    """The bump material's Height fed by a Brick Texture's Fac (make_brick) on the object's own
+    coordinates through a Mapping node (BRICK_MAPPING), Distance BRICK_DISTANCE: texture_case
+    "brick", its properties as the layer's settings, its control without the layer's
+    "mapping"."""
+    keys = {"frequency": "Scale", "mortar_size": "Mortar Size", "mortar_smooth": "Mortar Smooth",
+            "brick_width": "Brick Width", "row_height": "Row Height"}
+    return texture_case(settings, ob, work, "brick", make_brick, keys, BRICK_INPUTS,
+                        BRICK_PROPS, {"detail", "roughness", "randomness", "offset"},
+                        BRICK_MAPPING, BRICK_DISTANCE, ("mapping",))
+
+
 def voronoi_checks(settings, ob):
     """Layers from Material on Voronoi Textures: Manhattan, Chebychev and Minkowski give the
     scene's metrics, Feature Output F2 and the Color output no layer and a reason; and a volume
@@ -2904,6 +2939,7 @@ def blender_make(work, library_path, sabotage):
     manifest["voronoi"] = voronoi_case(settings, ob, work)
     manifest["noise_uv"] = noise_uv_case(settings, ob, work)
     manifest["noise_world"] = noise_world_case(settings, ob, work)
+    manifest["brick"] = brick_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
@@ -2968,6 +3004,7 @@ def blender_compare(work):
     results["voronoi_lean"] = lean_stats(work, "voronoi")
     results["noise_uv"] = against_cycles(work, "noise_uv")
     results["noise_world"] = against_cycles(work, "noise_world")
+    results["brick"] = against_cycles(work, "brick")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -3232,6 +3269,11 @@ def evaluate(manifest, results):
         results["noise_world"], "without the layer's mapping (its own coordinates)",
         NOISE_MEDIAN_DEG, NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
     failures += evaluate_case_against_cycles(
+        "brick", "a Brick Texture's Fac (" + ", ".join(f"{k} {v:g}" for k, v in BRICK_INPUTS.items())
+        + f", {BRICK_PROPS}) on object coordinates through a Mapping node (Point), Distance "
+        f"{BRICK_DISTANCE:g}", manifest["brick"], results["brick"], "without the layer's mapping",
+        NOISE_MEDIAN_DEG, NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
+    failures += evaluate_case_against_cycles(
         "musgrave", "a Musgrave Texture (fBM, 3D, "
         + ", ".join(f"{k} {v:g}" for k, v in MUSGRAVE_INPUTS.items())
         + ") on object coordinates through a Mapping node (Point), Distance "
@@ -3275,6 +3317,7 @@ def evaluate(manifest, results):
                   + manifest["musgrave_ridged"]["checks"]
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
                   + manifest["noise_uv"]["checks"] + manifest["noise_world"]["checks"]
+                  + manifest["brick"]["checks"]
                   + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")
