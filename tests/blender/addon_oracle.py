@@ -2946,6 +2946,15 @@ def blender_make(work, library_path, sabotage):
                           + musgrave_checks(settings, ob)
                           + wave_checks(settings, ob)
                           + voronoi_checks(settings, ob)
+                          + [hand_made_check(
+                              settings, "brick", "Blender Brick",
+                              {"function": "blender-brick", "frequency": 4.0,
+                               "mortar_size": 0.05, "squash": 2.0, "offset_frequency": 3,
+                               "amplitude": 0.01},
+                              {"function": "blender-brick", "mortar_size": 0.05,
+                               "mortar_smooth": 0.1, "squash": 2.0, "offset_frequency": 3,
+                               "squash_frequency": 2},
+                              ("detail", "randomness", "offset", "seed", "mapping"))]
                           + worker_thread_checks(settings, ob)
                           + error_reports(settings, prefs, height, work, library_path))
     with open(os.path.join(work, "manifest.json"), "w", encoding="ascii") as f:
