@@ -926,9 +926,12 @@ PROCEDURAL_TEXTURES = {
                "profile": ("wave_profile", {"SIN": "sine", "SAW": "saw", "TRI": "triangle"})},
         inputs={"phase": "Phase Offset"}),
     "TEX_VORONOI": ProceduralTexture(
-        "blender-voronoi", "voronoi_dimensions", {"feature": "F1"}, outputs=("Distance",),
-        enums={"metric": ("distance", {"EUCLIDEAN": "euclidean", "MANHATTAN": "manhattan",
-                                       "CHEBYCHEV": "chebyshev", "MINKOWSKI": "minkowski"})},
+        "blender-voronoi", "voronoi_dimensions", outputs=("Distance",),
+        enums={"feature": ("feature", {"F1": "f1", "F2": "f2", "SMOOTH_F1": "smooth-f1",
+                                       "DISTANCE_TO_EDGE": "distance-to-edge"}),
+               "metric": (lambda tex: None if tex.feature == "DISTANCE_TO_EDGE" else "distance",
+                          {"EUCLIDEAN": "euclidean", "MANHATTAN": "manhattan",
+                           "CHEBYCHEV": "chebyshev", "MINKOWSKI": "minkowski"})},
         others="each cell's random colour or its point, not a height; a volume layer is the "
                "Distance"),
     "TEX_BRICK": ProceduralTexture(
@@ -944,12 +947,14 @@ def _texture_inputs(texture, enums):
     """The inputs of procedural texture `texture` (PROCEDURAL_TEXTURES) whose enums are `enums`
     (in the scene's names) -> the layer settings that hold them: its Scale the frequency, the
     others of scene.texture_settings (a Musgrave Texture's Offset and Gain only where its type
-    uses them) but its enums under their own names (input Detail Scale -> detail_scale, but as
+    uses them, a Voronoi Texture's Smoothness, Exponent and metric only where its feature uses
+    them) but its enums under their own names (input Detail Scale -> detail_scale, but as
     texture.inputs renames them: Phase Offset -> phase, Offset -> musgrave_offset)."""
     inputs = {"Scale": "frequency"}
     inputs.update((texture.inputs.get(key, key.replace("_", " ").title()), key)
                   for key in scene.texture_settings(texture.function,
-                                                    enums.get("musgrave_type", "fbm"))
+                                                    enums.get("musgrave_type", "fbm"),
+                                                    enums.get("feature", "f1"))
                   if key not in texture.enums and key not in texture.props)
     return inputs
 
@@ -966,29 +971,32 @@ def _procedural_settings(tex, ob=None):
     """The settings of the volume layer of procedural texture node `tex`'s height output (a
     Noise, Musgrave or Wave Texture's Fac, a Voronoi Texture's Distance: PROCEDURAL_TEXTURES):
     its function with the node's enum properties in the scene's names (a Musgrave Texture's
-    type, a Wave Texture's type, direction and profile, a Voronoi Texture's Distance Metric) and
+    type, a Wave Texture's type, direction and profile, a Voronoi Texture's Feature Output and
+    Distance Metric (none for Distance to Edge)) and
     its inputs (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of
     a Noise Texture, Detail, Dimension and Lacunarity of a Musgrave Texture and the Offset and
     Gain its type uses, Distortion, Detail, Detail
-    Scale, Detail Roughness and Phase Offset of a Wave Texture, Randomness and Exponent of a
-    Voronoi Texture), the slopes as Cycles' Bump node takes them (gradient "bump-node"), on the
+    Scale, Detail Roughness and Phase Offset of a Wave Texture, Randomness, Exponent and
+    Smoothness of a Voronoi Texture where its feature uses them), the slopes as Cycles' Bump node takes them (gradient "bump-node"), on the
     coordinates its Vector reads (_vector_coordinates: object, Generated or world coordinates,
     or a UV map's; unlinked, the Generated coordinates, as Cycles reads a procedural texture);
     or a string saying why none is made: Dimensions other than 3D, a type the function is not
-    (a Voronoi Texture's Feature Output other than F1), an input fed by anything but constants
+    (a Voronoi Texture's N-Sphere Radius), an input fed by anything but constants
     (_constant), a Vector that is none of those coordinates (a normal, ...)."""
     texture = PROCEDURAL_TEXTURES[tex.type]
     if texture.dimensions and getattr(tex, texture.dimensions) != "3D":
         return (f"'{tex.name}' Dimensions {_enum_name(tex, texture.dimensions)} (a volume "
                 "layer is the 3D texture)")
     for prop, value in texture.fixed.items():
-        if getattr(tex, prop) != value:  # (Voronoi's Feature Output)
+        if getattr(tex, prop) != value:
             rna = tex.bl_rna.properties[prop]
             return (f"'{tex.name}' {rna.name.lower()} {_enum_name(tex, prop)} (a volume layer "
                     f"is the {rna.enum_items[value].name} {rna.name.lower()})")
     enums = {}  # (in the table's order: a Wave Texture's type before its direction)
     for key, (prop, names) in texture.enums.items():
         prop = prop(tex) if callable(prop) else prop
+        if prop is None:  # (not one the node has now: Distance to Edge's Distance Metric)
+            continue
         enums[key] = names.get(getattr(tex, prop))
         if enums[key] is None:
             return (f"'{tex.name}' {tex.bl_rna.properties[prop].name} "

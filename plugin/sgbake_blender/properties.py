@@ -102,8 +102,9 @@ FUNCTIONS = (
      "its type, direction, profile, Phase Offset, Distortion, Detail, Detail Scale and Detail "
      "Roughness"),
     ("blender-voronoi", "Blender Voronoi",
-     "Blender's Voronoi Texture (F1, 3D) Distance, as Cycles evaluates it: Frequency is the "
-     "node's Scale, with its Distance Metric, Randomness and Exponent"),
+     "Blender's Voronoi Texture (3D) Distance, as Cycles evaluates it: Frequency is the "
+     "node's Scale, with its Feature Output, Distance Metric, Smoothness, Randomness and "
+     "Exponent"),
     ("blender-brick", "Blender Brick",
      "Blender's Brick Texture Fac (the mortar), as Cycles evaluates it: Frequency is the node's "
      "Scale, with its Mortar Size and Smooth, Brick Width, Row Height, Offset, Squash and their "
@@ -152,6 +153,17 @@ METRICS = (
     ("manhattan", "Manhattan", "Sum of the coordinates' distances"),
     ("chebyshev", "Chebyshev", "Largest of the coordinates' distances"),
     ("minkowski", "Minkowski", "(sum of |d|^Exponent)^(1/Exponent)"),
+)
+
+
+# The Voronoi Texture's Feature Outputs that have a Distance, in the scene's names.
+VORONOI_FEATURES = (
+    ("f1", "F1", "Distance to the nearest cell point"),
+    ("f2", "F2", "Distance to the second-nearest cell point"),
+    ("smooth-f1", "Smooth F1", "A smooth minimum of the distances to the cell points "
+                               "(Smoothness)"),
+    ("distance-to-edge", "Distance to Edge",
+     "Distance to the nearest cell's boundary (Euclidean: no Distance Metric)"),
 )
 
 
@@ -355,6 +367,13 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     gain: FloatProperty(name="Gain", default=1.0, min=0.0, max=1000.0, precision=3,
                         description="Blender Musgrave: the Musgrave Texture's Gain (Ridged and "
                                     "Hybrid Multifractal)")
+    feature: EnumProperty(name="Feature Output", items=VORONOI_FEATURES, default="f1",
+                          description="Blender Voronoi: the Voronoi Texture's Feature Output "
+                                      "(its Distance is the height)")
+    smoothness: FloatProperty(name="Smoothness", default=1.0, min=0.0, max=1.0,
+                              subtype="FACTOR",
+                              description="Blender Voronoi: the Voronoi Texture's Smoothness "
+                                          "(Smooth F1)")
     metric: EnumProperty(name="Distance Metric", items=METRICS, default="euclidean",
                          description="Blender Voronoi: the Voronoi Texture's Distance Metric")
     randomness: FloatProperty(name="Randomness", default=1.0, min=0.0, max=1.0,

@@ -38,7 +38,7 @@ BLENDER_TEXTURE_SETTINGS = {
                          "gain"),
     "blender-wave": ("wave", "wave_direction", "profile", "distortion", "detail", "detail_scale",
                      "detail_roughness", "phase"),
-    "blender-voronoi": ("metric", "randomness", "exponent"),
+    "blender-voronoi": ("feature", "metric", "smoothness", "randomness", "exponent"),
     "blender-brick": ("mortar_size", "mortar_smooth", "brick_width", "row_height", "brick_offset",
                       "offset_frequency", "squash", "squash_frequency"),
 }
@@ -48,12 +48,19 @@ SETTING_KEYS = {"musgrave_offset": "offset"}
 # fBM use neither Offset nor Gain, Hetero Terrain no Gain.
 MUSGRAVE_UNUSED = {"fbm": ("musgrave_offset", "gain"),
                    "multifractal": ("musgrave_offset", "gain"), "hetero-terrain": ("gain",)}
+# The Voronoi Texture's settings its Feature Outputs do not use: Smoothness but for Smooth F1
+# (libsgbake refuses it); Distance to Edge has no Distance Metric nor Exponent (Blender hides
+# them, Cycles ignores them).
+VORONOI_UNUSED = {"f1": ("smoothness",), "f2": ("smoothness",),
+                  "distance-to-edge": ("smoothness", "metric", "exponent")}
 
 
-def texture_settings(function, musgrave_type="fbm"):
+def texture_settings(function, musgrave_type="fbm", feature="f1"):
     """The settings a volume of `function` sends (BLENDER_TEXTURE_SETTINGS; none for sine and
-    noise), a Blender Musgrave's less the inputs its `musgrave_type` does not use."""
-    unused = MUSGRAVE_UNUSED.get(musgrave_type, ()) if function == "blender-musgrave" else ()
+    noise), a Blender Musgrave's less the inputs its `musgrave_type` does not use, a Blender
+    Voronoi's less those its `feature` does not use."""
+    unused = (MUSGRAVE_UNUSED.get(musgrave_type, ()) if function == "blender-musgrave"
+              else VORONOI_UNUSED.get(feature, ()) if function == "blender-voronoi" else ())
     return tuple(key for key in BLENDER_TEXTURE_SETTINGS.get(function, ()) if key not in unused)
 
 
@@ -237,7 +244,8 @@ def layer_json(layer, uv_index, default_uv=None):
     distortion, a Blender Musgrave's type, detail, dimension and lacunarity and the offset and
     gain where its type uses them (texture_settings), a Blender Wave's type,
     direction, profile, distortion, detail, detail scale and roughness and phase, a Blender
-    Voronoi's metric, randomness and exponent: BLENDER_TEXTURE_SETTINGS; libsgbake refuses
+    Voronoi's feature and the metric, smoothness, randomness and exponent it uses:
+    BLENDER_TEXTURE_SETTINGS; libsgbake refuses
     another function's), and like a projection its "mapping" when it has one (a Mapping node,
     another object's or the Generated coordinates). A layer of one material slot
     (material_index >= 0) sends it as "material": libsgbake then applies it to the faces of
@@ -281,7 +289,8 @@ def layer_json(layer, uv_index, default_uv=None):
             entry.update(seed=int(layer.seed), octaves=int(layer.octaves))
         else:  # Blender's Noise, Musgrave, Wave or Voronoi Texture (its Scale: frequency)
             entry.update({SETTING_KEYS.get(key, key): _setting(getattr(layer, key))
-                          for key in texture_settings(layer.function, layer.musgrave_type)})
+                          for key in texture_settings(layer.function, layer.musgrave_type,
+                                                      layer.feature)})
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
         if layer.planar_projection != "axis":  # Blender's Flat, Sphere and Tube: about z

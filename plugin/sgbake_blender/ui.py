@@ -174,8 +174,10 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             elif layer.function == "noise":
                 col.prop(layer, "seed")
                 col.prop(layer, "octaves")
-            # A Blender texture's enums and inputs (a Musgrave's those of its type)
-            for name in scene.texture_settings(layer.function, layer.musgrave_type):
+            # A Blender texture's enums and inputs (a Musgrave's those of its type, a
+            # Voronoi's those of its feature)
+            for name in scene.texture_settings(layer.function, layer.musgrave_type,
+                                               layer.feature):
                 col.prop(layer, name)
             col.prop(layer, "gradient")
             if layer.gradient in ("central", "tetrahedral"):

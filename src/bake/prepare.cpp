@@ -317,7 +317,9 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                            .scale = layer.frequency,
                                            .randomness = layer.voronoiRandomness,
                                            .metric = layer.voronoiMetric,
-                                           .exponent = layer.voronoiExponent}));
+                                           .exponent = layer.voronoiExponent,
+                                           .feature = layer.voronoiFeature,
+                                           .smoothness = layer.voronoiSmoothness}));
     case VolumeFunction::kBlenderBrick: {
       BlenderBrickParams params = layer.brick;
       params.amplitude = layer.amplitude;

@@ -140,6 +140,11 @@ constexpr Named<MusgraveType> kMusgraveTypes[] = {
     {"ridged-multifractal", MusgraveType::kRidgedMultifractal},
     {"hybrid-multifractal", MusgraveType::kHybridMultifractal},
     {"hetero-terrain", MusgraveType::kHeteroTerrain}};
+constexpr Named<VoronoiFeature> kVoronoiFeatures[] = {
+    {"f1", VoronoiFeature::kF1},
+    {"f2", VoronoiFeature::kF2},
+    {"smooth-f1", VoronoiFeature::kSmoothF1},
+    {"distance-to-edge", VoronoiFeature::kDistanceToEdge}};
 constexpr Named<WaveType> kWaveTypes[] = {{"bands", WaveType::kBands}, {"rings", WaveType::kRings}};
 constexpr Named<WaveDirection> kWaveDirections[] = {{"x", WaveDirection::kX},
                                                     {"y", WaveDirection::kY},
@@ -472,6 +477,8 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "randomness",
            "metric",
            "exponent",
+           "feature",  // the Voronoi Texture's Feature Output and its smoothness
+           "smoothness",
            "mapping",
            "coordinates",
            "uv",
@@ -902,7 +909,8 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"roughness"}, noise, "blender-noise");
     onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
             "blender-wave");
-    onlyFor({"randomness", "metric", "exponent"}, voronoi, "blender-voronoi");
+    onlyFor({"randomness", "metric", "exponent", "feature", "smoothness"}, voronoi,
+            "blender-voronoi");
     onlyFor({"mortar_size", "mortar_smooth", "brick_width", "row_height", "brick_offset",
              "offset_frequency", "squash", "squash_frequency"},
             brick, "blender-brick");
@@ -956,6 +964,13 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     if (reader.has("randomness")) layer.voronoiRandomness = reader.number("randomness");
     reader.optionalName("metric", kVoronoiMetrics, layer.voronoiMetric);
     if (reader.has("exponent")) layer.voronoiExponent = reader.number("exponent");
+    reader.optionalName("feature", kVoronoiFeatures, layer.voronoiFeature);
+    if (voronoi && layer.voronoiFeature != VoronoiFeature::kSmoothF1 && reader.has("smoothness")) {
+      fail(where, "key 'smoothness' does not apply to a blender-voronoi volume of feature " +
+                      quote(nameIn(kVoronoiFeatures, layer.voronoiFeature)) +
+                      " (it is for smooth-f1)");
+    }
+    if (reader.has("smoothness")) layer.voronoiSmoothness = reader.number("smoothness");
     reader.optionalName("wave", kWaveTypes, layer.waveType);
     reader.optionalName("wave_direction", kWaveDirections, layer.waveDirection);
     reader.optionalName("profile", kWaveProfiles, layer.waveProfile);
@@ -1730,6 +1745,10 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["randomness"] = layer.voronoiRandomness;
         j["metric"] = nameIn(kVoronoiMetrics, layer.voronoiMetric);
         j["exponent"] = layer.voronoiExponent;
+        // (no "feature" key for F1: the manifests of scenes before it stay valid)
+        const VoronoiFeature feature = layer.voronoiFeature;
+        if (feature != VoronoiFeature::kF1) j["feature"] = nameIn(kVoronoiFeatures, feature);
+        if (feature == VoronoiFeature::kSmoothF1) j["smoothness"] = layer.voronoiSmoothness;
       } else {
         j["wave"] = nameIn(kWaveTypes, layer.waveType);
         j["wave_direction"] = nameIn(kWaveDirections, layer.waveDirection);

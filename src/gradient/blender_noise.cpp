@@ -514,12 +514,58 @@ double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
   return value;
 }
 
+namespace {
+
+/// Voronoi's Distance to Edge at @p local (within its cell), the points of the cells at offsets
+/// o ∈ {−1, 0, 1}³ given by @p pointAt(o); if @p gradient, its gradient times @p scale.
+template <class PointAt>
+double voronoiDistanceToEdge(Vec3d local, const PointAt& pointAt, double scale, Vec3d* gradient) {
+  const auto each = [](const auto& visit) {
+    for (int k = -1; k <= 1; ++k) {
+      for (int j = -1; j <= 1; ++j) {
+        for (int i = -1; i <= 1; ++i) visit(Vec3d{double(i), double(j), double(k)});
+      }
+    }
+  };
+  Vec3d toNearest{};
+  double nearest = 8;  // Cycles' start, a squared distance
+  each([&](Vec3d offset) {
+    const Vec3d v = pointAt(offset) - local;
+    const double d = dot(v, v);
+    if (d < nearest) {
+      nearest = d;
+      toNearest = v;
+    }
+  });
+  double best = 8;
+  Vec3d normal{};
+  each([&](Vec3d offset) {
+    const Vec3d v = pointAt(offset) - local;
+    const Vec3d across = v - toNearest;
+    const double length2 = dot(across, across);
+    if (length2 > 1e-4) {
+      const Vec3d n = (1 / std::sqrt(length2)) * across;
+      const double d = dot(0.5 * (toNearest + v), n);
+      if (d < best) {
+        best = d;
+        normal = n;
+      }
+    }
+  });
+  if (gradient != nullptr) *gradient = -scale * normal;
+  return best;
+}
+
+}  // namespace
+
 Result<BlenderVoronoi> BlenderVoronoi::create(const BlenderVoronoiParams& params) {
   if (Status finite = finiteSettings(
-          "Voronoi Texture", {params.amplitude, params.scale, params.randomness, params.exponent});
+          "Voronoi Texture",
+          {params.amplitude, params.scale, params.randomness, params.exponent, params.smoothness});
       !finite)
     return finite.error();
-  if (params.metric == VoronoiMetric::kMinkowski && !(params.exponent > 0)) {
+  if (params.metric == VoronoiMetric::kMinkowski &&
+      params.feature != VoronoiFeature::kDistanceToEdge && !(params.exponent > 0)) {
     return Error::badInput("a Voronoi Texture's Minkowski exponent must be greater than 0");
   }
   if (Status bounded = boundedSlopes("Voronoi Texture",
@@ -570,27 +616,69 @@ double BlenderVoronoi::output(Vec3d position, Vec3d* gradient) const {
       }
     }
   };
+  const auto pointAt = [&](const Vec3d& offset) {
+    return offset + randomness * voronoiCellPoint(cell + offset);
+  };
+  if (params_.feature == VoronoiFeature::kDistanceToEdge) {
+    return voronoiDistanceToEdge(local, pointAt, gradient ? params_.scale : 0.0, gradient);
+  }
+  if (params_.feature == VoronoiFeature::kSmoothF1) {
+    const double s = std::clamp(params_.smoothness / 2, 0.0, 0.5);
+    double smooth = 8;  // Cycles' start
+    Vec3d smoothSlope{};
+    for (int k = -2; k <= 2; ++k) {
+      for (int j = -2; j <= 2; ++j) {
+        for (int i = -2; i <= 2; ++i) {
+          Vec3d slope;
+          const double d = measure(local - pointAt({double(i), double(j), double(k)}),
+                                   gradient ? &slope : nullptr);
+          double h, dh = 0;  // h and ∂h/∂(D − d)
+          if (s == 0) {
+            h = smooth > d ? 1 : 0;
+          } else {
+            const double t = 0.5 + 0.5 * (smooth - d) / s;
+            h = t < 0 ? 0 : t >= 1 ? 1 : (3 - 2 * t) * (t * t);
+            if (t > 0 && t < 1) dh = 6 * t * (1 - t) * 0.5 / s;
+          }
+          if (gradient != nullptr) {
+            const Vec3d hSlope = dh * (smoothSlope - slope);
+            smoothSlope = smoothSlope + (d - smooth) * hSlope + h * (slope - smoothSlope) -
+                          (s * (1 - 2 * h)) * hSlope;
+          }
+          smooth = smooth + h * (d - smooth) - s * h * (1 - h);
+        }
+      }
+    }
+    if (gradient != nullptr) *gradient = params_.scale * smoothSlope;
+    return smooth;
+  }
+  const bool second = params_.feature == VoronoiFeature::kF2;
   double best = 8;  // Cycles' start: farther than any point of the 27 cells
-  Vec3d bestOffset{};
+  double next = 8;  // F2's
+  Vec3d bestOffset{}, nextOffset{};
   for (int k = -1; k <= 1; ++k) {
     for (int j = -1; j <= 1; ++j) {
       for (int i = -1; i <= 1; ++i) {
-        const Vec3d offset{double(i), double(j), double(k)};
-        const Vec3d point = offset + randomness * voronoiCellPoint(cell + offset);
+        const Vec3d point = pointAt({double(i), double(j), double(k)});
         const double d = measure(local - point, nullptr);
         if (d < best) {
+          next = best;
+          nextOffset = bestOffset;
           best = d;
           bestOffset = point;
+        } else if (second && d < next) {
+          next = d;
+          nextOffset = point;
         }
       }
     }
   }
   if (gradient != nullptr) {
     Vec3d slope;
-    measure(local - bestOffset, &slope);
+    measure(local - (second ? nextOffset : bestOffset), &slope);
     *gradient = params_.scale * slope;
   }
-  return best;
+  return second ? next : best;
 }
 
 Result<BlenderWave> BlenderWave::create(const BlenderWaveParams& params) {

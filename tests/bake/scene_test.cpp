@@ -1041,6 +1041,45 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
                                      "metric": "cosine"})")),
             "scene.json: layers[0]: unknown metric 'cosine' (expected euclidean, manhattan, "
             "chebyshev or minkowski)");
+  // The Voronoi Texture's Feature Output, f1 unless given, written back only when not f1 (so that
+  // the manifests of scenes before the key stay valid); Smoothness for smooth-f1 only.
+  EXPECT_EQ(voronoi->layers[0].voronoiFeature, VoronoiFeature::kF1);
+  EXPECT_EQ(layerParametersJson(voronoi->layers[0]).find("feature"), std::string::npos);
+  EXPECT_EQ(layerParametersJson(voronoi->layers[0]).find("smoothness"), std::string::npos);
+  Result<Scene> smooth = parseScene(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                    "feature": "smooth-f1", "smoothness": 0.25})"),
+                                    options());
+  ASSERT_TRUE(smooth) << smooth.error().message;
+  EXPECT_EQ(smooth->layers[0].voronoiFeature, VoronoiFeature::kSmoothF1);
+  EXPECT_EQ(smooth->layers[0].voronoiSmoothness, 0.25);
+  const std::string smoothJson = layerParametersJson(smooth->layers[0]);
+  for (const char* expected : {R"("feature":"smooth-f1")", R"("smoothness":0.25)"}) {
+    EXPECT_NE(smoothJson.find(expected), std::string::npos) << expected << " in " << smoothJson;
+  }
+  Result<Scene> edge = parseScene(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                    "feature": "distance-to-edge", "metric": "manhattan"})"),
+                                  options());
+  ASSERT_TRUE(edge) << edge.error().message;  // the metric accepted, and ignored
+  EXPECT_EQ(edge->layers[0].voronoiFeature, VoronoiFeature::kDistanceToEdge);
+  const std::string edgeJson = layerParametersJson(edge->layers[0]);
+  EXPECT_NE(edgeJson.find(R"("feature":"distance-to-edge")"), std::string::npos) << edgeJson;
+  EXPECT_EQ(edgeJson.find("smoothness"), std::string::npos) << edgeJson;
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                                     "feature": "f2", "smoothness": 0.5})")),
+            "scene.json: layers[0]: key 'smoothness' does not apply to a blender-voronoi volume "
+            "of feature 'f2' (it is for smooth-f1)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                                     "smoothness": 0.5})")),
+            "scene.json: layers[0]: key 'smoothness' does not apply to a blender-voronoi volume "
+            "of feature 'f1' (it is for smooth-f1)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-voronoi",
+                                     "feature": "radius"})")),
+            "scene.json: layers[0]: unknown feature 'radius' (expected f1, f2, smooth-f1 or "
+            "distance-to-edge)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise",
+                                     "feature": "f2"})")),
+            "scene.json: layers[0]: key 'feature' does not apply to a blender-noise volume (it "
+            "is for blender-voronoi)");
   EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise",
                                      "profile": "saw"})")),
             "scene.json: layers[0]: key 'profile' does not apply to a blender-noise volume (it "

@@ -120,10 +120,16 @@
    the node's settings (its metric in the scene's name) and its Mapping, sent so, baked as
    Cycles bakes it (VORONOI_*: median and p99), the same job without its "mapping" clearly
    worse; Cycles' normals must lean less than VORONOI_LEAN_DEG off the surface's.
+   The same with Feature Output Distance to Edge (voronoi_edge_case, VORONOI_EDGE_INPUTS): a
+   "blender-voronoi" layer of feature distance-to-edge (no metric, exponent or smoothness),
+   baked as Cycles bakes it, the same job with the layer left at F1 (without its "feature")
+   clearly worse.
    voronoi_checks: Manhattan, Chebychev and Minkowski give the scene's metrics (Chebychev ->
-   chebyshev), Feature Output F2 and the Color output no layer and a reason; a volume layer
-   made by hand with function Blender Voronoi sends its settings (nothing of the other
-   functions') and bakes.
+   chebyshev); Feature Outputs F2, Smooth F1 and Distance to Edge the scene's features (Smooth
+   F1 with its Smoothness, Distance to Edge without the metric and exponent); N-Sphere Radius
+   and the Color output no layer and a reason; volume layers made by hand with function
+   Blender Voronoi (F1 Minkowski, Smooth F1) send their settings (nothing of the other
+   functions', Smoothness only for Smooth F1) and bake.
    Noise Texture on UV coordinates (noise_uv_case): the Noise Texture on Suzanne's UV map's
    coordinates (Texture Coordinate UV) through a Mapping node: Layers from Material must make
    one "blender-noise" volume layer on "coordinates": "uv" of the render UV map's set, baked as
@@ -370,6 +376,11 @@ VORONOI_LEAN_DEG = 35.0
 VORONOI_MEDIAN_DEG = 0.01
 VORONOI_P99_DEG = 0.01
 VORONOI_CONTROL_FACTOR = 3.0
+# The same with Feature Output Distance to Edge (voronoi_edge_case: VORONOI_EDGE_INPUTS,
+# Distance VORONOI_EDGE_DISTANCE, the same mapping and bars): a "blender-voronoi" layer of
+# feature distance-to-edge; its control the layer left at F1.
+VORONOI_EDGE_INPUTS = {"Scale": 3.0, "Randomness": 0.9}
+VORONOI_EDGE_DISTANCE = 0.05
 
 CASES = {
     "tangent-normal": ("tangent-normal", 0, 1, False, None),
@@ -2788,12 +2799,14 @@ def wave_checks(settings, ob):
     return checks
 
 
-def make_voronoi(tree, inputs=None):
-    """A Voronoi Texture node in `tree` with its properties VORONOI_NODE and `inputs`
-    (VORONOI_INPUTS by default)."""
+def make_voronoi(tree, inputs=None, feature=None):
+    """A Voronoi Texture node in `tree` with its properties VORONOI_NODE (but its Feature Output
+    `feature` if given) and `inputs` (VORONOI_INPUTS by default)."""
     voronoi = tree.nodes.new("ShaderNodeTexVoronoi")
     for prop, value in VORONOI_NODE.items():
         setattr(voronoi, prop, value)
+    if feature is not None:
+        voronoi.feature = feature
     for name, value in (inputs or VORONOI_INPUTS).items():
         voronoi.inputs[name].default_value = value
     return voronoi
@@ -2813,6 +2826,22 @@ def voronoi_case(settings, ob, work):
                         {"roughness", "distortion", "detail", "dimension", "lacunarity",
                          "direction", "phase", "wave"}, VORONOI_MAPPING, VORONOI_DISTANCE,
                         ("mapping",), output="Distance")
+
+
+def voronoi_edge_case(settings, ob, work):
+    """The bump material's Height fed by a Voronoi Texture's Distance to Edge
+    (VORONOI_EDGE_INPUTS) on the object's own coordinates through a Mapping node
+    (VORONOI_MAPPING), Distance VORONOI_EDGE_DISTANCE: texture_case "voronoi_edge" (a
+    "blender-voronoi" layer of feature distance-to-edge, without a metric, exponent or
+    smoothness), its control the layer left at F1 (without its "feature")."""
+    return texture_case(
+        settings, ob, work, "voronoi_edge",
+        lambda tree: make_voronoi(tree, VORONOI_EDGE_INPUTS, "DISTANCE_TO_EDGE"),
+        {"frequency": "Scale", "randomness": "Randomness"}, VORONOI_EDGE_INPUTS,
+        {"feature": "distance-to-edge"},
+        {"roughness", "distortion", "detail", "metric", "exponent", "smoothness"},
+        VORONOI_MAPPING, VORONOI_EDGE_DISTANCE, ("feature",), output="Distance",
+        function="blender-voronoi")
 
 
 NOISE_KEYS = {"frequency": "Scale", "detail": "Detail", "roughness": "Roughness",
@@ -2866,9 +2895,10 @@ def brick_case(settings, ob, work):
 
 def voronoi_checks(settings, ob):
     """Layers from Material on Voronoi Textures: Manhattan, Chebychev and Minkowski give the
-    scene's metrics, Feature Output F2 and the Color output no layer and a reason; and a volume
-    layer made by hand with function Blender Voronoi. Returns check records like
-    expect_error's."""
+    scene's metrics; F2, Smooth F1 and Distance to Edge the scene's features (Smooth F1 with
+    its Smoothness, Distance to Edge without the metric and exponent); N-Sphere Radius and the
+    Color output no layer and a reason; and volume layers made by hand with function Blender
+    Voronoi. Returns check records like expect_error's."""
     import bpy
     from sgbake_blender import operators
     c = TextureChecks(ob, "voronoi")
@@ -2885,9 +2915,27 @@ def voronoi_checks(settings, ob):
                   len(found) == 1 and found[0].get("function") == "blender-voronoi"
                   and found[0].get("metric") == metric,
                   f"one blender-voronoi layer, metric {metric}", f"{found}; skipped {skipped}")
+        voronoi.inputs["Smoothness"].default_value = 0.4
+        for feature, name, want, unwanted in (
+                ("F2", "f2", {"metric": "minkowski", "exponent": 0.5}, ("smoothness",)),
+                ("SMOOTH_F1", "smooth-f1", {"metric": "minkowski", "smoothness": 0.4}, ()),
+                ("DISTANCE_TO_EDGE", "distance-to-edge", {},
+                 ("metric", "exponent", "smoothness"))):
+            voronoi.feature = feature
+            found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+            layer = found[0] if len(found) == 1 else {}
+            check(f"voronoi: Feature Output {feature} gives the scene's feature {name}",
+                  layer.get("function") == "blender-voronoi" and layer.get("feature") == name
+                  and all(layer.get(key) == value if isinstance(value, str)
+                          else abs(layer.get(key, -1) - value) < 1e-6
+                          for key, value in want.items())
+                  and not set(unwanted) & set(layer),
+                  f"one blender-voronoi layer, feature {name}, {want}, none of {unwanted}",
+                  f"{found}; skipped {skipped}")
         voronoi.distance = "EUCLIDEAN"
-        voronoi.feature = "F2"
-        refused("Feature Output F2", "feature output F2")
+        voronoi.feature = "N_SPHERE_RADIUS"
+        tree.links.new(voronoi.outputs["Radius"], bump.inputs["Height"])
+        refused("Feature Output N-Sphere Radius", "Radius output")
         voronoi.feature = "F1"
         tree.links.new(voronoi.outputs["Color"], bump.inputs["Height"])
         refused("the Color output", "Color output")
@@ -2903,7 +2951,14 @@ def voronoi_checks(settings, ob):
         {"function": "blender-voronoi", "metric": "minkowski", "frequency": 3.0,
          "randomness": 0.6, "exponent": 1.5},
         ("roughness", "detail", "distortion", "dimension", "lacunarity", "phase", "direction",
-         "seed", "octaves", "mapping")))
+         "seed", "octaves", "mapping", "smoothness")))
+    checks.append(hand_made_check(
+        settings, "voronoi", "Blender Voronoi (Smooth F1)",
+        {"function": "blender-voronoi", "feature": "smooth-f1", "smoothness": 0.3,
+         "frequency": 3.0, "amplitude": 0.01},
+        {"function": "blender-voronoi", "feature": "smooth-f1", "smoothness": 0.3,
+         "frequency": 3.0},
+        ("roughness", "detail", "distortion", "dimension", "lacunarity", "phase", "mapping")))
     return checks
 
 
@@ -2937,6 +2992,7 @@ def blender_make(work, library_path, sabotage):
     manifest["musgrave_ridged"] = musgrave_ridged_case(settings, ob, work)
     manifest["wave"] = wave_case(settings, ob, work)
     manifest["voronoi"] = voronoi_case(settings, ob, work)
+    manifest["voronoi_edge"] = voronoi_edge_case(settings, ob, work)
     manifest["noise_uv"] = noise_uv_case(settings, ob, work)
     manifest["noise_world"] = noise_world_case(settings, ob, work)
     manifest["brick"] = brick_case(settings, ob, work)
@@ -3011,6 +3067,7 @@ def blender_compare(work):
     results["wave_lean"] = lean_stats(work, "wave")
     results["voronoi"] = against_cycles(work, "voronoi")
     results["voronoi_lean"] = lean_stats(work, "voronoi")
+    results["voronoi_edge"] = against_cycles(work, "voronoi_edge")
     results["noise_uv"] = against_cycles(work, "noise_uv")
     results["noise_world"] = against_cycles(work, "noise_world")
     results["brick"] = against_cycles(work, "brick")
@@ -3313,6 +3370,13 @@ def evaluate(manifest, results):
         VORONOI_P99_DEG)
     failures += evaluate_lean("voronoi", results["voronoi_lean"], VORONOI_LEAN_DEG)
     failures += evaluate_case_against_cycles(
+        "voronoi_edge", "a Voronoi Texture's Distance (Distance to Edge, 3D, "
+        + ", ".join(f"{k} {v:g}" for k, v in VORONOI_EDGE_INPUTS.items())
+        + ") on object coordinates through a Mapping node (Point), Distance "
+        f"{VORONOI_EDGE_DISTANCE:g}", manifest["voronoi_edge"], results["voronoi_edge"],
+        "the layer left at F1 (no feature)", VORONOI_MEDIAN_DEG, VORONOI_CONTROL_FACTOR,
+        VORONOI_P99_DEG)
+    failures += evaluate_case_against_cycles(
         "noise_uv", "the Noise Texture on the UV map's coordinates (Texture Coordinate UV) "
         f"through a Mapping node (Point), Distance {NOISE_UV_DISTANCE:g}", manifest["noise_uv"],
         results["noise_uv"], "the layer on object coordinates", NOISE_MEDIAN_DEG,
@@ -3325,6 +3389,7 @@ def evaluate(manifest, results):
                   + manifest["noise"]["checks"] + manifest["musgrave"]["checks"]
                   + manifest["musgrave_ridged"]["checks"]
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
+                  + manifest["voronoi_edge"]["checks"]
                   + manifest["noise_uv"]["checks"] + manifest["noise_world"]["checks"]
                   + manifest["brick"]["checks"]
                   + manifest["errors"]):

@@ -99,7 +99,12 @@ the mapping 6.8 and 3.4 deg). voronoi_sphere (Euclidean, Randomness 0.8) and
 voronoi_minkowski_suzanne (Minkowski 1.6) bump with Blender's Voronoi Texture's F1 Distance,
 a "blender-voronoi" layer: median 0.0016 deg, p99 0.0019-0.0020 deg (exact slopes median 0.074
 and 0.11 deg, p99 4.4 and 6.3 deg at the cells' borders, where Cycles' differences straddle two
-points; without the mapping 5.8 and 6.9 deg).
+points; without the mapping 5.8 and 6.9 deg). Its other Feature Outputs, the layer's "feature":
+voronoi_edge_sphere (Distance to Edge), voronoi_f2_suzanne (F2, Euclidean) and
+voronoi_smooth_sphere (Smooth F1, Smoothness 0.6): median 0.0016 deg, p99 0.0018-0.0020 deg
+(exact slopes median 0.0016, 0.062 and 0.089 deg, p99 6.5, 6.7 and 0.36 deg: Distance to
+Edge's slopes are constant between its creases, where its p99 lies; without the mapping 5.8,
+5.6 and 4.3 deg).
 brick_suzanne bumps with Blender's Brick Texture's Fac (wide smoothed mortar, rows moved and
 squashed), a "blender-brick" layer: median 0.0016 deg, p99 0.0024 deg (exact slopes median 0.61
 deg, p99 8.8 deg at the bricks' corners; without the mapping 9.0 deg).
@@ -271,7 +276,8 @@ DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat
                  "noise_sphere", "noise_stretch_suzanne", "noise_uv_suzanne", "brick_suzanne",
                  "voronoi_uv_sphere", "musgrave_sphere", "musgrave_ridged_sphere",
                  "musgrave_hetero_suzanne", "wave_sphere",
-                 "wave_suzanne", "voronoi_sphere", "voronoi_minkowski_suzanne")
+                 "wave_suzanne", "voronoi_sphere", "voronoi_minkowski_suzanne",
+                 "voronoi_edge_sphere", "voronoi_f2_suzanne", "voronoi_smooth_sphere")
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
@@ -412,8 +418,13 @@ def sgbake_case(cli, entry, sabotage, threads):
                 kind = noise.get("kind", "noise")
                 layer = {"type": "volume", "amplitude": layer_scale, "frequency": noise["scale"],
                          "gradient": gradient, "function": "blender-" + kind}
-                if kind == "voronoi":
+                if kind == "voronoi":  # Blender's names, lower case, "-" for "_"
                     layer["metric"] = noise["metric"].lower()
+                    feature = noise.get("feature", "F1").lower().replace("_", "-")
+                    if feature != "f1":
+                        layer["feature"] = feature
+                    if "smoothness" in noise:
+                        layer["smoothness"] = noise["smoothness"]
                 elif kind != "brick":
                     layer["detail"] = noise["detail"]
                 keys = {"noise": ("roughness", "distortion"), "voronoi": ("randomness", "exponent"),

@@ -227,8 +227,9 @@ def reshape_height(mat, kind):
 # "musgrave" a Musgrave Texture (3D; its "musgrave_type", Blender's name, FBM unless given) of
 # {"scale", "detail", "dimension", "lacunarity", "mapping"} and "offset", "gain" where given, with "kind": "wave" a Wave Texture of {"wave", "direction", "profile" (Blender's
 # names), "scale", "distortion", "detail", "detail_scale", "detail_roughness", "phase",
-# "mapping"}, with "kind": "voronoi" a Voronoi Texture (F1, 3D, its Distance) of {"scale",
-# "randomness", "metric" (Blender's name), "exponent", "mapping"}. The manifest entry has
+# "mapping"}, with "kind": "voronoi" a Voronoi Texture (3D, its Distance; its "feature",
+# Blender's name, F1 unless given) of {"scale", "randomness", "metric" (Blender's name),
+# "exponent", "mapping"} and "smoothness" where given. The manifest entry has
 # "noise": these settings, sgbake's "blender-noise" (or "blender-musgrave", "blender-wave",
 # "blender-voronoi") volume layer with that "mapping". With "coordinates": "UV" the texture reads
 # the Texture Coordinate node's UV output instead, and the layer has "coordinates": "uv".
@@ -265,9 +266,10 @@ def bump_by_noise(mat, settings):
             socket for socket in ("Offset", "Gain") if socket.lower() in settings)
     elif settings.get("kind") == "voronoi":
         noise = nodes.new("ShaderNodeTexVoronoi")
-        noise.voronoi_dimensions, noise.feature = "3D", "F1"
+        noise.voronoi_dimensions, noise.feature = "3D", settings.get("feature", "F1")
         noise.distance = settings["metric"]
-        inputs = ("Scale", "Randomness", "Exponent")
+        inputs = ("Scale", "Randomness", "Exponent") + (
+            ("Smoothness",) if "smoothness" in settings else ())
     elif settings.get("kind") == "brick":
         noise = nodes.new("ShaderNodeTexBrick")
         noise.offset, noise.offset_frequency = settings["brick_offset"], settings["offset_frequency"]
@@ -625,6 +627,16 @@ noise_case("voronoi_sphere", "sphere", 512, 0.03, kind="voronoi", scale=3.0, ran
            metric="EUCLIDEAN", exponent=0.5, mapping=NOISE_MAPPING)
 noise_case("voronoi_minkowski_suzanne", "suzanne", 512, 0.025, kind="voronoi", scale=4.0,
            randomness=1.0, metric="MINKOWSKI", exponent=1.6, mapping=NOISE_MAPPING)
+# Its other Feature Outputs' Distance: Distance to Edge on the sphere, F2 (Euclidean) on Suzanne,
+# Smooth F1 (Smoothness 0.6) on the sphere.
+noise_case("voronoi_edge_sphere", "sphere", 512, 0.03, kind="voronoi",
+           feature="DISTANCE_TO_EDGE", scale=3.0, randomness=0.8, metric="EUCLIDEAN",
+           exponent=0.5, mapping=NOISE_MAPPING)
+noise_case("voronoi_f2_suzanne", "suzanne", 512, 0.025, kind="voronoi", feature="F2",
+           scale=3.5, randomness=0.9, metric="EUCLIDEAN", exponent=0.5, mapping=NOISE_MAPPING)
+noise_case("voronoi_smooth_sphere", "sphere", 512, 0.03, kind="voronoi", feature="SMOOTH_F1",
+           smoothness=0.6, scale=3.0, randomness=0.8, metric="EUCLIDEAN", exponent=0.5,
+           mapping=NOISE_MAPPING)
 noise_case("wave_suzanne", "suzanne", 512, 0.02, kind="wave", wave="RINGS",
            direction="SPHERICAL", profile="TRI", scale=0.6, distortion=0.0, detail=2.0,
            detail_scale=1.0, detail_roughness=0.5, phase=0.0, mapping=NOISE_MAPPING)

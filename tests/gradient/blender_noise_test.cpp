@@ -3,6 +3,8 @@
 /// against Cycles' own are checked by BlenderBakeOracle's noise cases.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -323,6 +325,122 @@ TEST(BlenderVoronoi, AnalyticGradientIsTheDerivativeOfTheValue) {
     }
   }
   EXPECT_GT(checked, 1150);  // borders are rare at this step
+}
+
+// With Randomness 0, F2 is the distance to the second-nearest lattice point: the nearest with the
+// axis farthest from its lattice plane flipped to the other side (a → 1 − a).
+TEST(BlenderVoronoi, F2WithoutRandomnessMeasuresToTheSecondNearestLatticePoint) {
+  std::mt19937_64 rng(33);
+  std::uniform_real_distribution<double> along(-4, 4);
+  for (const VoronoiMetric metric : {VoronoiMetric::kEuclidean, VoronoiMetric::kManhattan,
+                                     VoronoiMetric::kChebyshev, VoronoiMetric::kMinkowski}) {
+    Result<BlenderVoronoi> made = BlenderVoronoi::create({.scale = 2,
+                                                          .randomness = 0,
+                                                          .metric = metric,
+                                                          .exponent = 1.5,
+                                                          .feature = VoronoiFeature::kF2});
+    ASSERT_TRUE(made) << made.error().message;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3d p{along(rng), along(rng), along(rng)};
+      const auto nearest = [](double v) {
+        const double f = v - std::floor(v);
+        return std::min(f, 1 - f);
+      };
+      std::array<double, 3> a{nearest(2 * p.x), nearest(2 * p.y), nearest(2 * p.z)};
+      std::sort(a.begin(), a.end());
+      a[2] = 1 - a[2];
+      const double expected =
+          metric == VoronoiMetric::kEuclidean   ? std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+          : metric == VoronoiMetric::kManhattan ? a[0] + a[1] + a[2]
+          : metric == VoronoiMetric::kChebyshev
+              ? a[2]
+              : std::pow(std::pow(a[0], 1.5) + std::pow(a[1], 1.5) + std::pow(a[2], 1.5), 1 / 1.5);
+      EXPECT_NEAR(made->value(p), expected, 1e-12) << static_cast<int>(metric);
+    }
+  }
+}
+
+// With Randomness 0 the cells' points make a cubic lattice, whose nearest bisector plane is the
+// one across the axis farthest from the nearest point: Distance to Edge is ½ − that distance,
+// whatever the metric.
+TEST(BlenderVoronoi, DistanceToEdgeWithoutRandomnessIsToTheNearestCubeFace) {
+  std::mt19937_64 rng(34);
+  std::uniform_real_distribution<double> along(-4, 4);
+  for (const VoronoiMetric metric : {VoronoiMetric::kEuclidean, VoronoiMetric::kManhattan}) {
+    Result<BlenderVoronoi> made =
+        BlenderVoronoi::create({.scale = 2,
+                                .randomness = 0,
+                                .metric = metric,
+                                .exponent = -1,  // not used
+                                .feature = VoronoiFeature::kDistanceToEdge});
+    ASSERT_TRUE(made) << made.error().message;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3d p{along(rng), along(rng), along(rng)};
+      const auto nearest = [](double v) {
+        const double f = v - std::floor(v);
+        return std::min(f, 1 - f);
+      };
+      const double farthest = std::max({nearest(2 * p.x), nearest(2 * p.y), nearest(2 * p.z)});
+      EXPECT_NEAR(made->value(p), 0.5 - farthest, 1e-12);
+    }
+  }
+}
+
+// Smooth F1 with Smoothness 0 is F1 (but for the rounding of D + (d − D)); with Smoothness it is
+// a smooth minimum: never above F1, below it where another point is within the blend's reach.
+TEST(BlenderVoronoi, SmoothF1IsASmoothMinimumBelowF1) {
+  std::mt19937_64 rng(35);
+  std::uniform_real_distribution<double> along(-3, 3);
+  Result<BlenderVoronoi> f1 = BlenderVoronoi::create({.scale = 2, .randomness = 0});
+  Result<BlenderVoronoi> sharp = BlenderVoronoi::create(
+      {.scale = 2, .randomness = 0, .feature = VoronoiFeature::kSmoothF1, .smoothness = 0});
+  Result<BlenderVoronoi> f1Random = BlenderVoronoi::create({.scale = 2, .randomness = 0.8});
+  Result<BlenderVoronoi> smooth = BlenderVoronoi::create(
+      {.scale = 2, .randomness = 0.8, .feature = VoronoiFeature::kSmoothF1, .smoothness = 0.6});
+  ASSERT_TRUE(f1 && sharp && f1Random && smooth);
+  int below = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3d p{along(rng), along(rng), along(rng)};
+    EXPECT_NEAR(sharp->value(p), f1->value(p), 1e-15);
+    EXPECT_LE(smooth->value(p), f1Random->value(p) + 1e-15);
+    if (smooth->value(p) < f1Random->value(p) - 1e-3) ++below;
+  }
+  EXPECT_GT(below, 100);
+}
+
+// F2's, Distance to Edge's and Smooth F1's gradients are their values' derivatives (away from the
+// borders where F2's order or Distance to Edge's plane changes; Smooth F1 has none with the
+// Euclidean metric).
+TEST(BlenderVoronoi, OtherFeaturesGradientsAreTheDerivativesOfTheValues) {
+  std::mt19937_64 rng(36);
+  std::uniform_real_distribution<double> along(-2, 2);
+  for (const VoronoiFeature feature :
+       {VoronoiFeature::kF2, VoronoiFeature::kDistanceToEdge, VoronoiFeature::kSmoothF1}) {
+    for (const VoronoiMetric metric : {VoronoiMetric::kEuclidean, VoronoiMetric::kManhattan,
+                                       VoronoiMetric::kChebyshev, VoronoiMetric::kMinkowski}) {
+      Result<BlenderVoronoi> made = BlenderVoronoi::create({.amplitude = 0.3,
+                                                            .scale = 3,
+                                                            .randomness = 0.9,
+                                                            .metric = metric,
+                                                            .exponent = 1.7,
+                                                            .feature = feature,
+                                                            .smoothness = 0.7});
+      ASSERT_TRUE(made) << made.error().message;
+      const bool everywhere =
+          feature == VoronoiFeature::kSmoothF1 && metric == VoronoiMetric::kEuclidean;
+      int checked = 0;
+      for (int i = 0; i < 300; ++i) {
+        const Vec3d p{along(rng), along(rng), along(rng)};
+        const Vec3d central = centralGradient([&](Vec3d q) { return made->value(q); }, p, 1e-7);
+        const Vec3d exact = made->analyticGradient(p);
+        if (!everywhere && maxAbsDiff(exact, central) > 1e-3) continue;  // a border
+        EXPECT_LT(maxAbsDiff(exact, central), 1e-6)
+            << static_cast<int>(feature) << ' ' << static_cast<int>(metric);
+        ++checked;
+      }
+      EXPECT_GT(checked, 270) << static_cast<int>(feature) << ' ' << static_cast<int>(metric);
+    }
+  }
 }
 
 TEST(BlenderWave, RefusesADirectionItsTypeHasNot) {

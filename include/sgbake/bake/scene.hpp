@@ -85,7 +85,7 @@ enum class VolumeFunction {
   kBlenderNoise,     ///< "blender-noise": BlenderNoise, Blender's Noise Texture (3D)
   kBlenderMusgrave,  ///< "blender-musgrave": BlenderMusgrave, Blender's Musgrave Texture (3D)
   kBlenderWave,      ///< "blender-wave": BlenderWave, Blender's Wave Texture
-  kBlenderVoronoi,   ///< "blender-voronoi": BlenderVoronoi, Blender's Voronoi Texture (F1, 3D)
+  kBlenderVoronoi,   ///< "blender-voronoi": BlenderVoronoi, Blender's Voronoi Texture (3D)
   kBlenderBrick,     ///< "blender-brick": BlenderBrick, Blender's Brick Texture's Fac
 };
 
@@ -246,10 +246,14 @@ struct SceneLayer {
   double noiseDetailScale = 1;
   double noiseDetailRoughness = 0.5;
   /// blender-voronoi: "randomness", "metric" (euclidean | manhattan | chebyshev | minkowski),
-  /// "exponent" (Minkowski's)
+  /// "exponent" (Minkowski's), "feature" (f1 | f2 | smooth-f1 | distance-to-edge: the Feature
+  /// Output, whose Distance is the height; distance-to-edge ignores the metric, as Cycles does),
+  /// "smoothness" (smooth-f1's)
   double voronoiRandomness = 1;
   VoronoiMetric voronoiMetric = VoronoiMetric::kEuclidean;
   double voronoiExponent = 0.5;
+  VoronoiFeature voronoiFeature = VoronoiFeature::kF1;
+  double voronoiSmoothness = 1;
   /// blender-brick: "mortar_size", "mortar_smooth", "brick_width", "row_height",
   /// "brick_offset", "offset_frequency", "squash", "squash_frequency": the node's inputs and
   /// properties, Blender's defaults (its amplitude and scale are the layer's)

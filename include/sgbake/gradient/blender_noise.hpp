@@ -214,28 +214,49 @@ class BlenderWave final : public BlenderTextureVolume<BlenderWaveParams> {
 /// The Voronoi Texture's Distance Metric.
 enum class VoronoiMetric { kEuclidean, kManhattan, kChebyshev, kMinkowski };
 
-/// @brief The Voronoi Texture node's settings (Feature F1, 3D: its Distance output) and the
-/// height's scale.
+/// The Voronoi Texture's Feature Output (of those with a Distance output).
+enum class VoronoiFeature { kF1, kF2, kSmoothF1, kDistanceToEdge };
+
+/// @brief The Voronoi Texture node's settings (3D: its Distance output) and the height's scale.
 struct BlenderVoronoiParams {
   double amplitude = 1;   ///< height per unit of Distance
   double scale = 5;       ///< the node's Scale
   double randomness = 1;  ///< the node's Randomness (clamped to [0, 1])
-  VoronoiMetric metric = VoronoiMetric::kEuclidean;
+  VoronoiMetric metric = VoronoiMetric::kEuclidean;  ///< (ignored by Distance to Edge)
   double exponent = 0.5;  ///< the node's Exponent (Minkowski)
+  VoronoiFeature feature = VoronoiFeature::kF1;  ///< the node's Feature Output
+  double smoothness = 1;  ///< the node's Smoothness (Smooth F1; clamped to [0, 1])
 };
 
-/// @brief Blender's Voronoi Texture, Feature F1 (3D), its Distance output, times an amplitude: a
+/// @brief Blender's Voronoi Texture (3D), its Distance output, times an amplitude: a
 /// HeightVolume.
 ///
-/// p = scale · P; each of the 27 cells around p's holds one point, the cell's corner plus
-/// randomness · a hash of the cell's coordinates (three lookup3 hashes of the coordinates' float
-/// bits, the second and third with a fourth word 1 and 2, as Cycles hashes them); Distance is the
-/// metric's distance from p to the nearest (the first of equals, cells in z, y, x order). Its
-/// gradient is the metric's, exact but where the nearest point changes.
+/// p = scale · P, c = ⌊p⌋, l = p − c; the cell at integer offset o from c holds one point
+/// qₒ = o + r · h(c + o), r the randomness clamped to [0, 1], h a hash of the cell's coordinates
+/// (three lookup3 hashes of the coordinates' float bits, the second and third with a fourth word
+/// 1 and 2, as Cycles hashes them); d(a, b) is the metric's distance. Cells are visited in z, y, x
+/// order (o from −1 to 1 in each, or −2 to 2 for Smooth F1):
+/// - F1: Distance = min over the 27 cells of d(qₒ, l), the first of equals kept. Gradient: the
+///   metric's gradient at the nearest point, exact but where the nearest point changes.
+/// - F2: the second-smallest d(qₒ, l) of the 27, kept as Cycles keeps it (a distance strictly
+///   below F1 pushes F1 down to F2; else one strictly below F2 replaces F2). Gradient: the
+///   metric's at the second point, exact but where the order changes.
+/// - Distance to Edge (Euclidean whatever the metric, as in Cycles): first the vector
+///   v = qₙ − l to the nearest point by squared distance (the first of equals); then over the
+///   same 27 cells, for each point with |vₒ − v|² > 10⁻⁴ (vₒ = qₒ − l; so not the nearest),
+///   the distance to the bisector plane, ((v + vₒ) / 2) · (vₒ − v) / |vₒ − v|; Distance is the
+///   minimum (8 if none). Gradient: −(vₒ − v) / |vₒ − v| of the minimising plane (the unit normal
+///   pointing away from the edge, into the nearest point's cell), exact but at ties.
+/// - Smooth F1: s = clamp(smoothness / 2, 0, ½); starting from D = 8, for each of the 125 cells
+///   of the 5×5×5 neighbourhood, with dₒ = d(qₒ, l): h = smoothstep(0, 1, ½ + ½ (D − dₒ) / s)
+///   (3t² − 2t³ on [0, 1), 0 below, 1 from 1 on), D ← D + h (dₒ − D) − s h (1 − h). With s = 0,
+///   h = 1 where D > dₒ, else 0 (where Cycles' 0 / 0 gives NaN, at D = dₒ). Gradient: the chain
+///   rule through every step, with dh = 6t(1 − t) · ½ (dD − ddₒ) / s inside (0, 1), 0 outside.
+/// Every feature's gradient is then times scale.
 class BlenderVoronoi final : public BlenderTextureVolume<BlenderVoronoiParams> {
  public:
-  /// @return kBadInput for a non-finite setting, an exponent ≤ 0 with Minkowski, or slopes beyond
-  /// kMaxVolumeScale.
+  /// @return kBadInput for a non-finite setting, an exponent ≤ 0 with Minkowski (but for
+  /// Distance to Edge, which has no metric), or slopes beyond kMaxVolumeScale.
   static Result<BlenderVoronoi> create(const BlenderVoronoiParams& params);
 
   /// The node's Distance.
