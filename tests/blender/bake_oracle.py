@@ -1,14 +1,10 @@
 #!/usr/bin/env python3
-"""The BlenderBakeOracle test: sgbake's normal maps against Cycles' bakes of the same scenes.
+"""The BlenderBakeOracle tests (one per group of cases): sgbake's normal maps against Cycles'
+bakes of the same scenes.
 
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
-        [--keep DIR] [--cases suzanne,suzanne_live,sphere,cube_flat,suzanne_flat,cylinder_twist,
-                 nmap_sphere,nmap_sphere_s05,nmap_sphere_s2,nmap_sphere_object,nmap_cube,
-                 nmap_cube_s2,nmap_suzanne,nmap_suzanne_flat,nmap_sphere_steep,chain_sphere,
-                 chain_suzanne,stretch_sphere,stretch_cube,stretch_nmap_sphere,
-                 stretch_nmap_sphere_object,
-                 stretch_chain_suzanne,sphere_backfacing,nmap_sphere_backfacing,
-                 stretch_sphere_backfacing,stretch_nmap_sphere_backfacing]
+        [--keep DIR] [--group meshes|normal_maps|stretched|projections|displacement_remaps|
+                 procedural | --cases NAME,...]   (default: every case; CASE_GROUPS below)
         [--sabotage green|scale|input|strength|normal-green]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
@@ -257,27 +253,42 @@ STRETCH_CHAIN_P99_DEG = 3.0
 MASK_MISMATCH_FRACTION = 1e-5
 MASK_MISMATCH_SLACK = 0
 SGBAKE_TIMEOUT = 120
-DEFAULT_CASES = ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
-                 "cylinder_twist", "nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2",
-                 "nmap_sphere_object", "nmap_cube", "nmap_cube_s2", "nmap_suzanne",
-                 "nmap_suzanne_flat", "nmap_sphere_steep", "chain_sphere", "chain_suzanne",
-                 "stretch_sphere", "stretch_cube", "stretch_nmap_sphere",
-                 "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
-                 "nmap_sphere_backfacing", "stretch_sphere_backfacing",
-                 "stretch_nmap_sphere_backfacing", "planar_sphere", "planar_sphere_backfacing",
-                 "box_sphere", "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
-                 "box_empty_sphere", "box_generated_sphere", "box_strength_sphere", "box_nmap_sphere",
-                 "box_nmap_sphere_object", "flat_nmap_sphere",
-                 "box_nmap_stretch_sphere", "sphere_wrap_sphere", "tube_wrap_sphere",
-                 "sphere_nmap_sphere", "tube_nmap_sphere_object", "sphere_wrap_stretch_sphere",
-                 "displacement_sphere",
-                 "displacement_stretch_sphere", "displacement_object_sphere",
-                 "displacement_object_stretch_sphere", "ramp_sphere", "clamp_suzanne",
-                 "noise_sphere", "noise_stretch_suzanne", "noise_uv_suzanne", "brick_suzanne",
-                 "voronoi_uv_sphere", "musgrave_sphere", "musgrave_ridged_sphere",
-                 "musgrave_hetero_suzanne", "wave_sphere",
-                 "wave_suzanne", "voronoi_sphere", "voronoi_minkowski_suzanne",
-                 "voronoi_edge_sphere", "voronoi_f2_suzanne", "voronoi_smooth_sphere")
+# The cases in groups, one CTest test each (BlenderBakeOracle_<group>, `--group NAME`), so that
+# ctest -j runs them side by side and each stays well within its time limit; DEFAULT_CASES is
+# every group in turn.
+CASE_GROUPS = {
+    # Bumps from a height map on meshes of every kind, and Bumps chained on normal maps.
+    "meshes": ("suzanne", "suzanne_live", "sphere", "cube_flat", "suzanne_flat",
+               "cylinder_twist", "chain_sphere", "chain_suzanne"),
+    # Normal Map nodes in tangent and object space.
+    "normal_maps": ("nmap_sphere", "nmap_sphere_s05", "nmap_sphere_s2", "nmap_sphere_object",
+                    "nmap_cube", "nmap_cube_s2", "nmap_suzanne", "nmap_suzanne_flat",
+                    "nmap_sphere_steep"),
+    # Objects scaled unevenly, turned and moved; normals facing away from their triangle.
+    "stretched": ("stretch_sphere", "stretch_cube", "stretch_nmap_sphere",
+                  "stretch_nmap_sphere_object", "stretch_chain_suzanne", "sphere_backfacing",
+                  "nmap_sphere_backfacing", "stretch_sphere_backfacing",
+                  "stretch_nmap_sphere_backfacing"),
+    # Images projected onto object coordinates: Flat, Box, Sphere and Tube.
+    "projections": ("planar_sphere", "planar_sphere_backfacing", "box_sphere",
+                    "box_sphere_backfacing", "box_stretch_sphere", "box_mapped_sphere",
+                    "box_empty_sphere", "box_generated_sphere", "box_strength_sphere",
+                    "box_nmap_sphere", "box_nmap_sphere_object", "flat_nmap_sphere",
+                    "box_nmap_stretch_sphere", "sphere_wrap_sphere", "tube_wrap_sphere",
+                    "sphere_nmap_sphere", "tube_nmap_sphere_object",
+                    "sphere_wrap_stretch_sphere"),
+    # Heights through the Material Output's Displacement, and reshaped before the Bump node.
+    "displacement_remaps": ("displacement_sphere", "displacement_stretch_sphere",
+                            "displacement_object_sphere", "displacement_object_stretch_sphere",
+                            "ramp_sphere", "clamp_suzanne"),
+    # Blender's procedural textures.
+    "procedural": ("noise_sphere", "noise_stretch_suzanne", "noise_uv_suzanne", "brick_suzanne",
+                   "voronoi_uv_sphere", "musgrave_sphere", "musgrave_ridged_sphere",
+                   "musgrave_hetero_suzanne", "wave_sphere", "wave_suzanne", "voronoi_sphere",
+                   "voronoi_minkowski_suzanne", "voronoi_edge_sphere", "voronoi_f2_suzanne",
+                   "voronoi_smooth_sphere"),
+}
+DEFAULT_CASES = tuple(case for group in CASE_GROUPS.values() for case in group)
 # Blender's Sphere and Tube projections: their own wrap is the control of each other's
 # (ours_bake_swapped, nmap_swapped: the Sphere read as the Tube and the other way round).
 # Measured: heights with Cycles' slopes median 0.0016, p99 0.0018 deg (exact slopes median 0.09
@@ -848,12 +859,18 @@ def evaluate(name, r, planar=False):
 
 def main():
     parser = bc.oracle_parser(__doc__)
-    parser.add_argument("--cases", default=",".join(DEFAULT_CASES))
+    parser.add_argument("--cases", help="comma-separated case names (default: every case)")
+    parser.add_argument("--group", choices=tuple(CASE_GROUPS),
+                        help="the cases of one group (see CASE_GROUPS)")
     parser.add_argument("--threads", type=int, help="pass --threads N to sgbake")
     parser.add_argument("--sabotage", choices=("green", "scale", "input", "strength",
                                                "normal-green"),
                         help="make sgbake answer wrongly on purpose (the test must fail)")
     args = parser.parse_args()
+    if args.cases and args.group:
+        parser.error("--cases and --group exclude each other")
+    if not args.cases:
+        args.cases = ",".join(CASE_GROUPS[args.group] if args.group else DEFAULT_CASES)
 
     blender = bc.blender_or_skip(args.blender)
     bc.require_executable(args.cli)
