@@ -1,10 +1,9 @@
 #!/usr/bin/env python3
-"""The BlenderBakeOracle tests (one per group of cases): sgbake's normal maps against Cycles'
-bakes of the same scenes.
+"""BlenderBakeOracle_<group>: sgbake's normal maps against Cycles' bakes of the same scenes.
 
     python3 tests/blender/bake_oracle.py --cli build/src/sgbake [--blender blender]
-        [--keep DIR] [--group meshes|normal_maps|stretched|projections|displacement_remaps|
-                 procedural | --cases NAME,...]   (default: every case; CASE_GROUPS below)
+        [--keep DIR] [--group NAME | --cases NAME,...]
+                 (a group of CASE_GROUPS below, one CTest test each; default: every case)
         [--sabotage green|scale|input|strength|normal-green]
 
 1. bake_scene.py (inside Blender) builds each case (see its docstring: Suzanne subdivided
