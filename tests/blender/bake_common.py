@@ -18,6 +18,7 @@ bake_orientation.py)
 
 Blender part (numpy and bpy)
     setup_cycles, reset_scene, new_float_image, image_array, save_exr, load_raw,
+    emit_plane, bake_emit, largest_differences (the Fac oracles' plane, bakes and comparison),
     decode_normals, angle_deg, erode, angle_stats.
 
 Conventions (docs: /work/shared/CONVENTIONS.md)
@@ -380,6 +381,69 @@ def save_exr(img, path, verify=True):
             diff = (np.abs(back[..., :3] - expected[..., :3]).max()
                     if back.shape == expected.shape else "shape")
             raise RuntimeError(f"{path}: EXR round trip is not exact (max diff {diff})")
+
+
+def emit_plane(out_dir, node_type, output):
+    """The scene of the Fac oracles (musgrave_fac_oracle.py, voronoi_distance_oracle.py,
+    texture_fac_oracle.py): a plane of side 2, turned and moved so that its object coordinates
+    vary in x, y and z, UV-mapped onto the whole square (written as OUT_DIR/mesh.obj), whose
+    material emits the `output` of a new node of type `node_type` on the object's coordinates,
+    with an active Image Texture to bake into. Returns (node, target): the texture node and the
+    Image Texture."""
+    import bpy
+    import mathutils
+    import objio
+    reset_scene()
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    ob = bpy.context.active_object
+    me = ob.data
+    me.transform(mathutils.Matrix.Rotation(0.6, 4, "X") @ mathutils.Matrix.Rotation(0.3, 4, "Y")
+                 @ mathutils.Matrix.Translation((0.3, -0.2, 0.1)))
+    me.calc_normals_split()
+    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me))
+    setup_cycles(bpy.context.scene)
+    mat = bpy.data.materials.new(node_type)
+    mat.use_nodes = True
+    me.materials.append(mat)
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    node = nodes.new(node_type)
+    emission = nodes.new("ShaderNodeEmission")
+    material_output = nodes.new("ShaderNodeOutputMaterial")
+    links.new(coordinates.outputs["Object"], node.inputs["Vector"])
+    links.new(node.outputs[output], emission.inputs["Color"])
+    links.new(emission.outputs["Emission"], material_output.inputs["Surface"])
+    target = nodes.new("ShaderNodeTexImage")
+    nodes.active = target
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    return node, target
+
+
+def bake_emit(target, name, size, path):
+    """Bakes EMIT (margin 0) into a new float image NAME (SIZE^2) that the Image Texture node
+    `target` holds, and saves it as the EXR at PATH."""
+    import bpy
+    image = new_float_image(name, size, size)
+    target.image = image
+    result = bpy.ops.object.bake(type="EMIT", margin=0, use_clear=True,
+                                 target="IMAGE_TEXTURES", save_mode="INTERNAL")
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"bake {name} returned {result}")
+    save_exr(image, path)
+
+
+def largest_differences(out_dir, case, prefixes=("ours", "control")):
+    """The largest |difference| of each PREFIX_CASE.exr from blender_CASE.exr in OUT_DIR (their
+    first channel), and the range of Blender's: {prefix: difference, "range": [min, max]}."""
+    import numpy as np
+    theirs = load_raw(os.path.join(out_dir, f"blender_{case}.exr"))[..., 0]
+    result = {prefix: float(np.abs(
+        load_raw(os.path.join(out_dir, f"{prefix}_{case}.exr"))[..., 0].astype(np.float64)
+        - theirs).max()) for prefix in prefixes}
+    result["range"] = [float(theirs.min()), float(theirs.max())]
+    return result
 
 
 def decode_normals(array):

@@ -66,67 +66,23 @@ def name(index, feature, metric):
 
 def bake(out_dir):
     """Step 1: mesh.obj and blender_S_CASE.exr."""
-    import bpy
-    import mathutils
-    bc.reset_scene()
-    bpy.ops.mesh.primitive_plane_add(size=2.0)
-    ob = bpy.context.active_object
-    me = ob.data
-    me.transform(mathutils.Matrix.Rotation(0.6, 4, "X") @ mathutils.Matrix.Rotation(0.3, 4, "Y")
-                 @ mathutils.Matrix.Translation((0.3, -0.2, 0.1)))
-    me.calc_normals_split()
-    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me))
-    scene = bpy.context.scene
-    bc.setup_cycles(scene)
-    mat = bpy.data.materials.new("voronoi")
-    mat.use_nodes = True
-    me.materials.append(mat)
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
-    coordinates = nodes.new("ShaderNodeTexCoord")
-    voronoi = nodes.new("ShaderNodeTexVoronoi")
+    voronoi, target = bc.emit_plane(out_dir, "ShaderNodeTexVoronoi", "Distance")
     voronoi.voronoi_dimensions = "3D"
-    emission = nodes.new("ShaderNodeEmission")
-    output = nodes.new("ShaderNodeOutputMaterial")
-    links.new(coordinates.outputs["Object"], voronoi.inputs["Vector"])
-    links.new(voronoi.outputs["Distance"], emission.inputs["Color"])
-    links.new(emission.outputs["Emission"], output.inputs["Surface"])
-    target = nodes.new("ShaderNodeTexImage")
-    nodes.active = target
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
     for index, settings in enumerate(SETTINGS):
         for feature, metric in CASES:
-            voronoi.feature, voronoi.distance = feature, metric
             # (the Distance output's link holds: every feature here has one)
-            links.new(voronoi.outputs["Distance"], emission.inputs["Color"])
+            voronoi.feature, voronoi.distance = feature, metric
             for socket, value in settings.items():
                 voronoi.inputs[socket].default_value = value
-            image = bc.new_float_image(name(index, feature, metric), SIZE, SIZE)
-            target.image = image
-            result = bpy.ops.object.bake(type="EMIT", margin=0, use_clear=True,
-                                         target="IMAGE_TEXTURES", save_mode="INTERNAL")
-            if result != {"FINISHED"}:
-                raise RuntimeError(f"bake {feature} {metric} returned {result}")
-            bc.save_exr(image,
-                        os.path.join(out_dir, f"blender_{name(index, feature, metric)}.exr"))
+            case = name(index, feature, metric)
+            bc.bake_emit(target, case, SIZE, os.path.join(out_dir, f"blender_{case}.exr"))
 
 
 def compare(out_dir):
     """Step 3: the largest |difference| of ours_ and control_S_CASE.exr from Cycles'."""
-    import numpy as np
-    result = {}
-    for index in range(len(SETTINGS)):
-        for feature, metric in CASES:
-            case = name(index, feature, metric)
-            theirs = bc.load_raw(os.path.join(out_dir, f"blender_{case}.exr"))[..., 0]
-            result[case] = {
-                prefix: float(np.abs(
-                    bc.load_raw(os.path.join(out_dir, f"{prefix}_{case}.exr"))[..., 0].astype(
-                        np.float64) - theirs).max())
-                for prefix in ("ours", "control")}
-            result[case]["range"] = [float(theirs.min()), float(theirs.max())]
-    return result
+    return {name(index, feature, metric): bc.largest_differences(out_dir,
+                                                                 name(index, feature, metric))
+            for index in range(len(SETTINGS)) for feature, metric in CASES}
 
 
 def blender_main(argv):
