@@ -18,7 +18,8 @@ bake_orientation.py)
 
 Blender part (numpy and bpy)
     setup_cycles, reset_scene, new_float_image, image_array, save_exr, load_raw,
-    emit_plane, bake_emit, largest_differences (the Fac oracles' plane, bakes and comparison),
+    emit_plane, bake_emit, largest_differences, fac_oracle_blender (the Fac oracles' plane,
+    bakes and comparison; their driver fac_oracle_main),
     decode_normals, angle_deg, erode, angle_stats.
 
 Conventions (docs: /work/shared/CONVENTIONS.md)
@@ -446,6 +447,17 @@ def largest_differences(out_dir, case, prefixes=("ours", "control")):
     return result
 
 
+def fac_oracle_blender(argv, tag, bake, cases):
+    """The Blender half of a Fac oracle: argv "bake DIR" runs bake(DIR), "compare DIR" prints
+    largest_differences of each of `cases` (names), both as JSON after `tag`."""
+    if argv[0] == "bake":
+        bake(argv[1])
+        print(tag + json.dumps({"baked": True}), flush=True)
+    else:
+        print(tag + json.dumps({case: largest_differences(argv[1], case) for case in cases}),
+              flush=True)
+
+
 def decode_normals(array):
     """(H, W, >=3) encoded normal map -> (H, W, 3) float64 unit vectors (n = 2c - 1)."""
     import numpy as np
@@ -506,6 +518,48 @@ def judge_against_control(label, ours, control, median_limit, control_min, contr
           f"texels; {'ok  ' if told else 'FAIL'} {control_what} median "
           f"{control['median_deg']:.3f} deg (must exceed {control_min})")
     return ok and told
+
+
+def fac_oracle_main(doc, script, tag, size, layers, limit, quantity, control_what,
+                    sabotage_help, control_min=1e-2):
+    """The driver of a Fac oracle (musgrave_fac_oracle.py, voronoi_distance_oracle.py,
+    texture_fac_oracle.py; options --cli, --blender, --keep, --sabotage): Blender runs `script`
+    to bake blender_CASE.exr (fac_oracle_blender); the CLI bakes the "height" map (SIZE^2,
+    margin 0, 1 sample, 32-bit) of each layer of layers(sabotage) = {case: (ours, control)}
+    into ours_CASE.exr and control_CASE.exr; Blender compares. Each of ours must be within
+    limit(case) of Cycles' `quantity` (the node's output, "Fac" or "Distance"), each control
+    (`control_what`: "the next type's") at least `control_min` off. Returns the exit status."""
+    import objio
+    parser = oracle_parser(doc, blender_help=None)
+    parser.add_argument("--sabotage", action="store_true", help=sabotage_help)
+    args = parser.parse_args()
+    blender = blender_or_skip(args.blender)
+    require_executable(args.cli, "error: --cli {} is not an executable file")
+    with work_dir(args.keep, f"sgbake_{os.path.splitext(os.path.basename(script))[0]}_") as out:
+        if objio.run_blender_result(blender, script, ["bake", out], tag) is None:
+            return 1
+        for case, pair in layers(args.sabotage).items():
+            for prefix, layer in zip(("ours", "control"), pair):
+                scene = {"mesh": "mesh.obj", "layers": [layer],
+                         "outputs": [{"map": "height", "file": f"{prefix}_{case}.exr",
+                                      "size": size, "margin": 0, "samples": 1, "bit_depth": 32}]}
+                if not bake_scene_file(args.cli, out, f"{prefix}_{case}", scene):
+                    return 1
+        stats = objio.run_blender_result(blender, script, ["compare", out], tag)
+        if stats is None:
+            return 1
+        failures = []
+        for case, s in stats.items():
+            close, told = s["ours"] <= limit(case), s["control"] >= control_min
+            print(f"  {case}: {quantity} in [{s['range'][0]:.3f}, {s['range'][1]:.3f}], max "
+                  f"|diff| {s['ours']:.2g} (<= {limit(case):g}), {control_what} "
+                  f"{s['control']:.3g} (>= {control_min:g}) -> {'ok' if close and told else 'FAIL'}")
+            if not close:
+                failures.append(f"{case}: the {quantity} differs from Cycles' by {s['ours']:.3g}")
+            if not told:
+                failures.append(f"{case}: {control_what} {quantity} is within {s['control']:.3g} "
+                                "of Cycles' (the control cannot tell them apart)")
+        return report(failures)
 
 
 def bake_scene_file(cli, directory, name, scene):

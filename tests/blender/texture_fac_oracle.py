@@ -23,7 +23,6 @@ fail.
 Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed. Takes ~30 s.
 """
 
-import json
 import os
 import sys
 
@@ -95,54 +94,20 @@ def bake(out_dir):
 
 
 def blender_main(argv):
-    if argv[0] == "bake":
-        bake(argv[1])
-        print(RESULT_TAG + json.dumps({"baked": True}), flush=True)
-    else:
-        print(RESULT_TAG + json.dumps({case: bc.largest_differences(argv[1], case)
-                                       for case in cases()}), flush=True)
+    bc.fac_oracle_blender(argv, RESULT_TAG, bake, cases())
 
 
 # ---- The driver ------------------------------------------------------------------------------
 
 def main():
-    parser = bc.oracle_parser(__doc__, blender_help=None)
-    parser.add_argument("--sabotage", action="store_true",
-                        help="bake ours with an amplitude of 1 - 1e-4")
-    args = parser.parse_args()
-    blender = bc.blender_or_skip(args.blender)
-    bc.require_executable(args.cli, "error: --cli {} is not an executable file")
-
-    with bc.work_dir(args.keep, "sgbake_texture_fac_oracle_") as out_dir:
-        script = os.path.abspath(__file__)
-        if objio.run_blender_result(blender, script, ["bake", out_dir], RESULT_TAG) is None:
-            return 1
-        amplitude = 1.0 - 1e-4 if args.sabotage else 1.0
-        limits = {case: values[-1] for case, values in cases().items()}
-        for case, (_, _, _, ours, control, _) in cases().items():
-            for prefix, values in (("ours", ours), ("control", control)):
-                layer = dict(values, type="volume", amplitude=amplitude if prefix == "ours"
-                             else 1.0)
-                scene = {"mesh": "mesh.obj", "layers": [layer],
-                         "outputs": [{"map": "height", "file": f"{prefix}_{case}.exr",
-                                      "size": SIZE, "margin": 0, "samples": 1, "bit_depth": 32}]}
-                if not bc.bake_scene_file(args.cli, out_dir, f"{prefix}_{case}", scene):
-                    return 1
-        stats = objio.run_blender_result(blender, script, ["compare", out_dir], RESULT_TAG)
-        if stats is None:
-            return 1
-        failures = []
-        for case, s in stats.items():
-            close, told = s["ours"] <= limits[case], s["control"] >= CONTROL_MIN
-            print(f"  {case}: Fac in [{s['range'][0]:.3f}, {s['range'][1]:.3f}], max |diff| "
-                  f"{s['ours']:.2g} (<= {limits[case]:g}), its neighbour's {s['control']:.3g} "
-                  f"(>= {CONTROL_MIN:g}) -> {'ok' if close and told else 'FAIL'}")
-            if not close:
-                failures.append(f"{case}: the Fac differs from Cycles' by {s['ours']:.3g}")
-            if not told:
-                failures.append(f"{case}: its neighbour's Fac is within {s['control']:.3g} of "
-                                "Cycles' (the control cannot tell them apart)")
-        return bc.report(failures)
+    amplitude = {False: 1.0, True: 1.0 - 1e-4}
+    return bc.fac_oracle_main(
+        __doc__, os.path.abspath(__file__), RESULT_TAG, SIZE,
+        lambda sabotage: {case: (dict(ours, type="volume", amplitude=amplitude[sabotage]),
+                                 dict(control, type="volume", amplitude=1.0))
+                          for case, (_, _, _, ours, control, _) in cases().items()},
+        lambda case: cases()[case][-1], "Fac", "its neighbour's",
+        "bake ours with an amplitude of 1 - 1e-4", CONTROL_MIN)
 
 
 if __name__ == "__main__":
