@@ -902,11 +902,12 @@ def _scale_key(values):
 # node's enum properties the function takes (setting -> (the node's property, or a function of
 # the node naming it; Blender's values -> the scene's names)); the inputs whose name is not
 # their setting's in title case (setting -> input); why its other outputs make no layer; and
-# the node's other properties the function takes as they are (setting -> property).
+# the node's other properties the function takes as they are (setting -> property); and whether
+# the node has a Scale (the layer's frequency).
 ProceduralTexture = collections.namedtuple(
-    "ProceduralTexture", "function dimensions fixed outputs enums inputs others props",
+    "ProceduralTexture", "function dimensions fixed outputs enums inputs others props scaled",
     defaults=({}, ("Fac",), {}, {}, "three noises seeded apart; a volume layer is the noise of "
-                                    "its Fac", {}))
+                                    "its Fac", {}, True))
 PROCEDURAL_TEXTURES = {
     "TEX_NOISE": ProceduralTexture("blender-noise", "noise_dimensions"),
     "TEX_MUSGRAVE": ProceduralTexture(
@@ -940,6 +941,18 @@ PROCEDURAL_TEXTURES = {
                "(the mortar)",
         props={"brick_offset": "offset", "offset_frequency": "offset_frequency",
                "squash": "squash", "squash_frequency": "squash_frequency"}),
+    "TEX_GRADIENT": ProceduralTexture(
+        "blender-gradient", None, outputs=("Fac", "Color"),
+        enums={"gradient_type": ("gradient_type", {
+            "LINEAR": "linear", "QUADRATIC": "quadratic", "EASING": "easing",
+            "DIAGONAL": "diagonal", "SPHERICAL": "spherical",
+            "QUADRATIC_SPHERE": "quadratic-sphere", "RADIAL": "radial"})},
+        scaled=False),
+    "TEX_MAGIC": ProceduralTexture(
+        "blender-magic", None,
+        others="three channels of their own, not a height; a volume layer is the Fac (their "
+               "mean)",
+        props={"depth": "turbulence_depth"}),
 }
 
 
@@ -950,7 +963,7 @@ def _texture_inputs(texture, enums):
     uses them, a Voronoi Texture's Smoothness, Exponent and metric only where its feature uses
     them) but its enums under their own names (input Detail Scale -> detail_scale, but as
     texture.inputs renames them: Phase Offset -> phase, Offset -> musgrave_offset)."""
-    inputs = {"Scale": "frequency"}
+    inputs = {"Scale": "frequency"} if texture.scaled else {}
     inputs.update((texture.inputs.get(key, key.replace("_", " ").title()), key)
                   for key in scene.texture_settings(texture.function,
                                                     enums.get("musgrave_type", "fbm"),

@@ -109,6 +109,22 @@ FUNCTIONS = (
      "Blender's Brick Texture Fac (the mortar), as Cycles evaluates it: Frequency is the node's "
      "Scale, with its Mortar Size and Smooth, Brick Width, Row Height, Offset, Squash and their "
      "Frequencies"),
+    ("blender-gradient", "Blender Gradient",
+     "Blender's Gradient Texture Fac, as Cycles evaluates it: its Gradient Type (the node has "
+     "no Scale)"),
+    ("blender-magic", "Blender Magic",
+     "Blender's Magic Texture Fac (its Color's mean), as Cycles evaluates it: Frequency is the "
+     "node's Scale, with its Depth and Distortion"),
+)
+# The Gradient Texture's types in the scene's names.
+GRADIENT_TYPES = (
+    ("linear", "Linear", "Blender Gradient: x"),
+    ("quadratic", "Quadratic", "Blender Gradient: max(x, 0)^2"),
+    ("easing", "Easing", "Blender Gradient: 3r^2 - 2r^3 of r = x clamped to [0, 1]"),
+    ("diagonal", "Diagonal", "Blender Gradient: (x + y) / 2"),
+    ("spherical", "Spherical", "Blender Gradient: 1 - |p| (0 beyond the unit sphere)"),
+    ("quadratic-sphere", "Quadratic Sphere", "Blender Gradient: (1 - |p|)^2 inside the sphere"),
+    ("radial", "Radial", "Blender Gradient: the angle about z, atan2(y, x) / 2 pi + 1/2"),
 )
 # The Wave Texture's enums in the scene's names (Blender's Wave Type, Bands or Rings Direction,
 # Wave Profile). The directions depend on the type, as the node's two properties: the fourth
@@ -339,7 +355,8 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                               description="Blender Noise: the Noise Texture's Distortion (the "
                                           "point moved by three other noises first); Blender "
                                           "Wave: the Wave Texture's (the wave moved by a "
-                                          "noise)")
+                                          "noise); Blender Magic: the Magic Texture's (its "
+                                          "default there is 1)")
     detail_scale: FloatProperty(name="Detail Scale", default=1.0, precision=3,
                                 description="Blender Wave: the Wave Texture's Detail Scale (the "
                                             "distorting noise's frequency relative to Scale)")
@@ -383,6 +400,11 @@ class SgbakeLayer(bpy.types.PropertyGroup):
     exponent: FloatProperty(name="Exponent", default=0.5, min=0.0, precision=3,
                             description="Blender Voronoi: the Voronoi Texture's Exponent (of "
                                         "the Minkowski metric; the others ignore it)")
+    gradient_type: EnumProperty(name="Gradient Type", items=GRADIENT_TYPES, default="linear",
+                                description="Blender Gradient: the Gradient Texture's type (its "
+                                            "Fac clamped to [0, 1] as Cycles clamps it)")
+    depth: IntProperty(name="Depth", default=2, min=0, max=10,
+                       description="Blender Magic: the Magic Texture's Depth (its steps)")
     mortar_size: FloatProperty(name="Mortar Size", default=0.02, min=0.0, max=0.125,
                                precision=3, description="Blender Brick: the Brick Texture's "
                                                         "Mortar Size")

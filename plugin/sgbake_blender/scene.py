@@ -41,7 +41,11 @@ BLENDER_TEXTURE_SETTINGS = {
     "blender-voronoi": ("feature", "metric", "smoothness", "randomness", "exponent"),
     "blender-brick": ("mortar_size", "mortar_smooth", "brick_width", "row_height", "brick_offset",
                       "offset_frequency", "squash", "squash_frequency"),
+    "blender-gradient": ("gradient_type",),
+    "blender-magic": ("depth", "distortion"),
 }
+# Blender's textures without a Scale: their volumes take no "frequency".
+UNSCALED_FUNCTIONS = {"blender-gradient"}
 # The scene's keys of the settings whose layer property has another name.
 SETTING_KEYS = {"musgrave_offset": "offset"}
 # The Musgrave Texture's inputs its types do not use (libsgbake refuses them): Multifractal and
@@ -276,7 +280,9 @@ def layer_json(layer, uv_index, default_uv=None):
         entry.update(space=layer.space, strength=_number(layer.scale))
     elif layer.type == "volume":
         entry.update(function=layer.function, amplitude=_number(layer.amplitude),
-                     frequency=_number(layer.frequency), gradient=layer.gradient)
+                     gradient=layer.gradient)
+        if layer.function not in UNSCALED_FUNCTIONS:
+            entry["frequency"] = _number(layer.frequency)
         if layer.coordinates_uv:  # (u, v, 0) of its UV map, as a texture on a UV output
             entry["coordinates"] = "uv"
         # 0: the library's default; the Bump node's slopes take no step of their own.

@@ -167,7 +167,8 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             col.prop(layer, "function")
             col.prop(layer, "amplitude")
             texture = scene.BLENDER_TEXTURE_SETTINGS.get(layer.function)
-            col.prop(layer, "frequency", text="Scale" if texture else "Frequency")
+            if layer.function not in scene.UNSCALED_FUNCTIONS:
+                col.prop(layer, "frequency", text="Scale" if texture else "Frequency")
             if layer.function == "sine":
                 col.prop(layer, "direction")
                 col.prop(layer, "phase")

@@ -326,6 +326,14 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
       params.scale = layer.frequency;
       return owned(BlenderBrick::create(params));
     }
+    case VolumeFunction::kBlenderGradient:
+      return owned(
+          BlenderGradient::create({.amplitude = layer.amplitude, .type = layer.gradientType}));
+    case VolumeFunction::kBlenderMagic:
+      return owned(BlenderMagic::create({.amplitude = layer.amplitude,
+                                         .scale = layer.frequency,
+                                         .depth = layer.magicDepth,
+                                         .distortion = layer.noiseDistortion}));
     case VolumeFunction::kNoise:
       break;
   }

@@ -127,7 +127,9 @@ constexpr Named<VolumeFunction> kFunctions[] = {
     {"blender-musgrave", VolumeFunction::kBlenderMusgrave},
     {"blender-wave", VolumeFunction::kBlenderWave},
     {"blender-voronoi", VolumeFunction::kBlenderVoronoi},
-    {"blender-brick", VolumeFunction::kBlenderBrick}};
+    {"blender-brick", VolumeFunction::kBlenderBrick},
+    {"blender-gradient", VolumeFunction::kBlenderGradient},
+    {"blender-magic", VolumeFunction::kBlenderMagic}};
 constexpr Named<VolumeCoordinates> kVolumeCoordinates[] = {{"object", VolumeCoordinates::kObject},
                                                            {"uv", VolumeCoordinates::kUv}};
 constexpr Named<VoronoiMetric> kVoronoiMetrics[] = {{"euclidean", VoronoiMetric::kEuclidean},
@@ -145,6 +147,14 @@ constexpr Named<VoronoiFeature> kVoronoiFeatures[] = {
     {"f2", VoronoiFeature::kF2},
     {"smooth-f1", VoronoiFeature::kSmoothF1},
     {"distance-to-edge", VoronoiFeature::kDistanceToEdge}};
+constexpr Named<BlenderGradientType> kGradientTypes[] = {
+    {"linear", BlenderGradientType::kLinear},
+    {"quadratic", BlenderGradientType::kQuadratic},
+    {"easing", BlenderGradientType::kEasing},
+    {"diagonal", BlenderGradientType::kDiagonal},
+    {"spherical", BlenderGradientType::kSpherical},
+    {"quadratic-sphere", BlenderGradientType::kQuadraticSphere},
+    {"radial", BlenderGradientType::kRadial}};
 constexpr Named<WaveType> kWaveTypes[] = {{"bands", WaveType::kBands}, {"rings", WaveType::kRings}};
 constexpr Named<WaveDirection> kWaveDirections[] = {{"x", WaveDirection::kX},
                                                     {"y", WaveDirection::kY},
@@ -479,6 +489,8 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "exponent",
            "feature",  // the Voronoi Texture's Feature Output and its smoothness
            "smoothness",
+           "gradient_type",  // the Gradient Texture's type
+           "depth",          // the Magic Texture's
            "mapping",
            "coordinates",
            "uv",
@@ -889,7 +901,9 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     const bool wave = layer.function == VolumeFunction::kBlenderWave;
     const bool voronoi = layer.function == VolumeFunction::kBlenderVoronoi;
     const bool brick = layer.function == VolumeFunction::kBlenderBrick;
-    const bool blender = noise || musgrave || wave || voronoi || brick;
+    const bool gradientTexture = layer.function == VolumeFunction::kBlenderGradient;
+    const bool magic = layer.function == VolumeFunction::kBlenderMagic;
+    const bool blender = noise || musgrave || wave || voronoi || brick || gradientTexture || magic;
     const std::string function = nameIn(kFunctions, layer.function);
     const auto onlyFor = [&](std::initializer_list<const char*> keys, bool applies,
                              const char* owner) {
@@ -905,7 +919,12 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"seed", "octaves"}, layer.function == VolumeFunction::kNoise, "noise");
     onlyFor({"detail"}, noise || musgrave || wave,
             "blender-noise, blender-musgrave and blender-wave");
-    onlyFor({"distortion"}, noise || wave, "blender-noise and blender-wave");
+    onlyFor({"distortion"}, noise || wave || magic,
+            "blender-noise, blender-wave and blender-magic");
+    onlyFor({"frequency"}, !gradientTexture,
+            "the other functions: the Gradient Texture has no Scale");
+    onlyFor({"gradient_type"}, gradientTexture, "blender-gradient");
+    onlyFor({"depth"}, magic, "blender-magic");
     onlyFor({"roughness"}, noise, "blender-noise");
     onlyFor({"wave", "wave_direction", "profile", "detail_scale", "detail_roughness"}, wave,
             "blender-wave");
@@ -917,14 +936,18 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"dimension", "lacunarity", "musgrave_type", "offset", "gain"}, musgrave,
             "blender-musgrave");
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
-    if (blender) layer.frequency = 5;  // Blender's textures' default Scale
+    if (blender && !gradientTexture) layer.frequency = 5;  // Blender's textures' default Scale
     if (reader.has("frequency")) {
       layer.frequency = sine || blender ? reader.number("frequency")
                                         : reader.numberAtLeast("frequency", 0, /*exclusive=*/true);
     }
     if (reader.has("detail")) layer.noiseDetail = reader.number("detail");
     if (reader.has("roughness")) layer.noiseRoughness = reader.number("roughness");
+    if (magic) layer.noiseDistortion = 1;  // the Magic Texture's default Distortion
     if (reader.has("distortion")) layer.noiseDistortion = reader.number("distortion");
+    reader.optionalName("gradient_type", kGradientTypes, layer.gradientType);
+    if (reader.has("depth"))
+      layer.magicDepth = reader.smallInteger("depth", 0, kBlenderMagicMaxDepth);
     if (reader.has("dimension")) layer.noiseDimension = reader.number("dimension");
     if (reader.has("lacunarity")) layer.noiseLacunarity = reader.number("lacunarity");
     reader.optionalName("musgrave_type", kMusgraveTypes, layer.musgraveType);
@@ -1706,7 +1729,8 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
     case SceneLayerType::kVolume:
       j["function"] = nameIn(kFunctions, layer.function);
       j["amplitude"] = layer.amplitude;
-      j["frequency"] = layer.frequency;
+      // (the Gradient Texture has no Scale)
+      if (layer.function != VolumeFunction::kBlenderGradient) j["frequency"] = layer.frequency;
       if (layer.function == VolumeFunction::kSine) {
         j["direction"] = {layer.direction.x, layer.direction.y, layer.direction.z};
         j["phase"] = layer.phase;
@@ -1741,6 +1765,11 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["offset_frequency"] = b.offsetFrequency;
         j["squash"] = b.squash;
         j["squash_frequency"] = b.squashFrequency;
+      } else if (layer.function == VolumeFunction::kBlenderGradient) {
+        j["gradient_type"] = nameIn(kGradientTypes, layer.gradientType);
+      } else if (layer.function == VolumeFunction::kBlenderMagic) {
+        j["depth"] = layer.magicDepth;
+        j["distortion"] = layer.noiseDistortion;
       } else if (layer.function == VolumeFunction::kBlenderVoronoi) {
         j["randomness"] = layer.voronoiRandomness;
         j["metric"] = nameIn(kVoronoiMetrics, layer.voronoiMetric);

@@ -828,4 +828,153 @@ double BlenderBrick::output(Vec3d position, Vec3d* gradient) const {
   return fac;
 }
 
+Result<BlenderGradient> BlenderGradient::create(const BlenderGradientParams& params) {
+  if (Status finite = finiteSettings("Gradient Texture", {params.amplitude}); !finite)
+    return finite.error();
+  if (params.type < BlenderGradientType::kLinear || params.type > BlenderGradientType::kRadial) {
+    return Error::badInput("a Gradient Texture's type is not one of Blender's seven");
+  }
+  // The steepest slope per unit of P is 2 (Quadratic, Quadratic Sphere) but Radial's, which
+  // grows without bound toward its axis: a point's, not the settings'.
+  if (Status bounded =
+          boundedSlopes("Gradient Texture", 2 * std::abs(params.amplitude), "(amplitude × 2)");
+      !bounded)
+    return bounded.error();
+  return BlenderGradient(params);
+}
+
+double BlenderGradient::output(Vec3d p, Vec3d* gradient) const {
+  // Cycles' value before its clamp to [0, 1], and its gradient.
+  double value = 0;
+  Vec3d slope{};
+  switch (params_.type) {
+    case BlenderGradientType::kLinear:
+      value = p.x, slope = {1, 0, 0};
+      break;
+    case BlenderGradientType::kQuadratic: {
+      const double r = std::max(p.x, 0.0);
+      value = r * r, slope = {2 * r, 0, 0};
+      break;
+    }
+    case BlenderGradientType::kEasing: {
+      const double r = std::clamp(p.x, 0.0, 1.0);
+      value = r * r * (3 - 2 * r), slope = {6 * r * (1 - r), 0, 0};
+      break;
+    }
+    case BlenderGradientType::kDiagonal:
+      value = (p.x + p.y) * 0.5, slope = {0.5, 0.5, 0};
+      break;
+    case BlenderGradientType::kRadial: {
+      value = std::atan2(p.y, p.x) / (2 * kPi) + 0.5;
+      const double r2 = p.x * p.x + p.y * p.y;
+      if (r2 > 0) slope = Vec3d{-p.y, p.x, 0} * (1 / (2 * kPi * r2));
+      break;
+    }
+    case BlenderGradientType::kSpherical:
+    case BlenderGradientType::kQuadraticSphere: {
+      constexpr double kUnitNudge = 0.999999f;  // Cycles' float, for unit vectors to give 0
+      const double length = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+      const double s = std::max(kUnitNudge - length, 0.0);
+      // d s / d P = −P / |P| inside the sphere, 0 beyond it and at its centre.
+      const Vec3d ds = s > 0 && length > 0 ? p * (-1 / length) : Vec3d{};
+      const bool quadratic = params_.type == BlenderGradientType::kQuadraticSphere;
+      value = quadratic ? s * s : s;
+      slope = quadratic ? ds * (2 * s) : ds;
+      break;
+    }
+  }
+  // Cycles' saturate; where it holds the Fac at a bound the gradient is 0.
+  const bool clamped = !(value > 0 && value < 1);
+  if (gradient != nullptr) *gradient = clamped ? Vec3d{} : slope;
+  return std::clamp(value, 0.0, 1.0);
+}
+
+Result<BlenderMagic> BlenderMagic::create(const BlenderMagicParams& params) {
+  if (Status finite =
+          finiteSettings("Magic Texture", {params.amplitude, params.scale, params.distortion});
+      !finite)
+    return finite.error();
+  if (params.depth < 0 || params.depth > kBlenderMagicMaxDepth) {
+    return Error::badInput("a Magic Texture's Depth must be an integer from 0 to " +
+                           std::to_string(kBlenderMagicMaxDepth));
+  }
+  // Each step's sine or cosine of three values, each d times a sine or cosine: 3|d| times its
+  // inputs' slopes; at Depth 0 the division by 2d is not balanced by a product.
+  const double d = std::abs(params.distortion);
+  double slopes = std::abs(params.amplitude) * std::abs(params.scale) * 5 * std::sqrt(3.0) *
+                  std::pow(std::max(1.0, 3 * d), params.depth);
+  if (params.depth == 0 && d != 0) slopes /= 2 * d;
+  if (Status bounded = boundedSlopes(
+          "Magic Texture", slopes,
+          "(amplitude × scale × 5√3 × max(1, 3 |distortion|)^depth, / 2 |distortion| at depth 0)");
+      !bounded)
+    return bounded.error();
+  return BlenderMagic(params);
+}
+
+namespace {
+
+/// A value and its gradient with respect to P, carried through the Magic Texture's steps.
+struct MagicTerm {
+  double value;
+  Vec3d slope;
+};
+
+/// One of the Magic Texture's steps: component `target` (0 x, 1 y, 2 z) becomes `sign` times the
+/// sine (else the cosine) of Σ signs[k] · (x, y, z)[k].
+struct MagicStep {
+  int target;
+  double sign;
+  bool sine;
+  double signs[3];
+};
+
+/// Cycles 3.4's ten steps, in order; Depth n takes the first n.
+constexpr MagicStep kMagicSteps[kBlenderMagicMaxDepth] = {
+    {1, -1, false, {1, -1, 1}},  {0, 1, false, {1, -1, -1}}, {2, 1, true, {-1, -1, -1}},
+    {0, -1, false, {-1, 1, -1}}, {1, -1, true, {-1, 1, 1}},  {1, -1, false, {-1, 1, 1}},
+    {0, 1, false, {1, 1, 1}},    {2, 1, true, {1, 1, -1}},   {0, -1, false, {-1, -1, 1}},
+    {1, -1, true, {1, -1, 1}}};
+
+/// sign · sin(a) (else sign · cos(a)) of a term a, with its gradient.
+MagicTerm magicWave(double sign, bool sine, const MagicTerm& a) {
+  const double s = std::sin(a.value), c = std::cos(a.value);
+  return sine ? MagicTerm{sign * s, a.slope * (sign * c)}
+              : MagicTerm{sign * c, a.slope * (-sign * s)};
+}
+
+}  // namespace
+
+double BlenderMagic::output(Vec3d position, Vec3d* gradient) const {
+  const BlenderMagicParams& m = params_;
+  const Vec3d p = position * m.scale;
+  const double k = 5 * m.scale;  // d(5 p) / dP
+  MagicTerm t[3] = {magicWave(1, true, {5 * (p.x + p.y + p.z), Vec3d{1, 1, 1} * k}),
+                    magicWave(1, false, {5 * (-p.x + p.y - p.z), Vec3d{-1, 1, -1} * k}),
+                    magicWave(-1, false, {5 * (-p.x - p.y + p.z), Vec3d{-1, -1, 1} * k})};
+  const double d = m.distortion;
+  const auto distort = [d](MagicTerm& term) {
+    term.value *= d;
+    term.slope = term.slope * d;
+  };
+  if (m.depth > 0) {
+    for (MagicTerm& term : t) distort(term);
+  }
+  for (int i = 0; i < m.depth; ++i) {
+    const MagicStep& step = kMagicSteps[i];
+    MagicTerm argument{0, Vec3d{}};
+    for (int c = 0; c < 3; ++c) {
+      argument.value += step.signs[c] * t[c].value;
+      argument.slope = argument.slope + t[c].slope * step.signs[c];
+    }
+    t[step.target] = magicWave(step.sign, step.sine, argument);
+    distort(t[step.target]);
+  }
+  // Color = ½ − (x, y, z) / 2d (d ≠ 0), Fac its mean.
+  const double divisor = d != 0 ? 3 * (2 * d) : 3;
+  const double sum = t[0].value + t[1].value + t[2].value;
+  if (gradient != nullptr) *gradient = (t[0].slope + t[1].slope + t[2].slope) * (-1 / divisor);
+  return 0.5 - sum / divisor;
+}
+
 }  // namespace sgbake

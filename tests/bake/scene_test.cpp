@@ -921,6 +921,77 @@ TEST(Scene, BlenderBrickVolumesTakeTheNodesSettings) {
             std::string::npos);
 }
 
+// "blender-gradient" takes the Gradient Texture's type (no Scale: no "frequency") and writes it
+// back; "blender-magic" its Depth (an integer from 0 to 10) and Distortion (1 unless given).
+// Others' keys, typos and values out of range are refused, each in one line.
+TEST(Scene, BlenderGradientAndMagicVolumesTakeTheNodesSettings) {
+  const auto layerOf = [](const char* json) {
+    Result<Scene> scene = parseScene(withLayer(json), options());
+    EXPECT_TRUE(scene) << scene.error().message;
+    return scene->layers[0];
+  };
+  const SceneLayer linear = layerOf(R"({"type": "volume", "function": "blender-gradient"})");
+  EXPECT_EQ(linear.gradientType, BlenderGradientType::kLinear);
+  const SceneLayer radial =
+      layerOf(R"({"type": "volume", "function": "blender-gradient", "gradient_type": "radial"})");
+  EXPECT_EQ(radial.gradientType, BlenderGradientType::kRadial);
+  const std::string radialJson = layerParametersJson(radial);
+  EXPECT_NE(radialJson.find(R"("gradient_type":"radial")"), std::string::npos) << radialJson;
+  EXPECT_EQ(radialJson.find("frequency"), std::string::npos) << radialJson;
+  EXPECT_EQ(layerOf(R"({"type": "volume", "function": "blender-gradient",
+                        "gradient_type": "quadratic-sphere"})")
+                .gradientType,
+            BlenderGradientType::kQuadraticSphere);
+  const SceneLayer magic = layerOf(R"({"type": "volume", "function": "blender-magic"})");
+  EXPECT_EQ(magic.frequency, 5);
+  EXPECT_EQ(magic.magicDepth, 2);
+  EXPECT_EQ(magic.noiseDistortion, 1);
+  const SceneLayer deep = layerOf(
+      R"({"type": "volume", "function": "blender-magic", "depth": 10, "distortion": 2.5,
+          "frequency": 1.5})");
+  EXPECT_EQ(deep.magicDepth, 10);
+  EXPECT_EQ(deep.noiseDistortion, 2.5);
+  EXPECT_EQ(deep.frequency, 1.5);
+  const std::string deepJson = layerParametersJson(deep);
+  for (const char* expected : {R"("depth":10)", R"("distortion":2.5)", R"("frequency":1.5)"}) {
+    EXPECT_NE(deepJson.find(expected), std::string::npos) << expected << " in " << deepJson;
+  }
+  // The other volumes' manifests are as they were: no new keys.
+  const std::string brick =
+      layerParametersJson(layerOf(R"({"type": "volume", "function": "blender-brick"})"));
+  EXPECT_EQ(brick.find("depth"), std::string::npos) << brick;
+  EXPECT_EQ(brick.find("gradient_type"), std::string::npos) << brick;
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-gradient",
+                                     "gradient_type": "sphere"})")),
+            "scene.json: layers[0]: unknown gradient_type 'sphere' (expected linear, quadratic, "
+            "easing, diagonal, spherical, quadratic-sphere or radial)");
+  EXPECT_EQ(
+      parseError(
+          withLayer(R"({"type": "volume", "function": "blender-gradient", "frequency": 2})")),
+      "scene.json: layers[0]: key 'frequency' does not apply to a blender-gradient volume (it is "
+      "for the other functions: the Gradient Texture has no Scale)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-gradient", "depth": 2})")),
+      "scene.json: layers[0]: key 'depth' does not apply to a blender-gradient volume (it is for "
+      "blender-magic)");
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "volume", "function": "blender-magic", "gradient_type": "linear"})")),
+            "scene.json: layers[0]: key 'gradient_type' does not apply to a blender-magic volume "
+            "(it is for blender-gradient)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-magic", "depth": 11})")),
+      "scene.json: layers[0]: depth 11 is out of range 0..10");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-magic", "depth": 2.5})")),
+      "scene.json: layers[0]: 'depth' must be an integer, not 2.5");  // (as any integer key)
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-magic", "detph": 2})")),
+            "scene.json: layers[0]: unknown key 'detph' (did you mean 'depth'?)");
+  EXPECT_EQ(
+      parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "depth": 2})")),
+      "scene.json: layers[0]: key 'depth' does not apply to a blender-noise volume (it is for "
+      "blender-magic)");
+}
+
 TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
   Result<Scene> plain =
       parseScene(withLayer(R"({"type": "volume", "function": "blender-noise"})"), options());

@@ -137,6 +137,12 @@
    worse. noise_world_case: the same on world positions (a Geometry node's Position), Suzanne
    turned and scaled: a "blender-noise" layer whose mapping's matrix is the object's
    matrix_world, baked as Cycles bakes it, the layer without its mapping clearly worse.
+   Gradient and Magic Textures (gradient_case, magic_case): a Gradient Texture's Fac (Quadratic
+   Sphere) and a Magic Texture's (MAGIC_INPUTS, Depth MAGIC_DEPTH) on Suzanne's own coordinates
+   through a Mapping node: one "blender-gradient" (no "frequency") and one "blender-magic"
+   volume layer, baked as Cycles bakes them, the layers without their mapping clearly worse;
+   gradient_magic_checks: the Magic Texture's Color output and a Scale fed by a node give no
+   layer and a reason, layers made by hand send their settings and bake.
    Brick Texture (brick_case): a Brick Texture's Fac (BRICK_INPUTS, BRICK_PROPS) on Suzanne's
    own coordinates through a Mapping node: one "blender-brick" volume layer of its inputs and
    properties, baked as Cycles bakes it, the layer without its mapping clearly worse.
@@ -365,6 +371,16 @@ BRICK_INPUTS = {"Scale": 3.0, "Mortar Size": 0.08, "Mortar Smooth": 1.0, "Brick 
 BRICK_PROPS = {"brick_offset": 0.25, "offset_frequency": 3, "squash": 1.5, "squash_frequency": 2}
 BRICK_MAPPING = ((0.1, 0.3, -0.2), (0.3, -0.2, 0.4), (1.1, 1.2, 0.9))
 BRICK_DISTANCE = 0.005
+# The Gradient and Magic cases (gradient_case, magic_case): a Gradient Texture (Quadratic Sphere)
+# and a Magic Texture (MAGIC_INPUTS, Depth MAGIC_DEPTH) on Suzanne's own coordinates through a
+# Mapping node, their Fac into the Bump: one "blender-gradient" (no "frequency": the node has no
+# Scale) and one "blender-magic" volume layer, baked as Cycles bakes them (NOISE_* bars), the
+# same jobs without the layer's "mapping" clearly worse.
+GRADIENT_MAPPING = ((0.2, -0.1, 0.1), (0.2, 0.3, -0.4), (1.2, 1.0, 1.4))
+GRADIENT_DISTANCE = 0.1
+MAGIC_INPUTS = {"Scale": 1.3, "Distortion": 1.4}
+MAGIC_DEPTH = 3
+MAGIC_DISTANCE = 0.01
 # The Noise on world positions case (noise_world_case): Suzanne moved, turned and scaled so.
 NOISE_WORLD_PLACEMENT = ((0.4, -0.3, 0.2), (0.5, -0.3, 0.9), (1.4, 0.8, 1.2))
 VORONOI_NODE = {"voronoi_dimensions": "3D", "feature": "F1", "distance": "EUCLIDEAN"}
@@ -2893,6 +2909,72 @@ def brick_case(settings, ob, work):
                         BRICK_MAPPING, BRICK_DISTANCE, ("mapping",))
 
 
+def make_gradient(tree):
+    """A Gradient Texture node (Quadratic Sphere) in `tree`."""
+    gradient = tree.nodes.new("ShaderNodeTexGradient")
+    gradient.gradient_type = "QUADRATIC_SPHERE"
+    return gradient
+
+
+def gradient_case(settings, ob, work):
+    """The bump material's Height fed by a Gradient Texture's Fac (make_gradient) on the
+    object's own coordinates through a Mapping node (GRADIENT_MAPPING): texture_case
+    "gradient", its type the layer's, no frequency sent, its control without the mapping."""
+    return texture_case(settings, ob, work, "gradient", make_gradient, {}, {},
+                        {"gradient_type": "quadratic-sphere"}, {"frequency", "detail", "depth"},
+                        GRADIENT_MAPPING, GRADIENT_DISTANCE, ("mapping",))
+
+
+def make_magic(tree):
+    """A Magic Texture node in `tree` with MAGIC_INPUTS and Depth MAGIC_DEPTH."""
+    magic = tree.nodes.new("ShaderNodeTexMagic")
+    for name, value in MAGIC_INPUTS.items():
+        magic.inputs[name].default_value = value
+    magic.turbulence_depth = MAGIC_DEPTH
+    return magic
+
+
+def magic_case(settings, ob, work):
+    """The bump material's Height fed by a Magic Texture's Fac (make_magic) on the object's own
+    coordinates through a Mapping node (BRICK_MAPPING): texture_case "magic", its Depth as the
+    layer's, its control without the mapping."""
+    return texture_case(settings, ob, work, "magic", make_magic,
+                        {"frequency": "Scale", "distortion": "Distortion"}, MAGIC_INPUTS,
+                        {"depth": MAGIC_DEPTH}, {"detail", "gradient_type", "roughness"},
+                        BRICK_MAPPING, MAGIC_DISTANCE, ("mapping",))
+
+
+def gradient_magic_checks(settings, ob):
+    """Layers from Material on a Magic Texture it does not take (its Color output, a Scale fed
+    by a node: no layer, a reason), and volume layers made by hand with function Blender
+    Gradient (sent without a frequency) and Blender Magic. Returns check records."""
+    c = TextureChecks(ob, "magic")
+    magic = make_magic(c.tree)
+    try:
+        c.tree.links.new(magic.outputs["Color"], c.bump.inputs["Height"])
+        c.refused("its Color output", "Color output")
+        c.tree.links.new(magic.outputs["Fac"], c.bump.inputs["Height"])
+        feeder = c.tree.nodes.new("ShaderNodeTexNoise")
+        c.tree.links.new(feeder.outputs["Fac"], magic.inputs["Scale"])
+        c.refused("a Scale fed by another texture", "Scale from a node")
+        c.tree.nodes.remove(feeder)
+    finally:
+        c.tree.nodes.remove(magic)
+        c.tree.links.new(c.tex.outputs["Color"], c.bump.inputs["Height"])
+    return c.checks + [
+        hand_made_check(settings, "gradient", "Blender Gradient",
+                        {"function": "blender-gradient", "gradient_type": "radial",
+                         "frequency": 3.0, "amplitude": 0.01},
+                        {"function": "blender-gradient", "gradient_type": "radial"},
+                        ("frequency", "depth", "distortion", "detail", "mapping")),
+        hand_made_check(settings, "magic", "Blender Magic",
+                        {"function": "blender-magic", "frequency": 2.0, "depth": 5,
+                         "distortion": 1.7, "amplitude": 0.01},
+                        {"function": "blender-magic", "frequency": 2.0, "depth": 5,
+                         "distortion": 1.7},
+                        ("gradient_type", "detail", "roughness", "mapping"))]
+
+
 def voronoi_checks(settings, ob):
     """Layers from Material on Voronoi Textures: Manhattan, Chebychev and Minkowski give the
     scene's metrics; F2, Smooth F1 and Distance to Edge the scene's features (Smooth F1 with
@@ -2996,12 +3078,15 @@ def blender_make(work, library_path, sabotage):
     manifest["noise_uv"] = noise_uv_case(settings, ob, work)
     manifest["noise_world"] = noise_world_case(settings, ob, work)
     manifest["brick"] = brick_case(settings, ob, work)
+    manifest["gradient"] = gradient_case(settings, ob, work)
+    manifest["magic"] = magic_case(settings, ob, work)
     layers_from_material(settings, distance)  # the material's layer again, for what follows
     manifest["errors"] = (material_checks(settings, ob, distance) + remap_checks(ob, distance)
                           + noise_checks(settings, ob, distance)
                           + musgrave_checks(settings, ob)
                           + wave_checks(settings, ob)
                           + voronoi_checks(settings, ob)
+                          + gradient_magic_checks(settings, ob)
                           + [hand_made_check(
                               settings, "brick", "Blender Brick",
                               {"function": "blender-brick", "frequency": 4.0,
@@ -3071,6 +3156,8 @@ def blender_compare(work):
     results["noise_uv"] = against_cycles(work, "noise_uv")
     results["noise_world"] = against_cycles(work, "noise_world")
     results["brick"] = against_cycles(work, "brick")
+    results["gradient"] = against_cycles(work, "gradient")
+    results["magic"] = against_cycles(work, "magic")
     with open(os.path.join(work, "results.json"), "w", encoding="ascii") as f:
         json.dump(results, f, indent=1)
 
@@ -3340,6 +3427,16 @@ def evaluate(manifest, results):
         f"{BRICK_DISTANCE:g}", manifest["brick"], results["brick"], "without the layer's mapping",
         NOISE_MEDIAN_DEG, NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
     failures += evaluate_case_against_cycles(
+        "gradient", "a Gradient Texture's Fac (Quadratic Sphere) on object coordinates through a "
+        f"Mapping node (Point), Distance {GRADIENT_DISTANCE:g}", manifest["gradient"],
+        results["gradient"], "without the layer's mapping", NOISE_MEDIAN_DEG,
+        NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
+    failures += evaluate_case_against_cycles(
+        "magic", "a Magic Texture's Fac (" + ", ".join(f"{k} {v:g}" for k, v in MAGIC_INPUTS.items())
+        + f", Depth {MAGIC_DEPTH}) on object coordinates through a Mapping node (Point), Distance "
+        f"{MAGIC_DISTANCE:g}", manifest["magic"], results["magic"], "without the layer's mapping",
+        NOISE_MEDIAN_DEG, NOISE_CONTROL_FACTOR, NOISE_P99_DEG)
+    failures += evaluate_case_against_cycles(
         "musgrave", "a Musgrave Texture (fBM, 3D, "
         + ", ".join(f"{k} {v:g}" for k, v in MUSGRAVE_INPUTS.items())
         + ") on object coordinates through a Mapping node (Point), Distance "
@@ -3391,7 +3488,8 @@ def evaluate(manifest, results):
                   + manifest["wave"]["checks"] + manifest["voronoi"]["checks"]
                   + manifest["voronoi_edge"]["checks"]
                   + manifest["noise_uv"]["checks"] + manifest["noise_world"]["checks"]
-                  + manifest["brick"]["checks"]
+                  + manifest["brick"]["checks"] + manifest["gradient"]["checks"]
+                  + manifest["magic"]["checks"]
                   + manifest["errors"]):
         print(f"  check, {check['name']}: {check['message']!r} -> "
               f"{'ok' if check['ok'] else 'FAIL'}")

@@ -18,6 +18,8 @@ bake_orientation.py)
 
 Blender part (numpy and bpy)
     setup_cycles, reset_scene, new_float_image, image_array, save_exr, load_raw,
+    emit_plane, bake_emit, largest_differences, fac_oracle_blender (the Fac oracles' plane,
+    bakes and comparison; their driver fac_oracle_main),
     decode_normals, angle_deg, erode, angle_stats.
 
 Conventions (docs: /work/shared/CONVENTIONS.md)
@@ -382,6 +384,80 @@ def save_exr(img, path, verify=True):
             raise RuntimeError(f"{path}: EXR round trip is not exact (max diff {diff})")
 
 
+def emit_plane(out_dir, node_type, output):
+    """The scene of the Fac oracles (musgrave_fac_oracle.py, voronoi_distance_oracle.py,
+    texture_fac_oracle.py): a plane of side 2, turned and moved so that its object coordinates
+    vary in x, y and z, UV-mapped onto the whole square (written as OUT_DIR/mesh.obj), whose
+    material emits the `output` of a new node of type `node_type` on the object's coordinates,
+    with an active Image Texture to bake into. Returns (node, target): the texture node and the
+    Image Texture."""
+    import bpy
+    import mathutils
+    import objio
+    reset_scene()
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    ob = bpy.context.active_object
+    me = ob.data
+    me.transform(mathutils.Matrix.Rotation(0.6, 4, "X") @ mathutils.Matrix.Rotation(0.3, 4, "Y")
+                 @ mathutils.Matrix.Translation((0.3, -0.2, 0.1)))
+    me.calc_normals_split()
+    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me))
+    setup_cycles(bpy.context.scene)
+    mat = bpy.data.materials.new(node_type)
+    mat.use_nodes = True
+    me.materials.append(mat)
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    node = nodes.new(node_type)
+    emission = nodes.new("ShaderNodeEmission")
+    material_output = nodes.new("ShaderNodeOutputMaterial")
+    links.new(coordinates.outputs["Object"], node.inputs["Vector"])
+    links.new(node.outputs[output], emission.inputs["Color"])
+    links.new(emission.outputs["Emission"], material_output.inputs["Surface"])
+    target = nodes.new("ShaderNodeTexImage")
+    nodes.active = target
+    ob.select_set(True)
+    bpy.context.view_layer.objects.active = ob
+    return node, target
+
+
+def bake_emit(target, name, size, path):
+    """Bakes EMIT (margin 0) into a new float image NAME (SIZE^2) that the Image Texture node
+    `target` holds, and saves it as the EXR at PATH."""
+    import bpy
+    image = new_float_image(name, size, size)
+    target.image = image
+    result = bpy.ops.object.bake(type="EMIT", margin=0, use_clear=True,
+                                 target="IMAGE_TEXTURES", save_mode="INTERNAL")
+    if result != {"FINISHED"}:
+        raise RuntimeError(f"bake {name} returned {result}")
+    save_exr(image, path)
+
+
+def largest_differences(out_dir, case, prefixes=("ours", "control")):
+    """The largest |difference| of each PREFIX_CASE.exr from blender_CASE.exr in OUT_DIR (their
+    first channel), and the range of Blender's: {prefix: difference, "range": [min, max]}."""
+    import numpy as np
+    theirs = load_raw(os.path.join(out_dir, f"blender_{case}.exr"))[..., 0]
+    result = {prefix: float(np.abs(
+        load_raw(os.path.join(out_dir, f"{prefix}_{case}.exr"))[..., 0].astype(np.float64)
+        - theirs).max()) for prefix in prefixes}
+    result["range"] = [float(theirs.min()), float(theirs.max())]
+    return result
+
+
+def fac_oracle_blender(argv, tag, bake, cases):
+    """The Blender half of a Fac oracle: argv "bake DIR" runs bake(DIR), "compare DIR" prints
+    largest_differences of each of `cases` (names), both as JSON after `tag`."""
+    if argv[0] == "bake":
+        bake(argv[1])
+        print(tag + json.dumps({"baked": True}), flush=True)
+    else:
+        print(tag + json.dumps({case: largest_differences(argv[1], case) for case in cases}),
+              flush=True)
+
+
 def decode_normals(array):
     """(H, W, >=3) encoded normal map -> (H, W, 3) float64 unit vectors (n = 2c - 1)."""
     import numpy as np
@@ -442,6 +518,48 @@ def judge_against_control(label, ours, control, median_limit, control_min, contr
           f"texels; {'ok  ' if told else 'FAIL'} {control_what} median "
           f"{control['median_deg']:.3f} deg (must exceed {control_min})")
     return ok and told
+
+
+def fac_oracle_main(doc, script, tag, size, layers, limit, quantity, control_what,
+                    sabotage_help, control_min=1e-2):
+    """The driver of a Fac oracle (musgrave_fac_oracle.py, voronoi_distance_oracle.py,
+    texture_fac_oracle.py; options --cli, --blender, --keep, --sabotage): Blender runs `script`
+    to bake blender_CASE.exr (fac_oracle_blender); the CLI bakes the "height" map (SIZE^2,
+    margin 0, 1 sample, 32-bit) of each layer of layers(sabotage) = {case: (ours, control)}
+    into ours_CASE.exr and control_CASE.exr; Blender compares. Each of ours must be within
+    limit(case) of Cycles' `quantity` (the node's output, "Fac" or "Distance"), each control
+    (`control_what`: "the next type's") at least `control_min` off. Returns the exit status."""
+    import objio
+    parser = oracle_parser(doc, blender_help=None)
+    parser.add_argument("--sabotage", action="store_true", help=sabotage_help)
+    args = parser.parse_args()
+    blender = blender_or_skip(args.blender)
+    require_executable(args.cli, "error: --cli {} is not an executable file")
+    with work_dir(args.keep, f"sgbake_{os.path.splitext(os.path.basename(script))[0]}_") as out:
+        if objio.run_blender_result(blender, script, ["bake", out], tag) is None:
+            return 1
+        for case, pair in layers(args.sabotage).items():
+            for prefix, layer in zip(("ours", "control"), pair):
+                scene = {"mesh": "mesh.obj", "layers": [layer],
+                         "outputs": [{"map": "height", "file": f"{prefix}_{case}.exr",
+                                      "size": size, "margin": 0, "samples": 1, "bit_depth": 32}]}
+                if not bake_scene_file(args.cli, out, f"{prefix}_{case}", scene):
+                    return 1
+        stats = objio.run_blender_result(blender, script, ["compare", out], tag)
+        if stats is None:
+            return 1
+        failures = []
+        for case, s in stats.items():
+            close, told = s["ours"] <= limit(case), s["control"] >= control_min
+            print(f"  {case}: {quantity} in [{s['range'][0]:.3f}, {s['range'][1]:.3f}], max "
+                  f"|diff| {s['ours']:.2g} (<= {limit(case):g}), {control_what} "
+                  f"{s['control']:.3g} (>= {control_min:g}) -> {'ok' if close and told else 'FAIL'}")
+            if not close:
+                failures.append(f"{case}: the {quantity} differs from Cycles' by {s['ours']:.3g}")
+            if not told:
+                failures.append(f"{case}: {control_what} {quantity} is within {s['control']:.3g} "
+                                "of Cycles' (the control cannot tell them apart)")
+        return report(failures)
 
 
 def bake_scene_file(cli, directory, name, scene):

@@ -275,6 +275,14 @@ def bump_by_noise(mat, settings):
         noise.offset, noise.offset_frequency = settings["brick_offset"], settings["offset_frequency"]
         noise.squash, noise.squash_frequency = settings["squash"], settings["squash_frequency"]
         inputs = ("Scale", "Mortar Size", "Mortar Smooth", "Brick Width", "Row Height")
+    elif settings.get("kind") == "gradient":
+        noise = nodes.new("ShaderNodeTexGradient")
+        noise.gradient_type = settings["gradient_type"]
+        inputs = ()
+    elif settings.get("kind") == "magic":
+        noise = nodes.new("ShaderNodeTexMagic")
+        noise.turbulence_depth = settings["depth"]
+        inputs = ("Scale", "Distortion")
     elif settings.get("kind") == "wave":
         noise = nodes.new("ShaderNodeTexWave")
         noise.wave_type, noise.wave_profile = settings["wave"], settings["profile"]
@@ -606,6 +614,13 @@ noise_case("voronoi_uv_sphere", "sphere", 512, 0.02, kind="voronoi", scale=3.0, 
 noise_case("brick_suzanne", "suzanne", 512, 0.005, kind="brick", scale=3.0, mortar_size=0.08,
            mortar_smooth=1.0, brick_width=0.6, row_height=0.3, brick_offset=0.4,
            offset_frequency=2, squash=1.5, squash_frequency=3, mapping=NOISE_MAPPING)
+# Blender's Gradient Texture (Quadratic Sphere, mapped so that its unit sphere holds all of
+# Suzanne) on Suzanne, and its Magic Texture (Depth 3, Distortion 1.5) on the sphere.
+noise_case("gradient_suzanne", "suzanne", 256, 0.2, kind="gradient",
+           gradient_type="QUADRATIC_SPHERE",
+           mapping=((0.1, -0.1, 0.05), (0.4, 0.0, -0.6), (0.45, 0.6, 0.5)))
+noise_case("magic_sphere", "sphere", 256, 0.01, kind="magic", scale=1.2, depth=3,
+           distortion=1.5, mapping=NOISE_MAPPING)
 # Blender's Musgrave Texture (fBM) on the sphere: Detail 2.5, Dimension 1.5, Lacunarity 2.3.
 noise_case("musgrave_sphere", "sphere", 512, 0.02, kind="musgrave", scale=2.0, detail=2.5,
            dimension=1.5, lacunarity=2.3, mapping=NOISE_MAPPING)

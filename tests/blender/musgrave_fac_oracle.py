@@ -23,7 +23,6 @@ theirs), to see the test fail.
 Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed. Takes ~10 s.
 """
 
-import json
 import os
 import sys
 
@@ -63,72 +62,20 @@ def name(index, blender_type):
 
 def bake(out_dir):
     """Step 1: mesh.obj and blender_S_TYPE.exr."""
-    import bpy
-    import mathutils
-    bc.reset_scene()
-    bpy.ops.mesh.primitive_plane_add(size=2.0)
-    ob = bpy.context.active_object
-    me = ob.data
-    me.transform(mathutils.Matrix.Rotation(0.6, 4, "X") @ mathutils.Matrix.Rotation(0.3, 4, "Y")
-                 @ mathutils.Matrix.Translation((0.3, -0.2, 0.1)))
-    me.calc_normals_split()
-    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me))
-    scene = bpy.context.scene
-    bc.setup_cycles(scene)
-    mat = bpy.data.materials.new("musgrave")
-    mat.use_nodes = True
-    me.materials.append(mat)
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
-    coordinates = nodes.new("ShaderNodeTexCoord")
-    musgrave = nodes.new("ShaderNodeTexMusgrave")
+    musgrave, target = bc.emit_plane(out_dir, "ShaderNodeTexMusgrave", "Fac")
     musgrave.musgrave_dimensions = "3D"
-    emission = nodes.new("ShaderNodeEmission")
-    output = nodes.new("ShaderNodeOutputMaterial")
-    links.new(coordinates.outputs["Object"], musgrave.inputs["Vector"])
-    links.new(musgrave.outputs["Fac"], emission.inputs["Color"])
-    links.new(emission.outputs["Emission"], output.inputs["Surface"])
-    target = nodes.new("ShaderNodeTexImage")
-    nodes.active = target
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
     for index, settings in enumerate(SETTINGS):
         for blender_type in TYPES:
             musgrave.musgrave_type = blender_type
             for socket, value in settings.items():
                 musgrave.inputs[socket].default_value = value
-            image = bc.new_float_image(name(index, blender_type), SIZE, SIZE)
-            target.image = image
-            result = bpy.ops.object.bake(type="EMIT", margin=0, use_clear=True,
-                                         target="IMAGE_TEXTURES", save_mode="INTERNAL")
-            if result != {"FINISHED"}:
-                raise RuntimeError(f"bake {blender_type} returned {result}")
-            bc.save_exr(image, os.path.join(out_dir, f"blender_{name(index, blender_type)}.exr"))
-
-
-def compare(out_dir):
-    """Step 3: the largest |difference| of ours_ and control_S_TYPE.exr from Cycles'."""
-    import numpy as np
-    result = {}
-    for index in range(len(SETTINGS)):
-        for blender_type in TYPES:
             case = name(index, blender_type)
-            theirs = bc.load_raw(os.path.join(out_dir, f"blender_{case}.exr"))[..., 0]
-            result[case] = {
-                prefix: float(np.abs(
-                    bc.load_raw(os.path.join(out_dir, f"{prefix}_{case}.exr"))[..., 0].astype(
-                        np.float64) - theirs).max())
-                for prefix in ("ours", "control")}
-            result[case]["range"] = [float(theirs.min()), float(theirs.max())]
-    return result
+            bc.bake_emit(target, case, SIZE, os.path.join(out_dir, f"blender_{case}.exr"))
 
 
 def blender_main(argv):
-    if argv[0] == "bake":
-        bake(argv[1])
-        print(RESULT_TAG + json.dumps({"baked": True}), flush=True)
-    else:
-        print(RESULT_TAG + json.dumps(compare(argv[1])), flush=True)
+    bc.fac_oracle_blender(argv, RESULT_TAG, bake, [
+        name(index, blender_type) for index in range(len(SETTINGS)) for blender_type in TYPES])
 
 
 # ---- The driver ------------------------------------------------------------------------------
@@ -146,47 +93,19 @@ def layer(settings, blender_type, gain_factor=1.0):
     return values
 
 
-def main():
-    parser = bc.oracle_parser(__doc__, blender_help=None)
-    parser.add_argument("--sabotage", action="store_true",
-                        help="bake ours with a Gain 10%% above the node's")
-    args = parser.parse_args()
-    blender = bc.blender_or_skip(args.blender)
-    bc.require_executable(args.cli, "error: --cli {} is not an executable file")
+def layers(sabotage):
+    """Each case's layer and its control's: the same settings with the next type in TYPES."""
+    types = list(TYPES)
+    return {name(index, blender_type): (
+        layer(settings, blender_type, 1.1 if sabotage else 1.0),
+        layer(settings, types[(i + 1) % len(types)]))
+        for index, settings in enumerate(SETTINGS) for i, blender_type in enumerate(types)}
 
-    with bc.work_dir(args.keep, "sgbake_musgrave_fac_oracle_") as out_dir:
-        script = os.path.abspath(__file__)
-        if objio.run_blender_result(blender, script, ["bake", out_dir], RESULT_TAG) is None:
-            return 1
-        types = list(TYPES)
-        for index, settings in enumerate(SETTINGS):
-            for i, blender_type in enumerate(types):
-                case = name(index, blender_type)
-                other = types[(i + 1) % len(types)]
-                for prefix, layer_of in (
-                        ("ours", layer(settings, blender_type, 1.1 if args.sabotage else 1.0)),
-                        ("control", layer(settings, other))):
-                    scene = {"mesh": "mesh.obj", "layers": [layer_of],
-                             "outputs": [{"map": "height", "file": f"{prefix}_{case}.exr",
-                                          "size": SIZE, "margin": 0, "samples": 1,
-                                          "bit_depth": 32}]}
-                    if not bc.bake_scene_file(args.cli, out_dir, f"{prefix}_{case}", scene):
-                        return 1
-        stats = objio.run_blender_result(blender, script, ["compare", out_dir], RESULT_TAG)
-        if stats is None:
-            return 1
-        failures = []
-        for case, s in stats.items():
-            ok = s["ours"] <= FAC_LIMIT and s["control"] >= CONTROL_MIN
-            print(f"  {case}: Fac in [{s['range'][0]:.3f}, {s['range'][1]:.3f}], max |diff| "
-                  f"{s['ours']:.2g} (<= {FAC_LIMIT:g}), the next type's {s['control']:.3g} "
-                  f"(>= {CONTROL_MIN:g}) -> {'ok' if ok else 'FAIL'}")
-            if s["ours"] > FAC_LIMIT:
-                failures.append(f"{case}: the Fac differs from Cycles' by {s['ours']:.3g}")
-            if s["control"] < CONTROL_MIN:
-                failures.append(f"{case}: the next type's Fac is within {s['control']:.3g} of "
-                                "Cycles' (the control cannot tell the types apart)")
-        return bc.report(failures)
+
+def main():
+    return bc.fac_oracle_main(
+        __doc__, os.path.abspath(__file__), RESULT_TAG, SIZE, layers, lambda case: FAC_LIMIT,
+        "Fac", "the next type's", "bake ours with a Gain 10%% above the node's", CONTROL_MIN)
 
 
 if __name__ == "__main__":

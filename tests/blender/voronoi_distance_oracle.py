@@ -24,7 +24,6 @@ fail.
 Exit status: 0 pass, 1 fail, 2 usage error, 77 Blender is not installed. Takes ~30 s.
 """
 
-import json
 import os
 import sys
 
@@ -66,75 +65,21 @@ def name(index, feature, metric):
 
 def bake(out_dir):
     """Step 1: mesh.obj and blender_S_CASE.exr."""
-    import bpy
-    import mathutils
-    bc.reset_scene()
-    bpy.ops.mesh.primitive_plane_add(size=2.0)
-    ob = bpy.context.active_object
-    me = ob.data
-    me.transform(mathutils.Matrix.Rotation(0.6, 4, "X") @ mathutils.Matrix.Rotation(0.3, 4, "Y")
-                 @ mathutils.Matrix.Translation((0.3, -0.2, 0.1)))
-    me.calc_normals_split()
-    objio.write_obj(os.path.join(out_dir, "mesh.obj"), objio.mesh_arrays(me))
-    scene = bpy.context.scene
-    bc.setup_cycles(scene)
-    mat = bpy.data.materials.new("voronoi")
-    mat.use_nodes = True
-    me.materials.append(mat)
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
-    coordinates = nodes.new("ShaderNodeTexCoord")
-    voronoi = nodes.new("ShaderNodeTexVoronoi")
+    voronoi, target = bc.emit_plane(out_dir, "ShaderNodeTexVoronoi", "Distance")
     voronoi.voronoi_dimensions = "3D"
-    emission = nodes.new("ShaderNodeEmission")
-    output = nodes.new("ShaderNodeOutputMaterial")
-    links.new(coordinates.outputs["Object"], voronoi.inputs["Vector"])
-    links.new(voronoi.outputs["Distance"], emission.inputs["Color"])
-    links.new(emission.outputs["Emission"], output.inputs["Surface"])
-    target = nodes.new("ShaderNodeTexImage")
-    nodes.active = target
-    ob.select_set(True)
-    bpy.context.view_layer.objects.active = ob
     for index, settings in enumerate(SETTINGS):
         for feature, metric in CASES:
-            voronoi.feature, voronoi.distance = feature, metric
             # (the Distance output's link holds: every feature here has one)
-            links.new(voronoi.outputs["Distance"], emission.inputs["Color"])
+            voronoi.feature, voronoi.distance = feature, metric
             for socket, value in settings.items():
                 voronoi.inputs[socket].default_value = value
-            image = bc.new_float_image(name(index, feature, metric), SIZE, SIZE)
-            target.image = image
-            result = bpy.ops.object.bake(type="EMIT", margin=0, use_clear=True,
-                                         target="IMAGE_TEXTURES", save_mode="INTERNAL")
-            if result != {"FINISHED"}:
-                raise RuntimeError(f"bake {feature} {metric} returned {result}")
-            bc.save_exr(image,
-                        os.path.join(out_dir, f"blender_{name(index, feature, metric)}.exr"))
-
-
-def compare(out_dir):
-    """Step 3: the largest |difference| of ours_ and control_S_CASE.exr from Cycles'."""
-    import numpy as np
-    result = {}
-    for index in range(len(SETTINGS)):
-        for feature, metric in CASES:
             case = name(index, feature, metric)
-            theirs = bc.load_raw(os.path.join(out_dir, f"blender_{case}.exr"))[..., 0]
-            result[case] = {
-                prefix: float(np.abs(
-                    bc.load_raw(os.path.join(out_dir, f"{prefix}_{case}.exr"))[..., 0].astype(
-                        np.float64) - theirs).max())
-                for prefix in ("ours", "control")}
-            result[case]["range"] = [float(theirs.min()), float(theirs.max())]
-    return result
+            bc.bake_emit(target, case, SIZE, os.path.join(out_dir, f"blender_{case}.exr"))
 
 
 def blender_main(argv):
-    if argv[0] == "bake":
-        bake(argv[1])
-        print(RESULT_TAG + json.dumps({"baked": True}), flush=True)
-    else:
-        print(RESULT_TAG + json.dumps(compare(argv[1])), flush=True)
+    bc.fac_oracle_blender(argv, RESULT_TAG, bake, [
+        name(index, feature, metric) for index in range(len(SETTINGS)) for feature, metric in CASES])
 
 
 # ---- The driver ------------------------------------------------------------------------------
@@ -151,50 +96,22 @@ def layer(settings, feature, metric, randomness_factor=1.0):
     return values
 
 
-def main():
-    parser = bc.oracle_parser(__doc__, blender_help=None)
-    parser.add_argument("--sabotage", action="store_true",
-                        help="bake ours with a Randomness 5%% below the node's")
-    args = parser.parse_args()
-    blender = bc.blender_or_skip(args.blender)
-    bc.require_executable(args.cli, "error: --cli {} is not an executable file")
+def layers(sabotage):
+    """Each case's layer and its control's: the same settings with the next feature in
+    FEATURES, the metric kept."""
+    features = list(FEATURES)
+    return {name(index, feature, metric): (
+        layer(settings, feature, metric, 0.95 if sabotage else 1.0),
+        layer(settings, features[(features.index(feature) + 1) % len(features)], metric))
+        for index, settings in enumerate(SETTINGS) for feature, metric in CASES}
 
-    with bc.work_dir(args.keep, "sgbake_voronoi_distance_oracle_") as out_dir:
-        script = os.path.abspath(__file__)
-        if objio.run_blender_result(blender, script, ["bake", out_dir], RESULT_TAG) is None:
-            return 1
-        features = list(FEATURES)
-        for index, settings in enumerate(SETTINGS):
-            for feature, metric in CASES:
-                case = name(index, feature, metric)
-                other = features[(features.index(feature) + 1) % len(features)]
-                for prefix, layer_of in (
-                        ("ours", layer(settings, feature, metric,
-                                       0.95 if args.sabotage else 1.0)),
-                        ("control", layer(settings, other, metric))):
-                    scene = {"mesh": "mesh.obj", "layers": [layer_of],
-                             "outputs": [{"map": "height", "file": f"{prefix}_{case}.exr",
-                                          "size": SIZE, "margin": 0, "samples": 1,
-                                          "bit_depth": 32}]}
-                    if not bc.bake_scene_file(args.cli, out_dir, f"{prefix}_{case}", scene):
-                        return 1
-        stats = objio.run_blender_result(blender, script, ["compare", out_dir], RESULT_TAG)
-        if stats is None:
-            return 1
-        failures = []
-        for case, s in stats.items():
-            limit = MINKOWSKI_LIMIT if case.endswith("MINKOWSKI") else DISTANCE_LIMIT
-            ok = s["ours"] <= limit and s["control"] >= CONTROL_MIN
-            print(f"  {case}: Distance in [{s['range'][0]:.3f}, {s['range'][1]:.3f}], max "
-                  f"|diff| {s['ours']:.2g} (<= {limit:g}), the next feature's "
-                  f"{s['control']:.3g} (>= {CONTROL_MIN:g}) -> {'ok' if ok else 'FAIL'}")
-            if s["ours"] > limit:
-                failures.append(f"{case}: the Distance differs from Cycles' by {s['ours']:.3g}")
-            if s["control"] < CONTROL_MIN:
-                failures.append(f"{case}: the next feature's Distance is within "
-                                f"{s['control']:.3g} of Cycles' (the control cannot tell the "
-                                "features apart)")
-        return bc.report(failures)
+
+def main():
+    return bc.fac_oracle_main(
+        __doc__, os.path.abspath(__file__), RESULT_TAG, SIZE, layers,
+        lambda case: MINKOWSKI_LIMIT if case.endswith("MINKOWSKI") else DISTANCE_LIMIT,
+        "Distance", "the next feature's", "bake ours with a Randomness 5%% below the node's",
+        CONTROL_MIN)
 
 
 if __name__ == "__main__":

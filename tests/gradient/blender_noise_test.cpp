@@ -15,20 +15,13 @@
 namespace sgbake {
 namespace {
 
+using test::centralGradient;
 using test::maxAbsDiff;
 
 BlenderNoise makeNoise(const BlenderNoiseParams& params) {
   Result<BlenderNoise> made = BlenderNoise::create(params);
   EXPECT_TRUE(made) << made.error().message;
   return std::move(made).value();
-}
-
-/// Central differences of @p f at @p p, step @p h.
-template <class F>
-Vec3d centralGradient(const F& f, Vec3d p, double h) {
-  return {(f(p + Vec3d{h, 0, 0}) - f(p - Vec3d{h, 0, 0})) / (2 * h),
-          (f(p + Vec3d{0, h, 0}) - f(p - Vec3d{0, h, 0})) / (2 * h),
-          (f(p + Vec3d{0, 0, h}) - f(p - Vec3d{0, 0, h})) / (2 * h)};
 }
 
 // Perlin noise is 0 at every lattice point, so without distortion each octave there reads ½:

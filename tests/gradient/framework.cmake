@@ -10,6 +10,8 @@ sgbake_add_gtest(gradient_framework_tests
   bump_node_test.cpp
   remap_test.cpp
   blender_noise_test.cpp
-  blender_brick_test.cpp)
+  blender_brick_test.cpp
+  blender_gradient_test.cpp
+  blender_magic_test.cpp)
 # Cycles' valid-reflection guard, private to the library, is read directly by the layer tests.
 target_include_directories(gradient_framework_tests PRIVATE ${PROJECT_SOURCE_DIR}/src)

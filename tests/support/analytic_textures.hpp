@@ -1,11 +1,15 @@
 // Textures with closed-form values and exact derivatives, for tests whose reference is analytic.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <utility>
 
 #include "sgbake/core/math.hpp"
+#include "sgbake/core/result.hpp"
 #include "sgbake/gradient/texture.hpp"
 
 namespace sgbake::test {
@@ -16,6 +20,21 @@ inline double maxAbsDiff(Vec3d a, Vec3d b) {
 }
 inline double maxAbsDiff(Vec2d a, Vec2d b) {
   return std::max(std::abs(a.x - b.x), std::abs(a.y - b.y));
+}
+
+/// What a create() that must succeed made (its error reported as a failure otherwise).
+template <class T>
+T created(Result<T> made) {
+  EXPECT_TRUE(made) << made.error().message;
+  return std::move(made).value();
+}
+
+/// Central differences of @p f at @p p, step @p h.
+template <class F>
+Vec3d centralGradient(const F& f, Vec3d p, double h) {
+  return {(f(p + Vec3d{h, 0, 0}) - f(p - Vec3d{h, 0, 0})) / (2 * h),
+          (f(p + Vec3d{0, h, 0}) - f(p - Vec3d{0, h, 0})) / (2 * h),
+          (f(p + Vec3d{0, 0, h}) - f(p - Vec3d{0, 0, h})) / (2 * h)};
 }
 
 /// One normal everywhere, encoded n/2 + 0.5 as a normal map's texel.

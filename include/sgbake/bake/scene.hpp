@@ -87,6 +87,8 @@ enum class VolumeFunction {
   kBlenderWave,      ///< "blender-wave": BlenderWave, Blender's Wave Texture
   kBlenderVoronoi,   ///< "blender-voronoi": BlenderVoronoi, Blender's Voronoi Texture (3D)
   kBlenderBrick,     ///< "blender-brick": BlenderBrick, Blender's Brick Texture's Fac
+  kBlenderGradient,  ///< "blender-gradient": BlenderGradient, Blender's Gradient Texture
+  kBlenderMagic,     ///< "blender-magic": BlenderMagic, Blender's Magic Texture's Fac
 };
 
 /// @brief The scene's "subdivision" block: Blender's Subdivision Surface modifier on the mesh
@@ -258,6 +260,12 @@ struct SceneLayer {
   /// "brick_offset", "offset_frequency", "squash", "squash_frequency": the node's inputs and
   /// properties, Blender's defaults (its amplitude and scale are the layer's)
   BlenderBrickParams brick{};
+  /// blender-gradient: "gradient_type" (linear | quadratic | easing | diagonal | spherical |
+  /// quadratic-sphere | radial), the node's Gradient Type (it has no Scale: no "frequency")
+  BlenderGradientType gradientType = BlenderGradientType::kLinear;
+  /// blender-magic: "depth" (0 to 10), the node's Depth (also "distortion", 1 unless given, and
+  /// "frequency", its Scale)
+  int magicDepth = 2;
   GradientScheme gradient = GradientScheme::kAnalytic;  ///< "gradient"
   std::optional<double> step;  ///< "step"; default defaultStep(mesh bounding-box diagonal)
   VolumeCoordinates coordinates = VolumeCoordinates::kObject;  ///< "coordinates" (with "uv")

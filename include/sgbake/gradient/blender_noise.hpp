@@ -170,6 +170,87 @@ class BlenderBrick final : public BlenderTextureVolume<BlenderBrickParams> {
   using BlenderTextureVolume::BlenderTextureVolume;
 };
 
+/// The Gradient Texture's Gradient Type (Blender's LINEAR, QUADRATIC, EASING, DIAGONAL,
+/// SPHERICAL, QUADRATIC_SPHERE, RADIAL).
+enum class BlenderGradientType {
+  kLinear,
+  kQuadratic,
+  kEasing,
+  kDiagonal,
+  kSpherical,
+  kQuadraticSphere,
+  kRadial
+};
+
+/// @brief The Gradient Texture node's type and the height's scale (the node has no Scale: a
+/// Mapping node in front of it scales P).
+struct BlenderGradientParams {
+  double amplitude = 1;  ///< height per unit of Fac
+  BlenderGradientType type = BlenderGradientType::kLinear;
+};
+
+/// @brief Blender's Gradient Texture's Fac (its Color is (Fac, Fac, Fac)), times an amplitude: a
+/// HeightVolume.
+///
+/// Of P = (x, y, z), Cycles 3.4's `svm_gradient`, its result clamped to [0, 1]:
+/// - Linear x; Quadratic max(x, 0)²; Easing 3r² − 2r³ of r = clamp(x, 0, 1); Diagonal (x + y) / 2;
+/// - Spherical s = max(k − |P|, 0) and Quadratic Sphere s², k = 0.999999 (Cycles' float
+///   0.999999f, its nudge for unit vectors);
+/// - Radial atan2(y, x) / 2π + ½.
+///
+/// The gradient is exact where the Fac is not clamped, and 0 where it is (a point on a clamp's
+/// bound counts as clamped). Where it is not differentiable: Spherical's and Quadratic Sphere's
+/// apex P = 0 takes the gradient 0; Radial's is (−y, x) / (2π (x² + y²)), singular on the z axis,
+/// where it is taken as 0 (x² + y² = 0, underflow included; atan2(0, 0) = 0 gives the Fac ½), and
+/// across the half-plane y = 0, x < 0 the Fac jumps from 1 (y = +0) to 0 (y < 0): the gradient
+/// there is the smooth one of either side, the jump not seen.
+class BlenderGradient final : public BlenderTextureVolume<BlenderGradientParams> {
+ public:
+  /// @return kBadInput for a non-finite amplitude, an unknown type, or slopes beyond
+  /// kMaxVolumeScale.
+  static Result<BlenderGradient> create(const BlenderGradientParams& params);
+  /// The node's Fac.
+  double output(Vec3d p, Vec3d* gradient) const override;
+
+ private:
+  using BlenderTextureVolume::BlenderTextureVolume;
+};
+
+/// The Magic Texture's Depth: 0 to this (Blender's range).
+inline constexpr int kBlenderMagicMaxDepth = 10;
+
+/// @brief The Magic Texture node's settings and the height's scale.
+struct BlenderMagicParams {
+  double amplitude = 1;   ///< height per unit of Fac
+  double scale = 5;       ///< the node's Scale
+  int depth = 2;          ///< the node's Depth, 0 to kBlenderMagicMaxDepth
+  double distortion = 1;  ///< the node's Distortion
+};
+
+/// @brief Blender's Magic Texture's Fac, the mean of its Color's three channels (Cycles 3.4's
+/// `svm_node_tex_magic` writes Fac as average(color)), times an amplitude: a HeightVolume.
+///
+/// With p = scale · P and a = 5 (pₓ + p_y + p_z), b = 5 (−pₓ + p_y − p_z), c = 5 (−pₓ − p_y + p_z):
+/// x = sin a, y = cos b, z = −cos c. With Depth n > 0, each of x, y, z is times the Distortion
+/// d, then n of Cycles' ten steps follow in order, each setting one of x, y, z to d times a sine
+/// or cosine (signed) of ±x ± y ± z of the current values (Cycles' `svm_magic`: y = −cos(x − y +
+/// z), x = cos(x − y − z), z = sin(−x − y − z), x = −cos(−x + y − z), y = −sin(−x + y + z), y =
+/// −cos(−x + y + z), x = cos(x + y + z), z = sin(x + y − z), x = −cos(−x − y + z), y = −sin(x − y
+/// + z)). Where d ≠ 0, x, y, z are divided by 2d (at Depth 0 too). Color = ½ − (x, y, z); Fac =
+/// its mean. The gradient is exact: the chain rule through every sine and cosine.
+class BlenderMagic final : public BlenderTextureVolume<BlenderMagicParams> {
+ public:
+  /// @return kBadInput for a non-finite setting, a Depth out of [0, kBlenderMagicMaxDepth], or
+  /// slopes beyond kMaxVolumeScale (|amplitude| · |scale| · 5√3 · max(1, 3|d|)^n, divided by 2|d|
+  /// at Depth 0).
+  static Result<BlenderMagic> create(const BlenderMagicParams& params);
+  /// The node's Fac.
+  double output(Vec3d p, Vec3d* gradient) const override;
+
+ private:
+  using BlenderTextureVolume::BlenderTextureVolume;
+};
+
 /// The Wave Texture's Wave Type.
 enum class WaveType { kBands, kRings };
 /// Its Bands Direction (x, y, z, diagonal) or Rings Direction (x, y, z: around that axis;
