@@ -952,7 +952,7 @@ PROCEDURAL_TEXTURES = {
         "blender-magic", None,
         others="three channels of their own, not a height; a volume layer is the Fac (their "
                "mean)",
-        props={"depth": "turbulence_depth"}),
+        inputs={"magic_distortion": "Distortion"}, props={"depth": "turbulence_depth"}),
 }
 
 

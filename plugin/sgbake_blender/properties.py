@@ -355,8 +355,10 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                               description="Blender Noise: the Noise Texture's Distortion (the "
                                           "point moved by three other noises first); Blender "
                                           "Wave: the Wave Texture's (the wave moved by a "
-                                          "noise); Blender Magic: the Magic Texture's (its "
-                                          "default there is 1)")
+                                          "noise)")
+    # (Its own property: the Magic Texture's Distortion starts at 1, the others' at 0.)
+    magic_distortion: FloatProperty(name="Distortion", default=1.0, precision=3,
+                                    description="Blender Magic: the Magic Texture's Distortion")
     detail_scale: FloatProperty(name="Detail Scale", default=1.0, precision=3,
                                 description="Blender Wave: the Wave Texture's Detail Scale (the "
                                             "distorting noise's frequency relative to Scale)")

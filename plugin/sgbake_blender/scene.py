@@ -42,12 +42,12 @@ BLENDER_TEXTURE_SETTINGS = {
     "blender-brick": ("mortar_size", "mortar_smooth", "brick_width", "row_height", "brick_offset",
                       "offset_frequency", "squash", "squash_frequency"),
     "blender-gradient": ("gradient_type",),
-    "blender-magic": ("depth", "distortion"),
+    "blender-magic": ("depth", "magic_distortion"),
 }
 # Blender's textures without a Scale: their volumes take no "frequency".
 UNSCALED_FUNCTIONS = {"blender-gradient"}
 # The scene's keys of the settings whose layer property has another name.
-SETTING_KEYS = {"musgrave_offset": "offset"}
+SETTING_KEYS = {"musgrave_offset": "offset", "magic_distortion": "distortion"}
 # The Musgrave Texture's inputs its types do not use (libsgbake refuses them): Multifractal and
 # fBM use neither Offset nor Gain, Hetero Terrain no Gain.
 MUSGRAVE_UNUSED = {"fbm": ("musgrave_offset", "gain"),

@@ -2939,7 +2939,7 @@ def magic_case(settings, ob, work):
     coordinates through a Mapping node (BRICK_MAPPING): texture_case "magic", its Depth as the
     layer's, its control without the mapping."""
     return texture_case(settings, ob, work, "magic", make_magic,
-                        {"frequency": "Scale", "distortion": "Distortion"}, MAGIC_INPUTS,
+                        {"frequency": "Scale", "magic_distortion": "Distortion"}, MAGIC_INPUTS,
                         {"depth": MAGIC_DEPTH}, {"detail", "gradient_type", "roughness"},
                         BRICK_MAPPING, MAGIC_DISTANCE, ("mapping",))
 
@@ -2969,9 +2969,14 @@ def gradient_magic_checks(settings, ob):
                         ("frequency", "depth", "distortion", "detail", "mapping")),
         hand_made_check(settings, "magic", "Blender Magic",
                         {"function": "blender-magic", "frequency": 2.0, "depth": 5,
-                         "distortion": 1.7, "amplitude": 0.01},
+                         "magic_distortion": 1.7, "amplitude": 0.01},
                         {"function": "blender-magic", "frequency": 2.0, "depth": 5,
                          "distortion": 1.7},
+                        ("gradient_type", "detail", "roughness", "mapping")),
+        # Left as they start, its settings are the node's defaults: Depth 2, Distortion 1.
+        hand_made_check(settings, "magic", "Blender Magic (at its defaults)",
+                        {"function": "blender-magic", "amplitude": 0.01},
+                        {"function": "blender-magic", "depth": 2, "distortion": 1.0},
                         ("gradient_type", "detail", "roughness", "mapping"))]
 
 
