@@ -219,6 +219,14 @@ BAKE_MAX_DEG = {"suzanne_flat": 10.0}
 # medians 0.34-0.53 deg. That analytic bake is its negative control: it must fail these bars.
 BUMP_NODE_MEDIAN_DEG = 0.01
 BUMP_NODE_P99_DEG = 0.05
+# Per-case bars on the worst texel of (e) where the custom normals meet their triangles edge-on
+# (the back-facing spheres): there the bake's incoming direction grazes the surface, and Cycles'
+# guard drops a root beyond 89.82 deg from Ng for its other one (validReflectionNormal).
+# Measured max 0.30-0.69 deg; with the nearest root instead 90 deg (sphere_backfacing, 60
+# texels), 117 deg (stretch_sphere_backfacing, 58), and 56 and 49 texels over 10 deg on the
+# planar and Box-projected ones.
+BUMP_NODE_MAX_DEG = {"sphere_backfacing": 2.0, "stretch_sphere_backfacing": 2.0,
+                     "planar_sphere_backfacing": 2.0, "box_sphere_backfacing": 2.0}
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
@@ -628,8 +636,9 @@ def passes_bake(s, case=None):
             and s["max_deg"] <= BAKE_MAX_DEG.get(case, math.inf))
 
 
-def passes_bump_node(s):
-    return s["median_deg"] <= BUMP_NODE_MEDIAN_DEG and s["p99_deg"] <= BUMP_NODE_P99_DEG
+def passes_bump_node(s, case=None):
+    return (s["median_deg"] <= BUMP_NODE_MEDIAN_DEG and s["p99_deg"] <= BUMP_NODE_P99_DEG
+            and s["max_deg"] <= BUMP_NODE_MAX_DEG.get(case, math.inf))
 
 
 def passes_nmap(s, chain=False, stretched=False, case=None):
@@ -796,8 +805,9 @@ def evaluate(name, r, planar=False):
                          f"(max |diff| {same})")
     if not missing("bake_bump_node", "bump-node bake"):
         s = r["bake_bump_node"]
-        judge("(e) bump-node bake vs Blender: ", s, passes_bump_node(s),
-              f"(median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= {BUMP_NODE_P99_DEG})",
+        max_bar = (f", max <= {BUMP_NODE_MAX_DEG[name]}" if name in BUMP_NODE_MAX_DEG else "")
+        judge("(e) bump-node bake vs Blender: ", s, passes_bump_node(s, name),
+              f"(median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= {BUMP_NODE_P99_DEG}{max_bar})",
               "the bump-node bake differs from Blender's")
         if "bake" in r and "error" not in r["bake"] and passes_bump_node(r["bake"]):
             fails.append(f"{name}: negative control: the analytic bake passes the bump-node "
