@@ -225,8 +225,13 @@ BUMP_NODE_P99_DEG = 0.05
 # Measured max 0.30-0.69 deg; with the nearest root instead 90 deg (sphere_backfacing, 60
 # texels), 117 deg (stretch_sphere_backfacing, 58), and 56 and 49 texels over 10 deg on the
 # planar and Box-projected ones.
+# stretch_chain_suzanne: where the Bump node bumps the normal map's normal far below the
+# surface, Cycles' closure keeps it there (a normal far below passes the guard); sgbake dropped
+# the bump (no Γ stands for it) until such a normal was handed on as it is (HandedNormal):
+# measured max 3.8 deg (the Suzanne texel of case suzanne), 142 deg on 22 texels over 10 before.
 BUMP_NODE_MAX_DEG = {"sphere_backfacing": 2.0, "stretch_sphere_backfacing": 2.0,
-                     "planar_sphere_backfacing": 2.0, "box_sphere_backfacing": 2.0}
+                     "planar_sphere_backfacing": 2.0, "box_sphere_backfacing": 2.0,
+                     "stretch_chain_suzanne": 10.0}
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
@@ -693,10 +698,11 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
                              f"flipped still passes")
     if chain and "nmap_bump_node" in r:
         s = r["nmap_bump_node"]
-        ok = "error" not in s and passes_bump_node(s)
+        ok = "error" not in s and passes_bump_node(s, name)
         print(f"  (e) bump-node chain vs Blender:         {fmt_nmap(s)} -> "
               f"{'ok' if ok else 'FAIL'} (median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= "
-              f"{BUMP_NODE_P99_DEG})")
+              f"{BUMP_NODE_P99_DEG}"
+              + (f", max <= {BUMP_NODE_MAX_DEG[name]})" if name in BUMP_NODE_MAX_DEG else ")"))
         if not ok:
             fails.append(f"{name}: the bump-node chain differs from Blender's: {fmt_nmap(s)}")
         if passes_bump_node(r["nmap_tangent"]):
