@@ -536,8 +536,9 @@ inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint
 }
 
 /// shader.addLayerGradient of a normal map (or a layer on the layers above) at @p p, flagging
-/// @p slow where it decodes (or bumps their normal) below the surface. Out of line: inlined, it kept the compiler from inlining surfacePointAt into
-/// batchGradients (1 % of a one-thread bake with a triplanar layer).
+/// @p slow where it decodes (or bumps their normal) below the surface. Out of line: inlined,
+/// it kept the compiler from inlining surfacePointAt into batchGradients (1 % of a one-thread
+/// bake with a triplanar layer).
 [[gnu::noinline]] inline void addNormalMapGradient(const BakeShaderBase& shader, const Layer& layer,
                                                    const SurfacePoint& p, Vec3d& gamma,
                                                    std::int64_t& slow) {
