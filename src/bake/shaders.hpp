@@ -270,13 +270,18 @@ struct BakeShaderBase {
   /// then the layers on the layers above while what they make stays below); empty elsewhere.
   Vec3d gradient(const SurfacePoint& p, std::optional<Vec3d>& handed) const {
     handed.reset();
-    // Only a normal map first can start a normal below the surface: otherwise gradient(p).
+    // Only a normal map first or a layer on the layers above can start a normal below the
+    // surface: otherwise gradient(p).
     const auto first = std::find_if(layers.begin(), layers.end(), [](const Layer& layer) {
       return layer.weight != 0 && std::isfinite(layer.weight);
     });
-    if (first == layers.end() || first->base != LayerBase::kSurface ||
-        !(std::holds_alternative<TangentNormalSource>(first->source) ||
-          std::holds_alternative<ObjectNormalSource>(first->source))) {
+    const bool stacks = std::any_of(layers.begin(), layers.end(), [](const Layer& layer) {
+      return layer.base == LayerBase::kLayersAbove;
+    });
+    if (first == layers.end() ||
+        (!stacks && (first->base != LayerBase::kSurface ||
+                     !(std::holds_alternative<TangentNormalSource>(first->source) ||
+                       std::holds_alternative<ObjectNormalSource>(first->source))))) {
       return gradient(p);
     }
     Vec3d gamma{};
@@ -530,9 +535,10 @@ inline void batchUvHeightGradient(const ShadingTriangle& tri, const SurfacePoint
   }
 }
 
-/// shader.addLayerGradient of a normal map at @p p, flagging @p slow where it decodes below the
-/// surface. Out of line: inlined, it kept the compiler from inlining surfacePointAt into
-/// batchGradients (1 % of a one-thread bake with a triplanar layer).
+/// shader.addLayerGradient of a normal map (or a layer on the layers above) at @p p, flagging
+/// @p slow where it decodes (or bumps their normal) below the surface. Out of line: inlined,
+/// it kept the compiler from inlining surfacePointAt into batchGradients (1 % of a one-thread
+/// bake with a triplanar layer).
 [[gnu::noinline]] inline void addNormalMapGradient(const BakeShaderBase& shader, const Layer& layer,
                                                    const SurfacePoint& p, Vec3d& gamma,
                                                    std::int64_t& slow) {
@@ -557,10 +563,12 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
                             std::get<UvHeightSource>(layer.source), layer.weight, unitN, gamma);
       continue;
     }
-    // (Only a normal map on the surface can start a normal below it.)
-    const bool noteBelow = slow != nullptr && layer.base == LayerBase::kSurface &&
-                           (std::holds_alternative<TangentNormalSource>(layer.source) ||
-                            std::holds_alternative<ObjectNormalSource>(layer.source));
+    // (Only a normal map on the surface or a layer on the layers above can start a normal
+    // below it.)
+    const bool noteBelow = slow != nullptr && (layer.base == LayerBase::kLayersAbove ||
+                           (layer.base == LayerBase::kSurface &&
+                            (std::holds_alternative<TangentNormalSource>(layer.source) ||
+                             std::holds_alternative<ObjectNormalSource>(layer.source))));
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
       Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};

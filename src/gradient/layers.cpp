@@ -332,9 +332,10 @@ Vec3d stackGradientNoting(const Vec3d& gamma, double strength, const Vec3d& n, c
   }
   Vec3d bumped = n;
   const Vec3d result = stackGradient(gamma, strength, n, ng, gammaAbove, incoming, aboveNormal,
-                                     aboveNormal != nullptr ? &bumped : nullptr);
-  if (below != nullptr && aboveNormal != nullptr && belowSurface(bumped, n))
-    *below = {true, bumped, 1};
+                                     below != nullptr ? &bumped : nullptr);
+  // Below the surface whether it was given a normal there or bumped one above it that far
+  // (Cycles' closure keeps a normal far below as it is; the Γ would drop the bump).
+  if (below != nullptr && belowSurface(bumped, n)) *below = {true, bumped, 1};
   return result;
 }
 

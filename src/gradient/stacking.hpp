@@ -38,9 +38,10 @@ struct NormalBelowSurface {
 
 /// @brief Follows the normal a stack of layers hands on where no Γ stands for it
 /// (NormalBelowSurface), layer by layer, as a composite adds them in order: a normal map first
-/// (weight 1, unmasked, on the surface) that decodes below the surface starts it, the layers on
-/// the layers above carry it while what they make stays below, and any other layer ends it (a
-/// normal map below the surface added to other layers is their Γ sum's, mirrored).
+/// (weight 1, unmasked, on the surface) that decodes below the surface starts it, and so does a
+/// layer on the layers above that bumps their normal below it; the layers on the layers above
+/// carry it while what they make stays below, and any other layer ends it (a normal map below
+/// the surface added to other layers is their Γ sum's, mirrored).
 ///
 ///     HandedNormal handed;
 ///     for (each active layer) {
@@ -59,10 +60,11 @@ class HandedNormal {
   }
   /// After @p layer added its Γ, what it noted in @p step, at unit normal @p n.
   void add(const Layer& layer, const NormalBelowSurface& step, const Vec3d& n) {
-    const bool carried = givenTo(layer) != nullptr;
+    // A normal map first starts it, and so does a layer on the layers above that bumps their
+    // normal below the surface; such a layer carries it on.
     const bool starts = layers_ == 0 && layer.base == LayerBase::kSurface;
     ++layers_;
-    if (step.found && (carried || starts)) {
+    if (step.found && (starts || layer.base == LayerBase::kLayersAbove)) {
       handed_ = step.handedOn(n);
     } else {
       handed_.reset();

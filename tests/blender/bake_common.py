@@ -491,7 +491,8 @@ def erode(mask, texels=1):
 
 
 def angle_stats(angles):
-    """Median, 90th and 99th percentile, max (degrees) and count of a 1-D array of angles."""
+    """Median, 90th and 99th percentile, max (degrees), the number over 10 degrees and count of
+    a 1-D array of angles."""
     import numpy as np
     angles = np.asarray(angles, dtype=np.float64)
     if angles.size == 0:
@@ -501,6 +502,7 @@ def angle_stats(angles):
             "p90_deg": float(np.percentile(angles, 90)),
             "p99_deg": float(np.percentile(angles, 99)),
             "max_deg": float(angles.max()),
+            "over_10_deg": int((angles > 10.0).sum()),
             "texels": int(angles.size)}
 
 

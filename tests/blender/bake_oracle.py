@@ -201,12 +201,14 @@ BAKE_P99_DEG = {"sphere_backfacing": 10.0, "stretch_sphere_backfacing": 15.0}
 # from behind as a UV height's: p90 111 deg.
 BAKE_P90_DEG = {"planar_sphere_backfacing": 5.0, "box_sphere_backfacing": 5.0}
 # With the Bump node's differences ("gradient": "bump-node"), (e) holds them too: median 0.0016,
-# p99 0.0018 and 0.0021 deg (56 texels over 10 deg on the back-facing sphere).
+# p99 0.0018 and 0.0021 deg (max 0.68 deg on the back-facing sphere; 56 texels over 10 deg
+# before the guard dropped Cycles' root beyond 89.82 deg, BUMP_NODE_OVER_10_MAX).
 # Blender's Box projection (box_*, Blend 0.3: one, two and three planes, each side's mirror):
 # exact slopes median 0.76 / 0.75 / 0.67 deg (front, back-facing p90 under 5, stretched p99
-# 4.8); bump-node median 0.0016 deg, p99 0.0018 / 0.0028 / 0.0023 deg (49 texels over 10 deg
-# on the back-facing sphere, as the planar one's). The stretched sphere's planes are picked by
-# the world normal taken back to object space: by the object's own normal, p99 0.30 deg.
+# 4.8); bump-node median 0.0016 deg, p99 0.0018 / 0.0028 / 0.0023 deg (max 0.62 on the
+# back-facing sphere, 49 texels over 10 deg before, as the planar one's). The stretched
+# sphere's planes are picked by the world normal taken back to object space: by the object's
+# own normal, p99 0.30 deg.
 # Per-case bars on the worst texel of (b). suzanne_flat: its concave quads 162 and 163, which
 # Cycles shades on the other diagonal's triangles (bake_detail::cyclesShadingTriangles):
 # measured 2.3 deg, 117 deg on 48 texels when shaded on the baker's own triangles.
@@ -214,10 +216,25 @@ BAKE_MAX_DEG = {"suzanne_flat": 10.0}
 # (e) "gradient": "bump-node" (--height-gradient bump-node) reads the heights again where Cycles'
 # Bump node does when it bakes (half a texel along Cycles' orthonormals of Ng), so its bake is
 # Cycles' to float rounding: measured median 0.0016, p99 0.0020-0.0024 deg on the sphere, Suzanne
-# and the stretched sphere (max 2.6 deg at one Suzanne texel), where the analytic bake (b) is at
+# and the stretched sphere (max 2.6 deg at one Suzanne texel, column 257, row 492: not yet
+# explained), where the analytic bake (b) is at
 # medians 0.34-0.53 deg. That analytic bake is its negative control: it must fail these bars.
 BUMP_NODE_MEDIAN_DEG = 0.01
 BUMP_NODE_P99_DEG = 0.05
+# Per-case bars on the number of texels of (e) more than 10 deg off, where the custom normals
+# meet their triangles edge-on (the back-facing spheres): there the bake's incoming direction
+# grazes the surface, and Cycles' guard drops a root beyond 89.82 deg from Ng for its other one
+# (validReflectionNormal). Measured max 0.30-0.69 deg; with the nearest root instead 60 texels
+# at 90 deg (sphere_backfacing), 58 up to 117 deg (stretch_sphere_backfacing), 56 and 49 on the
+# planar and Box-projected ones. A single texel can still flip by 90 deg with Cycles' float
+# (box_sphere_backfacing once, [166, 33], in a run of every case; 0.62 deg alone): at most 2.
+# stretch_chain_suzanne: where the Bump node bumps the normal map's normal far below the
+# surface, Cycles' closure keeps it there (a normal far below passes the guard); sgbake dropped
+# the bump (no Gamma stands for it) until such a normal was handed on as it is (HandedNormal):
+# measured max 3.8 deg (the Suzanne texel of case suzanne), 22 texels up to 142 deg before.
+BUMP_NODE_OVER_10_MAX = {"sphere_backfacing": 2, "stretch_sphere_backfacing": 2,
+                         "planar_sphere_backfacing": 2, "box_sphere_backfacing": 2,
+                         "stretch_chain_suzanne": 2}
 SAME_IMAGE_ABS = 1e-6
 BACKGROUND_ABS = 1e-4
 NMAP_MEDIAN_DEG = 0.05
@@ -649,8 +666,9 @@ def passes_bake(s, case=None):
             and s["max_deg"] <= BAKE_MAX_DEG.get(case, math.inf))
 
 
-def passes_bump_node(s):
-    return s["median_deg"] <= BUMP_NODE_MEDIAN_DEG and s["p99_deg"] <= BUMP_NODE_P99_DEG
+def passes_bump_node(s, case=None):
+    return (s["median_deg"] <= BUMP_NODE_MEDIAN_DEG and s["p99_deg"] <= BUMP_NODE_P99_DEG
+            and s.get("over_10_deg", 0) <= BUMP_NODE_OVER_10_MAX.get(case, math.inf))
 
 
 def passes_nmap(s, chain=False, stretched=False, case=None):
@@ -705,10 +723,12 @@ def evaluate_nmap(name, r, nmap, stretched_case=False):
                              f"flipped still passes")
     if chain and "nmap_bump_node" in r:
         s = r["nmap_bump_node"]
-        ok = "error" not in s and passes_bump_node(s)
+        ok = "error" not in s and passes_bump_node(s, name)
         print(f"  (e) bump-node chain vs Blender:         {fmt_nmap(s)} -> "
               f"{'ok' if ok else 'FAIL'} (median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= "
-              f"{BUMP_NODE_P99_DEG})")
+              f"{BUMP_NODE_P99_DEG}"
+              + (f", texels over 10 deg: {s.get('over_10_deg')} <= {BUMP_NODE_OVER_10_MAX[name]})"
+                 if name in BUMP_NODE_OVER_10_MAX else ")"))
         if not ok:
             fails.append(f"{name}: the bump-node chain differs from Blender's: {fmt_nmap(s)}")
         if passes_bump_node(r["nmap_tangent"]):
@@ -817,8 +837,10 @@ def evaluate(name, r, planar=False):
                          f"(max |diff| {same})")
     if not missing("bake_bump_node", "bump-node bake"):
         s = r["bake_bump_node"]
-        judge("(e) bump-node bake vs Blender: ", s, passes_bump_node(s),
-              f"(median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= {BUMP_NODE_P99_DEG})",
+        max_bar = (f", texels over 10 deg: {s.get('over_10_deg')} <= {BUMP_NODE_OVER_10_MAX[name]}"
+                   if name in BUMP_NODE_OVER_10_MAX else "")
+        judge("(e) bump-node bake vs Blender: ", s, passes_bump_node(s, name),
+              f"(median <= {BUMP_NODE_MEDIAN_DEG}, p99 <= {BUMP_NODE_P99_DEG}{max_bar})",
               "the bump-node bake differs from Blender's")
         if "bake" in r and "error" not in r["bake"] and passes_bump_node(r["bake"]):
             fails.append(f"{name}: negative control: the analytic bake passes the bump-node "
