@@ -279,9 +279,7 @@ struct BakeShaderBase {
       return layer.base == LayerBase::kLayersAbove;
     });
     if (first == layers.end() ||
-        (!stacks && (first->base != LayerBase::kSurface ||
-                     !(std::holds_alternative<TangentNormalSource>(first->source) ||
-                       std::holds_alternative<ObjectNormalSource>(first->source))))) {
+        (!stacks && !gradient_detail::mayStartBelowSurface(*first))) {
       return gradient(p);
     }
     Vec3d gamma{};
@@ -565,10 +563,7 @@ inline void batchGradients(BakeShaderBase& shader, const SampleBatch& s, const L
     }
     // (Only a normal map on the surface or a layer on the layers above can start a normal
     // below it.)
-    const bool noteBelow = slow != nullptr && (layer.base == LayerBase::kLayersAbove ||
-                           (layer.base == LayerBase::kSurface &&
-                            (std::holds_alternative<TangentNormalSource>(layer.source) ||
-                             std::holds_alternative<ObjectNormalSource>(layer.source))));
+    const bool noteBelow = slow != nullptr && gradient_detail::mayStartBelowSurface(layer);
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3d b{s.b0[i], s.b1[i], s.b2[i]};
       Vec3d g{gamma.x[i], gamma.y[i], gamma.z[i]};

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <optional>
 #include <span>
+#include <variant>
 
 #include "gradient/prepared_uv_frame.hpp"
 #include "gradient/valid_reflection.hpp"
@@ -35,6 +36,16 @@ struct NormalBelowSurface {
                          : normalizeOr(n + (strength > 0 ? strength : 0.0) * (decoded - n), n);
   }
 };
+
+/// @brief Whether @p layer can start a normal below the surface (NormalBelowSurface): a normal
+/// map on the surface that decodes below it, or a layer on the layers above that bumps their
+/// normal below it. Any other layer's Γ stands for what it makes.
+inline bool mayStartBelowSurface(const Layer& layer) {
+  return layer.base == LayerBase::kLayersAbove ||
+         (layer.base == LayerBase::kSurface &&
+          (std::holds_alternative<TangentNormalSource>(layer.source) ||
+           std::holds_alternative<ObjectNormalSource>(layer.source)));
+}
 
 /// @brief Follows the normal a stack of layers hands on where no Γ stands for it
 /// (NormalBelowSurface), layer by layer, as a composite adds them in order: a normal map first
