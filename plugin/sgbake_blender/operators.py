@@ -896,7 +896,8 @@ def _scale_key(values):
 
 
 # A procedural texture whose value a volume layer takes: the volume's function; the node's
-# property holding its Dimensions (None: the node is 3D only); the node's properties that must
+# property holding its Dimensions where only 3D is baked (None: the node is 3D only, or its
+# Dimensions is one of its enums, "texture_dimensions"); the node's properties that must
 # have one value (property -> that value) for the function to be what Cycles computes; the
 # outputs the layer reads (grey: the Fac, a Wave Texture's Color (Fac, Fac, Fac) alike); the
 # node's enum properties the function takes (setting -> (the node's property, or a function of
@@ -904,15 +905,20 @@ def _scale_key(values):
 # their setting's in title case (setting -> input); why its other outputs make no layer; and
 # the node's other properties the function takes as they are (setting -> property); and whether
 # the node has a Scale (the layer's frequency).
+# The Noise and Musgrave Textures' Dimensions, named as the scene names them.
+TEXTURE_DIMENSIONS = {"1D": "1D", "2D": "2D", "3D": "3D", "4D": "4D"}
 ProceduralTexture = collections.namedtuple(
     "ProceduralTexture", "function dimensions fixed outputs enums inputs others props scaled",
     defaults=({}, ("Fac",), {}, {}, "three noises seeded apart; a volume layer is the noise of "
                                     "its Fac", {}, True))
 PROCEDURAL_TEXTURES = {
-    "TEX_NOISE": ProceduralTexture("blender-noise", "noise_dimensions"),
+    "TEX_NOISE": ProceduralTexture(
+        "blender-noise", None,
+        enums={"texture_dimensions": ("noise_dimensions", TEXTURE_DIMENSIONS)}),
     "TEX_MUSGRAVE": ProceduralTexture(
-        "blender-musgrave", "musgrave_dimensions",
-        enums={"musgrave_type": ("musgrave_type", {
+        "blender-musgrave", None,
+        enums={"texture_dimensions": ("musgrave_dimensions", TEXTURE_DIMENSIONS),
+               "musgrave_type": ("musgrave_type", {
             "FBM": "fbm", "MULTIFRACTAL": "multifractal",
             "RIDGED_MULTIFRACTAL": "ridged-multifractal",
             "HYBRID_MULTIFRACTAL": "hybrid-multifractal", "HETERO_TERRAIN": "hetero-terrain"})},
@@ -967,7 +973,8 @@ def _texture_inputs(texture, enums):
     inputs.update((texture.inputs.get(key, key.replace("_", " ").title()), key)
                   for key in scene.texture_settings(texture.function,
                                                     enums.get("musgrave_type", "fbm"),
-                                                    enums.get("feature", "f1"))
+                                                    enums.get("feature", "f1"),
+                                                    enums.get("texture_dimensions", "3D"))
                   if key not in texture.enums and key not in texture.props)
     return inputs
 
@@ -985,15 +992,16 @@ def _procedural_settings(tex, ob=None):
     Noise, Musgrave or Wave Texture's Fac, a Voronoi Texture's Distance: PROCEDURAL_TEXTURES):
     its function with the node's enum properties in the scene's names (a Musgrave Texture's
     type, a Wave Texture's type, direction and profile, a Voronoi Texture's Feature Output and
-    Distance Metric (none for Distance to Edge)) and
+    Distance Metric (none for Distance to Edge), a Noise or Musgrave Texture's Dimensions) and
     its inputs (_texture_inputs: its Scale as the frequency, Detail, Roughness and Distortion of
     a Noise Texture, Detail, Dimension and Lacunarity of a Musgrave Texture and the Offset and
-    Gain its type uses, Distortion, Detail, Detail
+    Gain its type uses, the W of either in 1D and 4D, Distortion, Detail, Detail
     Scale, Detail Roughness and Phase Offset of a Wave Texture, Randomness, Exponent and
     Smoothness of a Voronoi Texture where its feature uses them), the slopes as Cycles' Bump node takes them (gradient "bump-node"), on the
     coordinates its Vector reads (_vector_coordinates: object, Generated or world coordinates,
     or a UV map's; unlinked, the Generated coordinates, as Cycles reads a procedural texture);
-    or a string saying why none is made: Dimensions other than 3D, a type the function is not
+    or a string saying why none is made: a Voronoi Texture's Dimensions other than 3D, a type
+    the function is not
     (a Voronoi Texture's N-Sphere Radius), an input fed by anything but constants
     (_constant), a Vector that is none of those coordinates (a normal, ...)."""
     texture = PROCEDURAL_TEXTURES[tex.type]

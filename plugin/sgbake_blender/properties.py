@@ -151,6 +151,12 @@ WAVE_PROFILES = (
 
 
 # The Musgrave Texture's types in the scene's names (Blender's FBM, MULTIFRACTAL, ...).
+TEXTURE_DIMENSIONS = (
+    ("1D", "1D", "W alone: one value over the whole surface, no bump"),
+    ("2D", "2D", "The coordinates' x and y"),
+    ("3D", "3D", "The coordinates' x, y and z"),
+    ("4D", "4D", "The coordinates' x, y and z, and W"),
+)
 MUSGRAVE_TYPES = (
     ("fbm", "fBM", "Fractal Brownian motion: the octaves added"),
     ("multifractal", "Multifractal", "The octaves multiplied"),
@@ -344,6 +350,13 @@ class SgbakeLayer(bpy.types.PropertyGroup):
                     "Diagonal for Bands, is Spherical for Rings)")
     profile: EnumProperty(name="Wave Profile", items=WAVE_PROFILES, default="sine",
                           description="Blender Wave: the Wave Texture's profile")
+    texture_dimensions: EnumProperty(
+        name="Dimensions", items=TEXTURE_DIMENSIONS, default="3D",
+        description="Blender Noise and Musgrave: the texture's Dimensions (1D reads W alone: "
+                    "one value over the surface; 2D the object's x and y; 4D x, y, z and W)")
+    w: FloatProperty(name="W", default=0.0, precision=3,
+                     description="Blender Noise and Musgrave: the texture's W (1D and 4D), "
+                                 "scaled by its Scale as the coordinates are")
     detail: FloatProperty(name="Detail", default=2.0, min=0.0, max=15.0, precision=3,
                           description="Blender Noise, Musgrave and Wave: the texture node's "
                                       "Detail (Noise and Wave: octaves beyond the first; "

@@ -33,9 +33,9 @@ MAPS = (
 # frequency), sent under the same keys (but SETTING_KEYS'); libsgbake refuses another
 # function's keys (a "roughness" on a blender-musgrave volume).
 BLENDER_TEXTURE_SETTINGS = {
-    "blender-noise": ("detail", "roughness", "distortion"),
-    "blender-musgrave": ("musgrave_type", "detail", "dimension", "lacunarity", "musgrave_offset",
-                         "gain"),
+    "blender-noise": ("texture_dimensions", "w", "detail", "roughness", "distortion"),
+    "blender-musgrave": ("texture_dimensions", "w", "musgrave_type", "detail", "dimension",
+                         "lacunarity", "musgrave_offset", "gain"),
     "blender-wave": ("wave", "wave_direction", "profile", "distortion", "detail", "detail_scale",
                      "detail_roughness", "phase"),
     "blender-voronoi": ("feature", "metric", "smoothness", "randomness", "exponent"),
@@ -47,7 +47,10 @@ BLENDER_TEXTURE_SETTINGS = {
 # Blender's textures without a Scale: their volumes take no "frequency".
 UNSCALED_FUNCTIONS = {"blender-gradient"}
 # The scene's keys of the settings whose layer property has another name.
-SETTING_KEYS = {"musgrave_offset": "offset", "magic_distortion": "distortion"}
+SETTING_KEYS = {"musgrave_offset": "offset", "magic_distortion": "distortion",
+                "texture_dimensions": "dimensions"}
+# The Noise and Musgrave Textures' Dimensions that read W (the others take no "w").
+W_DIMENSIONS = {"1D", "4D"}
 # The Musgrave Texture's inputs its types do not use (libsgbake refuses them): Multifractal and
 # fBM use neither Offset nor Gain, Hetero Terrain no Gain.
 MUSGRAVE_UNUSED = {"fbm": ("musgrave_offset", "gain"),
@@ -59,12 +62,15 @@ VORONOI_UNUSED = {"f1": ("smoothness",), "f2": ("smoothness",),
                   "distance-to-edge": ("smoothness", "metric", "exponent")}
 
 
-def texture_settings(function, musgrave_type="fbm", feature="f1"):
+def texture_settings(function, musgrave_type="fbm", feature="f1", dimensions="3D"):
     """The settings a volume of `function` sends (BLENDER_TEXTURE_SETTINGS; none for sine and
     noise), a Blender Musgrave's less the inputs its `musgrave_type` does not use, a Blender
-    Voronoi's less those its `feature` does not use."""
+    Voronoi's less those its `feature` does not use, a Blender Noise's or Musgrave's W only for
+    the `dimensions` that read it (W_DIMENSIONS)."""
     unused = (MUSGRAVE_UNUSED.get(musgrave_type, ()) if function == "blender-musgrave"
               else VORONOI_UNUSED.get(feature, ()) if function == "blender-voronoi" else ())
+    if dimensions not in W_DIMENSIONS:
+        unused = (*unused, "w")
     return tuple(key for key in BLENDER_TEXTURE_SETTINGS.get(function, ()) if key not in unused)
 
 
@@ -244,9 +250,10 @@ def layer_json(layer, uv_index, default_uv=None):
     scene's "uv"). A height layer's Scale is in world units, as Cycles' Bump Distance, and is
     sent as it is: the scene's "transform" makes libsgbake bump in world space (scene_json). A
     height's Remap goes as "remap" (remap_points, which raises LayerError for bad text). A
-    volume sends its function's own settings only (a Blender Noise's detail, roughness and
-    distortion, a Blender Musgrave's type, detail, dimension and lacunarity and the offset and
-    gain where its type uses them (texture_settings), a Blender Wave's type,
+    volume sends its function's own settings only (a Blender Noise's Dimensions, detail,
+    roughness and distortion, a Blender Musgrave's Dimensions, type, detail, dimension and
+    lacunarity and the offset and gain where its type uses them, both their W in 1D and 4D
+    (texture_settings), a Blender Wave's type,
     direction, profile, distortion, detail, detail scale and roughness and phase, a Blender
     Voronoi's feature and the metric, smoothness, randomness and exponent it uses:
     BLENDER_TEXTURE_SETTINGS; libsgbake refuses
@@ -296,7 +303,7 @@ def layer_json(layer, uv_index, default_uv=None):
         else:  # Blender's Noise, Musgrave, Wave or Voronoi Texture (its Scale: frequency)
             entry.update({SETTING_KEYS.get(key, key): _setting(getattr(layer, key))
                           for key in texture_settings(layer.function, layer.musgrave_type,
-                                                      layer.feature)})
+                                                      layer.feature, layer.texture_dimensions)})
     elif layer.type == "planar":
         entry.update(kind=layer.kind, axis=layer.axis, scale=_number(layer.scale))
         if layer.planar_projection != "axis":  # Blender's Flat, Sphere and Tube: about z

@@ -178,7 +178,7 @@ class SGBAKE_PT_layers(bpy.types.Panel):
             # A Blender texture's enums and inputs (a Musgrave's those of its type, a
             # Voronoi's those of its feature)
             for name in scene.texture_settings(layer.function, layer.musgrave_type,
-                                               layer.feature):
+                                               layer.feature, layer.texture_dimensions):
                 col.prop(layer, name)
             col.prop(layer, "gradient")
             if layer.gradient in ("central", "tetrahedral"):

@@ -291,7 +291,9 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                          .scale = layer.frequency,
                                          .detail = layer.noiseDetail,
                                          .roughness = layer.noiseRoughness,
-                                         .distortion = layer.noiseDistortion}));
+                                         .distortion = layer.noiseDistortion,
+                                         .dimensions = layer.textureDimensions,
+                                         .w = layer.textureW}));
     case VolumeFunction::kBlenderMusgrave:
       return owned(BlenderMusgrave::create({.amplitude = layer.amplitude,
                                             .scale = layer.frequency,
@@ -300,7 +302,9 @@ Result<std::unique_ptr<HeightVolume>> makeVolume(const SceneLayer& layer) {
                                             .dimension = layer.noiseDimension,
                                             .lacunarity = layer.noiseLacunarity,
                                             .offset = layer.musgraveOffset,
-                                            .gain = layer.musgraveGain}));
+                                            .gain = layer.musgraveGain,
+                                            .dimensions = layer.textureDimensions,
+                                            .w = layer.textureW}));
     case VolumeFunction::kBlenderWave:
       return owned(BlenderWave::create({.amplitude = layer.amplitude,
                                         .scale = layer.frequency,

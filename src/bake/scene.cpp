@@ -147,6 +147,8 @@ constexpr Named<VoronoiFeature> kVoronoiFeatures[] = {
     {"f2", VoronoiFeature::kF2},
     {"smooth-f1", VoronoiFeature::kSmoothF1},
     {"distance-to-edge", VoronoiFeature::kDistanceToEdge}};
+/// The Noise and Musgrave Textures' Dimensions, as Blender names them.
+constexpr Named<int> kTextureDimensions[] = {{"1D", 1}, {"2D", 2}, {"3D", 3}, {"4D", 4}};
 constexpr Named<BlenderGradientType> kGradientTypes[] = {
     {"linear", BlenderGradientType::kLinear},
     {"quadratic", BlenderGradientType::kQuadratic},
@@ -468,6 +470,8 @@ std::vector<std::string> layerKeys(SceneLayerType type) {
            "distortion",
            "dimension",
            "lacunarity",
+           "dimensions",  // the Noise and Musgrave Textures' Dimensions, and their W
+           "w",
            "mortar_size",  // the Brick Texture's
            "mortar_smooth",
            "brick_width",
@@ -935,6 +939,19 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
             brick, "blender-brick");
     onlyFor({"dimension", "lacunarity", "musgrave_type", "offset", "gain"}, musgrave,
             "blender-musgrave");
+    onlyFor({"dimensions"}, noise || musgrave, "blender-noise and blender-musgrave");
+    reader.optionalName("dimensions", kTextureDimensions, layer.textureDimensions);
+    if (reader.has("w")) {
+      if (layer.textureDimensions != 1 && layer.textureDimensions != 4) {
+        fail(where, "key " + quote("w") + " does not apply to a " +
+                        (noise || musgrave
+                             ? nameIn(kTextureDimensions, layer.textureDimensions) + " " + function
+                             : function) +
+                        " volume (W is read by blender-noise and blender-musgrave of "
+                        "dimensions 1D and 4D)");
+      }
+      layer.textureW = reader.number("w");
+    }
     if (reader.has("amplitude")) layer.amplitude = reader.number("amplitude");
     if (blender && !gradientTexture) layer.frequency = 5;  // Blender's textures' default Scale
     if (reader.has("frequency")) {
@@ -1661,6 +1678,8 @@ std::string describeLayer(const SceneLayer& layer) {
       break;
     case SceneLayerType::kVolume:
       text = "volume " + nameIn(kFunctions, layer.function);
+      if (layer.textureDimensions != 3)
+        text += " " + nameIn(kTextureDimensions, layer.textureDimensions);
       if (layer.coordinates == VolumeCoordinates::kUv) {
         text += " on UV set " + std::to_string(layer.uvSet) + "'s coordinates";
       }
@@ -1672,6 +1691,14 @@ std::string describeLayer(const SceneLayer& layer) {
       break;
   }
   return layer.name.empty() ? text : "'" + layer.name + "', " + text;
+}
+
+/// A Noise or Musgrave Texture's Dimensions and W, written only when not 3D (so the manifests
+/// of scenes before them stay valid).
+void writeTextureDimensions(const SceneLayer& layer, json& j) {
+  if (layer.textureDimensions == 3) return;
+  j["dimensions"] = nameIn(kTextureDimensions, layer.textureDimensions);
+  if (layer.textureDimensions != 2) j["w"] = layer.textureW;
 }
 
 std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer) {
@@ -1741,7 +1768,9 @@ std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer)
         j["detail"] = layer.noiseDetail;
         j["roughness"] = layer.noiseRoughness;
         j["distortion"] = layer.noiseDistortion;
+        writeTextureDimensions(layer, j);
       } else if (layer.function == VolumeFunction::kBlenderMusgrave) {
+        writeTextureDimensions(layer, j);
         j["detail"] = layer.noiseDetail;
         j["dimension"] = layer.noiseDimension;
         j["lacunarity"] = layer.noiseLacunarity;

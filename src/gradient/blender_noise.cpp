@@ -93,22 +93,87 @@ float seedOffset(int seed, int axis) {
 inline constexpr double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 inline constexpr double fadeSlope(double t) { return 30 * t * t * (t - 1) * (t - 1); }
 
-/// Perlin's gradient for corner hash @p hash dotted with the offset @p d from the corner: the 12
-/// directions (4 of them twice) of his improved noise, ±d_u ± d_v with u = x for the low 4 bits
-/// h < 8, else y, and v = y for h < 4, x for 12 and 14, else z. With @p direction, the direction
-/// itself (the term's gradient with respect to d).
-template <bool kDirection>
-inline double cornerTerm(std::uint32_t hash, const double (&d)[3], double (&direction)[3]) {
-  const std::uint32_t h = hash & 15u;
-  const int u = h < 8 ? 0 : 1;
-  const int v = h < 4 ? 1 : (h == 12 || h == 14) ? 0 : 2;
-  const double su = (h & 1u) ? -1.0 : 1.0, sv = (h & 2u) ? -1.0 : 1.0;
-  if constexpr (kDirection) {
-    direction[0] = direction[1] = direction[2] = 0;
-    direction[u] += su;
-    direction[v] += sv;
+/// A point (or a gradient) of Blender's noise of N = 1 … 4 dimensions.
+template <int N>
+struct NoiseVec {
+  std::array<double, N> c{};
+  friend NoiseVec operator+(NoiseVec a, const NoiseVec& b) {
+    for (int i = 0; i < N; ++i) a.c[i] += b.c[i];
+    return a;
   }
-  return su * d[u] + sv * d[v];
+  friend NoiseVec operator*(double s, NoiseVec a) {
+    for (int i = 0; i < N; ++i) a.c[i] = s * a.c[i];
+    return a;
+  }
+};
+
+inline NoiseVec<3> toNoiseVec(Vec3d v) { return {{v.x, v.y, v.z}}; }
+inline Vec3d toVec3(const NoiseVec<3>& v) { return {v.c[0], v.c[1], v.c[2]}; }
+
+/// lookup3's hash of one word (Cycles' hash_uint): a, b and c all start at 0xdeadbeef + (1 << 2)
+/// + 13, the word is added to a, then the final mix.
+constexpr std::uint32_t hashWord(std::uint32_t x) {
+  constexpr std::uint32_t init = 0xdeadbeefu + (1u << 2) + 13u;
+  return finalMix(init + x, init, init);
+}
+
+/// The hash of a lattice corner's N integer coordinates (Cycles' hash_uint … hash_uint4).
+template <int N>
+std::uint32_t latticeHash(const std::uint32_t (&w)[N]) {
+  if constexpr (N == 1) return hashWord(w[0]);
+  if constexpr (N == 2) return hashWords(w[0], w[1]);
+  if constexpr (N == 3) return hashWords(w[0], w[1], w[2]);
+  if constexpr (N == 4) return hashWords(w[0], w[1], w[2], w[3]);
+}
+
+/// Cycles' gradient rule of N-dimensional Perlin noise: corner hash @p hash picks the corner's
+/// gradient g, and the corner's term is g · d, d the offset from the corner; with @p direction,
+/// g itself (the term's gradient with respect to d). Of the hash's low bits:
+/// - 1D (grad1): g = ±(1 + (h & 7)) of the low 4 bits, negative if bit 8 is set;
+/// - 2D (grad2): of the low 3 bits, ±e_u ± 2 e_v, (u, v) = (x, y) for h < 4, else (y, x);
+/// - 3D (grad3): of the low 4 bits, ±e_u ± e_v, u = x for h < 8, else y; v = y for h < 4, x for
+///   12 and 14, else z: Perlin's 12 directions of his improved noise, 4 of them twice;
+/// - 4D (grad4): of the low 5 bits, ±e_u ± e_v ± e_s, u = x for h < 24, else y; v = y for
+///   h < 16, else z; s = z for h < 8, else w.
+/// The signs are bits 1, 2 (and 4) of the hash.
+template <int N, bool kDirection>
+inline double cornerTerm(std::uint32_t hash, const double (&d)[N], double (&direction)[N]) {
+  const auto sign = [hash](std::uint32_t bit) { return (hash & bit) ? -1.0 : 1.0; };
+  if constexpr (kDirection) {
+    for (int a = 0; a < N; ++a) direction[a] = 0;
+  }
+  if constexpr (N == 1) {
+    const double g = sign(8u) * (1.0 + double(hash & 7u));
+    if constexpr (kDirection) direction[0] = g;
+    return g * d[0];
+  } else {
+    const std::uint32_t h = hash & (N == 2 ? 7u : N == 3 ? 15u : 31u);
+    int u, v;
+    double su = sign(1u), sv = sign(2u);
+    if constexpr (N == 2) {
+      u = h < 4 ? 0 : 1;
+      v = 1 - u;
+      sv *= 2;
+    } else if constexpr (N == 3) {
+      u = h < 8 ? 0 : 1;
+      v = h < 4 ? 1 : (h == 12 || h == 14) ? 0 : 2;
+    } else {
+      u = h < 24 ? 0 : 1;
+      v = h < 16 ? 1 : 2;
+    }
+    if constexpr (kDirection) {
+      direction[u] += su;
+      direction[v] += sv;
+    }
+    double term = su * d[u] + sv * d[v];
+    if constexpr (N == 4) {
+      const int s = h < 8 ? 2 : 3;
+      const double ss = sign(4u);
+      if constexpr (kDirection) direction[s] += ss;
+      term += ss * d[s];
+    }
+    return term;
+  }
 }
 
 /// The integer cell coordinate of x as Cycles casts it to a word (floor, two's complement),
@@ -118,48 +183,162 @@ inline std::uint32_t cellWord(double floored) {
   return static_cast<std::uint32_t>(static_cast<std::int32_t>(clamped));
 }
 
-/// perlin(x), and with kGradient its gradient: the corners' terms blended trilinearly by the
-/// faded fractions (x first, then y, then z).
-template <bool kGradient>
-double perlin(Vec3d x, Vec3d* gradient) {
-  const double cell[3] = {std::floor(x.x), std::floor(x.y), std::floor(x.z)};
-  const double f[3] = {x.x - cell[0], x.y - cell[1], x.z - cell[2]};
-  const std::uint32_t ix = cellWord(cell[0]), iy = cellWord(cell[1]), iz = cellWord(cell[2]);
-  double s[3], ds[3];
-  for (int a = 0; a < 3; ++a) {
+/// perlin(x) in N dimensions, and with kGradient its gradient: the 2ᴺ corners' terms blended
+/// multilinearly by the faded fractions (x first, then y, z and w).
+template <int N, bool kGradient>
+double perlin(const NoiseVec<N>& x, NoiseVec<N>* gradient) {
+  constexpr int kCorners = 1 << N;
+  double f[N], s[N], ds[N];
+  std::uint32_t cell[N];
+  for (int a = 0; a < N; ++a) {
+    const double floored = std::floor(x.c[a]);
+    f[a] = x.c[a] - floored;
+    cell[a] = cellWord(floored);
     s[a] = fade(f[a]);
     ds[a] = fadeSlope(f[a]);
   }
-  double term[8], dir[8][3];
-  for (int c = 0; c < 8; ++c) {
-    const std::uint32_t cx = c & 1, cy = (c >> 1) & 1, cz = (c >> 2) & 1;
-    const double d[3] = {f[0] - cx, f[1] - cy, f[2] - cz};
-    term[c] = cornerTerm<kGradient>(hashWords(ix + cx, iy + cy, iz + cz), d, dir[c]);
-  }
-  // Blend along x, then y, then z (the value, and for the gradient the blends of the terms'
-  // directions and the fade's slopes times the differences of the terms).
-  const auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
-  double xy[4];
-  for (int k = 0; k < 4; ++k) xy[k] = lerp(term[2 * k], term[2 * k + 1], s[0]);
-  const double z0 = lerp(xy[0], xy[1], s[1]), z1 = lerp(xy[2], xy[3], s[1]);
-  const double value = lerp(z0, z1, s[2]);
-  if constexpr (kGradient) {
-    double g[3] = {0, 0, 0};
-    for (int c = 0; c < 8; ++c) {
-      const int cx = c & 1, cy = (c >> 1) & 1, cz = (c >> 2) & 1;
-      const double wx = cx ? s[0] : 1 - s[0], wy = cy ? s[1] : 1 - s[1], wz = cz ? s[2] : 1 - s[2];
-      const double weight = wx * wy * wz;
-      const double sx = cx ? 1.0 : -1.0, sy = cy ? 1.0 : -1.0, sz = cz ? 1.0 : -1.0;
-      g[0] += weight * dir[c][0] + term[c] * sx * ds[0] * wy * wz;
-      g[1] += weight * dir[c][1] + term[c] * sy * ds[1] * wx * wz;
-      g[2] += weight * dir[c][2] + term[c] * sz * ds[2] * wx * wy;
+  double term[kCorners], dir[kCorners][N];
+  for (int c = 0; c < kCorners; ++c) {
+    double d[N];
+    std::uint32_t corner[N];
+    for (int a = 0; a < N; ++a) {
+      const std::uint32_t bit = (c >> a) & 1u;
+      d[a] = f[a] - bit;
+      corner[a] = cell[a] + bit;
     }
-    *gradient = {g[0], g[1], g[2]};
+    term[c] = cornerTerm<N, kGradient>(latticeHash<N>(corner), d, dir[c]);
   }
+  // Blend along x (pairs of corners 2k, 2k + 1), then along y the results, and so on.
+  const auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
+  double blend[kCorners];
+  for (int c = 0; c < kCorners; ++c) blend[c] = term[c];
+  for (int a = 0; a < N; ++a) {
+    for (int k = 0; k < (kCorners >> (a + 1)); ++k) {
+      blend[k] = lerp(blend[2 * k], blend[2 * k + 1], s[a]);
+    }
+  }
+  if constexpr (kGradient) {
+    // Each corner: its weight Π w_a times its direction, plus its term times the derivative
+    // of its weight along each axis (±fade′ times the other axes' weights).
+    NoiseVec<N> g;
+    for (int c = 0; c < kCorners; ++c) {
+      double w[N];
+      double weight = 1;
+      for (int a = 0; a < N; ++a) {
+        w[a] = ((c >> a) & 1) ? s[a] : 1 - s[a];
+        weight *= w[a];
+      }
+      for (int a = 0; a < N; ++a) {
+        double along = term[c] * (((c >> a) & 1) ? 1.0 : -1.0) * ds[a];
+        for (int b = 0; b < N; ++b) {
+          if (b != a) along *= w[b];
+        }
+        g.c[a] += weight * dir[c][a] + along;
+      }
+    }
+    *gradient = g;
+  }
+  return blend[0];
+}
+
+/// Cycles' noise_scale1 … noise_scale4: snoise = scale · perlin in N dimensions.
+template <int N>
+constexpr double kNoiseScale = N == 1 ? 0.2500 : N == 2 ? 0.6616 : N == 3 ? 0.9820 : 0.8344;
+
+/// Cycles' snoise in N dimensions at @p x, and its gradient if asked.
+template <int N>
+double signedNoise(const NoiseVec<N>& x, NoiseVec<N>* gradient) {
+  if (gradient == nullptr) return kNoiseScale<N> * perlin<N, false>(x, nullptr);
+  const double value = perlin<N, true>(x, gradient);
+  *gradient = kNoiseScale<N> * *gradient;
+  return kNoiseScale<N> * value;
+}
+
+/// The Noise Texture's fBm in N dimensions (blenderFractalNoise), and its gradient if asked.
+template <int N>
+double fractalNoise(const NoiseVec<N>& p, double detail, double roughness,
+                    NoiseVec<N>* gradient) {
+  detail = std::clamp(detail, 0.0, 15.0);
+  roughness = std::clamp(roughness, 0.0, 1.0);
+  const int octaves = static_cast<int>(detail);
+  double frequency = 1, amplitude = 1, weights = 0, sum = 0;
+  NoiseVec<N> slope{};
+  const auto octave = [&](double& value, NoiseVec<N>& g) {  // ½ snoise + ½ of p · frequency
+    value = 0.5 * signedNoise<N>(frequency * p, gradient ? &g : nullptr) + 0.5;
+    g = (0.5 * frequency) * g;
+  };
+  for (int i = 0; i <= octaves; ++i) {
+    double t;
+    NoiseVec<N> g{};
+    octave(t, g);
+    sum += t * amplitude;
+    slope = slope + amplitude * g;
+    weights += amplitude;
+    amplitude *= roughness;
+    frequency *= 2;
+  }
+  double value = sum / weights;
+  NoiseVec<N> valueSlope = (1 / weights) * slope;
+  const double rest = detail - std::floor(detail);
+  if (rest != 0) {  // one more octave, blended in by the fraction
+    double t;
+    NoiseVec<N> g{};
+    octave(t, g);
+    const double more = (sum + t * amplitude) / (weights + amplitude);
+    const NoiseVec<N> moreSlope = (1 / (weights + amplitude)) * (slope + amplitude * g);
+    value = (1 - rest) * value + rest * more;
+    valueSlope = (1 - rest) * valueSlope + rest * moreSlope;
+  }
+  if (gradient != nullptr) *gradient = valueSlope;
   return value;
 }
 
-constexpr double kNoiseScale3 = 0.9820;  // Cycles' noise_scale3
+/// The point a node of Dimensions N reads of its scaled Vector @p p and W @p w: (w) in 1D,
+/// (x, y) in 2D, (x, y, z) in 3D, (x, y, z, w) in 4D.
+template <int N>
+NoiseVec<N> nodePoint(Vec3d p, double w) {
+  if constexpr (N == 1) return {{w}};
+  if constexpr (N == 2) return {{p.x, p.y}};
+  if constexpr (N == 3) return {{p.x, p.y, p.z}};
+  if constexpr (N == 4) return {{p.x, p.y, p.z, w}};
+}
+
+/// The derivative of nodePoint's axis @p a with respect to the Vector: e_a for x, y and z, 0
+/// for W.
+template <int N>
+Vec3d nodeAxis(int a) {
+  if (N == 1 || a == 3) return {};
+  return {a == 0 ? 1.0 : 0.0, a == 1 ? 1.0 : 0.0, a == 2 ? 1.0 : 0.0};
+}
+
+/// A gradient @p g with respect to nodePoint, pulled back to the Vector (W held).
+template <int N>
+Vec3d vectorSlope(const NoiseVec<N>& g) {
+  Vec3d v{};
+  for (int a = 0; a < N; ++a) v = v + g.c[a] * nodeAxis<N>(a);
+  return v;
+}
+
+/// snoise of a node of Dimensions @p dimensions at its scaled Vector @p p and W @p w, and its
+/// gradient with respect to the Vector.
+double signedNoiseOf(int dimensions, Vec3d p, double w, Vec3d* gradient) {
+  const auto at = [&]<int N>() {
+    NoiseVec<N> g;
+    const double value = signedNoise<N>(nodePoint<N>(p, w), gradient ? &g : nullptr);
+    if (gradient != nullptr) *gradient = vectorSlope<N>(g);
+    return value;
+  };
+  switch (dimensions) {
+    case 1:
+      return at.template operator()<1>();
+    case 2:
+      return at.template operator()<2>();
+    case 4:
+      return at.template operator()<4>();
+    default:
+      return at.template operator()<3>();
+  }
+}
 
 /// The bits of @p v as the float Cycles hashes.
 inline std::uint32_t floatBits(double v) {
@@ -184,6 +363,13 @@ Status finiteSettings(std::string_view texture, std::initializer_list<double> se
   return Ok{};
 }
 
+/// The check of a node's Dimensions and W: "a <texture>'s Dimensions must be 1, 2, 3 or 4".
+Status validDimensions(std::string_view texture, int dimensions) {
+  if (dimensions >= 1 && dimensions <= 4) return Ok{};
+  return Error::badInput("a " + std::string(texture) + "'s Dimensions must be 1, 2, 3 or 4, not " +
+                         std::to_string(dimensions));
+}
+
 /// The bound every texture's create() puts on its slopes' scale @p slopes (kMaxVolumeScale), the
 /// message naming the @p formula it was computed by (if any).
 Status boundedSlopes(std::string_view texture, double slopes, std::string_view formula) {
@@ -200,54 +386,77 @@ Status boundedSlopes(std::string_view texture, double slopes, std::string_view f
 }  // namespace
 
 double blenderSignedNoise(Vec3d x, Vec3d* gradient) {
-  if (gradient == nullptr) return kNoiseScale3 * perlin<false>(x, nullptr);
-  const double value = perlin<true>(x, gradient);
-  *gradient = kNoiseScale3 * *gradient;
-  return kNoiseScale3 * value;
-}
-
-double blenderFractalNoise(Vec3d p, double detail, double roughness, Vec3d* gradient) {
-  detail = std::clamp(detail, 0.0, 15.0);
-  roughness = std::clamp(roughness, 0.0, 1.0);
-  const int octaves = static_cast<int>(detail);
-  double frequency = 1, amplitude = 1, weights = 0, sum = 0;
-  Vec3d slope{};
-  const auto octave = [&](double& value, Vec3d& g) {  // noise = ½ snoise + ½, of p · frequency
-    value = 0.5 * blenderSignedNoise(frequency * p, gradient ? &g : nullptr) + 0.5;
-    g = (0.5 * frequency) * g;
-  };
-  for (int i = 0; i <= octaves; ++i) {
-    double t;
-    Vec3d g{};
-    octave(t, g);
-    sum += t * amplitude;
-    slope = slope + amplitude * g;
-    weights += amplitude;
-    amplitude *= roughness;
-    frequency *= 2;
-  }
-  double value = sum / weights;
-  Vec3d valueSlope = (1 / weights) * slope;
-  const double rest = detail - std::floor(detail);
-  if (rest != 0) {  // one more octave, blended in by the fraction
-    double t;
-    Vec3d g{};
-    octave(t, g);
-    const double more = (sum + t * amplitude) / (weights + amplitude);
-    const Vec3d moreSlope = (1 / (weights + amplitude)) * (slope + amplitude * g);
-    value = (1 - rest) * value + rest * more;
-    valueSlope = (1 - rest) * valueSlope + rest * moreSlope;
-  }
-  if (gradient != nullptr) *gradient = valueSlope;
+  NoiseVec<3> g;
+  const double value = signedNoise<3>(toNoiseVec(x), gradient ? &g : nullptr);
+  if (gradient != nullptr) *gradient = toVec3(g);
   return value;
 }
 
+double blenderFractalNoise(Vec3d p, double detail, double roughness, Vec3d* gradient) {
+  NoiseVec<3> g;
+  const double value = fractalNoise<3>(toNoiseVec(p), detail, roughness, gradient ? &g : nullptr);
+  if (gradient != nullptr) *gradient = toVec3(g);
+  return value;
+}
+
+namespace {
+
+/// The offset Cycles adds to seed the 1D distortion (its random_float_offset(0)): 100 + 100 ·
+/// hash(the bits of 0.0f) / (2³² − 1).
+float seedOffset1D(int seed) {
+  const std::uint32_t h = hashWord(std::bit_cast<std::uint32_t>(float(seed)));
+  return 100.0f + static_cast<float>(h) / static_cast<float>(0xFFFFFFFFu) * 100.0f;
+}
+
+/// The Noise Texture's Fac in N dimensions at the object-space @p position, and its gradient
+/// with respect to it: the distortion moves each of the N axes of the node's point by snoise
+/// seeded with that axis's offset, and the gradient is pulled back through that map's Jacobian.
+template <int N>
+double noiseTexture(const BlenderNoiseParams& params,
+                    const std::array<std::array<double, 4>, 4>& offsets, Vec3d position,
+                    Vec3d* gradient) {
+  const double scale = params.scale;
+  const NoiseVec<N> p = nodePoint<N>(scale * position, scale * params.w);
+  // Row a: the derivative of the (moved) point's axis a with respect to the scaled Vector.
+  std::array<Vec3d, N> rows;
+  for (int a = 0; a < N; ++a) rows[static_cast<std::size_t>(a)] = nodeAxis<N>(a);
+  NoiseVec<N> moved = p;
+  if (params.distortion != 0) {
+    for (int k = 0; k < N; ++k) {
+      NoiseVec<N> seeded = p;
+      for (int a = 0; a < N; ++a) {
+        seeded.c[a] += offsets[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)];
+      }
+      NoiseVec<N> g;
+      moved.c[k] += signedNoise<N>(seeded, gradient ? &g : nullptr) * params.distortion;
+      if (gradient != nullptr) {
+        rows[static_cast<std::size_t>(k)] =
+            rows[static_cast<std::size_t>(k)] + params.distortion * vectorSlope<N>(g);
+      }
+    }
+  }
+  NoiseVec<N> valueSlope;
+  const double value =
+      fractalNoise<N>(moved, params.detail, params.roughness, gradient ? &valueSlope : nullptr);
+  if (gradient != nullptr) {
+    // d Fac / d position = scale · Jᵀ · ∇fbm.
+    Vec3d pulled{};
+    for (int a = 0; a < N; ++a) pulled = pulled + valueSlope.c[a] * rows[static_cast<std::size_t>(a)];
+    *gradient = scale * pulled;
+  }
+  return value;
+}
+
+}  // namespace
+
 Result<BlenderNoise> BlenderNoise::create(const BlenderNoiseParams& params) {
-  if (Status finite = finiteSettings(
-          "Noise Texture",
-          {params.amplitude, params.scale, params.detail, params.roughness, params.distortion});
+  if (Status finite = finiteSettings("Noise Texture",
+                                     {params.amplitude, params.scale, params.detail,
+                                      params.roughness, params.distortion, params.w});
       !finite)
     return finite.error();
+  if (Status dimensions = validDimensions("Noise Texture", params.dimensions); !dimensions)
+    return dimensions.error();
   const double detail = std::clamp(params.detail, 0.0, 15.0);
   const double slopes = std::abs(params.amplitude) * std::abs(params.scale) *
                         (1 + std::abs(params.distortion)) * std::exp2(std::ceil(detail));
@@ -259,46 +468,38 @@ Result<BlenderNoise> BlenderNoise::create(const BlenderNoiseParams& params) {
 }
 
 BlenderNoise::BlenderNoise(const BlenderNoiseParams& params) : BlenderTextureVolume(params) {
-  for (int k = 0; k < 3; ++k) {  // the distortion of axis k reads noise seeded k
-    distortionOffsets_[static_cast<std::size_t>(k)] = {seedOffset(k, 0), seedOffset(k, 1),
-                                                       seedOffset(k, 2)};
+  // The distortion of axis k reads noise seeded k: random_float_offset(0) in 1D, else
+  // random_floatN_offset(k).
+  for (std::size_t k = 0; k < 4; ++k) {
+    for (std::size_t a = 0; a < 4; ++a) {
+      distortionOffsets_[k][a] = params.dimensions == 1
+                                     ? seedOffset1D(static_cast<int>(k))
+                                     : seedOffset(static_cast<int>(k), static_cast<int>(a));
+    }
   }
 }
 
 double BlenderNoise::output(Vec3d position, Vec3d* gradient) const {
-  const double scale = params_.scale;
-  Vec3d p = scale * position;
-  // Distortion: p + d · (snoise(p + o₀), snoise(p + o₁), snoise(p + o₂)); its Jacobian's rows
-  // are e_k + d ∇snoise(p + o_k).
-  std::array<Vec3d, 3> jacobianRows{Vec3d{1, 0, 0}, Vec3d{0, 1, 0}, Vec3d{0, 0, 1}};
-  if (params_.distortion != 0) {
-    Vec3d moved = p;
-    for (std::size_t k = 0; k < 3; ++k) {
-      Vec3d g;
-      const double n = blenderSignedNoise(p + distortionOffsets_[k], gradient ? &g : nullptr);
-      (k == 0 ? moved.x : k == 1 ? moved.y : moved.z) += n * params_.distortion;
-      if (gradient != nullptr) jacobianRows[k] = jacobianRows[k] + params_.distortion * g;
-    }
-    p = moved;
+  switch (params_.dimensions) {
+    case 1:
+      return noiseTexture<1>(params_, distortionOffsets_, position, gradient);
+    case 2:
+      return noiseTexture<2>(params_, distortionOffsets_, position, gradient);
+    case 4:
+      return noiseTexture<4>(params_, distortionOffsets_, position, gradient);
+    default:
+      return noiseTexture<3>(params_, distortionOffsets_, position, gradient);
   }
-  Vec3d valueSlope;
-  const double value =
-      blenderFractalNoise(p, params_.detail, params_.roughness, gradient ? &valueSlope : nullptr);
-  if (gradient != nullptr) {
-    // d Fac / d position = scale · Jᵀ · ∇fbm.
-    const Vec3d pulled = valueSlope.x * jacobianRows[0] + valueSlope.y * jacobianRows[1] +
-                         valueSlope.z * jacobianRows[2];
-    *gradient = scale * pulled;
-  }
-  return value;
 }
 
 Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& params) {
   if (Status finite = finiteSettings(
           "Musgrave Texture", {params.amplitude, params.scale, params.detail, params.dimension,
-                               params.lacunarity, params.offset, params.gain});
+                               params.lacunarity, params.offset, params.gain, params.w});
       !finite)
     return finite.error();
+  if (Status dimensions = validDimensions("Musgrave Texture", params.dimensions); !dimensions)
+    return dimensions.error();
   const double detail = std::clamp(params.detail, 0.0, 15.0);
   const double lacunarity = std::max(params.lacunarity, 1e-5);
   const double h = std::max(params.dimension, 1e-5);
@@ -359,13 +560,16 @@ constexpr double kHybridThreshold = static_cast<double>(0.001f);
 /// The octaves of a Musgrave Texture at p: octave i reads snoise(Lⁱ p), and its gradient with
 /// respect to p (times Lⁱ) if asked.
 struct MusgraveOctaves {
+  int dimensions;
   Vec3d p;
+  double w;
   double lacunarity;
   bool gradient;
   double frequency = 1;
   /// snoise at the current frequency, its gradient in @p g; then the next octave.
   double next(Vec3d& g) {
-    const double s = blenderSignedNoise(frequency * p, gradient ? &g : nullptr);
+    const double s =
+        signedNoiseOf(dimensions, frequency * p, frequency * w, gradient ? &g : nullptr);
     if (gradient) g = frequency * g;
     frequency *= lacunarity;
     return s;
@@ -477,7 +681,11 @@ double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
   const int octaves = static_cast<int>(detail);
   const double rest = detail - std::floor(detail);
   if (params_.type != MusgraveType::kFbm) {
-    const MusgraveOctaves at{.p = p, .lacunarity = lacunarity, .gradient = gradient != nullptr};
+    const MusgraveOctaves at{.dimensions = params_.dimensions,
+                             .p = p,
+                             .w = params_.scale * params_.w,
+                             .lacunarity = lacunarity,
+                             .gradient = gradient != nullptr};
     Vec3d slope{};
     double value = 0;
     switch (params_.type) {
@@ -497,11 +705,13 @@ double BlenderMusgrave::output(Vec3d position, Vec3d* gradient) const {
     if (gradient != nullptr) *gradient = params_.scale * slope;
     return value;
   }
+  const double w = params_.scale * params_.w;
   double value = 0, weight = 1, frequency = 1;
   Vec3d slope{};
   const auto add = [&](double factor) {
     Vec3d g;
-    value += factor * weight * blenderSignedNoise(frequency * p, gradient ? &g : nullptr);
+    value += factor * weight *
+             signedNoiseOf(params_.dimensions, frequency * p, frequency * w, gradient ? &g : nullptr);
     if (gradient != nullptr) slope = slope + (factor * weight * frequency) * g;
   };
   for (int i = 0; i < octaves; ++i) {

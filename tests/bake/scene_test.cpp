@@ -1160,6 +1160,44 @@ TEST(Scene, BlenderNoiseVolumesTakeTheNodesSettingsAndAMapping) {
             "for noise)");
 }
 
+// The Noise and Musgrave Textures' Dimensions ("1D" … "4D", 3D unless given) and W (read in 1D
+// and 4D only); both are written into the parameters only when not 3D, so the manifests of
+// scenes before them stay valid.
+TEST(Scene, NoiseAndMusgraveDimensionsAndW) {
+  Result<Scene> noise = parseScene(
+      withLayer(R"({"type": "volume", "function": "blender-noise", "dimensions": "4D", "w": 0.3})"),
+      options());
+  ASSERT_TRUE(noise) << noise.error().message;
+  EXPECT_EQ(noise->layers[0].textureDimensions, 4);
+  EXPECT_EQ(noise->layers[0].textureW, 0.3);
+  const std::string noiseJson = layerParametersJson(noise->layers[0]);
+  for (const char* expected : {R"("dimensions":"4D")", R"("w":0.3)"}) {
+    EXPECT_NE(noiseJson.find(expected), std::string::npos) << expected << " in " << noiseJson;
+  }
+  Result<Scene> flat = parseScene(
+      withLayer(R"({"type": "volume", "function": "blender-musgrave", "dimensions": "2D"})"),
+      options());
+  ASSERT_TRUE(flat) << flat.error().message;
+  EXPECT_EQ(flat->layers[0].textureDimensions, 2);
+  EXPECT_NE(layerParametersJson(flat->layers[0]).find(R"("dimensions":"2D")"), std::string::npos);
+  EXPECT_EQ(layerParametersJson(flat->layers[0]).find(R"("w")"), std::string::npos);
+  Result<Scene> plain =
+      parseScene(withLayer(R"({"type": "volume", "function": "blender-noise"})"), options());
+  ASSERT_TRUE(plain) << plain.error().message;
+  EXPECT_EQ(plain->layers[0].textureDimensions, 3);
+  EXPECT_EQ(layerParametersJson(plain->layers[0]).find("dimensions"), std::string::npos);
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "volume", "function": "blender-noise", "dimensions": "4d"})")),
+            "scene.json: layers[0]: unknown dimensions '4d' (did you mean '4D'?)");
+  EXPECT_EQ(parseError(withLayer(R"({"type": "volume", "function": "blender-noise", "w": 1})")),
+            "scene.json: layers[0]: key 'w' does not apply to a 3D blender-noise volume (W is read "
+            "by blender-noise and blender-musgrave of dimensions 1D and 4D)");
+  EXPECT_EQ(parseError(withLayer(
+                R"({"type": "volume", "function": "blender-wave", "dimensions": "2D"})")),
+            "scene.json: layers[0]: key 'dimensions' does not apply to a blender-wave volume (it "
+            "is for blender-noise and blender-musgrave)");
+}
+
 TEST(Scene, ProjectionMappingIsParsedAndInTheParametersOnlyWhenGiven) {
   Result<Scene> mapped = parseScene(withLayer(R"({"type": "planar", "image": "h.png",
                     "mapping": {"location": [1, 2, 3], "rotation": [0, 0.5, 0]}})"),

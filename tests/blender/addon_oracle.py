@@ -85,10 +85,12 @@
    Cycles bakes it (NOISE_*: median and p99), the same job without its "mapping" clearly
    worse; then its Vector unlinked on Suzanne turned and scaled: the layer reads the Generated
    coordinates (its matrix takes the mesh's bounding box to [0, 1]^3), baked as Cycles bakes it,
-   its control without the "mapping". noise_checks: its Color output, Dimensions 2D, a Detail fed
-   by another texture and a UV Map node into its Vector give no layer and a reason; through a
-   Color Ramp it gives a blender-noise layer whose remap is the ramp's; a volume layer made by
-   hand with function Blender Noise sends its Detail, Roughness and Distortion and bakes.
+   its control without the "mapping". noise_checks: its Color output, a Detail fed by another
+   texture, a W fed by one in 4D and the normal into its Vector give no layer and a reason;
+   Dimensions 4D gives a layer of those Dimensions and its W, 2D one without W; a UV Map node
+   into its Vector a layer on that UV map; through a Color Ramp it gives a blender-noise layer
+   whose remap is the ramp's; a volume layer made by hand with function Blender Noise (4D)
+   sends its Dimensions, W, Detail, Roughness and Distortion and bakes.
    Musgrave Texture (musgrave_case): a Musgrave Texture (fBM, 3D, MUSGRAVE_INPUTS) on Suzanne's
    own object coordinates through a Mapping node (Point) into the Bump: Layers from Material
    must make one "blender-musgrave" volume layer of the node's settings and its Mapping (sent
@@ -101,8 +103,9 @@
    with the layer left at fBM (without its type, offset and gain) clearly worse.
    musgrave_checks: each of the five types makes a layer of its type in the scene's name with
    the Offset and Gain it uses (and not the others; a Hetero Terrain's unused Gain may come
-   from a node); Dimensions 2D, a Lacunarity and a Hetero Terrain's Offset fed by another
-   texture give no layer and a reason (the node back as fBM 3D gives one); volume layers made
+   from a node); Dimensions 1D gives a layer of those Dimensions and its W; a Lacunarity and a
+   Hetero Terrain's Offset fed by another texture give no layer and a reason (the node back as
+   fBM 3D gives one); volume layers made
    by hand with function Blender Musgrave send their type, Detail, Dimension and Lacunarity
    (nothing of Blender Noise's) and the Offset and Gain their type uses, and bake.
    Wave Texture (wave_case): a Wave Texture (WAVE_NODE: Rings, Spherical, Sine; WAVE_INPUTS) on
@@ -2423,8 +2426,9 @@ def hand_made_check(settings, label, title, values, want, absent):
 
 
 def noise_checks(settings, ob, distance):
-    """Layers from Material on Noise Textures it does not take (its Color output, 2D, a Detail
-    fed by a node, the normal into its Vector: no layer, a reason), on a UV Map node's
+    """Layers from Material on Noise Textures it does not take (its Color output, a Detail fed by
+    a node, a W fed by a node in 4D, the normal into its Vector: no layer, a reason), of
+    Dimensions 4D and 2D (a layer of those Dimensions, its W in 4D), on a UV Map node's
     coordinates (a volume on that UV map), through a Color Ramp (a remap), and a volume layer
     made by hand with function Blender Noise. Returns check records like expect_error's."""
     import bpy
@@ -2437,8 +2441,25 @@ def noise_checks(settings, ob, distance):
         tree.links.new(noise.outputs["Color"], bump.inputs["Height"])
         refused("its Color output", "Color output")
         tree.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        # Dimensions: 4D sends its W, 2D none; a W fed by a node is refused where it is read.
+        noise.noise_dimensions = "4D"
+        noise.inputs["W"].default_value = 0.4
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("noise: Dimensions 4D makes a layer of its Dimensions and W",
+              len(found) == 1 and found[0].get("texture_dimensions") == "4D"
+              and abs(found[0].get("w", -1) - 0.4) < 1e-6,
+              "one layer, texture_dimensions 4D, w 0.4", f"{found}; skipped {skipped}")
+        feeder = tree.nodes.new("ShaderNodeTexNoise")
+        tree.links.new(feeder.outputs["Fac"], noise.inputs["W"])
+        refused("a W fed by another texture in 4D", "W from a node")
         noise.noise_dimensions = "2D"
-        refused("Dimensions 2D", "Dimensions 2D")
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("noise: Dimensions 2D makes a layer of its Dimensions without W (its W, fed by a "
+              "node, not read)",
+              len(found) == 1 and found[0].get("texture_dimensions") == "2D"
+              and "w" not in found[0],
+              "one layer, texture_dimensions 2D, no w", f"{found}; skipped {skipped}")
+        tree.nodes.remove(feeder)
         noise.noise_dimensions = "3D"
         feeder = tree.nodes.new("ShaderNodeTexNoise")
         tree.links.new(feeder.outputs["Fac"], noise.inputs["Detail"])
@@ -2489,8 +2510,9 @@ def noise_checks(settings, ob, distance):
     checks.append(hand_made_check(
         settings, "noise", "Blender Noise",
         {"function": "blender-noise", "frequency": 5.0, "detail": 1.5, "roughness": 0.7,
-         "distortion": 0.2, "amplitude": 0.02},
-        {"function": "blender-noise", "detail": 1.5, "roughness": 0.7, "distortion": 0.2},
+         "distortion": 0.2, "amplitude": 0.02, "texture_dimensions": "4D", "w": 0.3},
+        {"function": "blender-noise", "detail": 1.5, "roughness": 0.7, "distortion": 0.2,
+         "dimensions": "4D", "w": 0.3},
         ("seed", "octaves", "mapping")))
     return checks
 
@@ -2647,8 +2669,9 @@ def texture_case(settings, ob, work, case, make, keys, inputs, enums, absent, ma
 def musgrave_checks(settings, ob):
     """Layers from Material on Musgrave Textures of each type (each taken: its type in the
     scene's name, the Offset and Gain where the type uses them, a Gain fed by a node where it
-    does not), on those it does not take (Dimensions 2D, a Lacunarity or a used Offset fed by a
-    node: no layer, a reason), and volume layers made by hand with function Blender Musgrave.
+    does not), of Dimensions 1D (its W sent), on those it does not take (a Lacunarity or a used
+    Offset fed by a node: no layer, a reason), and volume layers made by hand with function
+    Blender Musgrave.
     Returns check records like expect_error's."""
     import bpy
     from sgbake_blender import operators
@@ -2691,8 +2714,13 @@ def musgrave_checks(settings, ob):
         refused("a Hetero Terrain's Offset fed by another texture", "Offset from a node")
         tree.nodes.remove(feeder)
         musgrave.musgrave_type = "FBM"
-        musgrave.musgrave_dimensions = "2D"
-        refused("Dimensions 2D", "Dimensions 2D")
+        musgrave.musgrave_dimensions = "1D"
+        musgrave.inputs["W"].default_value = -0.6
+        found, skipped, _ = operators.material_layers(tree, "UVMap", ob)
+        check("musgrave: Dimensions 1D makes a layer of its Dimensions and W",
+              len(found) == 1 and found[0].get("texture_dimensions") == "1D"
+              and abs(found[0].get("w", 1) + 0.6) < 1e-6,
+              "one layer, texture_dimensions 1D, w -0.6", f"{found}; skipped {skipped}")
         musgrave.musgrave_dimensions = "3D"
         feeder = tree.nodes.new("ShaderNodeTexNoise")
         tree.links.new(feeder.outputs["Fac"], musgrave.inputs["Lacunarity"])

@@ -294,8 +294,9 @@ def bump_by_noise(mat, settings):
                   "Phase Offset")
     else:
         noise = nodes.new("ShaderNodeTexNoise")
-        noise.noise_dimensions = "3D"
-        inputs = ("Scale", "Detail", "Roughness", "Distortion")
+        noise.noise_dimensions = settings.get("dimensions", "3D")
+        inputs = ("Scale", "Detail", "Roughness", "Distortion") + (
+            ("W",) if "w" in settings else ())
     for socket in inputs:
         key = "phase" if socket == "Phase Offset" else socket.lower().replace(" ", "_")
         noise.inputs[socket].default_value = settings[key]
@@ -601,6 +602,9 @@ noise_case("noise_sphere", "sphere", 512, 0.05, scale=2.0, detail=2.5, roughness
            distortion=0.3, mapping=NOISE_MAPPING)
 noise_case("noise_stretch_suzanne", "stretch_chain_suzanne", 512, 0.03, scale=3.0, detail=3.0,
            roughness=0.6, distortion=0.0, mapping=NOISE_MAPPING)
+# Its Dimensions 4D (x, y, z and W) on Suzanne, distorted.
+noise_case("noise_4d_suzanne", "suzanne", 256, 0.04, scale=2.5, detail=2.0, roughness=0.5,
+           distortion=0.4, dimensions="4D", w=0.7, mapping=NOISE_MAPPING)
 # Procedural textures on the UV map's coordinates (Texture Coordinate UV, (u, v, 0)) through a
 # Mapping node: a Noise Texture on Suzanne (its UV islands of every size and stretch), a Voronoi
 # Texture on the sphere (its UVs stretched towards the poles).

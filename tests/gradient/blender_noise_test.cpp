@@ -83,6 +83,80 @@ TEST(BlenderNoise, SignedNoiseGradientIsItsDerivative) {
   }
 }
 
+// Dimensions 2D read (x, y) alone and 4D (x, y, z, W): Fac is ½ at their lattice points, 2D's does
+// not change along z (its gradient's z is 0), 4D's changes with W, and the gradient of each is
+// exact, with distortion and a fractional detail. 1D reads W alone: one Fac over the whole
+// surface, no slopes, changing with W.
+TEST(BlenderNoise, OtherDimensionsReadTheirAxesAndTheirGradientsAreTheDerivatives) {
+  const auto noiseOf = [](int dimensions, double w, double distortion) {
+    return makeNoise({.amplitude = 0.7, .scale = 2, .detail = 2.6, .roughness = 0.6,
+                      .distortion = distortion, .dimensions = dimensions, .w = w});
+  };
+  for (const int dimensions : {2, 4}) {
+    const BlenderNoise plain = noiseOf(dimensions, 1.5, 0);  // scaled W: 3, on the lattice
+    EXPECT_NEAR(plain.value({0.5, -1.5, 2.5}), 0.7 * 0.5, 1e-15) << dimensions;
+    EXPECT_NE(plain.value({0.5, -1.5, 2.5}), plain.value({0.6, -1.5, 2.5})) << dimensions;
+    for (const double distortion : {0.0, 0.8}) {
+      const BlenderNoise noise = noiseOf(dimensions, 0.37, distortion);
+      std::mt19937_64 rng(static_cast<std::uint64_t>(11 + dimensions));
+      std::uniform_real_distribution<double> along(-3, 3);
+      for (int i = 0; i < 200; ++i) {
+        const Vec3d p{along(rng), along(rng), along(rng)};
+        const Vec3d exact = noise.analyticGradient(p);
+        const Vec3d central = centralGradient([&](Vec3d q) { return noise.value(q); }, p, 1e-6);
+        EXPECT_LT(maxAbsDiff(exact, central), 2e-5) << dimensions << "D at " << p.x;
+        if (dimensions == 2) {
+          EXPECT_EQ(noise.value(p), noise.value({p.x, p.y, p.z + 1.3}));
+          EXPECT_EQ(exact.z, 0.0);
+        }
+      }
+    }
+    const bool wMatters = noiseOf(dimensions, 0.37, 0).value({0.3, 0.2, 0.1}) !=
+                          noiseOf(dimensions, 0.41, 0).value({0.3, 0.2, 0.1});
+    EXPECT_EQ(wMatters, dimensions == 4) << dimensions << "D";
+  }
+  const BlenderNoise line = noiseOf(1, 0.37, 0.8);
+  const double fac = line.value({0.1, 0.2, 0.3});
+  EXPECT_EQ(line.value({-2.5, 1.0, 7.0}), fac);
+  EXPECT_EQ(line.analyticGradient({0.1, 0.2, 0.3}), (Vec3d{0, 0, 0}));
+  EXPECT_NE(noiseOf(1, 0.41, 0.8).value({0.1, 0.2, 0.3}), fac);
+  EXPECT_GT(fac, 0.0);
+  EXPECT_LT(fac, 0.7);
+}
+
+// The Musgrave Texture of Dimensions 1D, 2D and 4D reads the same points as the Noise Texture's:
+// 1D one value over the surface, 2D none of z; its gradient is exact (fBM, multifractal). A
+// Dimensions beyond 4D is refused.
+TEST(BlenderMusgrave, OtherDimensionsReadTheirAxesAndTheirGradientsAreTheDerivatives) {
+  for (const MusgraveType type : {MusgraveType::kFbm, MusgraveType::kMultifractal}) {
+    for (const int dimensions : {1, 2, 4}) {
+      Result<BlenderMusgrave> made =
+          BlenderMusgrave::create({.amplitude = 0.4, .scale = 1.5, .type = type, .detail = 2.5,
+                                   .offset = 1, .gain = 1, .dimensions = dimensions, .w = 0.8});
+      ASSERT_TRUE(made) << made.error().message;
+      const BlenderMusgrave& musgrave = made.value();
+      std::mt19937_64 rng(static_cast<std::uint64_t>(5 + dimensions));
+      std::uniform_real_distribution<double> along(-3, 3);
+      for (int i = 0; i < 100; ++i) {
+        const Vec3d p{along(rng), along(rng), along(rng)};
+        const Vec3d exact = musgrave.analyticGradient(p);
+        const Vec3d central =
+            centralGradient([&](Vec3d q) { return musgrave.value(q); }, p, 1e-6);
+        EXPECT_LT(maxAbsDiff(exact, central), 2e-5) << dimensions << "D at " << p.x;
+        if (dimensions < 3) {
+          EXPECT_EQ(exact.z, 0.0);
+        }
+        if (dimensions == 1) {
+          EXPECT_EQ(musgrave.value(p), musgrave.value({0, 0, 0}));
+        }
+      }
+    }
+  }
+  Result<BlenderMusgrave> bad = BlenderMusgrave::create({.dimensions = 5});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, "a Musgrave Texture's Dimensions must be 1, 2, 3 or 4, not 5");
+}
+
 // Musgrave fBM: the signed noise summed over octaves at Lⁱ p weighted L^(−iH), a fractional
 // Detail adding part of one more; its gradient exact.
 TEST(BlenderMusgrave, SumsTheOctavesAndItsGradientIsTheDerivative) {

@@ -237,6 +237,11 @@ struct SceneLayer {
   /// hybrid-multifractal | hetero-terrain), "offset" (ridged, hybrid, hetero terrain) and "gain"
   /// (ridged, hybrid): the node's Type and inputs, Blender's defaults
   MusgraveType musgraveType = MusgraveType::kFbm;
+  /// blender-noise, blender-musgrave: "dimensions" ("1D" | "2D" | "3D" | "4D": the node's
+  /// Dimensions, which read W, (x, y), (x, y, z) or (x, y, z, W)) and "w" (the node's W, 1D
+  /// and 4D only)
+  int textureDimensions = 3;
+  double textureW = 0;
   double musgraveOffset = 0;
   double musgraveGain = 1;
   /// blender-wave: "wave" (bands | rings), "wave_direction" (x | y | z | diagonal (bands) |

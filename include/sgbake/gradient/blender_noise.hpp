@@ -1,5 +1,5 @@
 /// @file blender_noise.hpp
-/// @brief Blender's Noise Texture (3D, Cycles 3.4) as a height volume, with its exact gradient.
+/// @brief Blender's Noise Texture (Cycles 3.4) as a height volume, with its exact gradient.
 ///
 /// The most common procedural bump in Blender is a Noise Texture's Fac into a Bump node. To bake
 /// it as Cycles does, sgbake evaluates the same function (in double precision; Cycles in float):
@@ -18,6 +18,15 @@
 ///
 /// The gradient is exact for this function: the fade's and the corner terms' derivatives, the
 /// octaves' chain-rule factors 2ⁱ, and the distortion's Jacobian I + distortion · ∇snoise(p + oₖ).
+///
+/// Dimensions other than 3D (the Noise and Musgrave Textures') read other points: 1D the node's
+/// W alone (a constant over the surface: no slopes), 2D (x, y), 4D (x, y, z, W), W scaled by
+/// Scale as the Vector. Their perlin is the same multilinear blend over 2ᴺ corners with Cycles'
+/// rules for N: the corner's hash is lookup3's of its N words; its gradient is g = 1 … 8 of
+/// either sign in 1D, ±d_u ± 2 d_v in 2D, ±d_u ± d_v ± d_s in 4D (32 directions); snoise scales
+/// perlin by 0.25, 0.6616, 0.982 or 0.8344. The distortion moves each of the N axes, seeded per
+/// axis (1D: 100 + 100 · hash(0); else the offsets above, of N components). W holds still, so
+/// the gradient with respect to P is the N-dimensional one's x, y, z part, pulled back.
 #pragma once
 
 #include <array>
@@ -49,13 +58,15 @@ class BlenderTextureVolume : public HeightVolume {
   Params params_;
 };
 
-/// @brief The Noise Texture node's settings (Dimensions 3D) and the height's scale.
+/// @brief The Noise Texture node's settings and the height's scale.
 struct BlenderNoiseParams {
   double amplitude = 1;    ///< height per unit of Fac (a Bump node's Distance)
   double scale = 5;        ///< the node's Scale: P is multiplied by it
   double detail = 2;       ///< the node's Detail (clamped to [0, 15] as Cycles clamps it)
   double roughness = 0.5;  ///< the node's Roughness (clamped to [0, 1] as Cycles clamps it)
   double distortion = 0;   ///< the node's Distortion
+  int dimensions = 3;      ///< the node's Dimensions: 1 (W only), 2 (x, y), 3, 4 (x, y, z, W)
+  double w = 0;            ///< the node's W (read in 1D and 4D), scaled by Scale as the Vector
 };
 
 /// @brief Blender's Noise Texture Fac, times an amplitude: a HeightVolume.
@@ -70,7 +81,7 @@ class BlenderNoise final : public BlenderTextureVolume<BlenderNoiseParams> {
 
  private:
   explicit BlenderNoise(const BlenderNoiseParams& params);
-  std::array<Vec3d, 3> distortionOffsets_{};
+  std::array<std::array<double, 4>, 4> distortionOffsets_{};  ///< [axis][component]
 };
 
 /// The Musgrave Texture's Type (Blender's FBM, MULTIFRACTAL, RIDGED_MULTIFRACTAL,
@@ -83,7 +94,7 @@ enum class MusgraveType {
   kHeteroTerrain
 };
 
-/// @brief The Musgrave Texture node's settings (Dimensions 3D) and the height's scale.
+/// @brief The Musgrave Texture node's settings and the height's scale.
 struct BlenderMusgraveParams {
   double amplitude = 1;  ///< height per unit of Fac
   double scale = 5;      ///< the node's Scale
@@ -93,11 +104,14 @@ struct BlenderMusgraveParams {
   double lacunarity = 2;  ///< the node's Lacunarity L (at least 1e-5)
   double offset = 0;      ///< the node's Offset (ridged, hybrid, hetero terrain)
   double gain = 1;        ///< the node's Gain (ridged, hybrid)
+  int dimensions = 3;     ///< the node's Dimensions: 1 (W only), 2 (x, y), 3, 4 (x, y, z, W)
+  double w = 0;           ///< the node's W (read in 1D and 4D), scaled by Scale as the Vector
 };
 
-/// @brief Blender's Musgrave Texture (3D), times an amplitude: a HeightVolume.
+/// @brief Blender's Musgrave Texture, times an amplitude: a HeightVolume.
 ///
-/// With p = scale · P, sᵢ = snoise(Lⁱ p) (BlenderNoise's, unnormalized: Fac is signed), wᵢ =
+/// With p = scale · P (the point its Dimensions read, as BlenderNoise's), sᵢ = snoise(Lⁱ p)
+/// (BlenderNoise's, unnormalized: Fac is signed), wᵢ =
 /// L^(−iH), n = ⌊detail⌋ and r = detail − n (detail clamped to [0, 15]), Cycles 3.4's types:
 ///
 /// - fBM: Fac = Σ_{i < n} wᵢ sᵢ + r wₙ sₙ.
