@@ -895,6 +895,9 @@ def _scale_key(values):
     return "amplitude" if values["type"] == "volume" else "scale"
 
 
+# The Noise and Musgrave Textures' Dimensions, named as the scene names them.
+TEXTURE_DIMENSIONS = {"1D": "1D", "2D": "2D", "3D": "3D", "4D": "4D"}
+
 # A procedural texture whose value a volume layer takes: the volume's function; the node's
 # property holding its Dimensions where only 3D is baked (None: the node is 3D only, or its
 # Dimensions is one of its enums, "texture_dimensions"); the node's properties that must
@@ -905,8 +908,6 @@ def _scale_key(values):
 # their setting's in title case (setting -> input); why its other outputs make no layer; and
 # the node's other properties the function takes as they are (setting -> property); and whether
 # the node has a Scale (the layer's frequency).
-# The Noise and Musgrave Textures' Dimensions, named as the scene names them.
-TEXTURE_DIMENSIONS = {"1D": "1D", "2D": "2D", "3D": "3D", "4D": "4D"}
 ProceduralTexture = collections.namedtuple(
     "ProceduralTexture", "function dimensions fixed outputs enums inputs others props scaled",
     defaults=({}, ("Fac",), {}, {}, "three noises seeded apart; a volume layer is the noise of "

@@ -150,13 +150,14 @@ WAVE_PROFILES = (
 )
 
 
-# The Musgrave Texture's types in the scene's names (Blender's FBM, MULTIFRACTAL, ...).
+# The Noise and Musgrave Textures' Dimensions.
 TEXTURE_DIMENSIONS = (
     ("1D", "1D", "W alone: one value over the whole surface, no bump"),
     ("2D", "2D", "The coordinates' x and y"),
     ("3D", "3D", "The coordinates' x, y and z"),
     ("4D", "4D", "The coordinates' x, y and z, and W"),
 )
+# The Musgrave Texture's types in the scene's names (Blender's FBM, MULTIFRACTAL, ...).
 MUSGRAVE_TYPES = (
     ("fbm", "fBM", "Fractal Brownian motion: the octaves added"),
     ("multifractal", "Multifractal", "The octaves multiplied"),

@@ -149,6 +149,8 @@ constexpr Named<VoronoiFeature> kVoronoiFeatures[] = {
     {"distance-to-edge", VoronoiFeature::kDistanceToEdge}};
 /// The Noise and Musgrave Textures' Dimensions, as Blender names them.
 constexpr Named<int> kTextureDimensions[] = {{"1D", 1}, {"2D", 2}, {"3D", 3}, {"4D", 4}};
+/// Whether a Noise or Musgrave Texture of @p dimensions reads its W (1D and 4D do).
+constexpr bool readsW(int dimensions) { return dimensions == 1 || dimensions == 4; }
 constexpr Named<BlenderGradientType> kGradientTypes[] = {
     {"linear", BlenderGradientType::kLinear},
     {"quadratic", BlenderGradientType::kQuadratic},
@@ -942,7 +944,7 @@ SceneLayer parseLayer(const json& value, const std::string& where, const InputPa
     onlyFor({"dimensions"}, noise || musgrave, "blender-noise and blender-musgrave");
     reader.optionalName("dimensions", kTextureDimensions, layer.textureDimensions);
     if (reader.has("w")) {
-      if (layer.textureDimensions != 1 && layer.textureDimensions != 4) {
+      if (!readsW(layer.textureDimensions)) {
         fail(where, "key " + quote("w") + " does not apply to a " +
                         (noise || musgrave
                              ? nameIn(kTextureDimensions, layer.textureDimensions) + " " + function
@@ -1698,7 +1700,7 @@ std::string describeLayer(const SceneLayer& layer) {
 void writeTextureDimensions(const SceneLayer& layer, json& j) {
   if (layer.textureDimensions == 3) return;
   j["dimensions"] = nameIn(kTextureDimensions, layer.textureDimensions);
-  if (layer.textureDimensions != 2) j["w"] = layer.textureW;
+  if (readsW(layer.textureDimensions)) j["w"] = layer.textureW;
 }
 
 std::string layerParametersJson(const SceneLayer& layer, const PathNamer& namer) {

@@ -86,8 +86,7 @@ constexpr std::uint32_t hashWords(std::uint32_t x, std::uint32_t y) {
 float seedOffset(int seed, int axis) {
   const std::uint32_t h = hashWords(std::bit_cast<std::uint32_t>(float(seed)),
                                     std::bit_cast<std::uint32_t>(float(axis)));
-  const float unit = static_cast<float>(h) / static_cast<float>(0xFFFFFFFFu);
-  return 100.0f + unit * 100.0f;
+  return 100.0f + unitFloat(h) * 100.0f;
 }
 
 inline constexpr double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
@@ -319,15 +318,9 @@ Vec3d vectorSlope(const NoiseVec<N>& g) {
   return v;
 }
 
-/// snoise of a node of Dimensions @p dimensions at its scaled Vector @p p and W @p w, and its
-/// gradient with respect to the Vector.
-double signedNoiseOf(int dimensions, Vec3d p, double w, Vec3d* gradient) {
-  const auto at = [&]<int N>() {
-    NoiseVec<N> g;
-    const double value = signedNoise<N>(nodePoint<N>(p, w), gradient ? &g : nullptr);
-    if (gradient != nullptr) *gradient = vectorSlope<N>(g);
-    return value;
-  };
+/// @p at's `operator()<N>()` for N = @p dimensions (create() has checked it is 1 … 4).
+template <class At>
+double withDimensions(int dimensions, const At& at) {
   switch (dimensions) {
     case 1:
       return at.template operator()<1>();
@@ -338,6 +331,17 @@ double signedNoiseOf(int dimensions, Vec3d p, double w, Vec3d* gradient) {
     default:
       return at.template operator()<3>();
   }
+}
+
+/// snoise of a node of Dimensions @p dimensions at its scaled Vector @p p and W @p w, and its
+/// gradient with respect to the Vector.
+double signedNoiseOf(int dimensions, Vec3d p, double w, Vec3d* gradient) {
+  return withDimensions(dimensions, [&]<int N>() {
+    NoiseVec<N> g;
+    const double value = signedNoise<N>(nodePoint<N>(p, w), gradient ? &g : nullptr);
+    if (gradient != nullptr) *gradient = vectorSlope<N>(g);
+    return value;
+  });
 }
 
 /// The bits of @p v as the float Cycles hashes.
@@ -363,7 +367,7 @@ Status finiteSettings(std::string_view texture, std::initializer_list<double> se
   return Ok{};
 }
 
-/// The check of a node's Dimensions and W: "a <texture>'s Dimensions must be 1, 2, 3 or 4".
+/// The check of a node's Dimensions: "a <texture>'s Dimensions must be 1, 2, 3 or 4".
 Status validDimensions(std::string_view texture, int dimensions) {
   if (dimensions >= 1 && dimensions <= 4) return Ok{};
   return Error::badInput("a " + std::string(texture) + "'s Dimensions must be 1, 2, 3 or 4, not " +
@@ -404,8 +408,7 @@ namespace {
 /// The offset Cycles adds to seed the 1D distortion (its random_float_offset(0)): 100 + 100 ·
 /// hash(the bits of 0.0f) / (2³² − 1).
 float seedOffset1D(int seed) {
-  const std::uint32_t h = hashWord(std::bit_cast<std::uint32_t>(float(seed)));
-  return 100.0f + static_cast<float>(h) / static_cast<float>(0xFFFFFFFFu) * 100.0f;
+  return 100.0f + unitFloat(hashWord(std::bit_cast<std::uint32_t>(float(seed)))) * 100.0f;
 }
 
 /// The Noise Texture's Fac in N dimensions at the object-space @p position, and its gradient
@@ -480,16 +483,9 @@ BlenderNoise::BlenderNoise(const BlenderNoiseParams& params) : BlenderTextureVol
 }
 
 double BlenderNoise::output(Vec3d position, Vec3d* gradient) const {
-  switch (params_.dimensions) {
-    case 1:
-      return noiseTexture<1>(params_, distortionOffsets_, position, gradient);
-    case 2:
-      return noiseTexture<2>(params_, distortionOffsets_, position, gradient);
-    case 4:
-      return noiseTexture<4>(params_, distortionOffsets_, position, gradient);
-    default:
-      return noiseTexture<3>(params_, distortionOffsets_, position, gradient);
-  }
+  return withDimensions(params_.dimensions, [&]<int N>() {
+    return noiseTexture<N>(params_, distortionOffsets_, position, gradient);
+  });
 }
 
 Result<BlenderMusgrave> BlenderMusgrave::create(const BlenderMusgraveParams& params) {
